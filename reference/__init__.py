@@ -1,0 +1,5 @@
+"""The NumPy reference pipeline: the same stages as the GLSL in glsl/, written independently.
+
+It shares the scene model and the matrices with the GPU path (renderer/scene.py,
+renderer/transforms.py) and nothing of the shading.
+"""

@@ -1,0 +1,27 @@
+"""User-facing errors: one line naming the file, the key and the reason.
+
+The command line turns a `UserError` into that line on stderr and exit status 2; anything
+else is a bug and keeps its traceback.
+"""
+
+from __future__ import annotations
+
+
+class UserError(Exception):
+    """A mistake in the user's input (a scene file, a mesh, an option), not a bug."""
+
+    def __init__(self, reason: str, file: str | None = None, key: str | None = None):
+        self.reason, self.file, self.key = reason, file, key
+        super().__init__(self.line())
+
+    def line(self) -> str:
+        where = ": ".join(part for part in (self.file, self.key) if part)
+        return f"{where}: {self.reason}" if where else self.reason
+
+
+class SceneError(UserError):
+    """A scene file (or a mesh it names) that cannot be rendered."""
+
+
+class ContextError(UserError):
+    """No GL context could be made (missing system packages, no display)."""

@@ -1,0 +1,29 @@
+"""What a render hands back, from either pipeline."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Frame:
+    """One rendered image. Row 0 is the top row in every array (docs/conventions.md).
+
+    rgba8:  (H, W, 4) uint8, GL's unorm8 conversion of the clamped colour; alpha is 1 (255)
+            where something was drawn and 0 for the background.
+    linear: (H, W, 4) float32 linear colour before clamping, or None if not asked for.
+    depth:  (H, W) float32 camera-space distance along the viewing axis in scene units,
+            +inf where nothing was drawn, or None if not asked for.
+    milliseconds: wall time of the render call that produced it.
+    """
+    rgba8: np.ndarray
+    linear: np.ndarray | None = None
+    depth: np.ndarray | None = None
+    milliseconds: float = 0.0
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return self.rgba8.shape[1], self.rgba8.shape[0]

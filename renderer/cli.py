@@ -1,0 +1,139 @@
+"""The command line: `renderer render | compare | scenes` (also `python -m renderer`).
+
+A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
+with nothing written; a bug keeps its traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import statistics
+import sys
+import time
+from pathlib import Path
+
+from renderer.errors import UserError
+
+DEFAULT_SIZE = (640, 480)
+
+
+def parse_size(text: str) -> tuple[int, int]:
+    try:
+        width, height = (int(part) for part in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT such as 640x480, got {text!r}") from None
+    if not (1 <= width <= 16384 and 1 <= height <= 16384):
+        raise argparse.ArgumentTypeError(f"width and height must be 1 to 16384 pixels, got {text!r}")
+    return width, height
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):          # argparse's own two-line usage + message, but exit 2 anyway
+        raise UserError(f"{self.prog}: {message}")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="renderer", description="A GLSL renderer checked against a NumPy reference.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    def common(p):
+        p.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
+        p.add_argument("--size", type=parse_size, default=DEFAULT_SIZE, metavar="WxH",
+                       help="image size in pixels (default 640x480)")
+        p.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
+                       help="headless GL context (default: EGL, then OSMesa)")
+
+    render = sub.add_parser("render", help="render a scene to PNG")
+    common(render)
+    render.add_argument("-o", "--output", type=Path, help="PNG to write (default: SCENE_NAME.png)")
+    render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
+    render.add_argument("--depth", type=Path, metavar="OUT.npy",
+                        help="also write camera-space depth (float32, +inf where empty)")
+
+    compare = sub.add_parser("compare", help="render through the GPU and the reference and compare")
+    common(compare)
+    compare.add_argument("--out", type=Path, help="folder for gpu.png, reference.png, diff.png "
+                                                   "(default: compare-SCENE_NAME)")
+    compare.add_argument("--threshold", type=int, default=2, help="per-channel threshold of 255 (default 2)")
+
+    sub.add_parser("scenes", help="list the built-in scenes")
+    return parser
+
+
+def _load(scene_arg):
+    from renderer.builtin import resolve_scene
+    from renderer.scene_file import load_scene
+    return load_scene(resolve_scene(scene_arg))
+
+
+def _render_gpu(scene, size, context_kind, frames=1):
+    from renderer.gpu import GpuRenderer
+    with GpuRenderer(scene, *size, context_kind=context_kind) as gpu:
+        timings, frame = [], None
+        for _ in range(frames):
+            frame = gpu.render(depth=True)
+            timings.append(frame.milliseconds)
+        return frame, statistics.median(timings), gpu
+
+
+def cmd_render(args) -> int:
+    from renderer.imageio import write_npy, write_png
+    scene = _load(args.scene)
+    output = args.output or Path(f"{scene.name}.png")
+    if args.backend == "gpu":
+        frame, _, _ = _render_gpu(scene, args.size, args.context)
+    else:
+        import reference
+        frame = reference.render(scene, *args.size)
+    write_png(output, frame.rgba8)
+    if args.depth:
+        write_npy(args.depth, frame.depth)
+    print(f"wrote {output} ({args.size[0]}x{args.size[1]}, {args.backend}, {frame.milliseconds:.1f} ms)")
+    return 0
+
+
+def cmd_compare(args) -> int:
+    import reference
+    from renderer.compare import compare_frames, heat_map
+    from renderer.imageio import write_png
+    scene = _load(args.scene)
+    # Median of a few frames: the first one pays for shader compilation.
+    gpu_frame, gpu_ms, gpu = _render_gpu(scene, args.size, args.context, frames=3)
+    start = time.perf_counter()
+    ref_frame = reference.render(scene, *args.size, subpixel_bits=gpu.subpixel_bits)
+    reference_ms = (time.perf_counter() - start) * 1000.0
+    result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
+                            threshold=args.threshold)
+    out = args.out or Path(f"compare-{scene.name}")
+    write_png(out / "gpu.png", gpu_frame.rgba8)
+    write_png(out / "reference.png", ref_frame.rgba8)
+    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold))
+    figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
+               "gpu_ms": gpu_ms, "reference_ms": reference_ms,
+               "gl_renderer": gpu.gl_info.get("GL_RENDERER"), "context": gpu.gl_info.get("context")}
+    print(json.dumps(figures, allow_nan=True))
+    return 0
+
+
+def cmd_scenes(args) -> int:
+    from renderer.builtin import builtin_scenes, describe
+    for name in builtin_scenes():
+        print(f"{name}\t{describe(name)}")
+    return 0
+
+
+COMMANDS = {"render": cmd_render, "compare": cmd_compare, "scenes": cmd_scenes}
+
+
+def main(argv=None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        return COMMANDS[args.command](args)
+    except UserError as error:
+        print(f"renderer: {error.line()}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

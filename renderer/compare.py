@@ -1,0 +1,141 @@
+"""Comparing two frames the way dEQP does, and the figures `renderer compare` prints.
+
+Threshold compare with position deviation (dEQP tcuImageCompare.cpp,
+intThresholdPositionDeviationCompare): a pixel passes when some pixel within ±N of it in
+the other image matches within the threshold on every channel, checked both ways
+(GPU → reference and reference → GPU). That forgives an edge that moved by one pixel, which
+sub-pixel rounding may do, and nothing else.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+DEFAULT_THRESHOLD = 2          # of 255, per channel
+DEFAULT_DEVIATION = 1          # pixels
+
+
+def _offsets(deviation: int):
+    return [(dy, dx) for dy in range(-deviation, deviation + 1) for dx in range(-deviation, deviation + 1)]
+
+
+def _shifted(image: np.ndarray, dy: int, dx: int, fill) -> np.ndarray:
+    """image[y + dy, x + dx] at (y, x), `fill` where that falls outside the image."""
+    h, w = image.shape[:2]
+    out = np.full_like(image, fill)
+    ys, yd = slice(max(dy, 0), h + min(dy, 0)), slice(max(-dy, 0), h + min(-dy, 0))
+    xs, xd = slice(max(dx, 0), w + min(dx, 0)), slice(max(-dx, 0), w + min(-dx, 0))
+    out[yd, xd] = image[ys, xs]
+    return out
+
+
+def _matches_nearby(a: np.ndarray, b: np.ndarray, threshold: int, deviation: int) -> np.ndarray:
+    """(H, W) bool: pixel of `a` has a pixel of `b` within ±deviation matching within threshold."""
+    a16, b16 = a.astype(np.int16), b.astype(np.int16)
+    ok = np.zeros(a.shape[:2], dtype=bool)
+    for dy, dx in _offsets(deviation):
+        nearby = _shifted(b16, dy, dx, fill=np.int16(-1000))   # outside never matches
+        ok |= np.abs(a16 - nearby).max(axis=-1) <= threshold
+    return ok
+
+
+def position_deviation_mismatch(result: np.ndarray, reference: np.ndarray,
+                                threshold: int = DEFAULT_THRESHOLD,
+                                deviation: int = DEFAULT_DEVIATION) -> np.ndarray:
+    """(H, W) bool mask of pixels that fail the dEQP compare in either direction."""
+    return ~(_matches_nearby(result, reference, threshold, deviation)
+             & _matches_nearby(reference, result, threshold, deviation))
+
+
+def raw_mismatch(result: np.ndarray, reference: np.ndarray, threshold: int = DEFAULT_THRESHOLD) -> np.ndarray:
+    """(H, W) bool mask of pixels with any channel off by more than the threshold."""
+    return np.abs(result.astype(np.int16) - reference.astype(np.int16)).max(axis=-1) > threshold
+
+
+def _depth_rel_nearby(a: np.ndarray, b: np.ndarray, deviation: int) -> np.ndarray:
+    """Per pixel of `a`: smallest relative difference to a finite depth of `b` within ±deviation."""
+    best = np.full(a.shape, np.inf)
+    for dy, dx in _offsets(deviation):
+        nearby = _shifted(b.astype(np.float64), dy, dx, fill=np.inf)
+        with np.errstate(invalid="ignore"):
+            rel = np.abs(a - nearby) / np.abs(nearby)
+        best = np.fmin(best, np.where(np.isfinite(nearby), rel, np.inf))
+    return best
+
+
+def depth_max_rel(result: np.ndarray, reference: np.ndarray, deviation: int = DEFAULT_DEVIATION) -> float:
+    """Largest relative depth difference where both drew, with the same ±deviation as colour.
+
+    At a silhouette one image may see the object and the other the one behind it, exactly as
+    with colour, so each pixel is held against the nearest-matching depth within ±deviation,
+    both ways.
+    """
+    both = np.isfinite(result) & np.isfinite(reference)
+    if not both.any():
+        return 0.0
+    worst = max(_depth_rel_nearby(result, reference, deviation)[both].max(),
+                _depth_rel_nearby(reference, result, deviation)[both].max())
+    return float(worst)
+
+
+@dataclass
+class Comparison:
+    max_abs: int                  # largest channel difference, 0..255 (RGB)
+    mean_abs: float               # mean channel difference (RGB)
+    rmse: float                   # root mean square channel difference (RGB), 0..255 scale
+    psnr: float                   # dB on the 8-bit scale; inf for identical images
+    raw_mismatched_pixels: int    # pixels with any RGBA channel off by more than threshold
+    raw_mismatched_fraction: float
+    mismatched_pixels: int        # pixels still failing with ±deviation allowed, both ways
+    mismatched_fraction: float
+    depth_max_rel: float | None   # largest relative depth difference where both drew
+    threshold: int
+    deviation: int
+
+    def as_dict(self) -> dict:
+        return asdict(self)
+
+
+def compare_frames(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
+                   result_depth: np.ndarray | None = None, reference_depth: np.ndarray | None = None,
+                   threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION) -> Comparison:
+    if result_rgba8.shape != reference_rgba8.shape:
+        raise ValueError(f"image sizes differ: {result_rgba8.shape} and {reference_rgba8.shape}")
+    diff = np.abs(result_rgba8[..., :3].astype(np.int16) - reference_rgba8[..., :3].astype(np.int16))
+    total = result_rgba8.shape[0] * result_rgba8.shape[1]
+    rmse = float(np.sqrt(np.mean(diff.astype(np.float64) ** 2)))
+    raw = int(raw_mismatch(result_rgba8, reference_rgba8, threshold).sum())
+    deq = int(position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation).sum())
+    depth = None
+    if result_depth is not None and reference_depth is not None:
+        depth = depth_max_rel(result_depth, reference_depth, deviation)
+    return Comparison(
+        max_abs=int(diff.max()), mean_abs=float(diff.mean()), rmse=rmse,
+        psnr=math.inf if rmse == 0 else 20 * math.log10(255.0 / rmse),
+        raw_mismatched_pixels=raw, raw_mismatched_fraction=raw / total,
+        mismatched_pixels=deq, mismatched_fraction=deq / total,
+        depth_max_rel=depth, threshold=threshold, deviation=deviation,
+    )
+
+
+# Heat-map ramp: black (equal) → red → yellow → white (8 or more levels off).
+_RAMP = np.array([[0, 0, 0], [180, 0, 0], [255, 200, 0], [255, 255, 255]], dtype=np.float64)
+_RAMP_FULL_SCALE = 8.0
+_MISMATCH_COLOUR = (255, 0, 255)
+
+
+def heat_map(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
+             threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION) -> np.ndarray:
+    """(H, W, 3) uint8 amplified difference: the ramp reaches white at 8 levels of 255, and
+    pixels that fail the position-deviation compare are magenta."""
+    diff = np.abs(result_rgba8.astype(np.int16) - reference_rgba8.astype(np.int16)).max(axis=-1)
+    t = np.clip(diff / _RAMP_FULL_SCALE, 0.0, 1.0) * (len(_RAMP) - 1)
+    lo = np.floor(t).astype(int)
+    hi = np.minimum(lo + 1, len(_RAMP) - 1)
+    frac = (t - lo)[..., None]
+    image = _RAMP[lo] * (1 - frac) + _RAMP[hi] * frac
+    image[position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation)] = _MISMATCH_COLOUR
+    return image.round().astype(np.uint8)

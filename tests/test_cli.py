@@ -1,0 +1,62 @@
+"""The command line as a user types it."""
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from renderer.imageio import read_png
+
+
+def run(*args, cwd=None):
+    return subprocess.run([sys.executable, "-m", "renderer", *args], capture_output=True, text=True, cwd=cwd)
+
+
+def test_render_default_scene_writes_png_and_depth(tmp_path):
+    out, depth = tmp_path / "a.png", tmp_path / "d.npy"
+    result = run("render", "-o", str(out), "--size", "64x48", "--depth", str(depth))
+    assert result.returncode == 0, result.stderr
+    image = read_png(out)
+    assert image.shape == (48, 64, 4)
+    d = np.load(depth)
+    assert d.shape == (48, 64) and d.dtype == np.float32
+    assert np.isinf(d).any() and np.isfinite(d).any()
+
+
+def test_render_without_output_names_the_file_after_the_scene(tmp_path):
+    result = run("render", "--size", "32x24", "--backend", "reference", cwd=tmp_path)
+    assert result.returncode == 0, result.stderr
+    assert (tmp_path / "sphere.png").exists()
+
+
+def test_compare_prints_the_figures_and_writes_three_images(tmp_path):
+    result = run("compare", "sphere", "--size", "80x60", "--context", "osmesa", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    figures = json.loads(result.stdout)
+    for key in ("max_abs", "mean_abs", "rmse", "psnr", "raw_mismatched_pixels", "mismatched_pixels",
+                "mismatched_fraction", "depth_max_rel", "gpu_ms", "reference_ms"):
+        assert key in figures
+    assert figures["mismatched_pixels"] == 0
+    for name in ("gpu.png", "reference.png", "diff.png"):
+        assert read_png(tmp_path / name).shape[:2] == (60, 80)
+
+
+def test_scenes_lists_one_name_first_on_each_line():
+    result = run("scenes")
+    assert result.returncode == 0
+    names = [line.split()[0] for line in result.stdout.splitlines()]
+    assert "sphere" in names and len(names) >= 8
+
+
+def test_bad_size_is_one_line_and_status_2(tmp_path):
+    result = run("render", "--size", "wide", "-o", str(tmp_path / "x.png"))
+    assert result.returncode == 2
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_unknown_scene_names_the_built_in_ones(tmp_path):
+    result = run("render", "no_such_scene", "-o", str(tmp_path / "x.png"))
+    assert result.returncode == 2
+    assert "sphere" in result.stderr and "Traceback" not in result.stderr

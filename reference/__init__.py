@@ -3,3 +3,7 @@
 It shares the scene model and the matrices with the GPU path (renderer/scene.py,
 renderer/transforms.py) and nothing of the shading.
 """
+
+from reference.pipeline import render
+
+__all__ = ["render"]

@@ -1,0 +1,129 @@
+"""Frame times, printed: every built-in scene on the GPU path and the reference, and the
+renderer against a bare moderngl program doing the same GL work.
+
+    .venv/bin/python benchmarks/bench_pipeline.py [--size 640x480] [--frames 30] [--context egl]
+
+Not a test: this machine is shared and noisy, so figures are medians measured side by side
+in one run (the renderer and the bare program alternate frame by frame).
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+
+import numpy as np
+
+import reference
+from renderer import transforms
+from renderer.builtin import builtin_scenes
+from renderer.cli import parse_size
+from renderer.context import make_context
+from renderer.gpu import GpuRenderer
+from renderer.primitives import icosphere
+from renderer.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject
+from renderer.scene_file import load_scene
+from renderer.shaders import program_source
+
+
+def sphere_scene() -> Scene:
+    """The 20,480-triangle sphere (an icosphere of 5 subdivisions), Phong-shaded."""
+    mesh = icosphere(radius=1.0, subdivisions=5)
+    assert mesh.triangle_count == 20480
+    return Scene(
+        camera=Camera(eye=(0.0, 0.0, 3.5), look=(0.0, 0.0, 0.0)),
+        objects=[SceneObject("sphere", mesh, Material(ks=(0.5, 0.5, 0.5), n=40.0, shading="phong"))],
+        directional_lights=[DirectionalLight(direction=(-1.0, -1.0, -1.0))],
+        point_lights=[PointLight(position=(2.0, 2.0, 3.0), intensity=(0.6, 0.6, 0.6))],
+        name="sphere20480",
+    )
+
+
+class BareProgram:
+    """The same GL work as GpuRenderer.render for a one-object Phong scene, with nothing
+    else: the uniforms are set once, and a frame is clear, draw, read colour, read depth."""
+
+    def __init__(self, ctx, scene: Scene, width: int, height: int):
+        self.ctx = ctx
+        obj = scene.objects[0]
+        vertex, geometry, fragment = program_source(scene, obj.material)
+        self.program = ctx.program(vertex_shader=vertex, geometry_shader=geometry, fragment_shader=fragment)
+        m = scene.matrices(width, height)
+        mesh = obj.mesh
+        data = np.hstack([mesh.positions, mesh.normals]).astype("f4")
+        self.vbo = ctx.buffer(data.tobytes())
+        self.ibo = ctx.buffer(mesh.faces.astype("i4").tobytes())
+        self.vao = ctx.vertex_array(self.program, [(self.vbo, "3f 3f", "in_position", "in_normal")], self.ibo)
+        self.colour = ctx.renderbuffer((width, height), 4)
+        self.depth = ctx.depth_texture((width, height))
+        self.fbo = ctx.framebuffer([self.colour], self.depth)
+        self.set_uniforms(scene, m)
+
+    def set_uniforms(self, scene, m):
+        from renderer.gpu import uniform_values
+        for name, value in uniform_values(scene, scene.objects[0], m, 0).items():
+            if name in self.program:
+                self.program[name].write(value)
+
+    def frame(self):
+        self.fbo.use()
+        self.ctx.enable(self.ctx.DEPTH_TEST)
+        self.fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self.vao.render()
+        colour = self.fbo.read(components=4)
+        depth = self.fbo.read(attachment=-1, dtype="f4")
+        return colour, depth
+
+
+def timed(fn) -> float:
+    start = time.perf_counter()
+    fn()
+    return (time.perf_counter() - start) * 1000.0
+
+
+def bench_scenes(ctx, size, frames):
+    print(f"\nBuilt-in scenes at {size[0]}x{size[1]} (median ms per frame; GPU path = llvmpipe here)")
+    print(f"{'scene':<20} {'triangles':>9} {'gpu_ms':>8} {'reference_ms':>13} {'ratio':>7}")
+    for name, path in builtin_scenes().items():
+        scene = load_scene(path)
+        triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
+        with GpuRenderer(scene, *size, context=ctx) as gpu:
+            gpu.render()
+            gpu_ms = statistics.median(timed(gpu.render) for _ in range(frames))
+        ref_ms = statistics.median(timed(lambda: reference.render(scene, *size)) for _ in range(3))
+        print(f"{name:<20} {triangles:>9} {gpu_ms:>8.2f} {ref_ms:>13.1f} {ref_ms / gpu_ms:>6.1f}x")
+
+
+def bench_overhead(ctx, size, frames):
+    scene = sphere_scene()
+    bare = BareProgram(ctx, scene, *size)
+    with GpuRenderer(scene, *size, context=ctx) as gpu:
+        gpu.render(), bare.frame()                      # warm up both
+        ours, theirs = [], []
+        for _ in range(frames):                         # alternate, so both see the same noise
+            ours.append(timed(gpu.render))
+            theirs.append(timed(bare.frame))
+    ours_ms, bare_ms = statistics.median(ours), statistics.median(theirs)
+    ref_ms = statistics.median(timed(lambda: reference.render(scene, *size)) for _ in range(3))
+    print(f"\n20,480-triangle sphere at {size[0]}x{size[1]}, colour + depth read back")
+    print(f"  renderer         {ours_ms:8.2f} ms/frame (median of {frames})")
+    print(f"  bare moderngl    {bare_ms:8.2f} ms/frame")
+    print(f"  ratio            {ours_ms / bare_ms:8.3f}  (target <= 1.2)")
+    print(f"  reference        {ref_ms:8.1f} ms/frame, {ref_ms / ours_ms:.1f}x the GPU path (target <= 100)")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=parse_size, default=(640, 480))
+    parser.add_argument("--frames", type=int, default=30)
+    parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
+    args = parser.parse_args()
+    ctx = make_context(args.context)
+    print(f"GL: {ctx.info['GL_RENDERER']} | {ctx.info['GL_VERSION']} | context {args.context}")
+    bench_overhead(ctx, args.size, args.frames)
+    bench_scenes(ctx, args.size, max(5, args.frames // 3))
+
+
+if __name__ == "__main__":
+    main()

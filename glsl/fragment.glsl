@@ -1,0 +1,56 @@
+// Twin: reference/fragment.py
+#version 330 core
+// Per-fragment shading. Flat and Gouraud pick the colour lit for the side seen
+// (gl_FrontFacing: counter-clockwise in window coordinates); Phong renormalises the
+// interpolated normal, flips it for a two-sided back face, and lights the fragment.
+// out_color is clamped and converted to unorm8 by GL; LINEAR_OUTPUT adds the unclamped
+// float colour as a second output. Alpha is 1: the background is cleared to alpha 0.
+
+#if defined(SHADING_PHONG)
+#include "lighting.glsl"
+in vec3 v_world_position;
+in vec3 v_world_normal;
+#elif defined(SHADING_FLAT)
+flat in vec3 f_color_front;          // from geometry.glsl, one per triangle
+#ifdef TWO_SIDED
+flat in vec3 f_color_back;
+#endif
+#else
+in vec3 v_color_front;               // from vertex.glsl, interpolated
+#ifdef TWO_SIDED
+in vec3 v_color_back;
+#endif
+#endif
+
+layout(location = 0) out vec4 out_color;
+#ifdef LINEAR_OUTPUT
+layout(location = 1) out vec4 out_linear_color;
+#endif
+
+void main() {
+#if defined(SHADING_PHONG)
+    vec3 N = normalize(v_world_normal);
+#ifdef TWO_SIDED
+    if (!gl_FrontFacing) {
+        N = -N;                      // the back face is seen: light its side
+    }
+#endif
+    vec3 color = shade(v_world_position, N);
+#elif defined(SHADING_FLAT)
+#ifdef TWO_SIDED
+    vec3 color = gl_FrontFacing ? f_color_front : f_color_back;
+#else
+    vec3 color = f_color_front;
+#endif
+#else
+#ifdef TWO_SIDED
+    vec3 color = gl_FrontFacing ? v_color_front : v_color_back;
+#else
+    vec3 color = v_color_front;
+#endif
+#endif
+    out_color = vec4(color, 1.0);
+#ifdef LINEAR_OUTPUT
+    out_linear_color = vec4(color, 1.0);
+#endif
+}

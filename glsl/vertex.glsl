@@ -1,0 +1,50 @@
+// Twin: reference/vertex.py
+#version 330 core
+// Vertex processing: object space to world space (M) and on to clip space (P V), normals by
+// the normal matrix (inverse-transpose of M's linear part), renormalised.
+// SHADING_FLAT:    hands the world position on to geometry.glsl, which lights the face.
+// SHADING_GOURAUD: lights the vertex here (front colour; back colour too if TWO_SIDED).
+// SHADING_PHONG:   hands world position and normal on to fragment.glsl.
+
+#include "lighting.glsl"
+
+uniform mat4 u_model;                // M_world
+uniform mat3 u_normal_matrix;        // (M_world[:3, :3])^-T
+uniform mat4 u_view;                 // V
+uniform mat4 u_projection;           // P
+
+in vec3 in_position;                 // object space
+in vec3 in_normal;                   // object space, unit
+
+#if defined(SHADING_FLAT)
+out vec3 v_world_position;
+#elif defined(SHADING_GOURAUD)
+out vec3 v_color_front;              // lit with N
+#ifdef TWO_SIDED
+out vec3 v_color_back;               // lit with -N
+#endif
+#elif defined(SHADING_PHONG)
+out vec3 v_world_position;
+out vec3 v_world_normal;
+#else
+#error "define one of SHADING_FLAT, SHADING_GOURAUD, SHADING_PHONG"
+#endif
+
+void main() {
+    vec4 world_position = u_model * vec4(in_position, 1.0);
+    gl_Position = u_projection * (u_view * world_position);        // p_clip = P V M p
+#if defined(SHADING_FLAT)
+    v_world_position = world_position.xyz;
+#else
+    vec3 world_normal = normalize(u_normal_matrix * in_normal);
+#if defined(SHADING_GOURAUD)
+    v_color_front = shade(world_position.xyz, world_normal);
+#ifdef TWO_SIDED
+    v_color_back = shade(world_position.xyz, -world_normal);
+#endif
+#else
+    v_world_position = world_position.xyz;
+    v_world_normal = world_normal;
+#endif
+#endif
+}

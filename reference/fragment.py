@@ -1,0 +1,83 @@
+"""# Twin: glsl/fragment.glsl
+
+Per-fragment shading, run only for the fragment that survived the depth test at each pixel
+(there is no blending, so deferring it changes nothing).
+
+- flat:    out_color = gl_FrontFacing ? f_color_front : f_color_back (flat varyings from
+           the geometry stage);
+- gouraud: out_color = gl_FrontFacing ? v_color_front : v_color_back, interpolated;
+- phong:   N = normalize(v_world_normal); N = -N for a two-sided material seen from the
+           back; out_color = lighting(v_world_position, N).
+Alpha is 1. Also out_view_depth, the interpolated -z_eye, for the depth image.
+
+Inputs:  `ObjectVaryings` (the vertex and geometry stage outputs of one object, its faces
+         and material), and per fragment: triangle (N,) int64 index into the object's
+         faces, weights (N, 3) perspective-correct weights of that triangle's vertices,
+         gl_FrontFacing (N,) bool.
+Outputs: out_color (N, 4) and out_view_depth (N,), in the pipeline's dtype.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.geometry import TriangleOutputs
+from reference.lighting import Lights, MaterialUniforms, dot, lighting
+from reference.vertex import VertexOutputs
+
+
+@dataclass
+class ObjectVaryings:
+    material: object
+    faces: np.ndarray                  # (T, 3) int64
+    vertices: VertexOutputs
+    triangles: TriangleOutputs | None  # flat shading only
+
+
+def interpolate(varying: np.ndarray, faces: np.ndarray, triangle: np.ndarray,
+                weights: np.ndarray) -> np.ndarray:
+    """sum_j weights[:, j] * varying[faces[triangle, j]] for per-vertex varyings (V, ...)."""
+    corners = faces[triangle]                                    # (N, 3) vertex indices
+    w = weights.reshape(weights.shape + (1,) * (varying.ndim - 1))
+    return (w[:, 0] * varying[corners[:, 0]] + w[:, 1] * varying[corners[:, 1]]
+            + w[:, 2] * varying[corners[:, 2]])
+
+
+def select_by_facing(gl_FrontFacing: np.ndarray, front: np.ndarray, back: np.ndarray) -> np.ndarray:
+    """gl_FrontFacing ? front : back, per fragment."""
+    return np.where(gl_FrontFacing[:, None], front, back)
+
+
+def normalize_nonzero(v: np.ndarray) -> np.ndarray:
+    """normalize(), leaving a zero vector as zero instead of NaN (an interpolated normal can
+    vanish between opposite vertex normals; GLSL would give NaN there)."""
+    length = np.sqrt(dot(v, v))
+    return v / np.where(length > 0, length, np.ones_like(length))
+
+
+def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
+                    gl_FrontFacing: np.ndarray, lights: Lights, u_eye: np.ndarray):
+    """The fragment stage for one object's surviving fragments -> (out_color, out_view_depth)."""
+    material, faces, vertices = obj.material, obj.faces, obj.vertices
+    dtype = vertices.gl_Position.dtype
+    if material.shading == "flat":
+        color = select_by_facing(gl_FrontFacing, obj.triangles.f_color_front[triangle],
+                                 obj.triangles.f_color_back[triangle])
+    elif material.shading == "gouraud":
+        color = select_by_facing(gl_FrontFacing,
+                                 interpolate(vertices.v_color_front, faces, triangle, weights),
+                                 interpolate(vertices.v_color_back, faces, triangle, weights))
+    elif material.shading == "phong":
+        P = interpolate(vertices.v_world_position, faces, triangle, weights)
+        N = normalize_nonzero(interpolate(vertices.v_world_normal, faces, triangle, weights))
+        if material.two_sided:
+            N = np.where(gl_FrontFacing[:, None], N, -N)
+        color = lighting(P, N, np.asarray(u_eye, dtype=dtype),
+                         MaterialUniforms.from_material(material, dtype), lights)
+    else:
+        raise ValueError(f"unknown shading mode {material.shading!r}")
+    out_color = np.concatenate([color, np.ones((len(color), 1), dtype=dtype)], axis=1)
+    out_view_depth = interpolate(vertices.v_view_depth, faces, triangle, weights)
+    return out_color, out_view_depth

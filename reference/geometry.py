@@ -1,0 +1,52 @@
+"""# Twin: glsl/geometry.glsl
+
+Flat shading: one colour per triangle, lit at the triangle's centroid with the face normal
+normalize((p1 - p0) x (p2 - p0)) in world space (vertex order as in the mesh).
+
+Inputs:  v_world_position (T, 3, 3) world positions of each triangle's vertices (`dtype`),
+         the material, the packed lights and the eye (3,).
+Outputs: `TriangleOutputs` in the same dtype:
+         f_face_normal (T, 3)   unit face normal
+         f_centroid (T, 3)      (p0 + p1 + p2) / 3
+         f_color_front (T, 3)   colour lit with the face normal (flat varying)
+         f_color_back (T, 3)    colour lit with -normal for a two-sided material, else
+                                the front colour; the fragment picks by gl_FrontFacing
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from reference.lighting import Lights, MaterialUniforms, lighting, normalize
+
+
+@dataclass
+class TriangleOutputs:
+    f_face_normal: np.ndarray
+    f_centroid: np.ndarray
+    f_color_front: np.ndarray
+    f_color_back: np.ndarray
+
+
+def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
+    """normalize((p1 - p0) x (p2 - p0)): counter-clockwise vertices face the normal."""
+    with np.errstate(invalid="ignore", divide="ignore"):   # degenerate triangles draw nothing
+        return normalize(np.cross(p1 - p0, p2 - p0))
+
+
+def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,
+                    u_eye: np.ndarray) -> TriangleOutputs:
+    """The geometry stage for a flat-shaded object."""
+    dtype = v_world_position.dtype
+    p0, p1, p2 = v_world_position[:, 0], v_world_position[:, 1], v_world_position[:, 2]
+    f_face_normal = face_normal(p0, p1, p2)
+    f_centroid = (p0 + p1 + p2) / 3.0
+    uniforms = MaterialUniforms.from_material(material, dtype)
+    eye = np.asarray(u_eye, dtype=dtype)
+    with np.errstate(invalid="ignore"):
+        f_color_front = lighting(f_centroid, f_face_normal, eye, uniforms, lights)
+        f_color_back = (lighting(f_centroid, -f_face_normal, eye, uniforms, lights)
+                        if material.two_sided else f_color_front)
+    return TriangleOutputs(f_face_normal, f_centroid, f_color_front, f_color_back)

@@ -1,0 +1,125 @@
+"""# Twin: glsl/lighting.glsl
+
+The lighting equation of docs/conventions.md ("Lighting", section 2.1 of the notes), in
+world space, vectorised over any number of surface points:
+
+    I = I_a k_a + sum_l att_l I_l k_d max(N.L, 0) + sum_l att_l I_l k_s spec_l
+
+Inputs:  P (..., 3) surface points and N (..., 3) unit normals in world space, E (3,) the
+         eye, a `renderer.scene.Material` and the scene's lights packed as `Lights`
+         (the NumPy twin of the GLSL light uniforms). Everything in one float dtype.
+Output:  I (..., 3) linear RGB in that dtype, unclamped.
+
+The sides rule (one-sided / two-sided) is not applied here: callers pass the normal that
+is to be lit (the vertex, geometry and fragment stages flip it for back faces).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Lights:
+    """The scene's lights as uniform arrays, named as the GLSL uniforms would be.
+
+    u_ambient (3,); directional: u_directional_direction (Ld, 3) (the way the light
+    travels) and u_directional_intensity (Ld, 3); point: u_point_position (Lp, 3),
+    u_point_intensity (Lp, 3), u_point_attenuation (Lp, 3) as (c, l, q).
+    """
+    u_ambient: np.ndarray
+    u_directional_direction: np.ndarray
+    u_directional_intensity: np.ndarray
+    u_point_position: np.ndarray
+    u_point_intensity: np.ndarray
+    u_point_attenuation: np.ndarray
+
+    @classmethod
+    def from_scene(cls, scene, dtype=np.float64) -> "Lights":
+        def rows(values) -> np.ndarray:
+            return np.asarray(values, dtype=dtype).reshape(-1, 3)
+
+        return cls(
+            u_ambient=np.asarray(scene.ambient, dtype=dtype),
+            u_directional_direction=rows([d.direction for d in scene.directional_lights]),
+            u_directional_intensity=rows([d.intensity for d in scene.directional_lights]),
+            u_point_position=rows([p.position for p in scene.point_lights]),
+            u_point_intensity=rows([p.intensity for p in scene.point_lights]),
+            u_point_attenuation=rows([p.attenuation for p in scene.point_lights]),
+        )
+
+
+@dataclass
+class MaterialUniforms:
+    """A material's coefficients as arrays of the pipeline's dtype: k_a, k_d, k_s (3,), n."""
+    u_ka: np.ndarray
+    u_kd: np.ndarray
+    u_ks: np.ndarray
+    u_n: np.ndarray
+
+    @classmethod
+    def from_material(cls, material, dtype=np.float64) -> "MaterialUniforms":
+        return cls(np.asarray(material.ka, dtype=dtype), np.asarray(material.kd, dtype=dtype),
+                   np.asarray(material.ks, dtype=dtype), np.asarray(material.n, dtype=dtype))
+
+
+def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """GLSL dot() of 3-vectors over the last axis, kept as length 1 to broadcast against RGB."""
+    return (a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2])[..., None]
+
+
+def normalize(v: np.ndarray) -> np.ndarray:
+    """GLSL normalize() over the last axis."""
+    return v / np.sqrt(dot(v, v))
+
+
+def reflect_light(N: np.ndarray, L: np.ndarray, n_dot_l: np.ndarray) -> np.ndarray:
+    """R = 2 (N.L) N - L, the perfect reflection of the light vector L about N."""
+    return 2.0 * n_dot_l * N - L
+
+
+def specular_term(n_dot_l: np.ndarray, r_dot_v: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """spec = max(R.V, 0)^n where N.L > 0 and R.V > 0, else 0 (pow never sees a base <= 0)."""
+    lit = (n_dot_l > 0) & (r_dot_v > 0)
+    base = np.where(lit, r_dot_v, np.ones_like(r_dot_v))
+    return np.where(lit, np.power(base, n), np.zeros_like(r_dot_v))
+
+
+def directional_light_vector(direction: np.ndarray) -> np.ndarray:
+    """L = normalize(-D) for a light travelling along D; its attenuation is 1."""
+    return normalize(-direction)
+
+
+def point_light_vector(P: np.ndarray, position: np.ndarray, attenuation: np.ndarray):
+    """L = (Q - P) / d with d = |Q - P|, and att = 1 / (c + l d + q d^2). Returns (L, att)."""
+    to_light = position - P
+    d = np.sqrt(dot(to_light, to_light))
+    c, l, q = attenuation
+    return to_light / d, 1.0 / (c + l * d + q * d * d)
+
+
+def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> np.ndarray:
+    """att I_l (k_d max(N.L, 0) + k_s spec) for one light."""
+    n_dot_l = dot(N, L)
+    R = reflect_light(N, L, n_dot_l)
+    diffuse = material.u_kd * np.maximum(n_dot_l, 0.0)
+    specular = material.u_ks * specular_term(n_dot_l, dot(R, V), material.u_n)
+    return att * intensity * (diffuse + specular)
+
+
+def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
+             lights: Lights) -> np.ndarray:
+    """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3)."""
+    V = normalize(E - P)
+    I = np.broadcast_to(lights.u_ambient * material.u_ka, np.broadcast_shapes(P.shape, N.shape))
+    I = I.astype(P.dtype, copy=True)
+    for direction, intensity in zip(lights.u_directional_direction, lights.u_directional_intensity):
+        L = directional_light_vector(direction)
+        I += light_contribution(N, L, V, 1.0, intensity, material)
+    for position, intensity, attenuation in zip(lights.u_point_position, lights.u_point_intensity,
+                                                lights.u_point_attenuation):
+        L, att = point_light_vector(P, position, attenuation)
+        I += light_contribution(N, L, V, att, intensity, material)
+    return I

@@ -1,0 +1,93 @@
+"""# Twin: renderer/gpu.py (the draw as a whole; each stage's twin is named in its module)
+
+The reference draw, stage by stage as dEQP's drawBasicPrimitives reads: for each object in
+scene order, vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping
+-> viewport transform and snapping -> facing and culling -> rasterisation -> depth test;
+then fragment shading for the one surviving fragment per pixel, and output conversion.
+
+Input:  a `renderer.scene.Scene` and the image size. Output: a `renderer.frame.Frame`
+(rgba8 (H, W, 4) uint8 row 0 at the top, optional linear (H, W, 4) float32, depth (H, W)
+float32 -z_eye with +inf background). Conventions: docs/conventions.md.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from reference.clipping import clip_triangles
+from reference.depth_test import DepthBuffer
+from reference.fragment import ObjectVaryings, shade_fragments
+from reference.geometry import shade_triangles
+from reference.lighting import Lights
+from reference.output import compose_frame
+from reference.rasterizer import SUBPIXEL_BITS, is_drawn, rasterize, setup_triangles
+from reference.vertex import shade_vertices
+from renderer.frame import Frame
+
+
+def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, depth: DepthBuffer,
+                first_order: int, width: int, height: int, subpixel_bits: int, dtype) -> ObjectVaryings:
+    """Vertex processing to depth test for one object; returns what the fragment stage needs.
+
+    Draw order is first_order + the triangle's index in the mesh, so it is global across
+    objects; the triangles a clipped triangle turns into share its order.
+    """
+    mesh, material = obj.mesh, obj.material
+    vertices = shade_vertices(mesh.positions, mesh.normals, u_model=matrices.model,
+                              u_normal_matrix=matrices.normal, u_view=frame_matrices.view,
+                              u_projection=frame_matrices.projection, u_eye=eye,
+                              material=material, lights=lights, dtype=dtype)
+    faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
+    triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye)
+                 if material.shading == "flat" else None)
+    clipped = clip_triangles(vertices.gl_Position[faces])
+    window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits)
+    keep = is_drawn(window.area2, obj.cull)
+    window, source, clip_weights = window.select(keep), clipped.source[keep], clipped.weights[keep]
+
+    for fragments in rasterize(window, width, height):
+        t = fragments.triangle
+        # weights w.r.t. the source triangle's vertices: sum_k b_k * clip_weights[k, :]
+        b, cw = fragments.barycentric, clip_weights[t]
+        weights = b[:, 0:1] * cw[:, 0] + b[:, 1:2] * cw[:, 1] + b[:, 2:3] * cw[:, 2]
+        depth.test_and_write(fragments.y * width + fragments.x, fragments.z_w,
+                             first_order + source[t],
+                             object=np.full(len(t), index, dtype=np.int32), triangle=source[t],
+                             weights=weights, gl_FrontFacing=fragments.gl_FrontFacing)
+    return ObjectVaryings(material, faces, vertices, triangles)
+
+
+def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: int = SUBPIXEL_BITS,
+           linear: bool = False, depth: bool = True) -> Frame:
+    """Render `scene` at width x height with the NumPy reference pipeline."""
+    start = time.perf_counter()
+    dtype = np.dtype(dtype)
+    frame_matrices = scene.matrices(width, height)
+    lights = Lights.from_scene(scene, dtype)
+    eye = np.asarray(scene.camera.eye, dtype=dtype)
+    depth_buffer = DepthBuffer(width, height, dtype)
+
+    objects, first_order = [], 0
+    for index, (obj, matrices) in enumerate(zip(scene.objects, frame_matrices.objects)):
+        objects.append(draw_object(index, obj, matrices, frame_matrices, lights, eye, depth_buffer,
+                                   first_order, width, height, subpixel_bits, dtype))
+        first_order += len(obj.mesh.faces)
+
+    color = np.zeros((width * height, 4), dtype=dtype)
+    view_depth = np.full(width * height, np.inf, dtype=dtype)
+    drawn = depth_buffer.drawn
+    for index, varyings in enumerate(objects):
+        pixels = np.flatnonzero(drawn & (depth_buffer.payload.get("object", -1) == index))
+        if len(pixels) == 0:
+            continue
+        out_color, out_view_depth = shade_fragments(
+            varyings, depth_buffer.payload["triangle"][pixels], depth_buffer.payload["weights"][pixels],
+            depth_buffer.payload["gl_FrontFacing"][pixels], lights, eye)
+        color[pixels] = out_color
+        view_depth[pixels] = out_view_depth
+
+    return compose_frame(color, drawn, view_depth if depth else None, scene.background,
+                         width, height, linear=linear,
+                         milliseconds=(time.perf_counter() - start) * 1000.0)

@@ -1,0 +1,288 @@
+"""# Twin: fixed-function GL (OpenGL 4.5 core spec §13.6 Coordinate Transformations, §14.6 Polygons)
+
+Perspective divide and viewport transform, vertex snapping, facing and culling, and
+rasterisation with fixed-point edge functions, written down as llvmpipe does them (checked
+against it in tests/test_rasterizer.py):
+
+- window coordinates x_w = (x_ndc + 1) W / 2, y_w = (y_ndc + 1) H / 2, z_w = (z_ndc + 1) / 2,
+  origin at the bottom-left, y up; pixel (i, j) is sampled at its centre (i + 1/2, j + 1/2);
+- x_w and y_w are snapped to 1 / 2^subpixel_bits of a pixel, rounding to nearest (ties to
+  even), and coverage is decided exactly with int64 edge functions of the snapped vertices;
+- facing comes from the signed area of the snapped triangle: counter-clockwise is front;
+  zero-area triangles produce no fragments;
+- fill rule: a pixel centre exactly on an edge is covered when the edge is a left edge or a
+  bottom edge (horizontal, triangle above it), never when it is a right or top edge;
+- barycentrics are perspective-correct (weights 1 / w_clip) for the varyings, and plain
+  screen-space (affine) for z_w, since z_ndc is affine in window coordinates; like
+  llvmpipe's attribute set-up they are computed from the unsnapped window positions (this
+  keeps depth within float32 rounding of llvmpipe's; the snapped positions would put it up
+  to 1/512 px of slope away on steep triangles).
+
+The triangles are walked in batches: each batch expands its triangles' bounding boxes
+(clipped to the viewport) into (triangle, pixel) candidates with np.repeat and tests them
+all at once; no Python loop runs over pixels.
+
+Inputs:  gl_Position (T, 3, 4) clip coordinates of triangles already clipped to the view
+         volume, the viewport size and the number of sub-pixel bits.
+Outputs: `WindowTriangles` (setup) and, from `rasterize`, batches of `Fragments`:
+         x, y (N,) int64         pixel column and row (row 0 at the bottom, as GL)
+         triangle (N,) int64     index of the window triangle
+         barycentric (N, 3)      perspective-correct weights of its three vertices
+         z_w (N,)                window depth in [0, 1]
+         gl_FrontFacing (N,)     bool
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Iterator
+
+import numpy as np
+
+SUBPIXEL_BITS = 8                  # GL_SUBPIXEL_BITS on llvmpipe (FIXED_ORDER in lp_rast.h)
+MAX_CANDIDATES_PER_BATCH = 1 << 19  # (triangle, pixel) pairs tested at once
+
+
+@dataclass
+class WindowTriangles:
+    """Triangles after the viewport transform and snapping.
+
+    x, y (T, 3) int64   snapped window coordinates in units of 1 / 2^subpixel_bits pixel
+    x_w, y_w (T, 3)     the unsnapped window coordinates (float dtype), for interpolation
+    z_w (T, 3)          window depth (float dtype)
+    inv_w (T, 3)        1 / w_clip, the perspective-correction weights
+    area2 (T,) int64    twice the signed area of the snapped triangle (> 0: CCW, front)
+    """
+    x: np.ndarray
+    y: np.ndarray
+    x_w: np.ndarray
+    y_w: np.ndarray
+    z_w: np.ndarray
+    inv_w: np.ndarray
+    area2: np.ndarray
+    subpixel_bits: int = SUBPIXEL_BITS
+
+    def __len__(self) -> int:
+        return len(self.area2)
+
+    def select(self, mask: np.ndarray) -> "WindowTriangles":
+        return WindowTriangles(self.x[mask], self.y[mask], self.x_w[mask], self.y_w[mask],
+                               self.z_w[mask], self.inv_w[mask], self.area2[mask],
+                               self.subpixel_bits)
+
+
+@dataclass
+class Fragments:
+    x: np.ndarray
+    y: np.ndarray
+    triangle: np.ndarray
+    barycentric: np.ndarray
+    z_w: np.ndarray
+    gl_FrontFacing: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.x)
+
+
+# --- the rules, one small helper each ---------------------------------------------------
+
+def viewport_transform(gl_Position: np.ndarray, width: int, height: int):
+    """Perspective divide and GL's viewport transform. Returns (x_w, y_w, z_w, 1 / w_clip)."""
+    inv_w = 1.0 / gl_Position[..., 3]
+    x_ndc, y_ndc, z_ndc = (gl_Position[..., i] * inv_w for i in range(3))
+    x_w = (x_ndc + 1.0) * (width / 2.0)
+    y_w = (y_ndc + 1.0) * (height / 2.0)
+    z_w = (z_ndc + 1.0) / 2.0
+    return x_w, y_w, z_w, inv_w
+
+
+def snap_to_subpixel_grid(coordinate: np.ndarray, subpixel_bits: int) -> np.ndarray:
+    """Window coordinate -> int64 fixed point with `subpixel_bits` fraction bits, rounded to
+    nearest with ties to even (llvmpipe's subpixel_snap: lrint of x * 2^bits)."""
+    return np.rint(coordinate * float(1 << subpixel_bits)).astype(np.int64)
+
+
+def pixel_centre(index: np.ndarray, subpixel_bits: int) -> np.ndarray:
+    """Fixed-point coordinate of the centre of pixel column/row `index`: index + 1/2."""
+    return (index << subpixel_bits) + (1 << (subpixel_bits - 1))
+
+
+def edge_function(xa, ya, xb, yb, px, py):
+    """(b - a) x (p - a): > 0 when p lies to the left of the directed edge a -> b."""
+    return (xb - xa) * (py - ya) - (yb - ya) * (px - xa)
+
+
+def signed_area_twice(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Twice the signed area of triangles (T, 3); positive when counter-clockwise (y up)."""
+    return edge_function(x[:, 0], y[:, 0], x[:, 1], y[:, 1], x[:, 2], y[:, 2])
+
+
+def is_front_facing(area2: np.ndarray) -> np.ndarray:
+    """GL_CCW: counter-clockwise in window coordinates is the front face."""
+    return area2 > 0
+
+
+def is_drawn(area2: np.ndarray, cull: str) -> np.ndarray:
+    """Zero-area triangles are never drawn; cull 'back' drops CW, 'front' drops CCW."""
+    if cull == "back":
+        return area2 > 0
+    if cull == "front":
+        return area2 < 0
+    if cull == "none":
+        return area2 != 0
+    raise ValueError(f"unknown cull mode {cull!r}")
+
+
+def is_left_or_bottom_edge(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """For an edge (dx, dy) of a counter-clockwise triangle (interior on its left):
+    a left edge runs downwards (dy < 0); a bottom edge is horizontal running right."""
+    return (dy < 0) | ((dy == 0) & (dx > 0))
+
+
+def is_inside_edge(edge_value: np.ndarray, inclusive: np.ndarray) -> np.ndarray:
+    """The fill rule: a centre on the edge (value 0) counts only for inclusive edges."""
+    return np.where(inclusive, edge_value >= 0, edge_value > 0)
+
+
+# --- setup ----------------------------------------------------------------------------
+
+def setup_triangles(gl_Position: np.ndarray, width: int, height: int,
+                    subpixel_bits: int = SUBPIXEL_BITS) -> WindowTriangles:
+    """Window coordinates, snapping and signed area for clipped triangles (T, 3, 4)."""
+    x_w, y_w, z_w, inv_w = viewport_transform(gl_Position, width, height)
+    x = snap_to_subpixel_grid(x_w, subpixel_bits)
+    y = snap_to_subpixel_grid(y_w, subpixel_bits)
+    return WindowTriangles(x, y, x_w, y_w, z_w, inv_w, signed_area_twice(x, y), subpixel_bits)
+
+
+def bounding_boxes(tris: WindowTriangles, width: int, height: int):
+    """Pixel ranges [i0, i1] x [j0, j1] whose centres may be covered, clipped to the viewport."""
+    bits = tris.subpixel_bits
+    half = 1 << (bits - 1)
+    i0 = -((half - tris.x.min(axis=1)) >> bits)           # ceil((x_min - half) / one)
+    j0 = -((half - tris.y.min(axis=1)) >> bits)
+    i1 = (tris.x.max(axis=1) - half) >> bits               # floor((x_max - half) / one)
+    j1 = (tris.y.max(axis=1) - half) >> bits
+    return (np.maximum(i0, 0), np.minimum(i1, width - 1),
+            np.maximum(j0, 0), np.minimum(j1, height - 1))
+
+
+def _work_items(tris: WindowTriangles, width: int, height: int, max_candidates: int):
+    """Split each triangle's bounding box into row bands of at most `max_candidates` pixels.
+
+    Returns per item: triangle, i0, box width, j0, band height.
+    """
+    i0, i1, j0, j1 = bounding_boxes(tris, width, height)
+    box_w = np.maximum(i1 - i0 + 1, 0)
+    box_h = np.maximum(j1 - j0 + 1, 0)
+    rows_per_band = np.maximum(max_candidates // np.maximum(box_w, 1), 1)
+    bands = np.where(box_w * box_h > 0, -(-box_h // rows_per_band), 0)
+    tri = np.repeat(np.arange(len(tris)), bands)
+    band = np.arange(len(tri)) - np.repeat(np.cumsum(bands) - bands, bands)
+    band_j0 = j0[tri] + band * rows_per_band[tri]
+    band_h = np.minimum(rows_per_band[tri], j1[tri] + 1 - band_j0)
+    return tri, i0[tri], box_w[tri], band_j0, band_h
+
+
+def screen_barycentrics(tris: WindowTriangles, t: np.ndarray, px: np.ndarray,
+                        py: np.ndarray) -> np.ndarray:
+    """Screen-space barycentrics (N, 3) of pixel centres in triangles t.
+
+    Coverage is decided on the snapped vertices, but like llvmpipe (whose attribute planes
+    are set up from the float window positions) the weights come from the unsnapped
+    positions, solved relative to vertex 0:
+    p - v0 = l1 (v1 - v0) + l2 (v2 - v0), l0 = 1 - l1 - l2.
+    Where the unsnapped triangle has no area the snapped one is used instead.
+    """
+    dtype = tris.x_w.dtype
+    x0, y0 = tris.x_w[t, 0], tris.y_w[t, 0]
+    dx1, dy1 = tris.x_w[t, 1] - x0, tris.y_w[t, 1] - y0
+    dx2, dy2 = tris.x_w[t, 2] - x0, tris.y_w[t, 2] - y0
+    area = dx1 * dy2 - dy1 * dx2
+    if not np.all(area != 0):
+        scale = dtype.type(1 << tris.subpixel_bits)
+        snapped = (tris.x[t] / scale).astype(dtype), (tris.y[t] / scale).astype(dtype)
+        flat = area == 0
+        x0 = np.where(flat, snapped[0][:, 0], x0)
+        y0 = np.where(flat, snapped[1][:, 0], y0)
+        dx1 = np.where(flat, snapped[0][:, 1] - x0, dx1)
+        dy1 = np.where(flat, snapped[1][:, 1] - y0, dy1)
+        dx2 = np.where(flat, snapped[0][:, 2] - x0, dx2)
+        dy2 = np.where(flat, snapped[1][:, 2] - y0, dy2)
+        area = dx1 * dy2 - dy1 * dx2
+    qx = (px + 0.5).astype(dtype) - x0                             # pixel centre - v0
+    qy = (py + 0.5).astype(dtype) - y0
+    l1 = (qx * dy2 - qy * dx2) / area
+    l2 = (dx1 * qy - dy1 * qx) / area
+    return np.stack([1.0 - l1 - l2, l1, l2], axis=-1)
+
+
+@dataclass
+class EdgeEquations:
+    """E_k(p) = a_k p_y - b_k p_x + c_k for the edge opposite vertex k, oriented so that the
+    interior is positive (a counter-clockwise traversal); inclusive_k from the fill rule.
+    All (3, T) int64 / bool, row k for edge k. E_k is twice the area of the triangle formed
+    by p and edge k, so E_k / |area2| is vertex k's screen-space barycentric weight."""
+    a: np.ndarray
+    b: np.ndarray
+    c: np.ndarray
+    inclusive: np.ndarray
+
+
+def edge_equations(tris: WindowTriangles) -> EdgeEquations:
+    """Edge (start -> end) opposite each vertex, flipped for clockwise triangles."""
+    orientation = np.sign(tris.area2)
+    x, y = tris.x.T, tris.y.T                                   # (3, T)
+    start, end = [1, 2, 0], [2, 0, 1]
+    dx = orientation * (x[end] - x[start])
+    dy = orientation * (y[end] - y[start])
+    # edge_function(start, end, p) = dx (p_y - start_y) - dy (p_x - start_x)
+    c = dy * x[start] - dx * y[start]
+    return EdgeEquations(dx, dy, c, is_left_or_bottom_edge(dx, dy))
+
+
+def rasterize(tris: WindowTriangles, width: int, height: int, *,
+              max_candidates: int = MAX_CANDIDATES_PER_BATCH) -> Iterator[Fragments]:
+    """Fragments of the triangles in batches of at most about 2 * max_candidates tested
+    (triangle, pixel) pairs, in triangle order. Triangles must have area2 != 0."""
+    edges = edge_equations(tris)
+    tri, i0, box_w, j0, box_h = _work_items(tris, width, height, max_candidates)
+    counts = box_w * box_h
+    ends = np.cumsum(counts)
+    batch_of_item = (ends - counts) // max_candidates
+    boundaries = np.flatnonzero(np.diff(batch_of_item)) + 1
+    for items in np.split(np.arange(len(tri)), boundaries):
+        if len(items):
+            yield _rasterize_items(tris, edges, tri[items], i0[items], box_w[items],
+                                   j0[items], box_h[items])
+
+
+def _expand(starts: np.ndarray, lengths: np.ndarray):
+    """For runs (start, length): (run index, start + offset) for every member of every run."""
+    run = np.repeat(np.arange(len(lengths)), lengths)
+    offset = np.arange(len(run)) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    return run, starts[run] + offset
+
+
+def _rasterize_items(tris: WindowTriangles, edges: EdgeEquations,
+                     tri, i0, box_w, j0, box_h) -> Fragments:
+    """Test every pixel centre of the items' boxes against the three edges."""
+    item_of_row, py = _expand(j0, box_h)                         # every row of every box
+    row_of_pixel, px = _expand(i0[item_of_row], box_w[item_of_row])   # every pixel of it
+    t, py = tri[item_of_row][row_of_pixel], py[row_of_pixel]     # (triangle, pixel) pairs
+    bits = tris.subpixel_bits
+    cx, cy = pixel_centre(px, bits), pixel_centre(py, bits)
+
+    covered = np.ones(len(t), dtype=bool)
+    for k in range(3):
+        value = edges.a[k].take(t) * cy - edges.b[k].take(t) * cx + edges.c[k].take(t)
+        covered &= is_inside_edge(value, edges.inclusive[k].take(t))
+    del cx, cy
+
+    t, px, py = t[covered], px[covered], py[covered]
+    screen = screen_barycentrics(tris, t, px, py)
+    z = tris.z_w[t]
+    z_w = screen[:, 0] * z[:, 0] + screen[:, 1] * z[:, 1] + screen[:, 2] * z[:, 2]  # affine
+    perspective = screen * tris.inv_w[t]                         # weights lambda_k / w_k
+    barycentric = perspective / (perspective[:, 0] + perspective[:, 1] + perspective[:, 2])[:, None]
+    return Fragments(px, py, t, barycentric, z_w, is_front_facing(tris.area2[t]))

@@ -1,0 +1,405 @@
+"""The GPU path: the scene drawn with the GLSL programs of glsl/ into an off-screen framebuffer.
+
+    with GpuRenderer(scene, 640, 480) as gpu:        # EGL, else OSMesa
+        frame = gpu.render()                         # Frame: rgba8, depth (and linear if asked)
+
+Everything GL is made once per renderer: one program per shader variant the scene's materials
+use, one vertex buffer (positions and normals, float32, interleaved), index buffer and vertex
+array per object, and a single-sample framebuffer with an RGBA8 colour buffer and a 32-bit
+float depth buffer (DEPTH_COMPONENT32F, so the stored depth is the rasteriser's float z_w with
+no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-specified through
+glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
+variants that write it, are made the first time `render(linear=True)` asks for them.
+
+Uniform values are computed once, as bytes, from `Scene.matrices()` and the scene's lights
+and materials, and `render()` only hands them to GL. After changing the scene (camera, lights,
+materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
+list of objects needs a new renderer.
+Conventions (matrices, window, depth, colour, lighting): docs/conventions.md.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import struct
+import time
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from renderer.context import activate, context_kind, gl_function, make_context, release_context
+from renderer.frame import Frame
+from renderer.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
+from renderer.shaders import ProgramCache, ShaderVariant
+from renderer.transforms import to_glsl
+
+GL_DITHER = 0x0BD0
+GL_RENDERBUFFER = 0x8D41
+GL_RENDERBUFFER_INTERNAL_FORMAT = 0x8D44
+GL_DEPTH_COMPONENT24 = 0x81A6
+GL_DEPTH_COMPONENT32F = 0x8CAC
+DEPTH_FORMAT_NAMES = {GL_DEPTH_COMPONENT24: "DEPTH_COMPONENT24",
+                      GL_DEPTH_COMPONENT32F: "DEPTH_COMPONENT32F"}
+
+CULL_FLAGS = {"none": None, "back": "back", "front": "front"}   # SceneObject.cull -> GL face
+
+
+def _vec3s(values) -> bytes:
+    """Bytes of a GLSL vec3 (or vec3[]) uniform."""
+    return np.asarray(values, dtype=np.float32).tobytes()
+
+
+def _float(value: float) -> bytes:
+    return struct.pack("f", value)
+
+
+def frame_uniform_values(scene: Scene, matrices: FrameMatrices) -> dict[str, bytes]:
+    """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
+    A light array is absent when the scene has no light of that kind (nor does the shader)."""
+    values = {
+        "u_view": to_glsl(matrices.view),
+        "u_projection": to_glsl(matrices.projection),
+        "u_eye": _vec3s(scene.camera.eye),
+        "u_ambient": _vec3s(scene.ambient),
+    }
+    if scene.directional_lights:
+        values["u_directional_direction"] = _vec3s([l.direction for l in scene.directional_lights])
+        values["u_directional_intensity"] = _vec3s([l.intensity for l in scene.directional_lights])
+    if scene.point_lights:
+        values["u_point_position"] = _vec3s([l.position for l in scene.point_lights])
+        values["u_point_intensity"] = _vec3s([l.intensity for l in scene.point_lights])
+        values["u_point_attenuation"] = _vec3s([l.attenuation for l in scene.point_lights])
+    return values
+
+
+def object_uniform_values(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, bytes]:
+    """One object's uniforms: its model and normal matrices and its material."""
+    material = obj.material
+    return {
+        "u_model": to_glsl(matrices.model),
+        "u_normal_matrix": to_glsl(matrices.normal),
+        "u_ka": _vec3s(material.ka),
+        "u_kd": _vec3s(material.kd),
+        "u_ks": _vec3s(material.ks),
+        "u_n": _float(material.n),
+    }
+
+
+def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
+                   index: int) -> dict[str, bytes]:
+    """Every uniform (name -> bytes) for drawing `obj`, object number `index` of `scene`.
+    A program may lack some (the compiler drops unused ones): skip names it does not have."""
+    return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])
+
+
+@dataclass
+class _ObjectBuffers:
+    """GL objects of one scene object: its mesh on the GPU and its vertex arrays per variant."""
+    obj: SceneObject
+    mesh: Mesh                             # the mesh uploaded (update() re-uploads a new one)
+    vbo: moderngl.Buffer | None            # in_position, in_normal: float32, interleaved
+    ibo: moderngl.Buffer | None            # faces, uint32
+    vertex_arrays: dict                    # ShaderVariant -> moderngl.VertexArray
+    uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
+
+
+@dataclass
+class _Draw:
+    """One draw call of a frame, with everything resolved ahead of time."""
+    vertex_array: moderngl.VertexArray
+    enable: int                            # moderngl flags for enable_only
+    cull_face: str | None
+    uploads: list                          # [(moderngl Uniform, bytes)]
+
+
+class GpuRenderer:
+    """Renders one scene at one size through GLSL; see the module docstring."""
+
+    def __init__(self, scene: Scene, width: int, height: int,
+                 context: moderngl.Context | None = None, context_kind: str = "auto"):
+        if int(width) < 1 or int(height) < 1:
+            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        self.scene = scene
+        self.width, self.height = int(width), int(height)
+        self._owns_context = context is None
+        self.ctx = make_context(context_kind) if context is None else context
+        self._released = False
+        self._programs = ProgramCache(self.ctx)
+        self._objects: list[_ObjectBuffers] = []
+        self._renderbuffers: list = []
+        self._framebuffers: dict[bool, moderngl.Framebuffer] = {}
+        self._plans: dict[bool, list[_Draw]] = {}
+        try:
+            activate(self.ctx)
+            self._check_size()
+            self._glDisable = gl_function(self.ctx, "glDisable", None, ctypes.c_uint)
+            self._build_targets()
+            self._build_objects()
+            self.update()
+        except BaseException:
+            self.release()
+            raise
+
+    # -- building ----------------------------------------------------------------------------
+    def _check_size(self) -> None:
+        limit = int(self.ctx.info["GL_MAX_RENDERBUFFER_SIZE"])
+        if max(self.width, self.height) > limit:
+            raise ValueError(f"image size {self.width}x{self.height} exceeds this GL's "
+                             f"renderbuffer limit of {limit} pixels")
+
+    def _build_targets(self) -> None:
+        size = (self.width, self.height)
+        self._color = self.ctx.renderbuffer(size, 4)                       # RGBA8
+        self._depth = self.ctx.depth_renderbuffer(size)
+        self.depth_format = self._make_float_depth(self._depth)
+        self._renderbuffers += [self._color, self._depth]
+        self._framebuffers[False] = self.ctx.framebuffer([self._color], self._depth)
+        # Read-back staging, bottom row first as GL returns it.
+        self._rgba_staging = np.empty((self.height, self.width, 4), np.uint8)
+        self._depth_staging = np.empty((self.height, self.width), np.float32)
+        self._linear_staging = None
+
+    def _make_float_depth(self, renderbuffer) -> str:
+        """Re-specify moderngl's 24-bit depth renderbuffer as DEPTH_COMPONENT32F where GL lets
+        us; returns the format in use."""
+        c_uint, c_int = ctypes.c_uint, ctypes.c_int
+        bind = gl_function(self.ctx, "glBindRenderbuffer", None, c_uint, c_uint)
+        storage = gl_function(self.ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
+        query = gl_function(self.ctx, "glGetRenderbufferParameteriv", None, c_uint, c_uint,
+                            ctypes.POINTER(c_int))
+        if bind is None or storage is None or query is None:
+            return "DEPTH_COMPONENT24"
+        value = c_int(0)
+        bind(GL_RENDERBUFFER, renderbuffer.glo)
+        storage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, self.width, self.height)
+        self.ctx.error                                          # clear any error it raised
+        query(GL_RENDERBUFFER, GL_RENDERBUFFER_INTERNAL_FORMAT, ctypes.byref(value))
+        bind(GL_RENDERBUFFER, 0)
+        return DEPTH_FORMAT_NAMES.get(value.value, hex(value.value))
+
+    def _linear_framebuffer(self) -> moderngl.Framebuffer:
+        fbo = self._framebuffers.get(True)
+        if fbo is None:
+            linear = self.ctx.renderbuffer((self.width, self.height), 4, dtype="f4")  # RGBA32F
+            self._renderbuffers.append(linear)
+            fbo = self._framebuffers[True] = self.ctx.framebuffer([self._color, linear], self._depth)
+            self._linear_staging = np.empty((self.height, self.width, 4), np.float32)
+        return fbo
+
+    def _build_objects(self) -> None:
+        for obj in self.scene.objects:
+            if obj.cull not in CULL_FLAGS:
+                raise ValueError(f"object {obj.name!r}: cull must be one of "
+                                 f"{', '.join(CULL_FLAGS)}, got {obj.cull!r}")
+            item = _ObjectBuffers(obj, obj.mesh, None, None, {}, {})
+            self._objects.append(item)
+            self._upload(item)
+
+    def _upload(self, item: _ObjectBuffers) -> None:
+        mesh = item.mesh = item.obj.mesh
+        if mesh.triangle_count:
+            vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
+            item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
+            item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
+
+    @staticmethod
+    def _release_buffers(item: _ObjectBuffers) -> None:
+        for vao in item.vertex_arrays.values():
+            vao.release()
+        for buffer in (item.vbo, item.ibo):
+            if buffer is not None:
+                buffer.release()
+        item.vertex_arrays, item.vbo, item.ibo = {}, None, None
+
+    def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
+        return ShaderVariant.for_material(self.scene, obj.material, linear)
+
+    def _vertex_array(self, item: _ObjectBuffers, variant: ShaderVariant) -> moderngl.VertexArray:
+        vao = item.vertex_arrays.get(variant)
+        if vao is None:
+            program = self._programs.get(variant)
+            if program.get("in_normal", None) is not None:
+                content = (item.vbo, "3f 3f", "in_position", "in_normal")
+            else:                                    # flat: the normal is the face's, not read
+                content = (item.vbo, "3f 3x4", "in_position")
+            vao = self.ctx.vertex_array(program, [content], index_buffer=item.ibo,
+                                        index_element_size=4)
+            item.vertex_arrays[variant] = vao
+        return vao
+
+    # -- uniforms ----------------------------------------------------------------------------
+    def update(self) -> None:
+        """Recompute every uniform from the scene (camera, lights, materials, transforms)."""
+        scene = self.scene
+        if len(scene.objects) != len(self._objects) or any(
+                a is not b.obj for a, b in zip(scene.objects, self._objects)):
+            raise ValueError("the scene's objects changed since this GpuRenderer was made; "
+                             "make a new one")
+        for item in self._objects:
+            if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
+                self._release_buffers(item)
+                self._upload(item)
+        matrices = scene.matrices(self.width, self.height)
+        self._frame_uniforms = frame_uniform_values(scene, matrices)
+        for item, object_matrices in zip(self._objects, matrices.objects):
+            item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
+        self._depth_from_window = _depth_conversion(matrices.projection)
+        self._plans.clear()
+
+    def _plan(self, linear: bool) -> list[_Draw]:
+        """The frame's draw calls; made once per update() for each kind of output."""
+        plan = self._plans.get(linear)
+        if plan is not None:
+            return plan
+        plan, programs = [], {}
+        for item in self._objects:
+            if item.vbo is None:
+                continue
+            variant = self._variant(item.obj, linear)
+            vao = self._vertex_array(item, variant)
+            program = programs[variant] = self._programs.get(variant)
+            uploads = [(program[name], data) for name, data in item.uniform_bytes.items()
+                       if program.get(name, None) is not None]
+            cull = CULL_FLAGS[item.obj.cull]
+            enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
+            plan.append(_Draw(vao, enable, cull, uploads))
+        for program in programs.values():          # the same for every object: set once here
+            for name, data in self._frame_uniforms.items():
+                uniform = program.get(name, None)
+                if uniform is not None:
+                    uniform.write(data)
+        self._plans[linear] = plan
+        return plan
+
+    # -- rendering ---------------------------------------------------------------------------
+    def render(self, *, linear: bool = False, depth: bool = True) -> Frame:
+        """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked."""
+        if self._released:
+            raise RuntimeError("this GpuRenderer was released")
+        start = time.perf_counter()
+        ctx = self.ctx
+        activate(ctx)
+        if self._glDisable is not None:
+            self._glDisable(GL_DITHER)              # unorm8 output must be the plain rounding
+        fbo = self._linear_framebuffer() if linear else self._framebuffers[False]
+        plan = self._plan(linear)
+        fbo.use()
+        red, green, blue = self.scene.background
+        fbo.clear(red, green, blue, 0.0, depth=1.0)
+        ctx.depth_func = "<"
+        ctx.front_face = "ccw"
+        ctx.wireframe = False
+        for draw in plan:
+            ctx.enable_only(draw.enable)
+            if draw.cull_face:
+                ctx.cull_face = draw.cull_face
+            for uniform, data in draw.uploads:
+                uniform.write(data)
+            draw.vertex_array.render(moderngl.TRIANGLES)
+
+        fbo.read_into(self._rgba_staging, components=4, attachment=0, alignment=1, dtype="f1")
+        rgba8 = self._rgba_staging[::-1].copy()                    # row 0 at the top
+        linear_color = depth_map = None
+        if linear:
+            fbo.read_into(self._linear_staging, components=4, attachment=1, alignment=1, dtype="f4")
+            linear_color = self._linear_staging[::-1].copy()
+        if depth:
+            fbo.read_into(self._depth_staging, components=1, attachment=-1, alignment=1, dtype="f4")
+            depth_map = self._depth_from_window(self._depth_staging[::-1])
+        return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0)
+
+    # -- information -------------------------------------------------------------------------
+    @property
+    def gl_info(self) -> dict:
+        """GL_VENDOR, GL_RENDERER, GL_VERSION, the context kind ("egl", "osmesa", or
+        "external" for a context passed in) and the depth buffer's format."""
+        info = self.ctx.info
+        return {key: info[key] for key in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")} | {
+            "context": context_kind(self.ctx), "depth_format": self.depth_format}
+
+    @property
+    def subpixel_bits(self) -> int:
+        """GL_SUBPIXEL_BITS: vertices snap to 1 / 2^bits of a pixel (8 on llvmpipe)."""
+        return int(self.ctx.info["GL_SUBPIXEL_BITS"])
+
+    @property
+    def framebuffer(self) -> moderngl.Framebuffer:
+        return self._framebuffers[False]
+
+    @property
+    def programs(self) -> dict:
+        """ShaderVariant -> moderngl.Program, for the variants made so far."""
+        return dict(self._programs.items())
+
+    @property
+    def vertex_arrays(self) -> list:
+        """Every vertex array made so far, objects in scene order."""
+        return [vao for item in self._objects for vao in item.vertex_arrays.values()]
+
+    # -- lifetime ----------------------------------------------------------------------------
+    def release(self) -> None:
+        """Free every GL object; the context too if this renderer made it. Idempotent."""
+        if self._released:
+            return
+        self._released = True
+        self._plans.clear()
+        try:
+            activate(self.ctx)
+            for item in self._objects:
+                self._release_buffers(item)
+            for fbo in self._framebuffers.values():
+                fbo.release()
+            for renderbuffer in self._renderbuffers:
+                renderbuffer.release()
+            self._programs.release()
+        finally:
+            self._objects, self._framebuffers, self._renderbuffers = [], {}, []
+            if self._owns_context:
+                release_context(self.ctx)
+
+    def __enter__(self) -> "GpuRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+    def __repr__(self) -> str:
+        state = "released" if self._released else context_kind(self.ctx)
+        return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
+
+
+def _depth_conversion(projection: np.ndarray):
+    """A function from window depth z_w (bottom-up rows, float32) to -z_eye (float32, +inf
+    where z_w == 1, the cleared value), for the projection matrix P of the frame.
+
+    z_ndc = 2 z_w - 1. Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye, so
+    -z_eye = P23 / (P22 + z_ndc) = a / (z_w + b) with a = P23 / 2, b = (P22 - 1) / 2.
+    Parallel (P[3] = (0, 0, 0, 1)): z_ndc = P22 z_eye + P23, so -z_eye = s z_w + t.
+    b is split into a float32 head and tail so that z_w + b loses nothing where z_w is near 1
+    (the head's sum with z_w is exact there, Sterbenz), giving float64-like accuracy in float32.
+    """
+    p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    perspective = projection[3, 2] == -1.0 and projection[3, 3] == 0.0
+    if perspective:
+        a = np.float32(p23 / 2.0)
+        b = (p22 - 1.0) / 2.0
+        b_head = np.float32(b)
+        b_tail = np.float32(b - float(b_head))
+
+        def convert(window_depth: np.ndarray) -> np.ndarray:
+            out = np.add(window_depth, b_head)           # a new C-contiguous array
+            out += b_tail
+            np.divide(a, out, out=out)
+            np.copyto(out, np.inf, where=window_depth == 1.0)
+            return out
+    else:
+        s = np.float32(-2.0 / p22)
+        t = np.float32((p23 + 1.0) / p22)
+
+        def convert(window_depth: np.ndarray) -> np.ndarray:
+            out = np.multiply(window_depth, s)
+            out += t
+            np.copyto(out, np.inf, where=window_depth == 1.0)
+            return out
+    return convert

@@ -1,0 +1,658 @@
+"""Scene files: the built-in scenes, the documented example, and every refusal's message.
+
+Each bad input must raise a SceneError whose line is "FILE: KEY.PATH: reason"; the command
+line must turn it into that one line on stderr, exit status 2 and no output file.
+"""
+
+import dataclasses
+import re
+import subprocess
+import sys
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from renderer.builtin import (DEFAULT_SCENE, assets_dir, builtin_scenes, resolve_scene,
+                              scene_descriptions)
+from renderer.errors import SceneError
+from renderer.primitives import cube, plane, uv_sphere
+from renderer.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
+                            Transform)
+from renderer.scene_file import load_scene, scene_from_dict
+
+REPO = Path(__file__).resolve().parent.parent
+BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_plane",
+                 "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
+                 "hierarchy"}
+# Scenes whose objects deliberately reach outside the view (through the near plane).
+PARTLY_OUTSIDE = {"near_plane"}
+IMAGE_SIZES = [(640, 480), (320, 240)]
+
+OBJ_TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
+
+
+def write(folder: Path, name: str, text: str) -> Path:
+    path = folder / name
+    path.write_text(text)
+    return path
+
+
+def load_error(tmp_path: Path, text: str, name: str = "scene.toml") -> tuple[Path, str]:
+    path = write(tmp_path, name, text)
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    return path, info.value.line()
+
+
+# --------------------------------------------------------------------------- built-in scenes
+
+def test_the_builtin_scenes_are_all_there():
+    assert set(builtin_scenes()) == BUILTIN_NAMES
+    for name, path in builtin_scenes().items():
+        assert path == assets_dir() / "scenes" / f"{name}.toml"
+
+
+@pytest.mark.parametrize("name", sorted(BUILTIN_NAMES))
+def test_builtin_scene_loads(name):
+    scene = load_scene(builtin_scenes()[name])
+    assert scene.name == name
+    assert scene.source == str(builtin_scenes()[name])
+    assert scene.objects and (scene.directional_lights or scene.point_lights)
+    description = scene_descriptions()[name]
+    assert description and "\n" not in description
+    for obj in scene.objects:
+        assert obj.mesh.triangle_count > 0
+        assert np.isfinite(obj.mesh.positions).all()
+    world = scene.world_matrices()
+    assert all(abs(np.linalg.det(m[:3, :3])) > 1e-6 for m in world)
+
+
+def clip_coordinates(scene: Scene, width: int, height: int):
+    """Per object: clip coordinates of its vertices, triangle centroids and edge midpoints."""
+    frame = scene.matrices(width, height)
+    out = []
+    for obj, matrices in zip(scene.objects, frame.objects):
+        tri = obj.mesh.positions[obj.mesh.faces]
+        samples = np.concatenate([obj.mesh.positions, tri.mean(axis=1),
+                                  (tri + np.roll(tri, 1, axis=1)).reshape(-1, 3) / 2])
+        homogeneous = np.c_[samples, np.ones(len(samples))]
+        clip = (frame.projection @ frame.view @ matrices.model @ homogeneous.T).T
+        out.append((obj.name, clip, len(obj.mesh.positions)))
+    return out
+
+
+def inside_clip_volume(clip):
+    w = clip[:, 3]
+    return (w > 0) & (np.abs(clip[:, :3]) <= w[:, None]).all(axis=1)
+
+
+@pytest.mark.parametrize("name", sorted(BUILTIN_NAMES))
+@pytest.mark.parametrize("size", IMAGE_SIZES)
+def test_every_object_of_a_builtin_scene_is_in_view(name, size):
+    scene = load_scene(builtin_scenes()[name])
+    for obj_name, clip, vertex_count in clip_coordinates(scene, *size):
+        inside = inside_clip_volume(clip)
+        assert inside.any(), f"{name}: {obj_name} is out of view"
+        if name not in PARTLY_OUTSIDE:
+            assert inside[:vertex_count].all(), f"{name}: {obj_name} is partly out of view"
+
+
+def test_near_plane_scene_has_triangles_crossing_the_near_plane():
+    scene = load_scene(builtin_scenes()["near_plane"])
+    frame = scene.matrices(640, 480)
+    crossing = 0
+    for obj, matrices in zip(scene.objects, frame.objects):
+        homogeneous = np.c_[obj.mesh.positions, np.ones(len(obj.mesh.positions))]
+        eye_z = (frame.view @ matrices.model @ homogeneous.T).T[:, 2]
+        depth = -eye_z[obj.mesh.faces]                                   # (F, 3) distances
+        crossing += int(((depth < scene.camera.near).any(axis=1)
+                         & (depth > scene.camera.near).any(axis=1)).sum())
+        if obj.name in ("room", "rail"):
+            assert (depth < 0).any(), f"{obj.name} should reach behind the camera"
+    assert crossing >= 4
+
+
+def test_builtin_scenes_cover_shading_modes_sides_and_projections():
+    scenes = {name: load_scene(path) for name, path in builtin_scenes().items()}
+    materials = [obj.material for s in scenes.values() for obj in s.objects]
+    assert {m.shading for m in materials} == {"flat", "gouraud", "phong"}
+    assert {m.two_sided for m in materials} == {True, False}
+    assert {s.camera.projection for s in scenes.values()} == {"perspective", "parallel"}
+    assert scenes["orthographic"].camera.projection == "parallel"
+
+
+def test_default_sphere_scene():
+    scene = load_scene(resolve_scene(None))
+    assert scene.name == DEFAULT_SCENE == "sphere"
+    assert len(scene.directional_lights) == 1 and len(scene.point_lights) == 1
+    [ball] = scene.objects
+    assert ball.material.shading == "phong" and min(ball.material.ks) > 0
+
+
+def test_gouraud_vs_phong_is_the_same_coarse_sphere_twice():
+    a, b = load_scene(builtin_scenes()["gouraud_vs_phong"]).objects
+    assert (a.material.shading, b.material.shading) == ("gouraud", "phong")
+    assert dataclasses.replace(a.material, shading="phong") == b.material
+    np.testing.assert_array_equal(a.mesh.positions, b.mesh.positions)
+    assert a.mesh.triangle_count <= 512
+
+
+def test_point_light_plane_puts_the_light_over_the_middle_of_a_grid_cell():
+    scene = load_scene(builtin_scenes()["point_light_plane"])
+    shadings = {obj.material.shading for obj in scene.objects}
+    assert shadings == {"gouraud", "phong"}
+    world = scene.world_matrices()
+    for obj, model in zip(scene.objects, world):
+        vertices = (model @ np.c_[obj.mesh.positions, np.ones(len(obj.mesh.positions))].T).T
+        nearest = min(np.linalg.norm(vertices[:, :3] - light.position, axis=1).min()
+                      for light in scene.point_lights)
+        lowest = min(light.position[1] for light in scene.point_lights)
+        assert nearest > 1.2 * lowest            # no vertex right under a light
+
+
+def test_mesh_file_scene_uses_obj_ply_and_stl():
+    scene = load_scene(builtin_scenes()["mesh_file"])
+    suffixes = {Path(obj.mesh.source).suffix for obj in scene.objects}
+    assert suffixes == {".obj", ".ply", ".stl"}
+
+
+def test_open_mesh_inside_scene_has_both_sides():
+    scene = load_scene(builtin_scenes()["open_mesh_inside"])
+    assert sorted(obj.material.two_sided for obj in scene.objects) == [False, True]
+
+
+def test_hierarchy_scene_has_parents_shear_and_rotation():
+    scene = load_scene(builtin_scenes()["hierarchy"])
+    by_name = {obj.name: obj for obj in scene.objects}
+    assert by_name["ring"].parent == "planet" and by_name["planet"].parent == "sun"
+    assert any(obj.transform.shear for obj in scene.objects)
+    assert any(obj.parent and by_name[obj.parent].transform.shear for obj in scene.objects)
+
+
+# --------------------------------------------------------------------------- resolving names
+
+def test_resolve_scene_by_name_and_by_path(tmp_path):
+    assert resolve_scene(None) == builtin_scenes()["sphere"]
+    assert resolve_scene("hierarchy") == builtin_scenes()["hierarchy"]
+    mine = write(tmp_path, "mine.toml", "")
+    assert resolve_scene(str(mine)) == mine
+
+
+def test_resolve_scene_unknown_lists_the_builtin_names():
+    with pytest.raises(SceneError) as info:
+        resolve_scene("spher")
+    assert info.value.line() == (
+        "spher: no such scene file or built-in scene; did you mean 'sphere'? built-in scenes: "
+        + ", ".join(sorted(BUILTIN_NAMES)))
+
+
+def test_resolve_scene_missing_path(tmp_path):
+    missing = str(tmp_path / "nothing.toml")
+    with pytest.raises(SceneError) as info:
+        resolve_scene(missing)
+    assert info.value.line().startswith(f"{missing}: no such scene file or built-in scene; ")
+
+
+# --------------------------------------------------------------------------- the complete example
+
+def documented_example() -> str:
+    text = (REPO / "docs" / "scene-format.md").read_text()
+    return re.search(r"## Complete example.*?```toml\n(.*?)```", text, re.S)[1]
+
+
+def summary(scene: Scene) -> dict:
+    """Everything in a scene, comparable with == (meshes by their arrays)."""
+    return {
+        "camera": dataclasses.asdict(scene.camera), "ambient": scene.ambient,
+        "background": scene.background, "name": scene.name,
+        "directional": [dataclasses.asdict(x) for x in scene.directional_lights],
+        "point": [dataclasses.asdict(x) for x in scene.point_lights],
+        "objects": [(o.name, o.parent, o.cull, dataclasses.asdict(o.material),
+                     dataclasses.asdict(o.transform), o.mesh.positions.tolist(),
+                     o.mesh.normals.tolist(), o.mesh.faces.tolist()) for o in scene.objects],
+    }
+
+
+def test_complete_example_loads_with_every_value(tmp_path):
+    scene = load_scene(write(tmp_path, "example.toml", documented_example()))
+    assert scene.name == "example"
+    assert scene.background == (0.05, 0.05, 0.1) and scene.ambient == (0.2, 0.2, 0.2)
+    assert scene.camera == Camera(eye=(0.0, 2.0, 8.0), look=(0.0, 0.5, 0.0), up=(0.0, 1.0, 0.0),
+                                  projection="perspective", fov_y=50.0, height=4.0, near=0.5,
+                                  far=60.0)
+    assert scene.directional_lights == [DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8))]
+    assert scene.point_lights == [PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01))]
+    floor, ball, box, knot = scene.objects
+    red = Material((0.3, 0.05, 0.05), (0.8, 0.1, 0.1), (0.6, 0.6, 0.6), 50.0, False, "phong")
+    grey = Material((0.4, 0.4, 0.4), (0.5, 0.5, 0.5), (0.0, 0.0, 0.0), 1.0, True, "gouraud")
+    assert (floor.name, floor.material, floor.cull, floor.parent) == ("floor", grey, "none", None)
+    assert floor.transform == Transform(translate=(0.0, -1.0, 0.0))
+    np.testing.assert_array_equal(floor.mesh.positions, plane(10.0, 4).positions)
+    assert (ball.material, ball.cull) == (red, "back")
+    assert ball.transform == Transform((1.0, 1.5, 1.0), {}, (0.0, 0.0, 10.0), (-2.0, 0.5, 0.0))
+    np.testing.assert_array_equal(ball.mesh.faces, uv_sphere(1.0, 24, 12).faces)
+    assert box.parent == "ball"
+    assert box.material == Material(kd=(0.1, 0.2, 0.9), ks=(0.5, 0.5, 0.5), n=10.0,
+                                    shading="flat")
+    assert box.transform == Transform((0.8, 0.8, 0.8), {"xy": 0.3, "zx": -0.2},
+                                      (30.0, 45.0, 0.0), (0.0, 1.2, 0.0))
+    np.testing.assert_array_equal(box.mesh.positions, cube(0.5).positions)
+    assert Path(knot.mesh.source) == assets_dir() / "meshes" / "torus_knot.obj"
+    assert knot.material == Material() and knot.cull == "back"
+    # the child's world matrix is its parent's times its own
+    world = dict(zip([o.name for o in scene.objects], scene.world_matrices()))
+    np.testing.assert_allclose(world["box"], world["ball"] @ box.transform.matrix())
+
+
+def test_complete_example_round_trip_file_dict_and_dataclasses(tmp_path):
+    text = documented_example()
+    from_file = load_scene(write(tmp_path, "example.toml", text))
+    from_dict = scene_from_dict(tomllib.loads(text), source="example", base_dir=tmp_path)
+    assert summary(from_file) == summary(from_dict)
+    # the same scene written with the dataclasses
+    red = Material((0.3, 0.05, 0.05), (0.8, 0.1, 0.1), (0.6, 0.6, 0.6), 50.0, False, "phong")
+    grey = Material((0.4, 0.4, 0.4), (0.5, 0.5, 0.5), (0.0, 0.0, 0.0), 1.0, True, "gouraud")
+    built = Scene(
+        camera=Camera((0.0, 2.0, 8.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), "perspective",
+                      50.0, 4.0, 0.5, 60.0),
+        objects=[
+            SceneObject("floor", plane(10.0, 4), grey, Transform(translate=(0.0, -1.0, 0.0))),
+            SceneObject("ball", uv_sphere(1.0, 24, 12), red,
+                        Transform((1.0, 1.5, 1.0), {}, (0.0, 0.0, 10.0), (-2.0, 0.5, 0.0)),
+                        cull="back"),
+            SceneObject("box", cube(0.5),
+                        Material(kd=(0.1, 0.2, 0.9), ks=(0.5, 0.5, 0.5), n=10.0, shading="flat"),
+                        Transform((0.8, 0.8, 0.8), {"xy": 0.3, "zx": -0.2}, (30.0, 45.0, 0.0),
+                                  (0.0, 1.2, 0.0)), parent="ball"),
+            from_file.objects[3],
+        ],
+        directional_lights=[DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8))],
+        point_lights=[PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01))],
+        ambient=(0.2, 0.2, 0.2), background=(0.05, 0.05, 0.1), name="example")
+    assert summary(built) == summary(from_file)
+    for a, b in zip(built.world_matrices(), from_file.world_matrices()):
+        np.testing.assert_array_equal(a, b)
+
+
+def test_empty_file_gives_the_defaults(tmp_path):
+    scene = load_scene(write(tmp_path, "blank.toml", ""))
+    assert scene.name == "blank"
+    assert summary(scene) == summary(Scene(name="blank"))
+
+
+def test_defaults_of_objects_lights_and_scalars(tmp_path):
+    scene = load_scene(write(tmp_path, "d.toml", """
+ambient = 0.3
+[[lights]]
+type = "point"
+[[lights]]
+type = "directional"
+[[objects]]
+mesh = { primitive = "cube" }
+scale = 2
+"""))
+    assert scene.ambient == (0.3, 0.3, 0.3)
+    assert scene.point_lights == [PointLight()] and scene.directional_lights == [DirectionalLight()]
+    [obj] = scene.objects
+    assert obj.name == "object0" and obj.material == Material() and obj.cull == "none"
+    assert obj.transform == Transform(scale=(2.0, 2.0, 2.0))
+
+
+def test_parallel_camera_allows_a_negative_near(tmp_path):
+    scene = load_scene(write(tmp_path, "p.toml", """
+[camera]
+projection = "parallel"
+near = -5.0
+far = 5.0
+height = 3.0
+"""))
+    assert (scene.camera.projection, scene.camera.near, scene.camera.height) == ("parallel", -5.0, 3.0)
+
+
+def test_mesh_file_relative_to_the_scene_folder(tmp_path):
+    (tmp_path / "meshes").mkdir()
+    mesh_path = write(tmp_path / "meshes", "tri.obj", OBJ_TRIANGLE)
+    scene = load_scene(write(tmp_path, "s.toml", '[[objects]]\nmesh = { file = "meshes/tri.obj" }\n'))
+    assert scene.objects[0].mesh.source == str(mesh_path)
+    assert scene.objects[0].mesh.triangle_count == 1
+
+
+def test_scene_from_dict_accepts_tuples_and_names_its_source():
+    scene = scene_from_dict({"camera": {"eye": (1, 2, 3)},
+                             "objects": [{"name": "c", "mesh": {"primitive": "cube"}}]})
+    assert scene.camera.eye == (1.0, 2.0, 3.0) and scene.source == "<dict>"
+    with pytest.raises(SceneError) as info:
+        scene_from_dict({"camera": {"eye": (1, 2)}}, source="built in Python")
+    assert info.value.line() == ("built in Python: camera.eye: expected a list of 3 numbers, "
+                                 "got a list of 2 items")
+
+
+# --------------------------------------------------------------------------- refusals
+
+OBJECT = '[[objects]]\nname = "ball"\nmesh = { primitive = "uv_sphere" }\n'
+
+# (test id, scene text, expected "KEY.PATH: reason" after "FILE: ")
+BAD_SCENES = [
+    # unknown keys, with the closest known key suggested
+    ("unknown top-level key", "objcts = []\n", "objcts: unknown key; did you mean 'objects'?"),
+    ("unknown camera key", "[camera]\nfovy = 40\n", "camera.fovy: unknown key; did you mean 'fov_y'?"),
+    ("unknown key, no close match", "[camera]\nzoom = 2\n",
+     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far"),
+    ("unknown inline material key", OBJECT + 'material = { kdd = [1, 0, 0] }\n',
+     "objects[0].material.kdd: unknown key; did you mean 'kd'?"),
+    ("unknown light key for its type", '[[lights]]\ntype = "directional"\nposition = [0, 1, 0]\n',
+     "lights[0].position: belongs to point lights, not directional ones; keys here: type, "
+     "direction, intensity"),
+    ("unknown object key", OBJECT + "translation = [0, 1, 0]\n",
+     "objects[0].translation: unknown key; did you mean 'translate'?"),
+    ("unknown shear factor", OBJECT + "shear = { xx = 1.0 }\n",
+     "objects[0].shear.xx: unknown key; known keys here: xy, xz, yx, yz, zx, zy"),
+    # wrong types
+    ("string for a vector", '[camera]\nup = "y"\n',
+     "camera.up: expected a list of 3 numbers, got a string ('y')"),
+    ("short vector", "[camera]\neye = [0, 5]\n",
+     "camera.eye: expected a list of 3 numbers, got a list of 2 items"),
+    ("string inside a vector", '[camera]\nlook = [0, "up", 0]\n',
+     "camera.look: expected a list of 3 numbers, item 1 is a string ('up')"),
+    ("string for a number", '[camera]\nfov_y = "wide"\n',
+     "camera.fov_y: expected a number, got a string ('wide')"),
+    ("boolean for a number", "[materials.m]\nn = true\n",
+     "materials.m.n: expected a number, got a boolean (true)"),
+    ("number for a boolean", "[materials.m]\ntwo_sided = 1\n",
+     "materials.m.two_sided: expected true or false, got an integer (1)"),
+    ("float for a count", '[[objects]]\nmesh = { primitive = "uv_sphere", segments = 16.0 }\n',
+     "objects[0].mesh.segments: expected an integer, got a number (16)"),
+    ("string for a colour", 'background = "black"\n',
+     "background: expected a number or a list of 3 numbers, got a string ('black')"),
+    ("table for a scale", OBJECT + "scale = { x = 2 }\n",
+     "objects[0].scale: expected a number or a list of 3 numbers, got a table"),
+    ("objects as a table", "[objects]\nname = 'a'\n",
+     "objects: expected a list of tables ([[objects]]), got a table"),
+    ("camera as a list", "camera = [1, 2, 3]\n",
+     "camera: expected a table, got a list of 3 items"),
+    ("mesh as a string", '[[objects]]\nmesh = "cube"\n',
+     "objects[0].mesh: expected a table such as {primitive = \"uv_sphere\"} or "
+     "{file = \"meshes/knot.obj\"}, got a string ('cube')"),
+    ("material as a number", OBJECT + "material = 3\n",
+     "objects[0].material: expected a material name (string) or an inline table, got an integer (3)"),
+    ("parent as a number", OBJECT + "parent = 1\n",
+     "objects[0].parent: expected a string, got an integer (1)"),
+    # NaN and Inf (TOML allows them)
+    ("nan number", "[camera]\nfov_y = nan\n", "camera.fov_y: expected a finite number, got nan"),
+    ("inf in a vector", "[camera]\neye = [0, inf, 5]\n",
+     "camera.eye: expected finite numbers, item 1 is inf"),
+    ("nan in a colour", "[materials.m]\nkd = [0.5, nan, 0.5]\n",
+     "materials.m.kd: expected finite numbers, item 1 is nan"),
+    ("-inf translate", OBJECT + "translate = [0, 0, -inf]\n",
+     "objects[0].translate: expected finite numbers, item 2 is -inf"),
+    ("nan light intensity", '[[lights]]\ntype = "point"\nintensity = nan\n',
+     "lights[0].intensity: expected finite numbers, item 0 is nan"),
+    ("nan scale", OBJECT + "scale = nan\n", "objects[0].scale: expected finite numbers, item 0 is nan"),
+    ("nan primitive argument", '[[objects]]\nmesh = { primitive = "cube", size = nan }\n',
+     "objects[0].mesh.size: expected a finite number, got nan"),
+    # the camera
+    ("zero up", "[camera]\nup = [0, 0, 0]\n",
+     "camera.up: must not be zero length; up says which way is up in the image"),
+    ("up parallel to the view", "[camera]\neye = [0, 5, 0]\nup = [0, -2, 0]\n",
+     "camera.up: [0, -2, 0] is parallel to the view direction (eye - look = [0, 5, 0]); "
+     "up must point across the view"),
+    ("default up parallel to the view", "[camera]\neye = [0, 5, 0]\n",
+     "camera.up: [0, 1, 0] (the default) is parallel to the view direction (eye - look = "
+     "[0, 5, 0]); up must point across the view"),
+    ("eye equals look", "[camera]\neye = [1, 2, 3]\nlook = [1, 2, 3]\n",
+     "camera.look: is the same point as camera.eye; the camera needs eye - look to be a direction"),
+    ("zero near", "[camera]\nnear = 0\n",
+     "camera.near: must be > 0 for a perspective camera, got 0"),
+    ("negative near", "[camera]\nnear = -1.0\n",
+     "camera.near: must be > 0 for a perspective camera, got -1"),
+    ("far below near", "[camera]\nnear = 0.1\nfar = 0.05\n",
+     "camera.far: must be greater than near (0.1), got 0.05"),
+    ("far equal to near", "[camera]\nnear = 2.0\nfar = 2.0\n",
+     "camera.far: must be greater than near (2), got 2"),
+    ("parallel far below near", '[camera]\nprojection = "parallel"\nnear = -1.0\nfar = -2.0\n',
+     "camera.far: must be greater than near (-1), got -2"),
+    ("zero parallel height", '[camera]\nprojection = "parallel"\nheight = 0\n',
+     "camera.height: must be > 0, got 0"),
+    ("fov_y zero", "[camera]\nfov_y = 0\n",
+     "camera.fov_y: must be between 0 and 180 degrees (both excluded), got 0"),
+    ("fov_y 180", "[camera]\nfov_y = 180\n",
+     "camera.fov_y: must be between 0 and 180 degrees (both excluded), got 180"),
+    ("fov_y negative", "[camera]\nfov_y = -45.0\n",
+     "camera.fov_y: must be between 0 and 180 degrees (both excluded), got -45"),
+    ("unknown projection", '[camera]\nprojection = "orthographic"\n',
+     "camera.projection: unknown projection 'orthographic'; expected one of: perspective, parallel"),
+    # transforms
+    ("zero scale", OBJECT + "scale = [1, 0, 1]\n",
+     "objects[0].scale: must be > 0 in every component, got [1, 0, 1]: a zero scale makes the "
+     "model matrix singular and a negative one turns the object inside out"),
+    ("zero uniform scale", OBJECT + "scale = 0\n",
+     "objects[0].scale: must be > 0 in every component, got [0, 0, 0]: a zero scale makes the "
+     "model matrix singular and a negative one turns the object inside out"),
+    ("negative scale", OBJECT + "scale = [-1, 1, 1]\n",
+     "objects[0].scale: must be > 0 in every component, got [-1, 1, 1]: a zero scale makes the "
+     "model matrix singular and a negative one turns the object inside out"),
+    ("singular shear", OBJECT + "shear = { xy = 1.0, yx = 1.0 }\n",
+     "objects[0].shear: makes the model matrix singular: its determinant is 0; it must stay > 0"),
+    ("mirroring shear", OBJECT + "shear = { xy = 2.0, yx = 1.0 }\n",
+     "objects[0].shear: makes the model matrix a mirror (inside out): its determinant is -1; "
+     "it must stay > 0"),
+    ("unknown cull", OBJECT + 'cull = "backface"\n',
+     "objects[0].cull: unknown cull mode 'backface'; did you mean 'back'? expected one of: "
+     "none, back, front"),
+    # names and parents
+    ("duplicate names", OBJECT + OBJECT,
+     "objects[1].name: duplicate object name 'ball' (objects[0] has it too)"),
+    ("duplicate default name", '[[objects]]\nname = "object1"\nmesh = { primitive = "cube" }\n'
+     '[[objects]]\nmesh = { primitive = "cube" }\n',
+     "objects[1]: duplicate object name 'object1' (objects[0] has it too)"),
+    ("unknown parent", OBJECT + '[[objects]]\nname = "box"\nmesh = { primitive = "cube" }\n'
+     'parent = "bal"\n',
+     "objects[1].parent: no object named 'bal'; did you mean 'ball'? objects in this scene: ball, box"),
+    ("parent cycle", '[[objects]]\nname = "a"\nparent = "b"\nmesh = { primitive = "cube" }\n'
+     '[[objects]]\nname = "b"\nparent = "a"\nmesh = { primitive = "cube" }\n',
+     "objects[0].parent: parent cycle: a -> b -> a"),
+    ("longer parent cycle", '[[objects]]\nname = "root"\nmesh = { primitive = "cube" }\n'
+     '[[objects]]\nname = "a"\nparent = "c"\nmesh = { primitive = "cube" }\n'
+     '[[objects]]\nname = "b"\nparent = "a"\nmesh = { primitive = "cube" }\n'
+     '[[objects]]\nname = "c"\nparent = "b"\nmesh = { primitive = "cube" }\n',
+     "objects[1].parent: parent cycle: a -> c -> b -> a"),
+    ("own parent", OBJECT + 'parent = "ball"\n', "objects[0].parent: parent cycle: ball -> ball"),
+    # primitives
+    ("unknown primitive", '[[objects]]\nmesh = { primitive = "sphere" }\n',
+     "objects[0].mesh.primitive: unknown primitive 'sphere'; did you mean 'uv_sphere'? expected "
+     "one of: uv_sphere, icosphere, plane, cube, cylinder, torus"),
+    ("too few segments", '[[objects]]\nmesh = { primitive = "uv_sphere", segments = 2 }\n',
+     "objects[0].mesh.segments: must be >= 3, got 2"),
+    ("too few rings", '[[objects]]\nmesh = { primitive = "uv_sphere", rings = 1 }\n',
+     "objects[0].mesh.rings: must be >= 2, got 1"),
+    ("zero radius", '[[objects]]\nmesh = { primitive = "cylinder", radius = 0 }\n',
+     "objects[0].mesh.radius: must be > 0, got 0"),
+    ("negative torus radius", '[[objects]]\nmesh = { primitive = "torus", minor_radius = -0.2 }\n',
+     "objects[0].mesh.minor_radius: must be > 0, got -0.2"),
+    ("too many subdivisions", '[[objects]]\nmesh = { primitive = "icosphere", subdivisions = 9 }\n',
+     "objects[0].mesh.subdivisions: must be <= 6, got 9"),
+    ("plane with no cells", '[[objects]]\nmesh = { primitive = "plane", segments = 0 }\n',
+     "objects[0].mesh.segments: must be >= 1, got 0"),
+    ("argument of another primitive", '[[objects]]\nmesh = { primitive = "cube", radius = 1 }\n',
+     "objects[0].mesh.radius: unknown key; known keys here: primitive, size"),
+    ("misspelt argument", '[[objects]]\nmesh = { primitive = "uv_sphere", radious = 1 }\n',
+     "objects[0].mesh.radious: unknown key; did you mean 'radius'?"),
+    ("primitive and file", '[[objects]]\nmesh = { primitive = "cube", file = "a.obj" }\n',
+     "objects[0].mesh: give either primitive or file, not both"),
+    ("mesh with neither", "[[objects]]\nmesh = {}\n", "objects[0].mesh: needs a primitive or a file key"),
+    ("no mesh", '[[objects]]\nname = "ghost"\n',
+     'objects[0].mesh: missing; give mesh = {primitive = "..."} or mesh = {file = "..."}'),
+    # materials
+    ("negative kd", "[materials.red]\nkd = [0.5, -0.2, 0.0]\n",
+     "materials.red.kd: must be >= 0 in every component, item 1 is -0.2"),
+    ("negative inline ka", OBJECT + "material = { ka = -0.1 }\n",
+     "objects[0].material.ka: must be >= 0 in every component, item 0 is -0.1"),
+    ("negative ks", "[materials.m]\nks = [-1, 0, 0]\n",
+     "materials.m.ks: must be >= 0 in every component, item 0 is -1"),
+    ("zero exponent", "[materials.m]\nn = 0\n", "materials.m.n: must be > 0, got 0"),
+    ("unknown shading", '[materials.red]\nshading = "smooth"\n',
+     "materials.red.shading: unknown shading 'smooth'; expected one of: flat, gouraud, phong"),
+    ("unknown inline shading", OBJECT + 'material = { shading = "phongg" }\n',
+     "objects[0].material.shading: unknown shading 'phongg'; did you mean 'phong'? expected one "
+     "of: flat, gouraud, phong"),
+    ("unknown material name", "[materials.green]\n" + OBJECT + 'material = "gren"\n',
+     "objects[0].material: no material named 'gren'; did you mean 'green'? [materials] defines: green"),
+    ("material name without materials", OBJECT + 'material = "red"\n',
+     "objects[0].material: no material named 'red': the file defines no [materials.NAME] tables"),
+    ("negative background", "background = [0, 0, -1]\n",
+     "background: must be >= 0 in every component, item 2 is -1"),
+    # lights
+    ("unknown light type", '[[lights]]\ntype = "directional"\n[[lights]]\ntype = "spot"\n',
+     "lights[1].type: unknown light type 'spot'; did you mean 'point'? expected one of: "
+     "directional, point"),
+    ("light without type", "[[lights]]\nintensity = 1\n",
+     "lights[0].type: missing; expected one of: directional, point"),
+    ("zero light direction", '[[lights]]\ntype = "directional"\ndirection = [0, 0, 0]\n',
+     "lights[0].direction: must not be zero length"),
+    ("negative attenuation", '[[lights]]\ntype = "point"\nattenuation = [1, -0.1, 0]\n',
+     "lights[0].attenuation: must be >= 0 in every component, item 1 is -0.1"),
+    ("zero attenuation", '[[lights]]\ntype = "point"\nattenuation = [0, 0, 0]\n',
+     "lights[0].attenuation: must not be all zero: the light is divided by c + l d + q d^2"),
+    ("negative intensity", '[[lights]]\ntype = "point"\nintensity = [1, 1, -1]\n',
+     "lights[0].intensity: must be >= 0 in every component, item 2 is -1"),
+]
+
+
+@pytest.mark.parametrize("text, expected", [case[1:] for case in BAD_SCENES],
+                         ids=[case[0] for case in BAD_SCENES])
+def test_bad_scene_message(tmp_path, text, expected):
+    path, line = load_error(tmp_path, text)
+    assert line == f"{path}: {expected}"
+
+
+def test_key_paths_count_objects_from_zero(tmp_path):
+    text = (OBJECT.replace("ball", "a") + OBJECT.replace("ball", "b") + OBJECT.replace("ball", "c")
+            + 'material = { kd = [1, 1, "x"] }\n')
+    path, line = load_error(tmp_path, text)
+    assert line == f"{path}: objects[2].material.kd: expected a number or a list of 3 numbers, " \
+                   f"item 2 is a string ('x')"
+
+
+@pytest.mark.parametrize("text, where", [
+    ("[camera]\neye = [0, 0, 5\n", r"at (end of file|line 3, column \d+)"),
+    ("name = \n", r"at line 1, column \d+"),
+    ("[camera]\nfov_y = 45 45\n", r"at line 2, column \d+"),
+    ("[camera]\nnear = 1\nnear = 2\n", r"at line 3, column \d+"),
+])
+def test_toml_syntax_error_names_the_line(tmp_path, text, where):
+    path, line = load_error(tmp_path, text)
+    assert re.match(re.escape(f"{path}: TOML syntax error ") + where + ": ", line), line
+
+
+def test_scene_file_not_found(tmp_path):
+    missing = tmp_path / "missing.toml"
+    with pytest.raises(SceneError) as info:
+        load_scene(missing)
+    assert info.value.line() == f"{missing}: scene file not found"
+
+
+def test_scene_file_not_utf8(tmp_path):
+    path = tmp_path / "latin1.toml"
+    path.write_bytes('name = "café"\n'.encode("latin-1"))
+    with pytest.raises(SceneError) as info:
+        load_scene(path)
+    assert info.value.line().startswith(f"{path}: not UTF-8 text")
+
+
+def test_missing_mesh_file(tmp_path):
+    text = '[[objects]]\nmesh = { file = "meshes/missing.obj" }\n'
+    path, line = load_error(tmp_path, text)
+    assert line.startswith(f"{path}: objects[0].mesh.file: mesh file not found: "
+                           f"'meshes/missing.obj' (looked in {(tmp_path / 'meshes').resolve()}")
+
+
+@pytest.mark.parametrize("mesh_text, reason", [
+    ("", "mesh has no triangles"),
+    ("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "mesh has no triangles"),
+    (OBJ_TRIANGLE.replace("v 1 0 0", "v 1 nan 0"),
+     "vertex 1 is not finite (1, nan, 0); 1 of 3 vertices are NaN or Inf"),
+    (OBJ_TRIANGLE.replace("v 1 0 0", "v inf 0 0"),
+     "vertex 1 is not finite (inf, 0, 0); 1 of 3 vertices are NaN or Inf"),
+    (OBJ_TRIANGLE.replace("f 1 2 3", "f 1 2 9"),
+     "line 4: face index 9 out of range (the file has 3 vertices; OBJ indices run from 1 to 3, "
+     "or -1 to -3 counting back)"),
+])
+def test_bad_mesh_file_names_scene_key_and_mesh(tmp_path, mesh_text, reason):
+    mesh = write(tmp_path, "bad.obj", mesh_text)
+    text = OBJECT + '[[objects]]\nname = "thing"\nmesh = { file = "bad.obj" }\n'
+    path, line = load_error(tmp_path, text)
+    assert line == f"{path}: objects[1].mesh.file: {mesh}: {reason}"
+
+
+def test_bad_ply_face_index_through_a_scene(tmp_path):
+    mesh = write(tmp_path, "bad.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                 "property float y\nproperty float z\nelement face 1\n"
+                 "property list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                 "3 0 1 3\n")
+    path, line = load_error(tmp_path, '[[objects]]\nmesh = { file = "bad.ply" }\n')
+    assert line == (f"{path}: objects[0].mesh.file: {mesh}: face 0 has vertex index 3 out of "
+                    f"range (the mesh has 3 vertices, indices 0 to 2)")
+
+
+# --------------------------------------------------------------------------- the command line
+
+CLI_CASES = [
+    ("syntax", "[camera\n", "TOML syntax error at line 1"),
+    ("unknown key", "[camera]\nfovy = 40\n", "camera.fovy: unknown key; did you mean 'fov_y'?"),
+    ("nan", "[camera]\neye = [0, nan, 5]\n", "camera.eye: expected finite numbers, item 1 is nan"),
+    ("eye is look", "[camera]\neye = [0, 0, 0]\n", "camera.look: is the same point as camera.eye"),
+    ("missing mesh", '[[objects]]\nmesh = { file = "nope.obj" }\n',
+     "objects[0].mesh.file: mesh file not found: 'nope.obj'"),
+    ("nan vertex", '[[objects]]\nmesh = { file = "nan.obj" }\n',
+     "objects[0].mesh.file: NANMESH: vertex 0 is not finite (nan, 0, 0)"),
+    ("parent cycle", '[[objects]]\nname = "a"\nparent = "a"\nmesh = { primitive = "cube" }\n',
+     "objects[0].parent: parent cycle: a -> a"),
+]
+
+
+def run_cli(scene_arg: str, out_png: Path) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", "renderer", "render", scene_arg, "-o", str(out_png),
+         "--backend", "reference", "--size", "32x24"],
+        cwd=REPO, capture_output=True, text=True, timeout=120)
+
+
+@pytest.mark.parametrize("text, expected", [case[1:] for case in CLI_CASES],
+                         ids=[case[0] for case in CLI_CASES])
+def test_cli_bad_scene_exits_2_with_one_line(tmp_path, text, expected):
+    nan_mesh = write(tmp_path, "nan.obj", OBJ_TRIANGLE.replace("v 0 0 0", "v nan 0 0"))
+    bad_scene = write(tmp_path, "bad.toml", text)
+    out_png = tmp_path / "out.png"
+    result = run_cli(str(bad_scene), out_png)
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert str(bad_scene) in lines[0]
+    assert expected.replace("NANMESH", str(nan_mesh)) in lines[0]
+    assert not out_png.exists()
+
+
+def test_cli_unknown_scene_name_exits_2_and_lists_builtins(tmp_path):
+    out_png = tmp_path / "out.png"
+    result = run_cli("no_such_scene", out_png)
+    assert result.returncode == 2, result.stderr
+    assert "Traceback" not in result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert "no_such_scene" in lines[0] and "sphere" in lines[0] and "hierarchy" in lines[0]
+    assert not out_png.exists()
+
+
+def test_cli_nan_is_not_rendered_even_when_unused(tmp_path):
+    """A NaN in a light's intensity must stop the render, not produce a black picture."""
+    bad_scene = write(tmp_path, "bad.toml", '[[lights]]\ntype = "point"\nintensity = [1, nan, 1]\n'
+                      + OBJECT)
+    out_png = tmp_path / "out.png"
+    result = run_cli(str(bad_scene), out_png)
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert "lights[0].intensity: expected finite numbers, item 1 is nan" in result.stderr
+    assert not out_png.exists()
+

@@ -1,0 +1,151 @@
+"""renderer/shaders.py: include expansion, #define placement, variants; the glsl/ files' headers."""
+
+import re
+
+import pytest
+
+from renderer.resources import assets_dir, glsl_dir
+from renderer.scene import DirectionalLight, Material, PointLight, Scene
+from renderer.shaders import (ProgramCache, ShaderSourceError, ShaderVariant, program_source,
+                              program_sources, shader_source)
+
+TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geometry.py",
+         "fragment.glsl": "reference/fragment.py", "lighting.glsl": "reference/lighting.py"}
+
+
+def write(folder, files):
+    for name, text in files.items():
+        (folder / name).write_text(text)
+    return folder
+
+
+def code_lines(text):
+    """The lines that are not #line directives (what the author wrote, plus our defines)."""
+    return [line for line in text.splitlines() if not line.startswith("#line")]
+
+
+def test_include_is_replaced_by_the_file(tmp_path):
+    write(tmp_path, {"main.glsl": '// main\n#version 330 core\n#include "lib.glsl"\nvoid main() {}\n',
+                     "lib.glsl": "// lib\nfloat helper() { return 1.0; }\n"})
+    source = shader_source("main.glsl", directory=tmp_path)
+    assert code_lines(source.text) == ["// main", "#version 330 core", "// lib",
+                                       "float helper() { return 1.0; }", "void main() {}"]
+    assert "#include" not in source.text
+    assert [name.rsplit("/", 1)[-1] for name in source.files] == ["main.glsl", "lib.glsl"]
+
+
+def test_line_directives_point_back_at_the_files(tmp_path):
+    write(tmp_path, {"main.glsl": '#version 330 core\n#include "lib.glsl"\nvoid main() {}\n',
+                     "lib.glsl": "float helper() { return 1.0; }\n"})
+    lines = shader_source("main.glsl", directory=tmp_path).text.splitlines()
+    # lib.glsl is source string 1 from its line 1; main.glsl resumes at its line 3.
+    assert lines[lines.index("float helper() { return 1.0; }") - 1] == "#line 1 1"
+    assert lines[lines.index("void main() {}") - 1] == "#line 3 0"
+
+
+def test_nested_and_repeated_includes_expand_once(tmp_path):
+    write(tmp_path, {"main.glsl": '#version 330 core\n#include "a.glsl"\n#include "b.glsl"\n',
+                     "a.glsl": '#include "b.glsl"\nfloat a;\n',
+                     "b.glsl": "float b;\n"})
+    text = shader_source("main.glsl", directory=tmp_path).text
+    assert text.count("float b;") == 1
+    assert text.index("float b;") < text.index("float a;")
+
+
+def test_unknown_include_names_file_line_and_target(tmp_path):
+    write(tmp_path, {"main.glsl": '#version 330 core\n\n#include "missing.glsl"\n'})
+    with pytest.raises(ShaderSourceError) as error:
+        shader_source("main.glsl", directory=tmp_path)
+    message = str(error.value)
+    assert "main.glsl:3" in message and '"missing.glsl"' in message and "no such file" in message
+
+
+def test_include_cycle_is_an_error(tmp_path):
+    write(tmp_path, {"main.glsl": '#version 330 core\n#include "a.glsl"\n',
+                     "a.glsl": '#include "b.glsl"\n', "b.glsl": '#include "a.glsl"\n'})
+    with pytest.raises(ShaderSourceError, match="include cycle"):
+        shader_source("main.glsl", directory=tmp_path)
+
+
+def test_malformed_include_is_an_error(tmp_path):
+    write(tmp_path, {"main.glsl": "#version 330 core\n#include <lib.glsl>\n"})
+    with pytest.raises(ShaderSourceError, match="malformed include"):
+        shader_source("main.glsl", directory=tmp_path)
+
+
+def test_defines_go_right_after_the_version_line(tmp_path):
+    write(tmp_path, {"main.glsl": "// a comment first\n#version 330 core\nvoid main() {}\n"})
+    text = shader_source("main.glsl", {"TWO_SIDED": True, "NUM_POINT_LIGHTS": 2,
+                                       "LINEAR_OUTPUT": False}, directory=tmp_path).text
+    lines = text.splitlines()
+    assert lines[:2] == ["// a comment first", "#version 330 core"]
+    assert set(lines[2:4]) == {"#define TWO_SIDED", "#define NUM_POINT_LIGHTS 2"}
+    assert lines[4] == "#line 3 0"                    # the author's line 3 keeps its number
+    assert "LINEAR_OUTPUT" not in text                # False leaves a flag out
+
+
+def test_missing_version_line_is_an_error(tmp_path):
+    write(tmp_path, {"main.glsl": "void main() {}\n"})
+    with pytest.raises(ShaderSourceError, match="no #version"):
+        shader_source("main.glsl", {"X": 1}, directory=tmp_path)
+
+
+def test_glsl_files_name_their_numpy_twin_and_version():
+    for name, twin in TWINS.items():
+        lines = (glsl_dir() / name).read_text().splitlines()
+        assert lines[0] == f"// Twin: {twin}", name
+        if name != "lighting.glsl":                   # the include has no #version of its own
+            assert re.fullmatch(r"#version (330|4[0-6]0) core", lines[1]), name
+
+
+def test_real_sources_expand_the_lighting_include():
+    variant = ShaderVariant("phong", two_sided=True, num_directional_lights=2, num_point_lights=0)
+    sources = program_sources(variant)
+    assert set(sources) == {"vertex_shader", "fragment_shader"}    # no geometry stage
+    fragment = sources["fragment_shader"].text
+    assert "vec3 shade(vec3 P, vec3 N)" in fragment and "#include" not in fragment
+    assert "#define NUM_DIRECTIONAL_LIGHTS 2" in fragment and "#define TWO_SIDED" in fragment
+
+
+def test_only_flat_links_a_geometry_shader():
+    assert "geometry_shader" in program_sources(ShaderVariant("flat"))
+    for shading in ("gouraud", "phong"):
+        assert "geometry_shader" not in program_sources(ShaderVariant(shading))
+
+
+def test_variant_from_scene_and_program_source():
+    scene = Scene(directional_lights=[DirectionalLight()], point_lights=[PointLight(), PointLight()])
+    material = Material(shading="gouraud", two_sided=True)
+    variant = ShaderVariant.for_material(scene, material)
+    assert variant == ShaderVariant("gouraud", True, 1, 2, False)
+    vertex, geometry, fragment = program_source(scene, material)
+    assert geometry is None and "#define SHADING_GOURAUD" in vertex and "#define NUM_POINT_LIGHTS 2" in fragment
+
+
+def test_unknown_shading_mode_is_rejected():
+    with pytest.raises(ValueError, match="shading"):
+        ShaderVariant("toon")
+
+
+def test_every_variant_compiles_and_is_cached(gl_contexts):
+    from renderer.context import activate
+    ctx = gl_contexts["egl"]
+    activate(ctx)
+    cache = ProgramCache(ctx)
+    try:
+        for shading in ("flat", "gouraud", "phong"):
+            for two_sided in (False, True):
+                for lights in ((0, 0), (1, 0), (0, 2), (3, 1)):
+                    for linear in (False, True):
+                        variant = ShaderVariant(shading, two_sided, *lights, linear)
+                        program = cache.get(variant)
+                        assert cache.get(variant) is program
+                        assert bool(program.geometry_vertices) == (shading == "flat")
+        assert len(cache) == 3 * 2 * 4 * 2
+    finally:
+        cache.release()
+
+
+def test_resource_folders_are_found():
+    assert (glsl_dir() / "vertex.glsl").is_file()
+    assert assets_dir().is_dir() and assets_dir().name == "assets"

@@ -93,6 +93,25 @@ def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
     return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])
 
 
+def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int) -> str:
+    """Re-specify moderngl's 24-bit depth renderbuffer as DEPTH_COMPONENT32F where GL lets
+    us; returns the format in use."""
+    c_uint, c_int = ctypes.c_uint, ctypes.c_int
+    bind = gl_function(ctx, "glBindRenderbuffer", None, c_uint, c_uint)
+    storage = gl_function(ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
+    query = gl_function(ctx, "glGetRenderbufferParameteriv", None, c_uint, c_uint,
+                        ctypes.POINTER(c_int))
+    if bind is None or storage is None or query is None:
+        return "DEPTH_COMPONENT24"
+    value = c_int(0)
+    bind(GL_RENDERBUFFER, renderbuffer.glo)
+    storage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height)
+    ctx.error                                               # clear any error it raised
+    query(GL_RENDERBUFFER, GL_RENDERBUFFER_INTERNAL_FORMAT, ctypes.byref(value))
+    bind(GL_RENDERBUFFER, 0)
+    return DEPTH_FORMAT_NAMES.get(value.value, hex(value.value))
+
+
 @dataclass
 class _ObjectBuffers:
     """GL objects of one scene object: its mesh on the GPU and its vertex arrays per variant."""
@@ -130,6 +149,7 @@ class GpuRenderer:
         self._renderbuffers: list = []
         self._framebuffers: dict[bool, moderngl.Framebuffer] = {}
         self._plans: dict[bool, list[_Draw]] = {}
+        self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
         try:
             activate(self.ctx)
             self._check_size()
@@ -152,31 +172,9 @@ class GpuRenderer:
         size = (self.width, self.height)
         self._color = self.ctx.renderbuffer(size, 4)                       # RGBA8
         self._depth = self.ctx.depth_renderbuffer(size)
-        self.depth_format = self._make_float_depth(self._depth)
+        self.depth_format = make_float_depth(self.ctx, self._depth, self.width, self.height)
         self._renderbuffers += [self._color, self._depth]
         self._framebuffers[False] = self.ctx.framebuffer([self._color], self._depth)
-        # Read-back staging, bottom row first as GL returns it.
-        self._rgba_staging = np.empty((self.height, self.width, 4), np.uint8)
-        self._depth_staging = np.empty((self.height, self.width), np.float32)
-        self._linear_staging = None
-
-    def _make_float_depth(self, renderbuffer) -> str:
-        """Re-specify moderngl's 24-bit depth renderbuffer as DEPTH_COMPONENT32F where GL lets
-        us; returns the format in use."""
-        c_uint, c_int = ctypes.c_uint, ctypes.c_int
-        bind = gl_function(self.ctx, "glBindRenderbuffer", None, c_uint, c_uint)
-        storage = gl_function(self.ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
-        query = gl_function(self.ctx, "glGetRenderbufferParameteriv", None, c_uint, c_uint,
-                            ctypes.POINTER(c_int))
-        if bind is None or storage is None or query is None:
-            return "DEPTH_COMPONENT24"
-        value = c_int(0)
-        bind(GL_RENDERBUFFER, renderbuffer.glo)
-        storage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, self.width, self.height)
-        self.ctx.error                                          # clear any error it raised
-        query(GL_RENDERBUFFER, GL_RENDERBUFFER_INTERNAL_FORMAT, ctypes.byref(value))
-        bind(GL_RENDERBUFFER, 0)
-        return DEPTH_FORMAT_NAMES.get(value.value, hex(value.value))
 
     def _linear_framebuffer(self) -> moderngl.Framebuffer:
         fbo = self._framebuffers.get(True)
@@ -184,7 +182,6 @@ class GpuRenderer:
             linear = self.ctx.renderbuffer((self.width, self.height), 4, dtype="f4")  # RGBA32F
             self._renderbuffers.append(linear)
             fbo = self._framebuffers[True] = self.ctx.framebuffer([self._color, linear], self._depth)
-            self._linear_staging = np.empty((self.height, self.width, 4), np.float32)
         return fbo
 
     def _build_objects(self) -> None:
@@ -244,7 +241,7 @@ class GpuRenderer:
         self._frame_uniforms = frame_uniform_values(scene, matrices)
         for item, object_matrices in zip(self._objects, matrices.objects):
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
-        self._depth_from_window = _depth_conversion(matrices.projection)
+        self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width))
         self._plans.clear()
 
     def _plan(self, linear: bool) -> list[_Draw]:
@@ -273,8 +270,14 @@ class GpuRenderer:
         return plan
 
     # -- rendering ---------------------------------------------------------------------------
-    def render(self, *, linear: bool = False, depth: bool = True) -> Frame:
-        """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked."""
+    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None) -> Frame:
+        """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked.
+
+        Each frame's arrays are new unless `out` names an earlier frame of this renderer:
+        then they are written into that frame's arrays, which a loop over many frames (a
+        viewer, a batch, a benchmark) can reuse to skip allocating (and page-faulting in)
+        a few megabytes per frame.
+        """
         if self._released:
             raise RuntimeError("this GpuRenderer was released")
         start = time.perf_counter()
@@ -298,16 +301,26 @@ class GpuRenderer:
                 uniform.write(data)
             draw.vertex_array.render(moderngl.TRIANGLES)
 
-        fbo.read_into(self._rgba_staging, components=4, attachment=0, alignment=1, dtype="f1")
-        rgba8 = self._rgba_staging[::-1].copy()                    # row 0 at the top
+        # GL returns rows bottom-up: read into staging arrays made once, then write each
+        # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
+        reuse = (out.rgba8, out.linear, out.depth) if out is not None else (None, None, None)
+        rgba8 = _flip_into(self._read(fbo, 0, np.uint8), reuse[0])
         linear_color = depth_map = None
         if linear:
-            fbo.read_into(self._linear_staging, components=4, attachment=1, alignment=1, dtype="f4")
-            linear_color = self._linear_staging[::-1].copy()
+            linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
         if depth:
-            fbo.read_into(self._depth_staging, components=1, attachment=-1, alignment=1, dtype="f4")
-            depth_map = self._depth_from_window(self._depth_staging[::-1])
+            depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
         return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0)
+
+    def _read(self, fbo, attachment: int, dtype) -> np.ndarray:
+        """The attachment's pixels, bottom row first, in a staging array reused every frame."""
+        out = self._staging.get(attachment)
+        if out is None:
+            shape = (self.height, self.width) + ((4,) if attachment >= 0 else ())
+            out = self._staging[attachment] = np.empty(shape, dtype)
+        fbo.read_into(out, components=4 if attachment >= 0 else 1, attachment=attachment,
+                      alignment=1, dtype="f1" if dtype is np.uint8 else "f4")
+        return out
 
     # -- information -------------------------------------------------------------------------
     @property
@@ -369,9 +382,26 @@ class GpuRenderer:
         return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
 
 
-def _depth_conversion(projection: np.ndarray):
-    """A function from window depth z_w (bottom-up rows, float32) to -z_eye (float32, +inf
-    where z_w == 1, the cleared value), for the projection matrix P of the frame.
+def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:
+    """`out` if it can take a result shaped and typed like `like`, else None (a new array)."""
+    if out is not None and out.shape == like.shape and out.dtype == like.dtype and out.flags.c_contiguous:
+        return out
+    return None
+
+
+def _flip_into(bottom_up: np.ndarray, out: np.ndarray | None) -> np.ndarray:
+    """Rows reversed (row 0 at the top), written into `out` when usable, else a new array."""
+    target = _usable(out, bottom_up)
+    if target is None:
+        return bottom_up[::-1].copy()
+    np.copyto(target, bottom_up[::-1])
+    return target
+
+
+def _depth_conversion(projection: np.ndarray, shape: tuple[int, int]):
+    """A function from window depth z_w (float32, any strides) to a C-contiguous array of
+    -z_eye (+inf where z_w == 1, the cleared value), for the projection matrix P of the frame;
+    the array is new unless a usable `out` is passed.
 
     z_ndc = 2 z_w - 1. Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye, so
     -z_eye = P23 / (P22 + z_ndc) = a / (z_w + b) with a = P23 / 2, b = (P22 - 1) / 2.
@@ -380,6 +410,7 @@ def _depth_conversion(projection: np.ndarray):
     (the head's sum with z_w is exact there, Sterbenz), giving float64-like accuracy in float32.
     """
     p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    mask = np.empty(shape, dtype=bool)                     # reused: no allocation per frame
     perspective = projection[3, 2] == -1.0 and projection[3, 3] == 0.0
     if perspective:
         a = np.float32(p23 / 2.0)
@@ -387,19 +418,19 @@ def _depth_conversion(projection: np.ndarray):
         b_head = np.float32(b)
         b_tail = np.float32(b - float(b_head))
 
-        def convert(window_depth: np.ndarray) -> np.ndarray:
-            out = np.add(window_depth, b_head)           # a new C-contiguous array
+        def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+            out = np.add(window_depth, b_head, out=_usable(out, window_depth))
             out += b_tail
             np.divide(a, out, out=out)
-            np.copyto(out, np.inf, where=window_depth == 1.0)
+            np.copyto(out, np.inf, where=np.equal(window_depth, 1.0, out=mask))
             return out
     else:
         s = np.float32(-2.0 / p22)
         t = np.float32((p23 + 1.0) / p22)
 
-        def convert(window_depth: np.ndarray) -> np.ndarray:
-            out = np.multiply(window_depth, s)
+        def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+            out = np.multiply(window_depth, s, out=_usable(out, window_depth))
             out += t
-            np.copyto(out, np.inf, where=window_depth == 1.0)
+            np.copyto(out, np.inf, where=np.equal(window_depth, 1.0, out=mask))
             return out
     return convert

@@ -234,3 +234,15 @@ def test_renderer_made_without_a_context_owns_one():
         assert gpu.gl_info["context"] == "osmesa"
         assert (gpu.render().rgba8[..., 3] == 255).any()
     assert gpu.ctx.mglo.__class__.__name__ == "InvalidObject"     # released with the renderer
+
+
+def test_render_into_an_earlier_frame_reuses_its_arrays(gl_contexts):
+    with GpuRenderer(sphere_scene(), 48, 32, context=gl_contexts["egl"]) as gpu:
+        first = gpu.render(linear=True)
+        kept = first.rgba8.copy(), first.linear.copy(), first.depth.copy()
+        second = gpu.render(linear=True, out=first)
+        assert second.rgba8 is first.rgba8 and second.linear is first.linear and second.depth is first.depth
+        for a, b in zip(kept, (second.rgba8, second.linear, second.depth)):
+            assert np.array_equal(a, b)
+        third = gpu.render()                                # without out: new arrays
+        assert third.rgba8 is not first.rgba8 and np.array_equal(third.rgba8, kept[0])

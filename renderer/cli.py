@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import statistics
 import sys
 import time
@@ -133,6 +134,9 @@ def main(argv=None) -> int:
     except UserError as error:
         print(f"renderer: {error.line()}", file=sys.stderr)
         return 2
+    except BrokenPipeError:              # `renderer scenes | head`: the reader left, not an error
+        sys.stdout = open(os.devnull, "w")
+        return 0
 
 
 if __name__ == "__main__":

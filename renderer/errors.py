@@ -6,6 +6,8 @@ else is a bug and keeps its traceback.
 
 from __future__ import annotations
 
+import math
+
 
 class UserError(Exception):
     """A mistake in the user's input (a scene file, a mesh, an option), not a bug."""
@@ -25,3 +27,12 @@ class SceneError(UserError):
 
 class ContextError(UserError):
     """No GL context could be made (missing system packages, no display)."""
+
+
+def show_number(x: float) -> str:
+    """A number as a message shows it: short, and nan / inf / -inf spelled as TOML does."""
+    if math.isnan(x):
+        return "nan"
+    if math.isinf(x):
+        return "inf" if x > 0 else "-inf"
+    return f"{x:g}"

@@ -17,13 +17,12 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import math
 from pathlib import Path
 
 import numpy as np
 import trimesh
 
-from renderer.errors import SceneError
+from renderer.errors import SceneError, show_number
 from renderer.scene import Mesh
 
 # Suffixes we hand to trimesh; the first three are the ones the tests cover.
@@ -147,7 +146,7 @@ def _check_geometry(positions: np.ndarray, faces: np.ndarray) -> None:
     bad = ~np.isfinite(positions).all(axis=1)
     if bad.any():
         i = int(np.argmax(bad))
-        shown = ", ".join(_format_number(x) for x in positions[i])
+        shown = ", ".join(show_number(x) for x in positions[i])
         raise _MeshProblem(f"vertex {i} is not finite ({shown}); "
                            f"{int(bad.sum())} of {len(positions)} vertices are NaN or Inf")
     out = (faces < 0) | (faces >= len(positions))
@@ -220,9 +219,3 @@ def _unit_or_fallback(vectors: np.ndarray, fallback: np.ndarray) -> np.ndarray:
     return np.where(ok, unit, fallback).astype(np.float64)
 
 
-def _format_number(x: float) -> str:
-    if math.isnan(x):
-        return "nan"
-    if math.isinf(x):
-        return "inf" if x > 0 else "-inf"
-    return f"{x:g}"

@@ -24,7 +24,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer import transforms
-from renderer.errors import SceneError
+from renderer.errors import SceneError, show_number
 from renderer.meshio import load_mesh
 from renderer.primitives import PRIMITIVES
 from renderer.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
@@ -123,7 +123,7 @@ def describe_value(value: Any) -> str:
     if isinstance(value, numbers.Integral):
         return f"an integer ({value})"
     if isinstance(value, numbers.Real):
-        return f"a number ({_show_number(float(value))})"
+        return f"a number ({show_number(float(value))})"
     if isinstance(value, str):
         shown = value if len(value) <= 30 else value[:27] + "..."
         return f"a string ({shown!r})"
@@ -134,16 +134,10 @@ def describe_value(value: Any) -> str:
     return f"a {type(value).__name__} ({value})"
 
 
-def _show_number(x: float) -> str:
-    if math.isnan(x):
-        return "nan"
-    if math.isinf(x):
-        return "inf" if x > 0 else "-inf"
-    return f"{x:g}"
 
 
 def _show_vec(v) -> str:
-    return "[" + ", ".join(_show_number(float(x)) for x in v) + "]"
+    return "[" + ", ".join(show_number(float(x)) for x in v) + "]"
 
 
 def _is_number(value: Any) -> bool:
@@ -219,7 +213,7 @@ class _Reader:
             self.fail(path, f"expected a number, got {describe_value(value)}")
         x = self.to_float(value, path)
         if not math.isfinite(x):
-            self.fail(path, f"expected a finite number, got {_show_number(x)}")
+            self.fail(path, f"expected a finite number, got {show_number(x)}")
         if minimum is not None and x < minimum:
             self.fail(path, f"must be >= {minimum:g}, got {x:g}")
         if above is not None and x <= above:
@@ -249,10 +243,10 @@ class _Reader:
                 self.fail(path, f"expected {expected}, item {i} is {describe_value(item)}")
             x = self.to_float(item, path)
             if not math.isfinite(x):
-                self.fail(path, f"expected finite numbers, item {i} is {_show_number(x)}")
+                self.fail(path, f"expected finite numbers, item {i} is {show_number(x)}")
             if minimum is not None and x < minimum:
                 self.fail(path, f"must be >= {minimum:g} in every component, "
-                                f"item {i} is {_show_number(x)}")
+                                f"item {i} is {show_number(x)}")
             components.append(x)
         return tuple(components)
 

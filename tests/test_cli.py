@@ -60,3 +60,13 @@ def test_unknown_scene_names_the_built_in_ones(tmp_path):
     result = run("render", "no_such_scene", "-o", str(tmp_path / "x.png"))
     assert result.returncode == 2
     assert "sphere" in result.stderr and "Traceback" not in result.stderr
+
+
+def test_written_files_get_the_usual_permissions(tmp_path):
+    import os
+    out = tmp_path / "p.png"
+    assert run("render", "--size", "16x12", "--backend", "reference", "-o", str(out)).returncode == 0
+    mask = os.umask(0)
+    os.umask(mask)
+    assert out.stat().st_mode & 0o777 == 0o666 & ~mask
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]     # no temporary left

@@ -656,3 +656,19 @@ def test_cli_nan_is_not_rendered_even_when_unused(tmp_path):
     assert "lights[0].intensity: expected finite numbers, item 1 is nan" in result.stderr
     assert not out_png.exists()
 
+
+
+@pytest.mark.parametrize("text, expected", [case[1:] for case in BAD_SCENES],
+                         ids=[case[0] for case in BAD_SCENES])
+def test_every_bad_scene_through_the_command_line(tmp_path, capsys, text, expected):
+    """Every case above, through `renderer render` in-process (the subprocess tests above
+    show that `python -m renderer` exits with what main() returns)."""
+    from renderer.cli import main
+    bad_scene = write(tmp_path, "bad.toml", text)
+    out_png = tmp_path / "out.png"
+    status = main(["render", str(bad_scene), "-o", str(out_png), "--backend", "reference",
+                   "--size", "32x24"])
+    stderr = capsys.readouterr().err
+    assert status == 2
+    assert stderr.splitlines() == [f"renderer: {bad_scene}: {expected}"]
+    assert list(tmp_path.iterdir()) == [bad_scene]           # nothing written, not even a temporary

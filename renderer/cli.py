@@ -75,7 +75,8 @@ def _render_gpu(scene, size, context_kind, frames=1):
         for _ in range(frames):
             frame = gpu.render(depth=True)
             timings.append(frame.milliseconds)
-        return frame, statistics.median(timings), gpu
+        # Read while the context is alive: afterwards it no longer knows its kind.
+        return frame, statistics.median(timings), gpu.gl_info, gpu.subpixel_bits
 
 
 def cmd_render(args) -> int:
@@ -83,7 +84,7 @@ def cmd_render(args) -> int:
     scene = _load(args.scene)
     output = args.output or Path(f"{scene.name}.png")
     if args.backend == "gpu":
-        frame, _, _ = _render_gpu(scene, args.size, args.context)
+        frame = _render_gpu(scene, args.size, args.context)[0]
     else:
         import reference
         frame = reference.render(scene, *args.size)
@@ -100,9 +101,9 @@ def cmd_compare(args) -> int:
     from renderer.imageio import write_png
     scene = _load(args.scene)
     # Median of a few frames: the first one pays for shader compilation.
-    gpu_frame, gpu_ms, gpu = _render_gpu(scene, args.size, args.context, frames=3)
+    gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
     start = time.perf_counter()
-    ref_frame = reference.render(scene, *args.size, subpixel_bits=gpu.subpixel_bits)
+    ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
     reference_ms = (time.perf_counter() - start) * 1000.0
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
                             threshold=args.threshold)
@@ -112,7 +113,7 @@ def cmd_compare(args) -> int:
     write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold))
     figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
                "gpu_ms": gpu_ms, "reference_ms": reference_ms,
-               "gl_renderer": gpu.gl_info.get("GL_RENDERER"), "context": gpu.gl_info.get("context")}
+               "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
     print(json.dumps(figures, allow_nan=True))
     return 0
 

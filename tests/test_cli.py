@@ -38,6 +38,7 @@ def test_compare_prints_the_figures_and_writes_three_images(tmp_path):
                 "mismatched_fraction", "depth_max_rel", "gpu_ms", "reference_ms"):
         assert key in figures
     assert figures["mismatched_pixels"] == 0
+    assert figures["context"] == "osmesa" and "llvmpipe" in figures["gl_renderer"]
     for name in ("gpu.png", "reference.png", "diff.png"):
         assert read_png(tmp_path / name).shape[:2] == (60, 80)
 

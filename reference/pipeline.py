@@ -4,6 +4,8 @@ The reference draw, stage by stage as dEQP's drawBasicPrimitives reads: for each
 scene order, vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping
 -> viewport transform and snapping -> facing and culling -> rasterisation -> depth test;
 then fragment shading for the one surviving fragment per pixel, and output conversion.
+Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
+docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 
 Input:  a `renderer.scene.Scene` and the image size. Output: a `renderer.frame.Frame`
 (rgba8 (H, W, 4) uint8 row 0 at the top, optional linear (H, W, 4) float32, depth (H, W)
@@ -75,19 +77,32 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
                                    first_order, width, height, subpixel_bits, dtype))
         first_order += len(obj.mesh.faces)
 
-    color = np.zeros((width * height, 4), dtype=dtype)
-    view_depth = np.full(width * height, np.inf, dtype=dtype)
     drawn = depth_buffer.drawn
+    color, view_depth = shade_surviving(objects, depth_buffer.payload, drawn, lights, eye, dtype)
+    frame = compose_frame(color, drawn, view_depth if depth else None, scene.background,
+                          width, height, linear=linear)
+    # Where two surfaces are closer in depth than GL can order, the other one may show: its
+    # colour goes beside the winner's, for comparisons to accept either (renderer/compare.py).
+    ties = depth_buffer.depth_ties()
+    if ties.any():
+        other, _ = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype)
+        frame.rgba8_tie = compose_frame(np.where(ties[:, None], other, color), drawn, None,
+                                        scene.background, width, height, linear=False).rgba8
+    frame.milliseconds = (time.perf_counter() - start) * 1000.0
+    return frame
+
+
+def shade_surviving(objects: list[ObjectVaryings], payload: dict, pixels_mask: np.ndarray,
+                    lights: Lights, eye, dtype) -> tuple[np.ndarray, np.ndarray]:
+    """Fragment stage for the fragments `payload` names at the pixels of `pixels_mask`:
+    (colour (H*W, 4), view depth (H*W,)), zero elsewhere."""
+    color = np.zeros((len(pixels_mask), 4), dtype=dtype)
+    view_depth = np.full(len(pixels_mask), np.inf, dtype=dtype)
     for index, varyings in enumerate(objects):
-        pixels = np.flatnonzero(drawn & (depth_buffer.payload.get("object", -1) == index))
+        pixels = np.flatnonzero(pixels_mask & (payload.get("object", -1) == index))
         if len(pixels) == 0:
             continue
-        out_color, out_view_depth = shade_fragments(
-            varyings, depth_buffer.payload["triangle"][pixels], depth_buffer.payload["weights"][pixels],
-            depth_buffer.payload["gl_FrontFacing"][pixels], lights, eye)
-        color[pixels] = out_color
-        view_depth[pixels] = out_view_depth
-
-    return compose_frame(color, drawn, view_depth if depth else None, scene.background,
-                         width, height, linear=linear,
-                         milliseconds=(time.perf_counter() - start) * 1000.0)
+        color[pixels], view_depth[pixels] = shade_fragments(
+            varyings, payload["triangle"][pixels], payload["weights"][pixels],
+            payload["gl_FrontFacing"][pixels], lights, eye)
+    return color, view_depth

@@ -97,7 +97,7 @@ def cmd_render(args) -> int:
 
 def cmd_compare(args) -> int:
     import reference
-    from renderer.compare import compare_frames, heat_map
+    from renderer.compare import compare_frames, depth_tie_pixels, heat_map
     from renderer.imageio import write_png
     scene = _load(args.scene)
     # Median of a few frames: the first one pays for shader compilation.
@@ -106,13 +106,14 @@ def cmd_compare(args) -> int:
     ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
     reference_ms = (time.perf_counter() - start) * 1000.0
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
-                            threshold=args.threshold)
+                            threshold=args.threshold, reference_tie=ref_frame.rgba8_tie)
     out = args.out or Path(f"compare-{scene.name}")
     write_png(out / "gpu.png", gpu_frame.rgba8)
     write_png(out / "reference.png", ref_frame.rgba8)
-    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold))
+    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold,
+                                         reference_tie=ref_frame.rgba8_tie))
     figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
-               "gpu_ms": gpu_ms, "reference_ms": reference_ms,
+               "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
     print(json.dumps(figures, allow_nan=True))
     return 0

@@ -44,15 +44,29 @@ def _matches_nearby(a: np.ndarray, b: np.ndarray, threshold: int, deviation: int
 
 def position_deviation_mismatch(result: np.ndarray, reference: np.ndarray,
                                 threshold: int = DEFAULT_THRESHOLD,
-                                deviation: int = DEFAULT_DEVIATION) -> np.ndarray:
-    """(H, W) bool mask of pixels that fail the dEQP compare in either direction."""
-    return ~(_matches_nearby(result, reference, threshold, deviation)
-             & _matches_nearby(reference, result, threshold, deviation))
+                                deviation: int = DEFAULT_DEVIATION,
+                                reference_tie: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) bool mask of pixels that fail the dEQP compare in either direction.
+
+    `reference_tie` (the reference frame's rgba8_tie) is a second acceptable reference: at
+    a depth tie either surface may show, so a pixel matching either one matches.
+    """
+    result_ok = _matches_nearby(result, reference, threshold, deviation)
+    reference_ok = _matches_nearby(reference, result, threshold, deviation)
+    if reference_tie is not None:
+        result_ok |= _matches_nearby(result, reference_tie, threshold, deviation)
+        reference_ok |= _matches_nearby(reference_tie, result, threshold, deviation)
+    return ~(result_ok & reference_ok)
 
 
-def raw_mismatch(result: np.ndarray, reference: np.ndarray, threshold: int = DEFAULT_THRESHOLD) -> np.ndarray:
-    """(H, W) bool mask of pixels with any channel off by more than the threshold."""
-    return np.abs(result.astype(np.int16) - reference.astype(np.int16)).max(axis=-1) > threshold
+def raw_mismatch(result: np.ndarray, reference: np.ndarray, threshold: int = DEFAULT_THRESHOLD,
+                 reference_tie: np.ndarray | None = None) -> np.ndarray:
+    """(H, W) bool mask of pixels with any channel off by more than the threshold (from
+    both the reference and, if given, its depth-tie alternative)."""
+    off = np.abs(result.astype(np.int16) - reference.astype(np.int16)).max(axis=-1) > threshold
+    if reference_tie is not None:
+        off &= np.abs(result.astype(np.int16) - reference_tie.astype(np.int16)).max(axis=-1) > threshold
+    return off
 
 
 def _depth_rel_nearby(a: np.ndarray, b: np.ndarray, deviation: int) -> np.ndarray:
@@ -81,6 +95,12 @@ def depth_max_rel(result: np.ndarray, reference: np.ndarray, deviation: int = DE
     return float(worst)
 
 
+def depth_tie_pixels(reference_frame) -> int:
+    """Pixels where the reference accepts another colour because of a depth tie."""
+    tie = reference_frame.rgba8_tie
+    return 0 if tie is None else int((tie != reference_frame.rgba8).any(axis=-1).sum())
+
+
 @dataclass
 class Comparison:
     max_abs: int                  # largest channel difference, 0..255 (RGB)
@@ -101,14 +121,23 @@ class Comparison:
 
 def compare_frames(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
                    result_depth: np.ndarray | None = None, reference_depth: np.ndarray | None = None,
-                   threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION) -> Comparison:
+                   threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION,
+                   reference_tie: np.ndarray | None = None) -> Comparison:
+    """The figures of `renderer compare`. `reference_tie`: the reference frame's rgba8_tie,
+    accepted wherever it differs (pixels at a depth tie); max_abs and the like measure
+    against the nearer of the two there."""
     if result_rgba8.shape != reference_rgba8.shape:
         raise ValueError(f"image sizes differ: {result_rgba8.shape} and {reference_rgba8.shape}")
     diff = np.abs(result_rgba8[..., :3].astype(np.int16) - reference_rgba8[..., :3].astype(np.int16))
+    if reference_tie is not None:
+        tie_diff = np.abs(result_rgba8[..., :3].astype(np.int16) - reference_tie[..., :3].astype(np.int16))
+        closer = tie_diff.max(axis=-1) < diff.max(axis=-1)
+        diff[closer] = tie_diff[closer]
     total = result_rgba8.shape[0] * result_rgba8.shape[1]
     rmse = float(np.sqrt(np.mean(diff.astype(np.float64) ** 2)))
-    raw = int(raw_mismatch(result_rgba8, reference_rgba8, threshold).sum())
-    deq = int(position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation).sum())
+    raw = int(raw_mismatch(result_rgba8, reference_rgba8, threshold, reference_tie).sum())
+    deq = int(position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation,
+                                          reference_tie).sum())
     depth = None
     if result_depth is not None and reference_depth is not None:
         depth = depth_max_rel(result_depth, reference_depth, deviation)
@@ -128,14 +157,18 @@ _MISMATCH_COLOUR = (255, 0, 255)
 
 
 def heat_map(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
-             threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION) -> np.ndarray:
+             threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION,
+             reference_tie: np.ndarray | None = None) -> np.ndarray:
     """(H, W, 3) uint8 amplified difference: the ramp reaches white at 8 levels of 255, and
     pixels that fail the position-deviation compare are magenta."""
     diff = np.abs(result_rgba8.astype(np.int16) - reference_rgba8.astype(np.int16)).max(axis=-1)
+    if reference_tie is not None:
+        diff = np.minimum(diff, np.abs(result_rgba8.astype(np.int16) - reference_tie.astype(np.int16)).max(axis=-1))
     t = np.clip(diff / _RAMP_FULL_SCALE, 0.0, 1.0) * (len(_RAMP) - 1)
     lo = np.floor(t).astype(int)
     hi = np.minimum(lo + 1, len(_RAMP) - 1)
     frac = (t - lo)[..., None]
     image = _RAMP[lo] * (1 - frac) + _RAMP[hi] * frac
-    image[position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation)] = _MISMATCH_COLOUR
+    image[position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation,
+                                      reference_tie)] = _MISMATCH_COLOUR
     return image.round().astype(np.uint8)

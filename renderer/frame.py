@@ -17,11 +17,20 @@ class Frame:
     depth:  (H, W) float32 camera-space distance along the viewing axis in scene units,
             +inf where nothing was drawn, or None if not asked for.
     milliseconds: wall time of the render call that produced it.
+    rgba8_tie: from the reference only, where some pixels' two nearest surfaces are closer in
+            window depth than GL's float32 arithmetic can order (reference/depth_test.py,
+            DEPTH_TIE_TOLERANCE): rgba8 with those pixels showing the other surface. GL may
+            draw either, so comparisons accept either. None when there is no such pixel.
+    gl_info: for a GPU frame, the GL implementation that drew it (GpuRenderer.gl_info:
+            GL_VENDOR, GL_RENDERER, GL_VERSION, context, depth_format); None from the
+            reference. Golden tests record it beside each golden.
     """
     rgba8: np.ndarray
     linear: np.ndarray | None = None
     depth: np.ndarray | None = None
     milliseconds: float = 0.0
+    rgba8_tie: np.ndarray | None = None
+    gl_info: dict | None = None
 
     @property
     def size(self) -> tuple[int, int]:

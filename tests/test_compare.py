@@ -73,3 +73,23 @@ def test_heat_map_marks_failing_pixels_magenta():
     image = heat_map(a, b)
     assert image.shape == (8, 8, 3) and tuple(image[4, 4]) == (255, 0, 255)
     assert tuple(image[0, 0]) == (0, 0, 0)
+
+
+def test_a_depth_tie_accepts_either_surface_and_nothing_else():
+    """Where the reference's rgba8_tie differs (two surfaces closer than GL can order), a
+    pixel matching either colour passes; a third colour still fails, and so does the tie
+    colour anywhere the reference has no tie."""
+    reference, tie = blank(value=40), blank(value=40)
+    tie[4, 4] = (200, 10, 10, 255)
+    result = reference.copy()
+    result[4, 4] = (200, 10, 10, 255)                   # the other surface won
+    assert position_deviation_mismatch(result, reference).sum() == 1
+    assert position_deviation_mismatch(result, reference, reference_tie=tie).sum() == 0
+    figures = compare_frames(result, reference, reference_tie=tie)
+    assert figures.mismatched_pixels == 0 and figures.raw_mismatched_pixels == 0 and figures.max_abs == 0
+    result[4, 4] = (10, 200, 10, 255)                    # neither surface
+    assert compare_frames(result, reference, reference_tie=tie).mismatched_pixels == 1
+    result[4, 4] = reference[4, 4]
+    result[1, 1] = (200, 10, 10, 255)                    # the tie's colour where there is no tie
+    assert compare_frames(result, reference, reference_tie=tie).mismatched_pixels == 1
+    assert not heat_map(reference, reference, reference_tie=tie).any()

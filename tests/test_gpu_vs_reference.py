@@ -36,7 +36,8 @@ def test_gpu_matches_reference(name, size, context_kind, gl_contexts):
     with GpuRenderer(scene_named(name), *size, context=gl_contexts[context_kind]) as gpu:
         frame = gpu.render(depth=True)
         expected = reference_frame(name, size, gpu.subpixel_bits)
-    result = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth)
+    result = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
+                            reference_tie=expected.rgba8_tie)
     figures = result.as_dict()
     assert result.mismatched_pixels == 0, figures
     assert result.raw_mismatched_fraction <= RAW_MISMATCH_LIMIT, figures

@@ -15,7 +15,7 @@ import pytest
 
 from reference import render
 from reference.clipping import clip_triangles
-from reference.depth_test import DepthBuffer
+from reference.depth_test import DEPTH_TIE_TOLERANCE, DepthBuffer
 from reference.fragment import interpolate
 from reference.output import to_unorm8
 from reference.rasterizer import is_drawn, rasterize, setup_triangles
@@ -236,6 +236,37 @@ def test_depth_buffer_keeps_nearest_and_first_of_ties():
     assert depth.payload["tag"][0] == 10
     depth.test_and_write(np.array([0]), np.array([0.4]), np.array([3]), tag=np.array([30]))
     assert depth.payload["tag"][0] == 30 and depth.z[0] == 0.4
+
+
+def test_depth_buffer_keeps_the_runner_up_and_flags_depth_ties():
+    """Per pixel the nearest losing fragment is kept too, across batches; a pixel is a depth
+    tie when it lies within DEPTH_TIE_TOLERANCE (4 float32 units at 1.0) of the winner.
+    Pixel 0: 0.5 wins, 0.5 + 1e-7 is runner-up (a tie). Pixel 1: 0.5 beats 0.6 (no tie).
+    Pixel 2: a lone fragment has no runner-up; the clear value is never one."""
+    depth = DepthBuffer(3, 1)
+    depth.test_and_write(np.array([0, 1, 2]), np.array([0.5 + 1e-7, 0.6, 0.3]),
+                         np.array([0, 1, 2]), tag=np.array([10, 11, 12]))
+    depth.test_and_write(np.array([0, 0, 1]), np.array([0.7, 0.5, 0.5]),
+                         np.array([3, 4, 5]), tag=np.array([20, 21, 22]))
+    assert list(depth.payload["tag"]) == [21, 22, 12]
+    assert list(depth.payload_second["tag"][:2]) == [10, 11]
+    assert list(depth.order_second) == [0, 1, -1]
+    assert list(depth.depth_ties()) == [True, False, False]
+    assert DEPTH_TIE_TOLERANCE == 4 * 2.0 ** -23
+    assert not depth.depth_ties(tolerance=0.5e-7)[0]
+
+
+def test_reference_offers_the_other_surface_where_two_meet_within_depth_precision():
+    """Two coincident planes: GL may show either, so the reference's rgba8_tie shows the
+    second drawn where rgba8 shows the first (which GL_LESS keeps on an exact tie)."""
+    red, blue = (1, 0, 0), (0, 0, 1)
+    frame = render(Scene(objects=[facing_plane("first", red, 4), facing_plane("second", blue, 4)],
+                         ambient=(1, 1, 1)), 16, 16)
+    assert tuple(frame.rgba8[8, 8]) == (255, 0, 0, 255)
+    assert tuple(frame.rgba8_tie[8, 8]) == (0, 0, 255, 255)
+    apart = render(Scene(objects=[facing_plane("near", red, 3.9), facing_plane("far", blue, 4)],
+                         ambient=(1, 1, 1)), 16, 16)
+    assert apart.rgba8_tie is None
 
 
 def facing_plane(name, colour, distance):

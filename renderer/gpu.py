@@ -155,6 +155,7 @@ class GpuRenderer:
             self._check_size()
             self._glDisable = gl_function(self.ctx, "glDisable", None, ctypes.c_uint)
             self._build_targets()
+            self._gl_info = self._query_gl_info()
             self._build_objects()
             self.update()
         except BaseException:
@@ -310,7 +311,8 @@ class GpuRenderer:
             linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
         if depth:
             depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
-        return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0)
+        return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
+                     gl_info=self._gl_info)
 
     def _read(self, fbo, attachment: int, dtype) -> np.ndarray:
         """The attachment's pixels, bottom row first, in a staging array reused every frame."""
@@ -323,13 +325,17 @@ class GpuRenderer:
         return out
 
     # -- information -------------------------------------------------------------------------
-    @property
-    def gl_info(self) -> dict:
-        """GL_VENDOR, GL_RENDERER, GL_VERSION, the context kind ("egl", "osmesa", or
-        "external" for a context passed in) and the depth buffer's format."""
+    def _query_gl_info(self) -> dict:
         info = self.ctx.info
         return {key: info[key] for key in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")} | {
             "context": context_kind(self.ctx), "depth_format": self.depth_format}
+
+    @property
+    def gl_info(self) -> dict:
+        """GL_VENDOR, GL_RENDERER, GL_VERSION, the context kind ("egl", "osmesa", or
+        "external" for a context passed in) and the depth buffer's format. Asked once, when
+        the renderer is made; every frame it renders carries the same dict."""
+        return dict(self._gl_info)
 
     @property
     def subpixel_bits(self) -> int:

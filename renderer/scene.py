@@ -9,7 +9,7 @@ docs/conventions.md; the file format: docs/scene-format.md.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal
 
 import numpy as np
@@ -163,3 +163,10 @@ class Scene:
         """The shading modes the scene uses, in a fixed order."""
         used = {obj.material.shading for obj in self.objects}
         return [mode for mode in SHADING_MODES if mode in used]
+
+    def with_shading(self, mode: ShadingMode) -> "Scene":
+        """A copy in which every material uses shading `mode`; meshes are shared, not copied."""
+        if mode not in SHADING_MODES:
+            raise ValueError(f"shading must be one of {', '.join(SHADING_MODES)}, got {mode!r}")
+        objects = [replace(obj, material=replace(obj.material, shading=mode)) for obj in self.objects]
+        return replace(self, objects=objects)

@@ -1,0 +1,27 @@
+"""Perceptual error: NVIDIA's ꟻLIP (the flip-evaluator package), for what a person would see.
+
+ꟻLIP gives each pixel an error in [0, 1] from a model of how people compare two images
+flipped back and forth (67 pixels per degree: a desktop monitor at arm's length). Its mean
+over the image summarises how visible a change is; it averages, so a small defect in a large
+image has a small mean (docs/goldens.md has measured figures).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def flip_error(expected_rgba8: np.ndarray, actual_rgba8: np.ndarray) -> tuple[float, np.ndarray]:
+    """(mean ꟻLIP error, (H, W, 3) uint8 error map in the magma colour map).
+
+    Alpha is left out: ꟻLIP compares colours as shown, and the background's colour is what
+    a viewer sees where alpha is 0. Inputs are sRGB-encoded 8-bit images, as ꟻLIP's LDR
+    mode expects.
+    """
+    import flip_evaluator        # imported here: only failing or ꟻLIP-policy comparisons pay for it
+
+    expected = np.ascontiguousarray(expected_rgba8[..., :3], dtype=np.float32) / 255.0
+    actual = np.ascontiguousarray(actual_rgba8[..., :3], dtype=np.float32) / 255.0
+    error_map, mean, _ = flip_evaluator.evaluate(expected, actual, "LDR")
+    image = np.clip(np.asarray(error_map) * 255.0 + 0.5, 0, 255).astype(np.uint8)
+    return float(mean), image

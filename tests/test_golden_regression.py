@@ -1,0 +1,65 @@
+"""What a golden suite is for, shown on this project's own: in a copy of the repository, a
+16x16 block painted into one golden fails that golden's tests and no other, writes the
+images and the results page, and `pytest --update-goldens` restores the golden."""
+
+import shutil
+import subprocess
+import sys
+import xml.etree.ElementTree as ElementTree
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from renderer.goldens import read_golden
+
+REPO = Path(__file__).resolve().parents[1]
+GOLDEN = "sphere-phong"
+# Every test that holds this golden: the GPU on both contexts, and the reference.
+ITS_TESTS = {f"test_gpu_matches_golden[{GOLDEN}-egl]", f"test_gpu_matches_golden[{GOLDEN}-osmesa]",
+             f"test_golden_matches_reference[{GOLDEN}]"}
+
+
+def copy_of_repository(target: Path) -> Path:
+    skip = shutil.ignore_patterns(".git", ".venv", "build", "dist", "*.egg-info", "__pycache__",
+                                  ".pytest_cache", "golden-results")
+    shutil.copytree(REPO, target, ignore=skip)
+    return target
+
+
+def run_golden_suite(repo: Path, *options: str):
+    """(exit status, names of failed tests, output) of tests/test_goldens.py in `repo`."""
+    report = repo / "report.xml"
+    result = subprocess.run([sys.executable, "-m", "pytest", "tests/test_goldens.py", "-q",
+                             "-p", "no:cacheprovider", f"--junitxml={report}", *options],
+                            cwd=repo, capture_output=True, text=True)
+    failed = {case.get("name") for case in ElementTree.parse(report).iter("testcase")
+              if case.find("failure") is not None or case.find("error") is not None}
+    return result.returncode, failed, result.stdout + result.stderr
+
+
+def test_a_painted_block_fails_only_its_golden_and_update_restores_it(tmp_path):
+    repo = copy_of_repository(tmp_path / "repo")
+    png = repo / "tests" / "goldens" / f"{GOLDEN}.png"
+    original = read_golden(png)
+    painted = original.copy()
+    painted[120:136, 120:136] = (255, 0, 255, 255)
+    Image.fromarray(painted).save(png)
+
+    status, failed, output = run_golden_suite(repo)
+    assert status == 1, output
+    assert failed == ITS_TESTS, output
+    assert "256 pixels fail" in output                       # the count, in the message
+    results = repo / "golden-results"
+    assert "golden-results/index.html" in output
+    page = (results / "index.html").read_text()
+    for folder in (GOLDEN, f"{GOLDEN}-2"):                   # one per failing GPU comparison
+        for image in ("expected", "actual", "diff", "flip"):
+            assert (results / folder / f"{image}.png").is_file()
+            assert f'src="{folder}/{image}.png"' in page
+
+    status, failed, output = run_golden_suite(repo, "--update-goldens")
+    assert status == 0 and not failed, output
+    np.testing.assert_array_equal(read_golden(png), original)
+    status, failed, output = run_golden_suite(repo)
+    assert status == 0 and not failed, output

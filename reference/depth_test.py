@@ -37,6 +37,18 @@ def drawn_earlier(order_fragment: np.ndarray, order_stored: np.ndarray) -> np.nd
     return (order_stored != NOTHING_DRAWN) & (order_fragment < order_stored)
 
 
+_LAST = np.iinfo(np.int64).max       # the order of a missing candidate: it sorts after all
+
+
+def _sort_key(order: np.ndarray) -> np.ndarray:
+    return np.where(order == NOTHING_DRAWN, _LAST, order)
+
+
+def _before(z_a, order_a, z_b, order_b) -> np.ndarray:
+    """Fragment a is kept over b: nearer, or as near and drawn earlier."""
+    return (z_a < z_b) | ((z_a == z_b) & (order_a < order_b))
+
+
 def nearest_two_per_pixel(pixel, z_w, order) -> tuple[np.ndarray, np.ndarray]:
     """(first, second): per pixel of the batch, the index of its nearest fragment (then the
     earliest drawn) and of the next one in the same order, -1 where it has only one."""
@@ -72,39 +84,40 @@ class DepthBuffer:
             return
         first, second = nearest_two_per_pixel(pixel, z_w, order)
         target = pixel[first]
-        # Four candidates per pixel: stored winner, stored runner-up, the batch's two nearest.
-        # The clear value takes part as a winner of order -1 (it wins ties: GL_LESS against
-        # 1.0 fails at 1.0) but never as a runner-up.
         has_second = second >= 0
         second = np.where(has_second, second, first)
-        cand_z = np.stack([self.z[target], self.z_second[target], z_w[first],
-                           np.where(has_second, z_w[second], np.inf)], axis=1)
-        cand_order = np.stack([self.order[target], self.order_second[target], order[first],
-                               np.where(has_second, order[second], NOTHING_DRAWN)], axis=1)
-        is_fragment = np.stack([self.order[target] != NOTHING_DRAWN, self.order_second[target] != NOTHING_DRAWN,
-                                np.ones(len(target), bool), has_second], axis=1)
-        # The clear (order -1, z 1.0) competes for first place; absent candidates sort last.
-        sort_order = np.where(is_fragment | (np.arange(4) == 0), cand_order, np.iinfo(np.int64).max)
-        sort_z = np.where(is_fragment | (np.arange(4) == 0), cand_z, np.inf)
-        ranked = np.lexsort((sort_order, sort_z), axis=1)
-        rows = np.arange(len(target))
-        win = ranked[:, 0]
-        # The runner-up: the best-ranked real fragment after the winner.
-        later_fragment = is_fragment[rows[:, None], ranked] & (np.arange(4) > 0)
-        has_runner_up = later_fragment.any(axis=1)
-        runner_up = ranked[rows, np.argmax(later_fragment, axis=1)]
+        # Candidates, each sorted already: (stored winner w, stored runner-up r) and (the
+        # batch's nearest b1, its next b2). The clear value is a winner of z 1.0 and order -1,
+        # so it wins ties (GL_LESS against 1.0 fails at 1.0), but it is never a runner-up.
+        # Missing candidates sort last.
+        wz, wo = self.z[target], self.order[target]
+        rz, ro = self.z_second[target], _sort_key(self.order_second[target])
+        b1z, b1o = z_w[first], order[first]
+        b2z, b2o = np.where(has_second, z_w[second], np.inf), np.where(has_second, order[second], _LAST)
+        b1_wins = _before(b1z, b1o, wz, wo)
+        # Runner-up: the better of (r, b1) if w stays; if b1 wins, of (w, b2), where w is
+        # replaced by r when w is only the clear value (r then lost to the clear).
+        w_real = wo != NOTHING_DRAWN
+        kz, ko = np.where(w_real, wz, rz), np.where(w_real, wo, ro)
+        b1_over_r = _before(b1z, b1o, rz, ro)
+        k_over_b2 = _before(kz, ko, b2z, b2o)
+        second_z = np.where(b1_wins, np.where(k_over_b2, kz, b2z), np.where(b1_over_r, b1z, rz))
+        second_o = np.where(b1_wins, np.where(k_over_b2, ko, b2o), np.where(b1_over_r, b1o, ro))
 
-        self.z[target], self.order[target] = cand_z[rows, win], cand_order[rows, win]
-        self.z_second[target] = np.where(has_runner_up, cand_z[rows, runner_up], np.inf)
-        self.order_second[target] = np.where(has_runner_up, cand_order[rows, runner_up], NOTHING_DRAWN)
         for name, values in payload.items():
             for store in (self.payload, self.payload_second):
                 if name not in store:
                     store[name] = np.zeros((len(self.z),) + values.shape[1:], dtype=values.dtype)
-            cand = np.stack([self.payload[name][target], self.payload_second[name][target],
-                             values[first], values[second]], axis=1)
-            self.payload[name][target] = cand[rows, win]
-            self.payload_second[name][target] = cand[rows, runner_up]
+            stored_w, stored_r = self.payload[name][target], self.payload_second[name][target]
+            pick = lambda mask, a, b: np.where(mask.reshape((-1,) + (1,) * (values.ndim - 1)), a, b)
+            stored_k = pick(w_real, stored_w, stored_r)
+            self.payload[name][target] = pick(b1_wins, values[first], stored_w)
+            self.payload_second[name][target] = pick(
+                b1_wins, pick(k_over_b2, stored_k, values[second]), pick(b1_over_r, values[first], stored_r))
+        self.z[target] = np.where(b1_wins, b1z, wz)
+        self.order[target] = np.where(b1_wins, b1o, wo)
+        self.z_second[target] = second_z
+        self.order_second[target] = np.where(second_o == _LAST, NOTHING_DRAWN, second_o)
 
     @property
     def drawn(self) -> np.ndarray:

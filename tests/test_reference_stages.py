@@ -256,6 +256,47 @@ def test_depth_buffer_keeps_the_runner_up_and_flags_depth_ties():
     assert not depth.depth_ties(tolerance=0.5e-7)[0]
 
 
+def test_a_fragment_that_lost_to_the_clear_is_the_runner_up_of_a_later_winner():
+    depth = DepthBuffer(1, 1)
+    depth.test_and_write(np.array([0]), np.array([1.0]), np.array([0]), tag=np.array([10]))
+    assert not depth.drawn[0]
+    depth.test_and_write(np.array([0]), np.array([0.5]), np.array([1]), tag=np.array([11]))
+    assert (depth.order[0], depth.order_second[0], depth.z_second[0]) == (1, 0, 1.0)
+    assert depth.payload_second["tag"][0] == 10
+
+
+def test_depth_buffer_matches_testing_fragments_one_by_one():
+    """Random batches with many exact ties, some fragments on the far plane (z_w = 1.0): the
+    batched buffer keeps the winner GL would keep and, where something was drawn, the
+    nearest other fragment, exactly as sorting all of a pixel's fragments by (z_w, order)."""
+    rng = np.random.default_rng(7)
+    depth = DepthBuffer(5, 1)
+    fragments = {pixel: [] for pixel in range(5)}
+    order = 0
+    for batch in range(30):
+        n = int(rng.integers(1, 5))
+        pixel = rng.integers(0, 5, n)
+        z = rng.choice([0.25, 0.5, 0.75, 1.0], n)
+        orders = order + rng.permutation(n)            # any order within a batch
+        order += n
+        depth.test_and_write(pixel, z, orders, tag=orders * 10)
+        for p, zz, o in zip(pixel, z, orders):
+            fragments[int(p)].append((zz, o))
+    for pixel, seen in fragments.items():
+        ranked = sorted(seen)
+        winners = [f for f in ranked if f[0] < 1.0]
+        if not winners:
+            assert not depth.drawn[pixel]
+            continue
+        assert (depth.z[pixel], depth.order[pixel]) == winners[0]
+        assert depth.payload["tag"][pixel] == winners[0][1] * 10
+        others = [f for f in ranked if f != winners[0]]
+        expected = others[0] if others else (np.inf, -1)
+        assert (depth.z_second[pixel], depth.order_second[pixel]) == expected
+        if others:
+            assert depth.payload_second["tag"][pixel] == others[0][1] * 10
+
+
 def test_reference_offers_the_other_surface_where_two_meet_within_depth_precision():
     """Two coincident planes: GL may show either, so the reference's rgba8_tie shows the
     second drawn where rgba8 shows the first (which GL_LESS keeps on an exact tie)."""

@@ -59,14 +59,23 @@ def position_deviation_mismatch(result: np.ndarray, reference: np.ndarray,
     return ~(result_ok & reference_ok)
 
 
+def channel_difference(result: np.ndarray, reference: np.ndarray,
+                       reference_tie: np.ndarray | None = None) -> np.ndarray:
+    """(H, W, C) int16 |result - reference| per channel; where `reference_tie` (the
+    reference frame's rgba8_tie) is nearer in its largest channel, against that instead."""
+    diff = np.abs(result.astype(np.int16) - reference.astype(np.int16))
+    if reference_tie is not None:
+        tie_diff = np.abs(result.astype(np.int16) - reference_tie.astype(np.int16))
+        closer = tie_diff.max(axis=-1) < diff.max(axis=-1)
+        diff[closer] = tie_diff[closer]
+    return diff
+
+
 def raw_mismatch(result: np.ndarray, reference: np.ndarray, threshold: int = DEFAULT_THRESHOLD,
                  reference_tie: np.ndarray | None = None) -> np.ndarray:
     """(H, W) bool mask of pixels with any channel off by more than the threshold (from
     both the reference and, if given, its depth-tie alternative)."""
-    off = np.abs(result.astype(np.int16) - reference.astype(np.int16)).max(axis=-1) > threshold
-    if reference_tie is not None:
-        off &= np.abs(result.astype(np.int16) - reference_tie.astype(np.int16)).max(axis=-1) > threshold
-    return off
+    return channel_difference(result, reference, reference_tie).max(axis=-1) > threshold
 
 
 def _depth_rel_nearby(a: np.ndarray, b: np.ndarray, deviation: int) -> np.ndarray:
@@ -128,14 +137,11 @@ def compare_frames(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
     against the nearer of the two there."""
     if result_rgba8.shape != reference_rgba8.shape:
         raise ValueError(f"image sizes differ: {result_rgba8.shape} and {reference_rgba8.shape}")
-    diff = np.abs(result_rgba8[..., :3].astype(np.int16) - reference_rgba8[..., :3].astype(np.int16))
-    if reference_tie is not None:
-        tie_diff = np.abs(result_rgba8[..., :3].astype(np.int16) - reference_tie[..., :3].astype(np.int16))
-        closer = tie_diff.max(axis=-1) < diff.max(axis=-1)
-        diff[closer] = tie_diff[closer]
+    difference = channel_difference(result_rgba8, reference_rgba8, reference_tie)
+    diff = difference[..., :3]
     total = result_rgba8.shape[0] * result_rgba8.shape[1]
     rmse = float(np.sqrt(np.mean(diff.astype(np.float64) ** 2)))
-    raw = int(raw_mismatch(result_rgba8, reference_rgba8, threshold, reference_tie).sum())
+    raw = int((difference.max(axis=-1) > threshold).sum())
     deq = int(position_deviation_mismatch(result_rgba8, reference_rgba8, threshold, deviation,
                                           reference_tie).sum())
     depth = None
@@ -161,9 +167,7 @@ def heat_map(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
              reference_tie: np.ndarray | None = None) -> np.ndarray:
     """(H, W, 3) uint8 amplified difference: the ramp reaches white at 8 levels of 255, and
     pixels that fail the position-deviation compare are magenta."""
-    diff = np.abs(result_rgba8.astype(np.int16) - reference_rgba8.astype(np.int16)).max(axis=-1)
-    if reference_tie is not None:
-        diff = np.minimum(diff, np.abs(result_rgba8.astype(np.int16) - reference_tie.astype(np.int16)).max(axis=-1))
+    diff = channel_difference(result_rgba8, reference_rgba8, reference_tie).max(axis=-1)
     t = np.clip(diff / _RAMP_FULL_SCALE, 0.0, 1.0) * (len(_RAMP) - 1)
     lo = np.floor(t).astype(int)
     hi = np.minimum(lo + 1, len(_RAMP) - 1)

@@ -19,9 +19,7 @@ import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
-from renderer.compare import heat_map, position_deviation_mismatch, raw_mismatch
+from renderer.compare import channel_difference, heat_map, position_deviation_mismatch
 from renderer.errors import show_number
 from renderer.goldens import GoldenError, Outcome
 from renderer.imageio import write_png, write_text
@@ -31,16 +29,15 @@ MARKER = ".golden-results"
 INDEX = "index.html"
 
 
-def figures_of(outcome: Outcome) -> dict:
+def figures_of(outcome: Outcome, mean_flip: float) -> dict:
     """Every figure a reviewer wants, whatever the policy measured (expected and actual must
-    have the same size)."""
+    have the same size; `mean_flip` is their mean ꟻLIP error)."""
     expected, actual = outcome.expected, outcome.actual
     threshold, deviation = outcome.policy.marking()
-    mean_flip, _ = flip_error(expected, actual)
-    difference = np.abs(expected.astype(np.int16) - actual.astype(np.int16))
+    difference = channel_difference(actual, expected).max(axis=-1)
     return {
         "size": [int(actual.shape[1]), int(actual.shape[0])],
-        "pixels_differing": int(raw_mismatch(actual, expected, threshold=0).sum()),
+        "pixels_differing": int((difference > 0).sum()),
         "pixels_failing": int(position_deviation_mismatch(actual, expected, threshold, deviation).sum()),
         "failing_rule": f"no match within ±{deviation} px at {threshold}/255",
         "max_channel_difference": int(difference.max()),
@@ -94,12 +91,13 @@ class ResultsFolder:
         entry = Entry(test, outcome, folder)
         path = self.root / folder
         write_png(path / "actual.png", outcome.actual)
-        if outcome.expected is not None and outcome.expected.shape == outcome.actual.shape:
+        if _compared(entry):
             threshold, deviation = outcome.policy.marking()
             write_png(path / "expected.png", outcome.expected)
             write_png(path / "diff.png", heat_map(outcome.actual, outcome.expected, threshold, deviation))
-            write_png(path / "flip.png", flip_error(outcome.expected, outcome.actual)[1])
-            entry.figures = figures_of(outcome)
+            mean_flip, flip_map = flip_error(outcome.expected, outcome.actual)
+            write_png(path / "flip.png", flip_map)
+            entry.figures = figures_of(outcome, mean_flip)
         entry.figures.update(test=test, golden=str(outcome.png), status=outcome.status, notes=outcome.notes)
         write_text(path / "figures.json", json.dumps(entry.figures, indent=2) + "\n")
         self.entries.append(entry)
@@ -148,7 +146,7 @@ def _entry_html(entry: Entry) -> str:
         f'alt="{name}"></a><figcaption>{caption}</figcaption></figure>'
         for name, caption in (("expected", "golden (expected)"), ("actual", "frame (actual)"),
                               ("diff", "difference"), ("flip", "ꟻLIP error"))
-        if (Path(entry.folder) / f"{name}.png").name and _exists(entry, name))
+        if name == "actual" or _compared(entry))
     rows = "".join(f"<tr><td>{e(key)}</td><td>{e(_show(value))}</td></tr>"
                    for key, value in entry.figures.items() if key not in ("notes", "test"))
     notes = "".join(f'<p class="note">{e(note)}</p>' for note in entry.outcome.notes)
@@ -156,9 +154,10 @@ def _entry_html(entry: Entry) -> str:
             f"<p><code>{e(entry.test)}</code></p>{notes}<div>{images}</div><table>{rows}</table></section>")
 
 
-def _exists(entry: Entry, name: str) -> bool:
-    return name == "actual" or entry.outcome.expected is not None and \
-        entry.outcome.expected.shape == entry.outcome.actual.shape
+def _compared(entry: Entry) -> bool:
+    """Whether there was a golden of the frame's size to compare with (and so its images)."""
+    expected = entry.outcome.expected
+    return expected is not None and expected.shape == entry.outcome.actual.shape
 
 
 def _show(value) -> str:

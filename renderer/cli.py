@@ -1,4 +1,4 @@
-"""The command line: `renderer render | compare | scenes` (also `python -m renderer`).
+"""The command line: `renderer render | compare | shaders | scenes` (also `python -m renderer`).
 
 A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
 with nothing written; a bug keeps its traceback.
@@ -57,6 +57,11 @@ def build_parser() -> argparse.ArgumentParser:
     compare.add_argument("--out", type=Path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
     compare.add_argument("--threshold", type=int, default=2, help="per-channel threshold of 255 (default 2)")
+
+    shaders = sub.add_parser("shaders", help="write the exact GLSL a scene's draws use")
+    shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
+    shaders.add_argument("--out", type=Path, help="folder for VARIANT.vert/.geom/.frag "
+                                                   "(default: shaders-SCENE_NAME)")
 
     sub.add_parser("scenes", help="list the built-in scenes")
     return parser
@@ -119,6 +124,28 @@ def cmd_compare(args) -> int:
     return 0
 
 
+def cmd_shaders(args) -> int:
+    """One set of files per shader variant the scene draws with, named after the variant,
+    and a line per variant naming the objects that use it."""
+    from renderer.imageio import write_text
+    from renderer.shaders import ShaderVariant, program_sources
+    scene = _load(args.scene)
+    out = args.out or Path(f"shaders-{scene.name}")
+    users: dict[ShaderVariant, list[str]] = {}
+    for obj in scene.objects:
+        if obj.mesh.triangle_count:
+            users.setdefault(ShaderVariant.for_material(scene, obj.material), []).append(obj.name)
+    suffixes = {"vertex_shader": "vert", "geometry_shader": "geom", "fragment_shader": "frag"}
+    for variant, names in users.items():
+        files = []
+        for stage, source in program_sources(variant).items():
+            path = out / f"{variant.name}.{suffixes[stage]}"
+            write_text(path, source.text)
+            files.append(path.name)
+        print(f"{variant.name}: {', '.join(files)} (objects: {', '.join(names)})")
+    return 0
+
+
 def cmd_scenes(args) -> int:
     from renderer.builtin import builtin_scenes, describe
     for name in builtin_scenes():
@@ -126,7 +153,7 @@ def cmd_scenes(args) -> int:
     return 0
 
 
-COMMANDS = {"render": cmd_render, "compare": cmd_compare, "scenes": cmd_scenes}
+COMMANDS = {"render": cmd_render, "compare": cmd_compare, "shaders": cmd_shaders, "scenes": cmd_scenes}
 
 
 def main(argv=None) -> int:

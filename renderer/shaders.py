@@ -142,6 +142,14 @@ class ShaderVariant:
         }
 
     @property
+    def name(self) -> str:
+        """A file-name-safe label, e.g. "phong-two-sided-1dir-2point"."""
+        sides = "-two-sided" if self.two_sided else ""
+        linear = "-linear" if self.linear_output else ""
+        return (f"{self.shading}{sides}-{self.num_directional_lights}dir-"
+                f"{self.num_point_lights}point{linear}")
+
+    @property
     def uses_geometry_shader(self) -> bool:
         return self.shading == "flat"
 

@@ -71,3 +71,36 @@ def test_written_files_get_the_usual_permissions(tmp_path):
     os.umask(mask)
     assert out.stat().st_mode & 0o777 == 0o666 & ~mask
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]     # no temporary left
+
+
+def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path, gl_contexts):
+    """hierarchy draws with three variants (phong, gouraud, flat with its geometry stage);
+    each file is the text the renderer compiles, and it compiles as it is."""
+    from renderer.builtin import builtin_scenes
+    from renderer.context import activate
+    from renderer.gpu import GpuRenderer
+    from renderer.scene_file import load_scene
+    from renderer.shaders import ShaderVariant, program_sources
+
+    result = run("shaders", "hierarchy", "--out", str(tmp_path))
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[0] == \
+        "phong-1dir-1point: phong-1dir-1point.vert, phong-1dir-1point.frag (objects: sun, planet, plinth)"
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "flat-1dir-1point.frag", "flat-1dir-1point.geom", "flat-1dir-1point.vert",
+        "gouraud-1dir-1point.frag", "gouraud-1dir-1point.vert",
+        "phong-1dir-1point.frag", "phong-1dir-1point.vert"]
+    ctx = gl_contexts["egl"]
+    with GpuRenderer(load_scene(builtin_scenes()["hierarchy"]), 16, 16, context=ctx) as gpu:
+        gpu.render()
+        assert sorted(variant.name for variant in gpu.programs) == \
+            ["flat-1dir-1point", "gouraud-1dir-1point", "phong-1dir-1point"]
+    flat = {stage: (tmp_path / f"flat-1dir-1point.{suffix}").read_text()
+            for stage, suffix in (("vertex_shader", "vert"), ("geometry_shader", "geom"),
+                                  ("fragment_shader", "frag"))}
+    assert flat == {stage: source.text for stage, source in
+                    program_sources(ShaderVariant("flat", False, 1, 1)).items()}
+    assert "#define SHADING_FLAT" in flat["fragment_shader"]
+    assert "#define NUM_POINT_LIGHTS 1" in flat["vertex_shader"]
+    activate(ctx)
+    ctx.program(**flat).release()

@@ -144,8 +144,8 @@ def check_golden(directory, name: str, actual_rgba8: np.ndarray, *, policy=None,
         raise GoldenError(f"a golden holds an (H, W, 4) uint8 RGBA image; got {actual.dtype} "
                           f"{actual.shape}", key=name)
     png, sidecar_path = golden_paths(directory, name)
-    wanted = make_sidecar(name, actual, policy, scene, gl_info)
     if update:
+        wanted = make_sidecar(name, actual, policy, scene, gl_info)
         return _update(png, sidecar_path, name, actual, policy, wanted)
     if not png.exists():
         return Outcome(name, "missing", png, actual, None, policy, None, [])

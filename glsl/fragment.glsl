@@ -22,6 +22,15 @@ in vec3 v_color_back;
 #endif
 #endif
 
+// A back face seen is lit from its own side only for a two-sided material. The all-features
+// build compiles that code for every material and asks u_two_sided at run time.
+#ifdef ALL_FEATURES
+uniform bool u_two_sided;
+#define BACK_FACE_LIT (!gl_FrontFacing && u_two_sided)
+#else
+#define BACK_FACE_LIT (!gl_FrontFacing)
+#endif
+
 layout(location = 0) out vec4 out_color;
 #ifdef LINEAR_OUTPUT
 layout(location = 1) out vec4 out_linear_color;
@@ -31,20 +40,20 @@ void main() {
 #if defined(SHADING_PHONG)
     vec3 N = normalize(v_world_normal);
 #ifdef TWO_SIDED
-    if (!gl_FrontFacing) {
+    if (BACK_FACE_LIT) {
         N = -N;                      // the back face is seen: light its side
     }
 #endif
     vec3 color = shade(v_world_position, N);
 #elif defined(SHADING_FLAT)
 #ifdef TWO_SIDED
-    vec3 color = gl_FrontFacing ? f_color_front : f_color_back;
+    vec3 color = BACK_FACE_LIT ? f_color_back : f_color_front;
 #else
     vec3 color = f_color_front;
 #endif
 #else
 #ifdef TWO_SIDED
-    vec3 color = gl_FrontFacing ? v_color_front : v_color_back;
+    vec3 color = BACK_FACE_LIT ? v_color_back : v_color_front;
 #else
     vec3 color = v_color_front;
 #endif

@@ -3,6 +3,9 @@
 //   I = I_a k_a + sum_l att_l I_l k_d max(N.L, 0) + sum_l att_l I_l k_s spec_l
 // Compile-time constants (renderer/shaders.py injects them): NUM_DIRECTIONAL_LIGHTS and
 // NUM_POINT_LIGHTS size the light arrays; an array is left out when its count is 0.
+// SPECULAR compiles the k_s term in; without it (every k_s is 0) neither R, V nor pow exist.
+// ALL_FEATURES (the build that does not specialise, renderer/shaders.py) keeps the arrays at
+// their full size and reads how many lights there are from uniforms at run time.
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
 #define NUM_DIRECTIONAL_LIGHTS 0
@@ -14,11 +17,23 @@
 // The material: the notes' reflection coefficients (linear RGB) and Phong exponent n.
 uniform vec3 u_ka;
 uniform vec3 u_kd;
+#ifdef SPECULAR
 uniform vec3 u_ks;
 uniform float u_n;
+uniform vec3 u_eye;                  // E, the camera's eye, world space
+#endif
 
 uniform vec3 u_ambient;              // I_a
-uniform vec3 u_eye;                  // E, the camera's eye, world space
+
+#ifdef ALL_FEATURES
+uniform int u_num_directional_lights;
+uniform int u_num_point_lights;
+#define DIRECTIONAL_LIGHTS u_num_directional_lights
+#define POINT_LIGHTS u_num_point_lights
+#else
+#define DIRECTIONAL_LIGHTS NUM_DIRECTIONAL_LIGHTS
+#define POINT_LIGHTS NUM_POINT_LIGHTS
+#endif
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
 uniform vec3 u_directional_direction[NUM_DIRECTIONAL_LIGHTS];   // D, the way the light travels
@@ -30,6 +45,7 @@ uniform vec3 u_point_intensity[NUM_POINT_LIGHTS];               // I_l
 uniform vec3 u_point_attenuation[NUM_POINT_LIGHTS];             // (c, l, q)
 #endif
 
+#ifdef SPECULAR
 // spec = max(R.V, 0)^n where N.L > 0 and R.V > 0, else 0: pow never sees a base <= 0.
 float specular_factor(float n_dot_l, float r_dot_v, float n) {
     if (n_dot_l > 0.0 && r_dot_v > 0.0) {
@@ -37,29 +53,36 @@ float specular_factor(float n_dot_l, float r_dot_v, float n) {
     }
     return 0.0;
 }
+#endif
 
 // One light's diffuse and specular terms: att I_l k_d max(N.L, 0) + att I_l k_s spec.
-// N, L, V are unit vectors; att_intensity is att * I_l.
+// N, L, V are unit vectors (V is unused without SPECULAR); att_intensity is att * I_l.
 vec3 light_terms(vec3 N, vec3 L, vec3 V, vec3 att_intensity) {
     float n_dot_l = dot(N, L);
+    vec3 I = att_intensity * u_kd * max(n_dot_l, 0.0);
+#ifdef SPECULAR
     vec3 R = 2.0 * n_dot_l * N - L;                  // perfect reflection of L about N
-    float spec = specular_factor(n_dot_l, dot(R, V), u_n);
-    return att_intensity * u_kd * max(n_dot_l, 0.0)
-         + att_intensity * u_ks * spec;
+    I += att_intensity * u_ks * specular_factor(n_dot_l, dot(R, V), u_n);
+#endif
+    return I;
 }
 
 // The colour I at world point P with unit normal N (already flipped for a two-sided back face).
 vec3 shade(vec3 P, vec3 N) {
+#ifdef SPECULAR
     vec3 V = normalize(u_eye - P);
+#else
+    vec3 V = vec3(0.0);                              // only the specular term looks at V
+#endif
     vec3 I = u_ambient * u_ka;
 #if NUM_DIRECTIONAL_LIGHTS > 0
-    for (int i = 0; i < NUM_DIRECTIONAL_LIGHTS; ++i) {
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
         vec3 L = normalize(-u_directional_direction[i]);
         I += light_terms(N, L, V, u_directional_intensity[i]);       // att = 1
     }
 #endif
 #if NUM_POINT_LIGHTS > 0
-    for (int i = 0; i < NUM_POINT_LIGHTS; ++i) {
+    for (int i = 0; i < POINT_LIGHTS; ++i) {
         vec3 to_light = u_point_position[i] - P;
         float d = length(to_light);
         vec3 L = to_light / d;

@@ -58,11 +58,13 @@ class MaterialUniforms:
     u_kd: np.ndarray
     u_ks: np.ndarray
     u_n: np.ndarray
+    specular: bool = True        # False when every k_s is 0: the term is not computed (SPECULAR)
 
     @classmethod
     def from_material(cls, material, dtype=np.float64) -> "MaterialUniforms":
         return cls(np.asarray(material.ka, dtype=dtype), np.asarray(material.kd, dtype=dtype),
-                   np.asarray(material.ks, dtype=dtype), np.asarray(material.n, dtype=dtype))
+                   np.asarray(material.ks, dtype=dtype), np.asarray(material.n, dtype=dtype),
+                   material.has_specular)
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -101,10 +103,13 @@ def point_light_vector(P: np.ndarray, position: np.ndarray, attenuation: np.ndar
 
 
 def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> np.ndarray:
-    """att I_l (k_d max(N.L, 0) + k_s spec) for one light."""
+    """att I_l (k_d max(N.L, 0) + k_s spec) for one light; the k_s term only when the
+    material has one (as the shader's SPECULAR)."""
     n_dot_l = dot(N, L)
-    R = reflect_light(N, L, n_dot_l)
     diffuse = material.u_kd * np.maximum(n_dot_l, 0.0)
+    if not material.specular:
+        return att * intensity * diffuse
+    R = reflect_light(N, L, n_dot_l)
     specular = material.u_ks * specular_term(n_dot_l, dot(R, V), material.u_n)
     return att * intensity * (diffuse + specular)
 

@@ -4,6 +4,7 @@ The reference draw, stage by stage as dEQP's drawBasicPrimitives reads: for each
 scene order, vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping
 -> viewport transform and snapping -> facing and culling -> rasterisation -> depth test;
 then fragment shading for the one surviving fragment per pixel, and output conversion.
+Objects wholly outside the view volume are skipped (renderer/visibility.py, as the GPU path).
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 
@@ -27,6 +28,7 @@ from reference.output import compose_frame
 from reference.rasterizer import SUBPIXEL_BITS, is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
 from renderer.frame import Frame
+from renderer.visibility import visible_objects
 
 
 def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, depth: DepthBuffer,
@@ -71,10 +73,13 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     eye = np.asarray(scene.camera.eye, dtype=dtype)
     depth_buffer = DepthBuffer(width, height, dtype)
 
+    # Objects wholly outside the view volume are skipped, as the GPU path skips them.
+    visible = visible_objects(scene, frame_matrices)
     objects, first_order = [], 0
     for index, (obj, matrices) in enumerate(zip(scene.objects, frame_matrices.objects)):
         objects.append(draw_object(index, obj, matrices, frame_matrices, lights, eye, depth_buffer,
-                                   first_order, width, height, subpixel_bits, dtype))
+                                   first_order, width, height, subpixel_bits, dtype)
+                       if visible[index] else None)
         first_order += len(obj.mesh.faces)
 
     drawn = depth_buffer.drawn
@@ -92,13 +97,15 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     return frame
 
 
-def shade_surviving(objects: list[ObjectVaryings], payload: dict, pixels_mask: np.ndarray,
+def shade_surviving(objects: list[ObjectVaryings | None], payload: dict, pixels_mask: np.ndarray,
                     lights: Lights, eye, dtype) -> tuple[np.ndarray, np.ndarray]:
     """Fragment stage for the fragments `payload` names at the pixels of `pixels_mask`:
     (colour (H*W, 4), view depth (H*W,)), zero elsewhere."""
     color = np.zeros((len(pixels_mask), 4), dtype=dtype)
     view_depth = np.full(len(pixels_mask), np.inf, dtype=dtype)
     for index, varyings in enumerate(objects):
+        if varyings is None:                                   # culled: it has no fragments
+            continue
         pixels = np.flatnonzero(pixels_mask & (payload.get("object", -1) == index))
         if len(pixels) == 0:
             continue

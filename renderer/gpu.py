@@ -11,6 +11,12 @@ no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-speci
 glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
 variants that write it, are made the first time `render(linear=True)` asks for them.
 
+Each frame is planned from its scene: a program per material is specialised to what that
+material and the scene use (renderer/shaders.py: light counts as constants, the specular term
+only where k_s > 0, back-face code only when two-sided), and an object wholly outside the
+view volume is left out of the plan (renderer/visibility.py). `specialise=False` draws with
+the all-features build instead, for benchmarks/bench_specialisation.py; the images are the same.
+
 Uniform values are computed once, as bytes, from `Scene.matrices()` and the scene's lights
 and materials, and `render()` only hands them to GL. After changing the scene (camera, lights,
 materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
@@ -31,8 +37,9 @@ import numpy as np
 from renderer.context import activate, context_kind, gl_function, make_context, release_context
 from renderer.frame import Frame
 from renderer.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
-from renderer.shaders import ProgramCache, ShaderVariant
+from renderer.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.transforms import to_glsl
+from renderer.visibility import visible_objects
 
 GL_DITHER = 0x0BD0
 GL_RENDERBUFFER = 0x8D41
@@ -54,27 +61,47 @@ def _float(value: float) -> bytes:
     return struct.pack("f", value)
 
 
-def frame_uniform_values(scene: Scene, matrices: FrameMatrices) -> dict[str, bytes]:
+def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
+                         light_slots: int | None = None) -> dict[str, bytes]:
     """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
-    A light array is absent when the scene has no light of that kind (nor does the shader)."""
+    A light array is absent when the scene has no light of that kind (nor does the shader).
+    `light_slots` is for the all-features build: arrays of that size (the slots past the
+    scene's lights are zeros, never read) and the counts as uniforms."""
+    directional, point = scene.directional_lights, scene.point_lights
     values = {
         "u_view": to_glsl(matrices.view),
         "u_projection": to_glsl(matrices.projection),
         "u_eye": _vec3s(scene.camera.eye),
         "u_ambient": _vec3s(scene.ambient),
     }
-    if scene.directional_lights:
-        values["u_directional_direction"] = _vec3s([l.direction for l in scene.directional_lights])
-        values["u_directional_intensity"] = _vec3s([l.intensity for l in scene.directional_lights])
-    if scene.point_lights:
-        values["u_point_position"] = _vec3s([l.position for l in scene.point_lights])
-        values["u_point_intensity"] = _vec3s([l.intensity for l in scene.point_lights])
-        values["u_point_attenuation"] = _vec3s([l.attenuation for l in scene.point_lights])
+    if light_slots is not None:
+        if max(len(directional), len(point)) > light_slots:
+            raise ValueError(f"the all-features build has room for {light_slots} lights of each "
+                             f"kind; the scene has {len(directional)} directional and "
+                             f"{len(point)} point lights")
+        values["u_num_directional_lights"] = struct.pack("i", len(directional))
+        values["u_num_point_lights"] = struct.pack("i", len(point))
+    slots = {"directional": light_slots or len(directional), "point": light_slots or len(point)}
+
+    def array(kind: str, values_per_light) -> bytes:
+        rows = np.zeros((slots[kind], 3), dtype=np.float32)
+        if values_per_light:
+            rows[:len(values_per_light)] = values_per_light
+        return rows.tobytes()
+
+    if slots["directional"]:
+        values["u_directional_direction"] = array("directional", [l.direction for l in directional])
+        values["u_directional_intensity"] = array("directional", [l.intensity for l in directional])
+    if slots["point"]:
+        values["u_point_position"] = array("point", [l.position for l in point])
+        values["u_point_intensity"] = array("point", [l.intensity for l in point])
+        values["u_point_attenuation"] = array("point", [l.attenuation for l in point])
     return values
 
 
 def object_uniform_values(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, bytes]:
-    """One object's uniforms: its model and normal matrices and its material."""
+    """One object's uniforms: its model and normal matrices and its material (u_two_sided
+    is read only by the all-features build)."""
     material = obj.material
     return {
         "u_model": to_glsl(matrices.model),
@@ -83,6 +110,7 @@ def object_uniform_values(obj: SceneObject, matrices: ObjectMatrices) -> dict[st
         "u_kd": _vec3s(material.kd),
         "u_ks": _vec3s(material.ks),
         "u_n": _float(material.n),
+        "u_two_sided": struct.pack("i", int(bool(material.two_sided))),
     }
 
 
@@ -136,11 +164,13 @@ class GpuRenderer:
     """Renders one scene at one size through GLSL; see the module docstring."""
 
     def __init__(self, scene: Scene, width: int, height: int,
-                 context: moderngl.Context | None = None, context_kind: str = "auto"):
+                 context: moderngl.Context | None = None, context_kind: str = "auto",
+                 specialise: bool = True):
         if int(width) < 1 or int(height) < 1:
             raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
         self.scene = scene
         self.width, self.height = int(width), int(height)
+        self.specialise = bool(specialise)
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._released = False
@@ -211,7 +241,8 @@ class GpuRenderer:
         item.vertex_arrays, item.vbo, item.ibo = {}, None, None
 
     def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
-        return ShaderVariant.for_material(self.scene, obj.material, linear)
+        return ShaderVariant.for_material(self.scene, obj.material, linear,
+                                          all_features=not self.specialise)
 
     def _vertex_array(self, item: _ObjectBuffers, variant: ShaderVariant) -> moderngl.VertexArray:
         vao = item.vertex_arrays.get(variant)
@@ -239,7 +270,11 @@ class GpuRenderer:
                 self._release_buffers(item)
                 self._upload(item)
         matrices = scene.matrices(self.width, self.height)
-        self._frame_uniforms = frame_uniform_values(scene, matrices)
+        self._frame_uniforms = frame_uniform_values(
+            scene, matrices, light_slots=None if self.specialise else ALL_FEATURES_LIGHTS)
+        # Objects wholly outside the view volume are left out of the frame's plan.
+        self._visible = (visible_objects(scene, matrices) if self.specialise
+                         else [True] * len(self._objects))
         for item, object_matrices in zip(self._objects, matrices.objects):
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
         self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width))
@@ -251,8 +286,8 @@ class GpuRenderer:
         if plan is not None:
             return plan
         plan, programs = [], {}
-        for item in self._objects:
-            if item.vbo is None:
+        for item, visible in zip(self._objects, self._visible):
+            if item.vbo is None or not visible:
                 continue
             variant = self._variant(item.obj, linear)
             vao = self._vertex_array(item, variant)
@@ -350,6 +385,13 @@ class GpuRenderer:
     def programs(self) -> dict:
         """ShaderVariant -> moderngl.Program, for the variants made so far."""
         return dict(self._programs.items())
+
+    @property
+    def drawn_objects(self) -> list[str]:
+        """Names of the objects the current frame plan draws, in order: those with triangles
+        and, when specialising, not wholly outside the view volume."""
+        return [item.obj.name for item, visible in zip(self._objects, self._visible)
+                if item.vbo is not None and visible]
 
     @property
     def vertex_arrays(self) -> list:

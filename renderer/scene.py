@@ -53,6 +53,12 @@ class Material:
     two_sided: bool = False
     shading: ShadingMode = "phong"
 
+    @property
+    def has_specular(self) -> bool:
+        """Whether the lighting has a specular term at all (some k_s not 0). Both pipelines
+        leave the term out otherwise (renderer/shaders.py, reference/lighting.py)."""
+        return any(float(k) != 0.0 for k in self.ks)
+
 
 @dataclass
 class Mesh:

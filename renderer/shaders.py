@@ -119,23 +119,49 @@ def _shader_source(filename: str, defines: tuple, directory: str) -> ShaderSourc
     return ShaderSource("\n".join(lines) + "\n", tuple(_display(p) for p in files))
 
 
+# The all-features build sizes its light arrays for this many lights of each kind.
+ALL_FEATURES_LIGHTS = 8
+
+
 @dataclass(frozen=True)
 class ShaderVariant:
-    """One combination of the shaders' compile-time constants."""
+    """One combination of the shaders' compile-time constants.
+
+    A specialised variant has only what its material and scene use: the shading mode's
+    stages, the lights of each kind as constant-sized arrays, the specular term only when
+    some k_s > 0, the back-face code only for a two-sided material. `all_features` is the
+    same GLSL with everything compiled in (specular, both sides, arrays of
+    ALL_FEATURES_LIGHTS lights of each kind) and the rest decided by uniforms at run time
+    (how many lights, whether the material is two-sided): what a renderer that does not
+    specialise runs. benchmarks/bench_specialisation.py compares the two.
+    """
     shading: str                     # "flat", "gouraud" or "phong"
     two_sided: bool = False
     num_directional_lights: int = 0
     num_point_lights: int = 0
     linear_output: bool = False      # second fragment output: the unclamped float colour
+    specular: bool = False           # the k_s term of the lighting equation
+    all_features: bool = False
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
             raise ValueError(f"unknown shading mode {self.shading!r}")
 
     def defines(self) -> dict[str, object]:
+        if self.all_features:
+            return {
+                f"SHADING_{self.shading.upper()}": True,
+                "ALL_FEATURES": True,
+                "TWO_SIDED": True,
+                "SPECULAR": True,
+                "NUM_DIRECTIONAL_LIGHTS": ALL_FEATURES_LIGHTS,
+                "NUM_POINT_LIGHTS": ALL_FEATURES_LIGHTS,
+                "LINEAR_OUTPUT": self.linear_output,
+            }
         return {
             f"SHADING_{self.shading.upper()}": True,
             "TWO_SIDED": self.two_sided,
+            "SPECULAR": self.specular,
             "NUM_DIRECTIONAL_LIGHTS": self.num_directional_lights,
             "NUM_POINT_LIGHTS": self.num_point_lights,
             "LINEAR_OUTPUT": self.linear_output,
@@ -143,10 +169,13 @@ class ShaderVariant:
 
     @property
     def name(self) -> str:
-        """A file-name-safe label, e.g. "phong-two-sided-1dir-2point"."""
-        sides = "-two-sided" if self.two_sided else ""
+        """A file-name-safe label, e.g. "phong-two-sided-specular-1dir-2point"."""
         linear = "-linear" if self.linear_output else ""
-        return (f"{self.shading}{sides}-{self.num_directional_lights}dir-"
+        if self.all_features:
+            return f"{self.shading}-all-features{linear}"
+        sides = "-two-sided" if self.two_sided else ""
+        specular = "-specular" if self.specular else ""
+        return (f"{self.shading}{sides}{specular}-{self.num_directional_lights}dir-"
                 f"{self.num_point_lights}point{linear}")
 
     @property
@@ -154,10 +183,14 @@ class ShaderVariant:
         return self.shading == "flat"
 
     @classmethod
-    def for_material(cls, scene, material, linear_output: bool = False) -> "ShaderVariant":
-        """The variant that draws `material` (a renderer.scene.Material) in `scene`."""
+    def for_material(cls, scene, material, linear_output: bool = False,
+                     all_features: bool = False) -> "ShaderVariant":
+        """The variant that draws `material` (a renderer.scene.Material) in `scene`:
+        specialised to what they use, or the all-features build."""
+        if all_features:
+            return cls(material.shading, linear_output=bool(linear_output), all_features=True)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
-                   len(scene.point_lights), bool(linear_output))
+                   len(scene.point_lights), bool(linear_output), material.has_specular)
 
 
 STAGES = (("vertex_shader", "vertex.glsl"),

@@ -85,22 +85,25 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
     result = run("shaders", "hierarchy", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[0] == \
-        "phong-1dir-1point: phong-1dir-1point.vert, phong-1dir-1point.frag (objects: sun, planet, plinth)"
+        ("phong-specular-1dir-1point: phong-specular-1dir-1point.vert, "
+         "phong-specular-1dir-1point.frag (objects: sun, planet, plinth)")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "flat-1dir-1point.frag", "flat-1dir-1point.geom", "flat-1dir-1point.vert",
-        "gouraud-1dir-1point.frag", "gouraud-1dir-1point.vert",
-        "phong-1dir-1point.frag", "phong-1dir-1point.vert"]
+        "flat-specular-1dir-1point.frag", "flat-specular-1dir-1point.geom",
+        "flat-specular-1dir-1point.vert",
+        "gouraud-specular-1dir-1point.frag", "gouraud-specular-1dir-1point.vert",
+        "phong-specular-1dir-1point.frag", "phong-specular-1dir-1point.vert"]
     ctx = gl_contexts["egl"]
     with GpuRenderer(load_scene(builtin_scenes()["hierarchy"]), 16, 16, context=ctx) as gpu:
         gpu.render()
         assert sorted(variant.name for variant in gpu.programs) == \
-            ["flat-1dir-1point", "gouraud-1dir-1point", "phong-1dir-1point"]
-    flat = {stage: (tmp_path / f"flat-1dir-1point.{suffix}").read_text()
+            ["flat-specular-1dir-1point", "gouraud-specular-1dir-1point", "phong-specular-1dir-1point"]
+    flat = {stage: (tmp_path / f"flat-specular-1dir-1point.{suffix}").read_text()
             for stage, suffix in (("vertex_shader", "vert"), ("geometry_shader", "geom"),
                                   ("fragment_shader", "frag"))}
     assert flat == {stage: source.text for stage, source in
-                    program_sources(ShaderVariant("flat", False, 1, 1)).items()}
+                    program_sources(ShaderVariant("flat", False, 1, 1, specular=True)).items()}
     assert "#define SHADING_FLAT" in flat["fragment_shader"]
     assert "#define NUM_POINT_LIGHTS 1" in flat["vertex_shader"]
+    assert "#define SPECULAR" in flat["geometry_shader"]
     activate(ctx)
     ctx.program(**flat).release()

@@ -3,8 +3,8 @@
     python tools/make_extreme_meshes.py
 
 slivers.obj             a disc as a fan of 240 thin triangles (sub-pixel at the centre), each
-                        followed by two zero-area ones: a repeated index and three collinear
-                        vertices; file normals
+                        followed by two zero-area ones, a repeated index and a repeated
+                        position; four collinear ones along the axes; file normals
 duplicate_vertices.obj  an octahedron with three vertices of its own per face (no normals in
                         the file: the loader merges them) and every face written twice
 bad_normals.obj         a 16 x 8 sphere whose file normals are zero-length (every fifth),
@@ -35,15 +35,19 @@ def write_obj(path: Path, positions, faces, comment: str, normals=None) -> None:
 
 def slivers(count: int = 240):
     """Fan around the origin in the xy plane facing +z; after each fan triangle (0, a, b),
-    a zero-area (0, a, a) and a collinear (0, m, a) with m the midpoint of 0 and a."""
+    a zero-area (0, a, a) and (0, a, a') with a' a copy of a. Collinear triangles (0, m, a),
+    m halfway to a, only along the axes: there every transform keeps them exactly
+    collinear, while elsewhere float rounding may give them a sliver of area in one
+    pipeline and not in the other (GL promises nothing for such triangles)."""
     angles = np.linspace(0.0, 2 * np.pi, count, endpoint=False)
-    rim = np.stack([np.cos(angles), np.sin(angles), np.zeros(count)], -1)
-    mid = rim / 2
-    positions = np.vstack([[[0.0, 0.0, 0.0]], rim, mid])
+    rim = np.round(np.stack([np.cos(angles), np.sin(angles), np.zeros(count)], -1), 12) + 0.0
+    positions = np.vstack([[[0.0, 0.0, 0.0]], rim, rim, rim / 2])
     faces = []
     for k in range(count):
-        a, b, m = 1 + k, 1 + (k + 1) % count, 1 + count + k
-        faces += [[0, a, b], [0, a, a], [0, m, a]]
+        a, b, copy, m = 1 + k, 1 + (k + 1) % count, 1 + count + k, 1 + 2 * count + k
+        faces += [[0, a, b], [0, a, a], [0, a, copy]]
+        if k % (count // 4) == 0:
+            faces.append([0, m, a])
     normals = np.tile([0.0, 0.0, 1.0], (len(positions), 1))
     return positions, np.array(faces), normals
 

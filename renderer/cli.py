@@ -165,16 +165,19 @@ def cmd_scenes(args) -> int:
 
 def cmd_extremes(args) -> int:
     """extremes.json and extremes.md in --out; status 1 when a case fails (as authored)."""
+    from renderer.builtin import resolve_scene
     from renderer.context import make_context, release_context
     from renderer.extremes import all_pass, extreme_scenes, measure_extremes, write_report
-    for path in args.scenes:
-        _load(path)                          # a bad extra scene: its one line before any work
+    from renderer.scene_file import load_scene
+    extra = [resolve_scene(arg) for arg in args.scenes]
+    for path in extra:
+        load_scene(path)                     # a bad extra scene: its one line before any work
     kinds = ("egl", "osmesa") if args.context == "both" else (args.context,)
     contexts = {}
     try:
         for kind in kinds:
             contexts[kind] = make_context(kind)
-        cases = measure_extremes(extreme_scenes(args.scenes), args.size, contexts)
+        cases = measure_extremes(extreme_scenes(extra), args.size, contexts)
     finally:
         for ctx in contexts.values():
             release_context(ctx)

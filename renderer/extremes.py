@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 import reference
-from renderer.builtin import assets_dir
+from renderer.builtin import assets_dir, scene_description
 from renderer.compare import compare_frames, depth_tie_pixels
 from renderer.errors import SceneError
 from renderer.gpu import GpuRenderer
@@ -130,7 +130,7 @@ def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: d
         except SceneError as error:
             cases.append(base | {"refused": error.line(), "passes": True})
             continue
-        description = _description(path)
+        description = scene_description(path)
         cases.append(base | {"tests": description, "reversed_z": scene.camera.reversed_z}
                      | measure_scene(scene, size, contexts))
         if scene.camera.reversed_z:
@@ -140,11 +140,6 @@ def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: d
                                  "row above", "before": True}
                          | measure_scene(standard, size, contexts))
     return cases
-
-
-def _description(path: Path) -> str:
-    from renderer.builtin import scene_description
-    return scene_description(path)
 
 
 # -------------------------------------------------------------------------- the report

@@ -11,7 +11,11 @@ no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-speci
 glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
 variants that write it, are made the first time `render(linear=True)` asks for them.
 
-Uniform values are computed once, as bytes, from `Scene.matrices()` and the scene's lights
+A camera with `reversed_z` draws with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), depth
+cleared to 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
+frame puts GL's default back, so renderers sharing a context never see each other's.
+
+Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the scene's lights
 and materials, and `render()` only hands them to GL. After changing the scene (camera, lights,
 materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
 list of objects needs a new renderer.

@@ -40,14 +40,14 @@ class Lights:
     def from_scene(cls, scene, dtype=np.float64, origin=(0.0, 0.0, 0.0)) -> "Lights":
         """Point-light positions relative to `origin` (the frame's camera-relative origin),
         subtracted in float64 before the cast to `dtype`."""
-        def rows(values, origin=np.zeros(3)) -> np.ndarray:
-            return (np.asarray(values, dtype=np.float64).reshape(-1, 3) - origin).astype(dtype)
+        def rows(values, minus=(0.0, 0.0, 0.0)) -> np.ndarray:
+            return (np.asarray(values, dtype=np.float64).reshape(-1, 3) - minus).astype(dtype)
 
         return cls(
             u_ambient=np.asarray(scene.ambient, dtype=dtype),
             u_directional_direction=rows([d.direction for d in scene.directional_lights]),
             u_directional_intensity=rows([d.intensity for d in scene.directional_lights]),
-            u_point_position=rows([p.position for p in scene.point_lights], np.asarray(origin)),
+            u_point_position=rows([p.position for p in scene.point_lights], origin),
             u_point_intensity=rows([p.intensity for p in scene.point_lights]),
             u_point_attenuation=rows([p.attenuation for p in scene.point_lights]),
         )

@@ -170,9 +170,10 @@ def test_look_at_along_up_falls_back_to_an_orthonormal_view(up):
 
 
 def test_look_at_is_unchanged_away_from_the_fallback():
-    view = tf.look_at((1, 2, 3), (0, 0, 0), (0, 1, 0))
-    np.testing.assert_allclose(view[:3, :3] @ np.array([0, 1, 0]) @ [1, 0, 0], 0.0, atol=1e-12)
-    np.testing.assert_allclose(tf.fallback_up(np.array([0.0, 0.0, -1.0])), [0, 1, 0])  # y before x
+    # eye on +z looking at the origin with up +y: the identity rotation, eye moved to 0
+    np.testing.assert_allclose(tf.look_at((0, 0, 5), (0, 0, 0), (0, 1, 0)), tf.translate(0, 0, -5))
+    # ties between world axes go to the later axis: looking along z, y (not x) is up
+    np.testing.assert_allclose(tf.fallback_up(np.array([0.0, 0.0, -1.0])), [0, 1, 0])
 
 
 # -- lighting -----------------------------------------------------------------------------------

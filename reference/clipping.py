@@ -1,7 +1,8 @@
 """# Twin: fixed-function GL (OpenGL 4.5 core spec §13.5 Primitive Clipping)
 
-Clips triangles in homogeneous clip space against the view volume -w <= x, y, z <= w, or
--w <= x, y <= w and 0 <= z <= w under reversed-Z (glClipControl ZERO_TO_ONE) (Sutherland-Hodgman, one plane at a time, vectorised over triangles) and re-fans each
+Clips triangles in homogeneous clip space against the view volume -w <= x, y, z <= w (under
+reversed-Z, glClipControl ZERO_TO_ONE: -w <= x, y <= w and 0 <= z <= w) with
+Sutherland-Hodgman, one plane at a time, vectorised over triangles, and re-fans each
 clipped polygon into triangles (0, k, k+1), as GL's clipper does.
 
 GL interpolates every varying of a new vertex linearly in clip space with the same

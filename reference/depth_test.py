@@ -2,17 +2,17 @@
 
 A depth buffer that keeps, per pixel, the fragment GL would keep: the depth test is GL_LESS
 on window depth z_w against a buffer cleared to 1.0 (reversed-Z: GL_GREATER against a buffer
-cleared to 0.0, which is GL_LESS on the key -z_w: see `depth_key`), fragments are tested in draw order, so
-among exact ties the fragment drawn first stays. Batches of fragments are resolved with a
-sort (pixel, z_w, draw order) instead of a loop: within a batch the first fragment per pixel
-is the one that would survive sequential testing, and it then faces the stored one with the
-same rule. Draw order is an explicit key, so batches may even arrive out of order.
+cleared to 0.0, run as GL_LESS on the key -z_w, see `depth_key`); fragments are tested in
+draw order, so among exact ties the fragment drawn first stays. Batches of fragments are
+resolved with a sort (pixel, z_w, draw order) instead of a loop: within a batch the first
+fragment per pixel is the one that would survive sequential testing, and it then faces the
+stored one with the same rule. Draw order is an explicit key, so batches may even arrive out of order.
 
 Inputs (per batch): pixel (N,) int64 flat index row * W + column (GL rows, bottom first),
          z_w (N,) float, order (N,) int64 draw order (>= 0), and payload arrays (N, ...)
          to keep with the winner (which object and triangle, weights, facing).
-State:   z (H*W,) float, the depth key, cleared to that of the clear value, order (H*W,) int64 cleared to -1 (nothing drawn),
-         payload arrays (H*W, ...) valid where order >= 0.
+State:   z (H*W,) float depth keys, cleared to the clear value's key, order (H*W,) int64
+         cleared to -1 (nothing drawn), payload arrays (H*W, ...) valid where order >= 0.
 """
 
 from __future__ import annotations

@@ -5,7 +5,8 @@ rasterisation with fixed-point edge functions, written down as llvmpipe does the
 against it in tests/test_rasterizer.py):
 
 - window coordinates x_w = (x_ndc + 1) W / 2, y_w = (y_ndc + 1) H / 2, z_w = (z_ndc + 1) / 2
-  (z_w = z_ndc under reversed-Z, glClipControl ZERO_TO_ONE), origin at the bottom-left, y up; pixel (i, j) is sampled at its centre (i + 1/2, j + 1/2);
+  (z_w = z_ndc under reversed-Z, glClipControl ZERO_TO_ONE), origin at the bottom-left,
+  y up; pixel (i, j) is sampled at its centre (i + 1/2, j + 1/2);
 - x_w and y_w are snapped to 1 / 2^subpixel_bits of a pixel, rounding to nearest (ties to
   even), and coverage is decided exactly with int64 edge functions of the snapped vertices;
 - facing comes from the signed area of the snapped triangle: counter-clockwise is front;

@@ -38,7 +38,7 @@ layout(location = 1) out vec4 out_linear_color;
 
 void main() {
 #if defined(SHADING_PHONG)
-    vec3 N = normalize(v_world_normal);
+    vec3 N = normalize_or_zero(v_world_normal);
 #ifdef TWO_SIDED
     if (BACK_FACE_LIT) {
         N = -N;                      // the back face is seen: light its side

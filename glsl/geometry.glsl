@@ -22,7 +22,7 @@ void main() {
     vec3 p0 = v_world_position[0];
     vec3 p1 = v_world_position[1];
     vec3 p2 = v_world_position[2];
-    vec3 face_normal = normalize(cross(p1 - p0, p2 - p0));
+    vec3 face_normal = normalize_or_zero(cross(p1 - p0, p2 - p0));
     vec3 face_centroid = (p0 + p1 + p2) / 3.0;
     vec3 front_color = shade(face_centroid, face_normal);
 #ifdef TWO_SIDED

@@ -45,6 +45,12 @@ uniform vec3 u_point_intensity[NUM_POINT_LIGHTS];               // I_l
 uniform vec3 u_point_attenuation[NUM_POINT_LIGHTS];             // (c, l, q)
 #endif
 
+// normalize(v), except that a zero vector stays zero (GLSL's normalize(0) is NaN): a normal
+// that vanishes (singular normal matrix, opposite normals interpolated) lights as ambient.
+vec3 normalize_or_zero(vec3 v) {
+    return dot(v, v) > 0.0 ? normalize(v) : vec3(0.0);
+}
+
 #ifdef SPECULAR
 // spec = max(R.V, 0)^n where N.L > 0 and R.V > 0, else 0: pow never sees a base <= 0.
 float specular_factor(float n_dot_l, float r_dot_v, float n) {
@@ -70,7 +76,7 @@ vec3 light_terms(vec3 N, vec3 L, vec3 V, vec3 att_intensity) {
 // The colour I at world point P with unit normal N (already flipped for a two-sided back face).
 vec3 shade(vec3 P, vec3 N) {
 #ifdef SPECULAR
-    vec3 V = normalize(u_eye - P);
+    vec3 V = normalize_or_zero(u_eye - P);
 #else
     vec3 V = vec3(0.0);                              // only the specular term looks at V
 #endif
@@ -85,7 +91,7 @@ vec3 shade(vec3 P, vec3 N) {
     for (int i = 0; i < POINT_LIGHTS; ++i) {
         vec3 to_light = u_point_position[i] - P;
         float d = length(to_light);
-        vec3 L = to_light / d;
+        vec3 L = d > 0.0 ? to_light / d : N;         // a light on the surface: fully incident
         vec3 c_l_q = u_point_attenuation[i];
         float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
         I += light_terms(N, L, V, att * u_point_intensity[i]);

@@ -36,7 +36,7 @@ void main() {
 #if defined(SHADING_FLAT)
     v_world_position = world_position.xyz;
 #else
-    vec3 world_normal = normalize(u_normal_matrix * in_normal);
+    vec3 world_normal = normalize_or_zero(u_normal_matrix * in_normal);
 #if defined(SHADING_GOURAUD)
     v_color_front = shade(world_position.xyz, world_normal);
 #ifdef TWO_SIDED

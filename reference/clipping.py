@@ -1,7 +1,8 @@
 """# Twin: fixed-function GL (OpenGL 4.5 core spec §13.5 Primitive Clipping)
 
-Clips triangles in homogeneous clip space against the view volume -w <= x, y, z <= w
-(Sutherland-Hodgman, one plane at a time, vectorised over triangles) and re-fans each
+Clips triangles in homogeneous clip space against the view volume -w <= x, y, z <= w (under
+reversed-Z, glClipControl ZERO_TO_ONE: -w <= x, y <= w and 0 <= z <= w) with
+Sutherland-Hodgman, one plane at a time, vectorised over triangles, and re-fans each
 clipped polygon into triangles (0, k, k+1), as GL's clipper does.
 
 GL interpolates every varying of a new vertex linearly in clip space with the same
@@ -27,9 +28,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# The six planes as (axis, sign): inside when w + sign * coordinate[axis] >= 0,
-# that is -w <= x, x <= w, -w <= y, y <= w, -w <= z (near), z <= w (far).
-CLIP_PLANES = ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0))
+# The six planes as (axis, sign, w_factor): inside when w_factor * w + sign * coordinate[axis]
+# >= 0, that is -w <= x, x <= w, -w <= y, y <= w, -w <= z (near), z <= w (far).
+CLIP_PLANES = ((0, 1.0, 1.0), (0, -1.0, 1.0), (1, 1.0, 1.0), (1, -1.0, 1.0),
+               (2, 1.0, 1.0), (2, -1.0, 1.0))
+# Reversed-Z (glClipControl ZERO_TO_ONE): the depth planes are 0 <= z (far) and z <= w (near).
+CLIP_PLANES_REVERSED_Z = CLIP_PLANES[:4] + ((2, 1.0, 0.0), (2, -1.0, 1.0))
 
 # A triangle clipped by six planes gains at most one vertex per plane.
 MAX_POLYGON_VERTICES = 3 + len(CLIP_PLANES)
@@ -45,9 +49,9 @@ class ClippedTriangles:
         return len(self.source)
 
 
-def plane_distance(gl_Position: np.ndarray, axis: int, sign: float) -> np.ndarray:
-    """Signed distance-like value w ± coordinate: >= 0 on the inside of the plane."""
-    return gl_Position[..., 3] + sign * gl_Position[..., axis]
+def plane_distance(gl_Position: np.ndarray, axis: int, sign: float, w_factor: float) -> np.ndarray:
+    """Signed distance-like value (w or 0) ± coordinate: >= 0 on the inside of the plane."""
+    return w_factor * gl_Position[..., 3] + sign * gl_Position[..., axis]
 
 
 def is_inside_plane(distance: np.ndarray) -> np.ndarray:
@@ -65,7 +69,7 @@ def intersect_edge(inside_vertex, outside_vertex, d_inside, d_outside):
     return inside_vertex + t * (outside_vertex - inside_vertex)
 
 
-def clip_polygons_against_plane(vertices: np.ndarray, count: np.ndarray, axis: int, sign: float):
+def clip_polygons_against_plane(vertices: np.ndarray, count: np.ndarray, plane: tuple):
     """One Sutherland-Hodgman pass over polygons (P, M, C) with `count` vertices each.
 
     Components C are the 4 clip coordinates followed by the weights; all of them are
@@ -78,8 +82,8 @@ def clip_polygons_against_plane(vertices: np.ndarray, count: np.ndarray, axis: i
     nxt = np.where(slot[None, :] + 1 < count[:, None], slot[None, :] + 1, 0)
     nxt_vertices = np.take_along_axis(vertices, nxt[..., None], axis=1)
 
-    d_cur = plane_distance(vertices, axis, sign)
-    d_nxt = plane_distance(nxt_vertices, axis, sign)
+    d_cur = plane_distance(vertices, *plane)
+    d_nxt = plane_distance(nxt_vertices, *plane)
     inside_cur, inside_nxt = is_inside_plane(d_cur), is_inside_plane(d_nxt)
     emit_current = valid & inside_cur
     emit_crossing = valid & (inside_cur != inside_nxt)
@@ -117,22 +121,23 @@ def fan_triangulate(vertices: np.ndarray, count: np.ndarray, source: np.ndarray)
     return np.concatenate(triangles), np.concatenate(sources)
 
 
-def classify_triangles(gl_Position: np.ndarray):
+def classify_triangles(gl_Position: np.ndarray, planes=CLIP_PLANES):
     """(all vertices inside every plane, all vertices outside some one plane) per triangle."""
-    inside = np.stack([is_inside_plane(plane_distance(gl_Position, axis, sign))
-                       for axis, sign in CLIP_PLANES], axis=-1)          # (T, 3, planes)
+    inside = np.stack([is_inside_plane(plane_distance(gl_Position, *plane))
+                       for plane in planes], axis=-1)                     # (T, 3, planes)
     trivially_inside = inside.all(axis=(1, 2))
     trivially_outside = (~inside).all(axis=1).any(axis=1)
     return trivially_inside, trivially_outside
 
 
-def clip_triangles(gl_Position: np.ndarray) -> ClippedTriangles:
+def clip_triangles(gl_Position: np.ndarray, reversed_z: bool = False) -> ClippedTriangles:
     """Clip triangles (T, 3, 4) against the view volume; see the module docstring."""
     gl_Position = np.asarray(gl_Position)
     dtype = gl_Position.dtype
     T = len(gl_Position)
+    planes = CLIP_PLANES_REVERSED_Z if reversed_z else CLIP_PLANES
     identity = np.broadcast_to(np.eye(3, dtype=dtype), (T, 3, 3))
-    trivially_inside, trivially_outside = classify_triangles(gl_Position)
+    trivially_inside, trivially_outside = classify_triangles(gl_Position, planes)
     needs_clipping = ~trivially_inside & ~trivially_outside
 
     kept = np.nonzero(trivially_inside)[0]
@@ -144,8 +149,8 @@ def clip_triangles(gl_Position: np.ndarray) -> ClippedTriangles:
         polygon[:, :3, :4] = gl_Position[clip_index]
         polygon[:, :3, 4:] = np.eye(3, dtype=dtype)
         count = np.full(len(clip_index), 3, dtype=np.int64)
-        for axis, sign in CLIP_PLANES:
-            polygon, count = clip_polygons_against_plane(polygon, count, axis, sign)
+        for plane in planes:
+            polygon, count = clip_polygons_against_plane(polygon, count, plane)
         fanned, fan_source = fan_triangulate(polygon, count, clip_index)
         positions.append(fanned[..., :4])
         weights.append(fanned[..., 4:])

@@ -1,17 +1,18 @@
 """# Twin: fixed-function GL (OpenGL 4.5 core spec §17.3.6 Depth Buffer Test, GL_LESS)
 
 A depth buffer that keeps, per pixel, the fragment GL would keep: the depth test is GL_LESS
-on window depth z_w against a buffer cleared to 1.0, fragments are tested in draw order, so
-among exact ties the fragment drawn first stays. Batches of fragments are resolved with a
-sort (pixel, z_w, draw order) instead of a loop: within a batch the first fragment per pixel
-is the one that would survive sequential testing, and it then faces the stored one with the
-same rule. Draw order is an explicit key, so batches may even arrive out of order.
+on window depth z_w against a buffer cleared to 1.0 (reversed-Z: GL_GREATER against a buffer
+cleared to 0.0, run as GL_LESS on the key -z_w, see `depth_key`); fragments are tested in
+draw order, so among exact ties the fragment drawn first stays. Batches of fragments are
+resolved with a sort (pixel, z_w, draw order) instead of a loop: within a batch the first
+fragment per pixel is the one that would survive sequential testing, and it then faces the
+stored one with the same rule. Draw order is an explicit key, so batches may even arrive out of order.
 
 Inputs (per batch): pixel (N,) int64 flat index row * W + column (GL rows, bottom first),
          z_w (N,) float, order (N,) int64 draw order (>= 0), and payload arrays (N, ...)
          to keep with the winner (which object and triangle, weights, facing).
-State:   z (H*W,) float cleared to 1.0, order (H*W,) int64 cleared to -1 (nothing drawn),
-         payload arrays (H*W, ...) valid where order >= 0.
+State:   z (H*W,) float depth keys, cleared to the clear value's key, order (H*W,) int64
+         cleared to -1 (nothing drawn), payload arrays (H*W, ...) valid where order >= 0.
 """
 
 from __future__ import annotations
@@ -19,12 +20,21 @@ from __future__ import annotations
 import numpy as np
 
 DEPTH_CLEAR_VALUE = 1.0
+DEPTH_CLEAR_VALUE_REVERSED_Z = 0.0
 NOTHING_DRAWN = -1
 # Window depths closer than this may be ordered either way by GL. Its float32 vertex and
 # interpolation arithmetic is exact to a few units in the last place of z_w, and a float32
 # unit near z_w = 1 is 2^-24..2^-23; at a silhouette the front and back faces meet and
 # their depths differ by less than that (measured: 4e-9 and 2.3e-8 on two 256x256 frames).
+# Under reversed-Z, z_w is small far away and float32 keeps its relative precision there, so
+# the tolerance is relative: 4 units in the last place of the winner's z_w.
 DEPTH_TIE_TOLERANCE = 4 * 2.0 ** -23
+
+
+def depth_key(z_w: np.ndarray, reversed_z: bool) -> np.ndarray:
+    """What the buffer compares: z_w for GL_LESS; -z_w for reversed-Z's GL_GREATER, so that
+    GL_GREATER on z_w is GL_LESS on the key and every rule below holds for both."""
+    return -z_w if reversed_z else z_w
 
 
 def depth_less(z_fragment: np.ndarray, z_stored: np.ndarray) -> np.ndarray:
@@ -68,9 +78,11 @@ class DepthBuffer:
     them either way, and `depth_ties()` says so (pipeline.py then shades both).
     """
 
-    def __init__(self, width: int, height: int, dtype=np.float64):
+    def __init__(self, width: int, height: int, dtype=np.float64, reversed_z: bool = False):
         self.width, self.height = width, height
-        self.z = np.full(width * height, DEPTH_CLEAR_VALUE, dtype=dtype)
+        self.reversed_z = reversed_z
+        clear = DEPTH_CLEAR_VALUE_REVERSED_Z if reversed_z else DEPTH_CLEAR_VALUE
+        self.z = np.full(width * height, depth_key(clear, reversed_z), dtype=dtype)
         self.order = np.full(width * height, NOTHING_DRAWN, dtype=np.int64)
         self.payload: dict[str, np.ndarray] = {}
         self.z_second = np.full(width * height, np.inf, dtype=dtype)
@@ -82,6 +94,7 @@ class DepthBuffer:
         """Depth-test one batch of fragments and write the survivors (and the runners-up)."""
         if len(pixel) == 0:
             return
+        z_w = depth_key(z_w, self.reversed_z)
         first, second = nearest_two_per_pixel(pixel, z_w, order)
         target = pixel[first]
         has_second = second >= 0
@@ -127,4 +140,6 @@ class DepthBuffer:
     def depth_ties(self, tolerance: float = None) -> np.ndarray:
         """(H*W,) bool: drawn pixels whose runner-up is within `tolerance` of the winner's z_w."""
         tolerance = DEPTH_TIE_TOLERANCE if tolerance is None else tolerance
+        if self.reversed_z:
+            tolerance = tolerance * np.abs(self.z)
         return self.drawn & (self.order_second != NOTHING_DRAWN) & (self.z_second - self.z <= tolerance)

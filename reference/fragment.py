@@ -6,7 +6,7 @@ Per-fragment shading, run only for the fragment that survived the depth test at 
 - flat:    out_color = gl_FrontFacing ? f_color_front : f_color_back (flat varyings from
            the geometry stage);
 - gouraud: out_color = gl_FrontFacing ? v_color_front : v_color_back, interpolated;
-- phong:   N = normalize(v_world_normal); N = -N for a two-sided material seen from the
+- phong:   N = normalize_or_zero(v_world_normal); N = -N for a two-sided material seen from the
            back; out_color = lighting(v_world_position, N).
 Alpha is 1. Also out_view_depth, the interpolated -z_eye, for the depth image.
 
@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.geometry import TriangleOutputs
-from reference.lighting import Lights, MaterialUniforms, dot, lighting
+from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
 from reference.vertex import VertexOutputs
 
 
@@ -50,13 +50,6 @@ def select_by_facing(gl_FrontFacing: np.ndarray, front: np.ndarray, back: np.nda
     return np.where(gl_FrontFacing[:, None], front, back)
 
 
-def normalize_nonzero(v: np.ndarray) -> np.ndarray:
-    """normalize(), leaving a zero vector as zero instead of NaN (an interpolated normal can
-    vanish between opposite vertex normals; GLSL would give NaN there)."""
-    length = np.sqrt(dot(v, v))
-    return v / np.where(length > 0, length, np.ones_like(length))
-
-
 def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
                     gl_FrontFacing: np.ndarray, lights: Lights, u_eye: np.ndarray):
     """The fragment stage for one object's surviving fragments -> (out_color, out_view_depth)."""
@@ -71,7 +64,7 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
                                  interpolate(vertices.v_color_back, faces, triangle, weights))
     elif material.shading == "phong":
         P = interpolate(vertices.v_world_position, faces, triangle, weights)
-        N = normalize_nonzero(interpolate(vertices.v_world_normal, faces, triangle, weights))
+        N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
         if material.two_sided:
             N = np.where(gl_FrontFacing[:, None], N, -N)
         color = lighting(P, N, np.asarray(u_eye, dtype=dtype),

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize
+from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
 
 
 @dataclass
@@ -31,9 +31,9 @@ class TriangleOutputs:
 
 
 def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
-    """normalize((p1 - p0) x (p2 - p0)): counter-clockwise vertices face the normal."""
-    with np.errstate(invalid="ignore", divide="ignore"):   # degenerate triangles draw nothing
-        return normalize(np.cross(p1 - p0, p2 - p0))
+    """normalize((p1 - p0) x (p2 - p0)): counter-clockwise vertices face the normal; zero for
+    a triangle without area (it draws nothing anyway)."""
+    return normalize_or_zero(np.cross(p1 - p0, p2 - p0))
 
 
 def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,

@@ -37,15 +37,17 @@ class Lights:
     u_point_attenuation: np.ndarray
 
     @classmethod
-    def from_scene(cls, scene, dtype=np.float64) -> "Lights":
-        def rows(values) -> np.ndarray:
-            return np.asarray(values, dtype=dtype).reshape(-1, 3)
+    def from_scene(cls, scene, dtype=np.float64, origin=(0.0, 0.0, 0.0)) -> "Lights":
+        """Point-light positions relative to `origin` (the frame's camera-relative origin),
+        subtracted in float64 before the cast to `dtype`."""
+        def rows(values, minus=(0.0, 0.0, 0.0)) -> np.ndarray:
+            return (np.asarray(values, dtype=np.float64).reshape(-1, 3) - minus).astype(dtype)
 
         return cls(
             u_ambient=np.asarray(scene.ambient, dtype=dtype),
             u_directional_direction=rows([d.direction for d in scene.directional_lights]),
             u_directional_intensity=rows([d.intensity for d in scene.directional_lights]),
-            u_point_position=rows([p.position for p in scene.point_lights]),
+            u_point_position=rows([p.position for p in scene.point_lights], origin),
             u_point_intensity=rows([p.intensity for p in scene.point_lights]),
             u_point_attenuation=rows([p.attenuation for p in scene.point_lights]),
         )
@@ -77,6 +79,13 @@ def normalize(v: np.ndarray) -> np.ndarray:
     return v / np.sqrt(dot(v, v))
 
 
+def normalize_or_zero(v: np.ndarray) -> np.ndarray:
+    """normalize(), except that a zero vector stays zero instead of NaN: a normal that
+    vanishes (singular normal matrix, opposite normals interpolated) lights as ambient."""
+    length = np.sqrt(dot(v, v))
+    return v / np.where(length > 0, length, np.ones_like(length))
+
+
 def reflect_light(N: np.ndarray, L: np.ndarray, n_dot_l: np.ndarray) -> np.ndarray:
     """R = 2 (N.L) N - L, the perfect reflection of the light vector L about N."""
     return 2.0 * n_dot_l * N - L
@@ -94,12 +103,14 @@ def directional_light_vector(direction: np.ndarray) -> np.ndarray:
     return normalize(-direction)
 
 
-def point_light_vector(P: np.ndarray, position: np.ndarray, attenuation: np.ndarray):
-    """L = (Q - P) / d with d = |Q - P|, and att = 1 / (c + l d + q d^2). Returns (L, att)."""
+def point_light_vector(P: np.ndarray, N: np.ndarray, position: np.ndarray, attenuation: np.ndarray):
+    """L = (Q - P) / d with d = |Q - P|, and att = 1 / (c + l d + q d^2). Returns (L, att).
+    A light on the surface (d = 0) is fully incident: L = N, att = 1 / c."""
     to_light = position - P
     d = np.sqrt(dot(to_light, to_light))
     c, l, q = attenuation
-    return to_light / d, 1.0 / (c + l * d + q * d * d)
+    L = np.where(d > 0, to_light / np.where(d > 0, d, np.ones_like(d)), N)
+    return L, 1.0 / (c + l * d + q * d * d)
 
 
 def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> np.ndarray:
@@ -117,7 +128,7 @@ def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> n
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
              lights: Lights) -> np.ndarray:
     """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3)."""
-    V = normalize(E - P)
+    V = normalize_or_zero(E - P)
     I = np.broadcast_to(lights.u_ambient * material.u_ka, np.broadcast_shapes(P.shape, N.shape))
     I = I.astype(P.dtype, copy=True)
     for direction, intensity in zip(lights.u_directional_direction, lights.u_directional_intensity):
@@ -125,6 +136,6 @@ def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUnif
         I += light_contribution(N, L, V, 1.0, intensity, material)
     for position, intensity, attenuation in zip(lights.u_point_position, lights.u_point_intensity,
                                                 lights.u_point_attenuation):
-        L, att = point_light_vector(P, position, attenuation)
+        L, att = point_light_vector(P, N, position, attenuation)
         I += light_contribution(N, L, V, att, intensity, material)
     return I

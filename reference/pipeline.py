@@ -46,8 +46,9 @@ def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, 
     faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
     triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye)
                  if material.shading == "flat" else None)
-    clipped = clip_triangles(vertices.gl_Position[faces])
-    window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits)
+    reversed_z = depth.reversed_z
+    clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
+    window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
     window, source, clip_weights = window.select(keep), clipped.source[keep], clipped.weights[keep]
 
@@ -69,9 +70,10 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     start = time.perf_counter()
     dtype = np.dtype(dtype)
     frame_matrices = scene.matrices(width, height)
-    lights = Lights.from_scene(scene, dtype)
-    eye = np.asarray(scene.camera.eye, dtype=dtype)
-    depth_buffer = DepthBuffer(width, height, dtype)
+    # Camera-relative positions, as the GPU gets them (renderer.scene.FrameMatrices).
+    lights = Lights.from_scene(scene, dtype, origin=frame_matrices.origin)
+    eye = frame_matrices.relative(scene.camera.eye).astype(dtype)
+    depth_buffer = DepthBuffer(width, height, dtype, scene.camera.reversed_z)
 
     # Objects wholly outside the view volume are skipped, as the GPU path skips them.
     visible = visible_objects(scene, frame_matrices)

@@ -4,8 +4,9 @@ Perspective divide and viewport transform, vertex snapping, facing and culling, 
 rasterisation with fixed-point edge functions, written down as llvmpipe does them (checked
 against it in tests/test_rasterizer.py):
 
-- window coordinates x_w = (x_ndc + 1) W / 2, y_w = (y_ndc + 1) H / 2, z_w = (z_ndc + 1) / 2,
-  origin at the bottom-left, y up; pixel (i, j) is sampled at its centre (i + 1/2, j + 1/2);
+- window coordinates x_w = (x_ndc + 1) W / 2, y_w = (y_ndc + 1) H / 2, z_w = (z_ndc + 1) / 2
+  (z_w = z_ndc under reversed-Z, glClipControl ZERO_TO_ONE), origin at the bottom-left,
+  y up; pixel (i, j) is sampled at its centre (i + 1/2, j + 1/2);
 - x_w and y_w are snapped to 1 / 2^subpixel_bits of a pixel, rounding to nearest (ties to
   even), and coverage is decided exactly with int64 edge functions of the snapped vertices;
 - facing comes from the signed area of the snapped triangle: counter-clockwise is front;
@@ -86,13 +87,15 @@ class Fragments:
 
 # --- the rules, one small helper each ---------------------------------------------------
 
-def viewport_transform(gl_Position: np.ndarray, width: int, height: int):
-    """Perspective divide and GL's viewport transform. Returns (x_w, y_w, z_w, 1 / w_clip)."""
+def viewport_transform(gl_Position: np.ndarray, width: int, height: int,
+                       reversed_z: bool = False):
+    """Perspective divide and GL's viewport transform. Returns (x_w, y_w, z_w, 1 / w_clip).
+    Reversed-Z (clip control ZERO_TO_ONE) takes z_w = z_ndc, keeping its float precision."""
     inv_w = 1.0 / gl_Position[..., 3]
     x_ndc, y_ndc, z_ndc = (gl_Position[..., i] * inv_w for i in range(3))
     x_w = (x_ndc + 1.0) * (width / 2.0)
     y_w = (y_ndc + 1.0) * (height / 2.0)
-    z_w = (z_ndc + 1.0) / 2.0
+    z_w = z_ndc if reversed_z else (z_ndc + 1.0) / 2.0
     return x_w, y_w, z_w, inv_w
 
 
@@ -147,9 +150,9 @@ def is_inside_edge(edge_value: np.ndarray, inclusive: np.ndarray) -> np.ndarray:
 # --- setup ----------------------------------------------------------------------------
 
 def setup_triangles(gl_Position: np.ndarray, width: int, height: int,
-                    subpixel_bits: int = SUBPIXEL_BITS) -> WindowTriangles:
+                    subpixel_bits: int = SUBPIXEL_BITS, reversed_z: bool = False) -> WindowTriangles:
     """Window coordinates, snapping and signed area for clipped triangles (T, 3, 4)."""
-    x_w, y_w, z_w, inv_w = viewport_transform(gl_Position, width, height)
+    x_w, y_w, z_w, inv_w = viewport_transform(gl_Position, width, height, reversed_z)
     x = snap_to_subpixel_grid(x_w, subpixel_bits)
     y = snap_to_subpixel_grid(y_w, subpixel_bits)
     return WindowTriangles(x, y, x_w, y_w, z_w, inv_w, signed_area_twice(x, y), subpixel_bits)

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize
+from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
 
 
 @dataclass
@@ -55,7 +55,7 @@ def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, *, u_model: n
 
     world = transform_points(u_model, in_position)                 # (V, 4), w = 1 for affine M
     v_world_position = world[:, :3]
-    v_world_normal = normalize(in_normal @ u_normal_matrix.T)       # N = normalize(Nm n)
+    v_world_normal = normalize_or_zero(in_normal @ u_normal_matrix.T)   # N = normalize(Nm n)
     eye_space = world @ u_view.T                                   # V M p
     gl_Position = eye_space @ u_projection.T                       # P V M p
     v_view_depth = -eye_space[:, 2]

@@ -1,4 +1,4 @@
-"""The command line: `renderer render | compare | shaders | scenes` (also `python -m renderer`).
+"""The command line: `renderer render | compare | shaders | scenes | extremes` (also `python -m renderer`).
 
 A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
 with nothing written; a bug keeps its traceback.
@@ -64,6 +64,16 @@ def build_parser() -> argparse.ArgumentParser:
                                                    "(default: shaders-SCENE_NAME)")
 
     sub.add_parser("scenes", help="list the built-in scenes")
+
+    extremes = sub.add_parser("extremes", help="render the extreme scenes (assets/extreme/) through "
+                                               "both pipelines and report their stability")
+    extremes.add_argument("scenes", nargs="*", help="further scene files to measure alike")
+    extremes.add_argument("--out", type=Path, default=Path("extremes"),
+                          help="folder for extremes.json and extremes.md (default: extremes)")
+    extremes.add_argument("--size", type=parse_size, default=(320, 240), metavar="WxH",
+                          help="image size in pixels (default 320x240)")
+    extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
+                          help="GL contexts to render with (default: both)")
     return parser
 
 
@@ -153,7 +163,36 @@ def cmd_scenes(args) -> int:
     return 0
 
 
-COMMANDS = {"render": cmd_render, "compare": cmd_compare, "shaders": cmd_shaders, "scenes": cmd_scenes}
+def cmd_extremes(args) -> int:
+    """extremes.json and extremes.md in --out; status 1 when a case fails (as authored)."""
+    from renderer.builtin import resolve_scene
+    from renderer.context import make_context, release_context
+    from renderer.extremes import all_pass, extreme_scenes, measure_extremes, write_report
+    from renderer.scene_file import load_scene
+    extra = [resolve_scene(arg) for arg in args.scenes]
+    for path in extra:
+        load_scene(path)                     # a bad extra scene: its one line before any work
+    kinds = ("egl", "osmesa") if args.context == "both" else (args.context,)
+    contexts = {}
+    try:
+        for kind in kinds:
+            contexts[kind] = make_context(kind)
+        cases = measure_extremes(extreme_scenes(extra), args.size, contexts)
+    finally:
+        for ctx in contexts.values():
+            release_context(ctx)
+    json_path, md_path = write_report(args.out, cases, args.size)
+    for case in cases:
+        state = "refused" if "refused" in case else ("pass" if case["passes"] else "FAIL")
+        if case.get("before"):
+            state = f"{state.lower()} (the 'before' of reversed-Z)"
+        print(f"{case['case']}: {state}")
+    print(f"wrote {json_path} and {md_path}")
+    return 0 if all_pass(cases) else 1
+
+
+COMMANDS = {"render": cmd_render, "compare": cmd_compare, "shaders": cmd_shaders, "scenes": cmd_scenes,
+            "extremes": cmd_extremes}
 
 
 def main(argv=None) -> int:

@@ -17,7 +17,11 @@ only where k_s > 0, back-face code only when two-sided), and an object wholly ou
 view volume is left out of the plan (renderer/visibility.py). `specialise=False` draws with
 the all-features build instead, for benchmarks/bench_specialisation.py; the images are the same.
 
-Uniform values are computed once, as bytes, from `Scene.matrices()` and the scene's lights
+A camera with `reversed_z` draws with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), depth
+cleared to 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
+frame puts GL's default back, so renderers sharing a context never see each other's.
+
+Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the scene's lights
 and materials, and `render()` only hands them to GL. After changing the scene (camera, lights,
 materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
 list of objects needs a new renderer.
@@ -35,6 +39,7 @@ import moderngl
 import numpy as np
 
 from renderer.context import activate, context_kind, gl_function, make_context, release_context
+from renderer.errors import ContextError
 from renderer.frame import Frame
 from renderer.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
 from renderer.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
@@ -42,6 +47,9 @@ from renderer.transforms import to_glsl
 from renderer.visibility import visible_objects
 
 GL_DITHER = 0x0BD0
+GL_LOWER_LEFT = 0x8CA1                   # glClipControl origin (GL's default)
+GL_NEGATIVE_ONE_TO_ONE = 0x935E          # glClipControl depth: GL's default, -w <= z <= w
+GL_ZERO_TO_ONE = 0x935F                  # reversed-Z: 0 <= z <= w and z_w = z_ndc
 GL_RENDERBUFFER = 0x8D41
 GL_RENDERBUFFER_INTERNAL_FORMAT = 0x8D44
 GL_DEPTH_COMPONENT24 = 0x81A6
@@ -65,13 +73,14 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
                          light_slots: int | None = None) -> dict[str, bytes]:
     """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
     A light array is absent when the scene has no light of that kind (nor does the shader).
+    Positions (eye, point lights) are camera-relative, as the model matrices are.
     `light_slots` is for the all-features build: arrays of that size (the slots past the
     scene's lights are zeros, never read) and the counts as uniforms."""
     directional, point = scene.directional_lights, scene.point_lights
     values = {
         "u_view": to_glsl(matrices.view),
         "u_projection": to_glsl(matrices.projection),
-        "u_eye": _vec3s(scene.camera.eye),
+        "u_eye": _vec3s(matrices.relative(scene.camera.eye)),
         "u_ambient": _vec3s(scene.ambient),
     }
     if light_slots is not None:
@@ -93,7 +102,7 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
         values["u_directional_direction"] = array("directional", [l.direction for l in directional])
         values["u_directional_intensity"] = array("directional", [l.intensity for l in directional])
     if slots["point"]:
-        values["u_point_position"] = array("point", [l.position for l in point])
+        values["u_point_position"] = array("point", [matrices.relative(l.position) for l in point])
         values["u_point_intensity"] = array("point", [l.intensity for l in point])
         values["u_point_attenuation"] = array("point", [l.attenuation for l in point])
     return values
@@ -184,6 +193,8 @@ class GpuRenderer:
             activate(self.ctx)
             self._check_size()
             self._glDisable = gl_function(self.ctx, "glDisable", None, ctypes.c_uint)
+            self._glClipControl = gl_function(self.ctx, "glClipControl", None, ctypes.c_uint,
+                                              ctypes.c_uint)
             self._build_targets()
             self._gl_info = self._query_gl_info()
             self._build_objects()
@@ -277,7 +288,8 @@ class GpuRenderer:
                          else [True] * len(self._objects))
         for item, object_matrices in zip(self._objects, matrices.objects):
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
-        self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width))
+        self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width),
+                                                    scene.camera.reversed_z)
         self._plans.clear()
 
     def _plan(self, linear: bool) -> list[_Draw]:
@@ -325,17 +337,25 @@ class GpuRenderer:
         plan = self._plan(linear)
         fbo.use()
         red, green, blue = self.scene.background
-        fbo.clear(red, green, blue, 0.0, depth=1.0)
-        ctx.depth_func = "<"
-        ctx.front_face = "ccw"
-        ctx.wireframe = False
-        for draw in plan:
-            ctx.enable_only(draw.enable)
-            if draw.cull_face:
-                ctx.cull_face = draw.cull_face
-            for uniform, data in draw.uploads:
-                uniform.write(data)
-            draw.vertex_array.render(moderngl.TRIANGLES)
+        reversed_z = self.scene.camera.reversed_z
+        # The context may be shared: set the clip control for this frame either way, and
+        # leave GL's default behind for whoever draws next.
+        self._clip_control(reversed_z)
+        try:
+            fbo.clear(red, green, blue, 0.0, depth=0.0 if reversed_z else 1.0)
+            ctx.depth_func = ">" if reversed_z else "<"
+            ctx.front_face = "ccw"
+            ctx.wireframe = False
+            for draw in plan:
+                ctx.enable_only(draw.enable)
+                if draw.cull_face:
+                    ctx.cull_face = draw.cull_face
+                for uniform, data in draw.uploads:
+                    uniform.write(data)
+                draw.vertex_array.render(moderngl.TRIANGLES)
+        finally:
+            if reversed_z:
+                self._clip_control(False)
 
         # GL returns rows bottom-up: read into staging arrays made once, then write each
         # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
@@ -348,6 +368,15 @@ class GpuRenderer:
             depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
         return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
                      gl_info=self._gl_info)
+
+    def _clip_control(self, reversed_z: bool) -> None:
+        """glClipControl: ZERO_TO_ONE depth for reversed-Z, GL's NEGATIVE_ONE_TO_ONE otherwise."""
+        if self._glClipControl is None:
+            if reversed_z:
+                raise ContextError("reversed_z needs glClipControl (OpenGL 4.5 or "
+                                   "ARB_clip_control), which this GL does not have")
+            return
+        self._glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE if reversed_z else GL_NEGATIVE_ONE_TO_ONE)
 
     def _read(self, fbo, attachment: int, dtype) -> np.ndarray:
         """The attachment's pixels, bottom row first, in a staging array reused every frame."""
@@ -446,23 +475,26 @@ def _flip_into(bottom_up: np.ndarray, out: np.ndarray | None) -> np.ndarray:
     return target
 
 
-def _depth_conversion(projection: np.ndarray, shape: tuple[int, int]):
+def _depth_conversion(projection: np.ndarray, shape: tuple[int, int], reversed_z: bool = False):
     """A function from window depth z_w (float32, any strides) to a C-contiguous array of
-    -z_eye (+inf where z_w == 1, the cleared value), for the projection matrix P of the frame;
-    the array is new unless a usable `out` is passed.
+    -z_eye (+inf where z_w is the cleared value: 1, or 0 with reversed-Z), for the projection
+    matrix P of the frame; the array is new unless a usable `out` is passed.
 
-    z_ndc = 2 z_w - 1. Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye, so
-    -z_eye = P23 / (P22 + z_ndc) = a / (z_w + b) with a = P23 / 2, b = (P22 - 1) / 2.
-    Parallel (P[3] = (0, 0, 0, 1)): z_ndc = P22 z_eye + P23, so -z_eye = s z_w + t.
-    b is split into a float32 head and tail so that z_w + b loses nothing where z_w is near 1
+    z_ndc = s z_w + t: (s, t) = (2, -1) for GL's default depth mapping, (1, 0) for reversed-Z
+    (glClipControl ZERO_TO_ONE). Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye,
+    so -z_eye = P23 / (P22 + z_ndc) = a / (z_w + b) with a = P23 / s, b = (P22 + t) / s.
+    Parallel (P[3] = (0, 0, 0, 1)): z_ndc = P22 z_eye + P23, so -z_eye = (s z_w + t - P23) / -P22.
+    b is split into a float32 head and tail so that z_w + b loses nothing where z_w is near -b
     (the head's sum with z_w is exact there, Sterbenz), giving float64-like accuracy in float32.
     """
     p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    s_ndc, t_ndc = (1.0, 0.0) if reversed_z else (2.0, -1.0)
+    cleared = 0.0 if reversed_z else 1.0
     mask = np.empty(shape, dtype=bool)                     # reused: no allocation per frame
     perspective = projection[3, 2] == -1.0 and projection[3, 3] == 0.0
     if perspective:
-        a = np.float32(p23 / 2.0)
-        b = (p22 - 1.0) / 2.0
+        a = np.float32(p23 / s_ndc)
+        b = (p22 + t_ndc) / s_ndc
         b_head = np.float32(b)
         b_tail = np.float32(b - float(b_head))
 
@@ -470,15 +502,15 @@ def _depth_conversion(projection: np.ndarray, shape: tuple[int, int]):
             out = np.add(window_depth, b_head, out=_usable(out, window_depth))
             out += b_tail
             np.divide(a, out, out=out)
-            np.copyto(out, np.inf, where=np.equal(window_depth, 1.0, out=mask))
+            np.copyto(out, np.inf, where=np.equal(window_depth, cleared, out=mask))
             return out
     else:
-        s = np.float32(-2.0 / p22)
-        t = np.float32((p23 + 1.0) / p22)
+        s = np.float32(-s_ndc / p22)
+        t = np.float32((p23 - t_ndc) / p22)
 
         def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
             out = np.multiply(window_depth, s, out=_usable(out, window_depth))
             out += t
-            np.copyto(out, np.inf, where=np.equal(window_depth, 1.0, out=mask))
+            np.copyto(out, np.inf, where=np.equal(window_depth, cleared, out=mask))
             return out
     return convert

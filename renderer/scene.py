@@ -33,14 +33,16 @@ class Camera:
     height: float = 2.0          # scene units, height of the view volume (parallel)
     near: float = 0.1            # scene units along the viewing axis
     far: float = 100.0
+    reversed_z: bool = False     # depth 1 at near, 0 at far (glClipControl ZERO_TO_ONE, GL_GREATER)
 
     def view(self) -> np.ndarray:
         return transforms.look_at(self.eye, self.look, self.up)
 
     def projection_matrix(self, aspect: float) -> np.ndarray:
         if self.projection == "perspective":
-            return transforms.perspective(math.radians(self.fov_y), aspect, self.near, self.far)
-        return transforms.orthographic(self.height, aspect, self.near, self.far)
+            return transforms.perspective(math.radians(self.fov_y), aspect, self.near, self.far,
+                                          self.reversed_z)
+        return transforms.orthographic(self.height, aspect, self.near, self.far, self.reversed_z)
 
 
 @dataclass
@@ -117,16 +119,27 @@ class PointLight:
 
 @dataclass
 class ObjectMatrices:
-    model: np.ndarray            # (4, 4) world matrix
-    normal: np.ndarray           # (3, 3) inverse-transpose of model's linear part
+    model: np.ndarray            # (4, 4) world matrix, camera-relative: T(-origin) M_world
+    normal: np.ndarray           # (3, 3) normal matrix of M_world (transforms.normal_matrix)
 
 
 @dataclass
 class FrameMatrices:
-    """Everything both pipelines need from the scene's geometry for one image size."""
+    """Everything both pipelines need from the scene's geometry for one image size.
+
+    Camera-relative coordinates (docs/conventions.md): world positions are handed to the
+    pipelines relative to `origin` (the eye), so that float32 keeps its precision near the
+    camera however far the scene lies from the world origin. `view` is then a rotation only;
+    the eye and point lights go through `relative()`.
+    """
     view: np.ndarray
     projection: np.ndarray
     objects: list[ObjectMatrices]
+    origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def relative(self, points) -> np.ndarray:
+        """World points (..., 3) relative to the origin, in float64."""
+        return np.asarray(points, dtype=np.float64) - self.origin
 
 
 @dataclass
@@ -158,11 +171,16 @@ class Scene:
         return [world(obj) for obj in self.objects]
 
     def matrices(self, width: int, height: int) -> FrameMatrices:
-        models = self.world_matrices()
+        """View, projection and per-object matrices, camera-relative (FrameMatrices), in float64."""
+        origin = np.asarray(self.camera.eye, dtype=np.float64)
+        to_origin = transforms.translate(*(-origin))
+        cam = self.camera
         return FrameMatrices(
-            view=self.camera.view(),
-            projection=self.camera.projection_matrix(width / height),
-            objects=[ObjectMatrices(m, transforms.normal_matrix(m)) for m in models],
+            view=transforms.look_at_rotation(cam.eye, cam.look, cam.up),
+            projection=cam.projection_matrix(width / height),
+            objects=[ObjectMatrices(to_origin @ m, transforms.normal_matrix(m))
+                     for m in self.world_matrices()],
+            origin=origin,
         )
 
     def shading_modes(self) -> list[str]:

@@ -36,7 +36,7 @@ LIGHT_TYPES = ("directional", "point")
 
 TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials", "lights",
             "objects")
-CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far")
+CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z")
 MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading")
 LIGHT_KEYS = {
     "directional": ("type", "direction", "intensity"),
@@ -60,8 +60,6 @@ PRIMITIVE_LIMITS = {
               "major_segments": (True, 3, MAX_SEGMENTS), "minor_segments": (True, 3, MAX_SEGMENTS)},
 }
 
-# Two directions closer to parallel than this (|sin| of the angle between them) are parallel.
-PARALLEL_TOLERANCE = 1e-6
 # A model matrix whose linear part has a determinant at or below this is refused.
 MIN_DETERMINANT = 1e-9
 
@@ -322,20 +320,16 @@ class _Reader:
             cam.near = self.number(raw["near"], key("near"))
         if "far" in raw:
             cam.far = self.number(raw["far"], key("far"))
+        if "reversed_z" in raw:
+            cam.reversed_z = self.boolean(raw["reversed_z"], key("reversed_z"))
 
         view = np.subtract(cam.eye, cam.look)
         if not np.any(view):
             self.fail(key("look"), f"is the same point as {key('eye')}; the camera needs "
                                    f"eye - look to be a direction")
-        up = np.asarray(cam.up)
-        if not np.any(up):
+        # Up parallel to the view is allowed: transforms.look_at falls back to another axis.
+        if not np.any(cam.up):
             self.fail(key("up"), "must not be zero length; up says which way is up in the image")
-        sine = np.linalg.norm(np.cross(view / np.linalg.norm(view), up / np.linalg.norm(up)))
-        if sine < PARALLEL_TOLERANCE:
-            given = "" if "up" in raw else " (the default)"
-            self.fail(key("up"), f"{_show_vec(up)}{given} is parallel to the view direction "
-                                 f"(eye - look = {_show_vec(view)}); up must point across "
-                                 f"the view")
         if cam.projection == "perspective" and cam.near <= 0:
             self.fail(key("near"), f"must be > 0 for a perspective camera, got {cam.near:g}")
         if cam.far <= cam.near:
@@ -355,7 +349,7 @@ class _Reader:
             if coefficient in raw:
                 setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
         if "n" in raw:
-            mat.n = self.number(raw["n"], _join(path, "n"), above=0.0)
+            mat.n = self.number(raw["n"], _join(path, "n"), minimum=0.0)
         if "two_sided" in raw:
             mat.two_sided = self.boolean(raw["two_sided"], _join(path, "two_sided"))
         if "shading" in raw:
@@ -431,11 +425,10 @@ class _Reader:
         t = Transform()
         if "scale" in raw:
             t.scale = self.vec3(raw["scale"], key("scale"), scalar_ok=True)
-            if min(t.scale) <= 0:
-                self.fail(key("scale"), f"must be > 0 in every component, got "
-                                        f"{_show_vec(t.scale)}: a zero "
-                                        f"scale makes the model matrix singular and a negative "
-                                        f"one turns the object inside out")
+            if min(t.scale) < 0:
+                self.fail(key("scale"), f"must be >= 0 in every component, got "
+                                        f"{_show_vec(t.scale)}: a negative scale turns the "
+                                        f"object inside out")
         if "shear" in raw:
             shear = self.table(raw["shear"], key("shear"), transforms.SHEAR_FACTORS)
             t.shear = {name: self.number(v, _join(key("shear"), name)) for name, v in shear.items()}

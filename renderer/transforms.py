@@ -71,54 +71,115 @@ def model_matrix(scale_xyz=(1.0, 1.0, 1.0), shear_factors=None,
 
 
 def normal_matrix(model: np.ndarray) -> np.ndarray:
-    """(3, 3) inverse-transpose of the model matrix's linear part: normals stay perpendicular
-    to surfaces under non-uniform scale and shear."""
-    return np.linalg.inv(model[:3, :3]).T
+    """(3, 3) normal matrix of the model matrix's linear part A: sign(det A) times the
+    cofactor matrix of A, scaled to the Frobenius norm of a rotation (sqrt 3).
+
+    The cofactor matrix equals det(A) A^-T, so where A is invertible this is A^-T up to a
+    positive factor (a rotation's is the rotation itself; normals are renormalised after it,
+    only directions matter), and unlike A^-T it is defined for a singular A (a zero scale):
+    a normal then keeps only its component across the flattened axis. The scaling, in
+    float64, keeps extreme non-uniform scales (1000 : 0.001) well inside float32 range.
+    A matrix of rank 1 or 0 (two axes flattened: nothing with area is drawn) gives zero.
+    """
+    a = np.asarray(model, dtype=np.float64)[:3, :3]
+    cofactor = np.cross(a[[1, 2, 0]], a[[2, 0, 1]])    # row i: a_j x a_k of A's rows, i j k cyclic
+    det = float(np.dot(a[0], cofactor[0]))
+    norm = np.linalg.norm(cofactor)
+    if norm == 0:
+        return cofactor
+    return cofactor * ((-1.0 if det < 0 else 1.0) * math.sqrt(3.0) / norm)
 
 
-def look_at(eye, look, up) -> np.ndarray:
-    """View matrix: eye to the origin, look - eye to -z, up (made perpendicular) to +y.
+# |forward x up| below this (unit vectors: the sine of the angle between them) means up is
+# parallel to the view direction, and look_at falls back to another up vector.
+PARALLEL_TOLERANCE = 1e-6
 
-    The notes' camera steps (translate eye to origin, align el with the z axis, align up
-    with +y) with GL's choice of looking down -z. The caller checks that up is not parallel
-    to the view direction (renderer/scene.py validates cameras).
+
+def fallback_up(forward: np.ndarray) -> np.ndarray:
+    """The up vector used when the given one is parallel to the view direction: the world
+    axis least aligned with `forward` (on a tie the later one: z before y before x)."""
+    alignment = np.abs(forward)
+    axis = 2 - int(np.argmin(alignment[::-1]))
+    return np.eye(3)[axis]
+
+
+def look_at_rotation(eye, look, up) -> np.ndarray:
+    """The rotation part of the view matrix: look - eye to -z, up (made perpendicular) to +y.
+
+    When up is zero or parallel to the view direction, `fallback_up(forward)` is used instead,
+    so that every camera with eye != look has a view (docs/conventions.md, "Camera").
     """
     eye, look, up = (np.asarray(v, dtype=float) for v in (eye, look, up))
     forward = look - eye
     forward = forward / np.linalg.norm(forward)
-    right = np.cross(forward, up)
+    up_length = np.linalg.norm(up)
+    right = np.cross(forward, up / up_length) if up_length > 0 else np.zeros(3)
+    if np.linalg.norm(right) < PARALLEL_TOLERANCE:
+        right = np.cross(forward, fallback_up(forward))
     right = right / np.linalg.norm(right)
     true_up = np.cross(right, forward)
     rotation = np.eye(4)
     rotation[0, :3] = right
     rotation[1, :3] = true_up
     rotation[2, :3] = -forward
-    return rotation @ translate(*(-eye))
+    return rotation
 
 
-def perspective(fov_y: float, aspect: float, near: float, far: float) -> np.ndarray:
+def look_at(eye, look, up) -> np.ndarray:
+    """View matrix: eye to the origin, look - eye to -z, up (made perpendicular) to +y.
+
+    The notes' camera steps (translate eye to origin, align el with the z axis, align up
+    with +y) with GL's choice of looking down -z. Up parallel to the view direction falls
+    back to `fallback_up` (see look_at_rotation).
+    """
+    return look_at_rotation(eye, look, up) @ translate(*(-np.asarray(eye, dtype=float)))
+
+
+def depth_row(near: float, far: float, *, perspective: bool, reversed_z: bool) -> np.ndarray:
+    """Row 2 of a projection matrix (z_clip from the eye-space point), with its depth mapping.
+
+    Standard (GL's): z_ndc = -1 at the near plane and +1 at the far plane, for the default
+    clip control (-w <= z <= w, z_w = (z_ndc + 1) / 2). Reversed-Z: z_ndc = 1 at near and
+    0 at far, for glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) (0 <= z <= w, z_w = z_ndc):
+    a float32 depth buffer then keeps about 1e-7 relative precision at every distance.
+    With perspective, w_clip = -z_eye; with a parallel projection, w_clip = 1.
+    """
+    n, f = float(near), float(far)
+    if perspective:
+        if reversed_z:                    # z_ndc = -(n z_eye + n f) / ((f - n) z_eye)
+            return np.array([0.0, 0.0, n / (f - n), f * n / (f - n)])
+        return np.array([0.0, 0.0, (f + n) / (n - f), 2 * f * n / (n - f)])
+    if reversed_z:
+        return np.array([0.0, 0.0, 1.0 / (f - n), f / (f - n)])
+    return np.array([0.0, 0.0, -2 / (f - n), -(f + n) / (f - n)])
+
+
+def perspective(fov_y: float, aspect: float, near: float, far: float,
+                reversed_z: bool = False) -> np.ndarray:
     """GL's perspective projection (gluPerspective); fov_y is the full vertical angle in radians.
 
     The notes' projection matrix maps (x, y, z) to (x d/z, y d/z); this is the same divide by
-    depth, with GL's -z viewing axis and depth mapped to [-1, 1] between near and far.
+    depth, with GL's -z viewing axis and depth mapped by `depth_row`.
     """
     f = 1.0 / math.tan(fov_y / 2.0)
     return np.array([
         [f / aspect, 0, 0, 0],
         [0, f, 0, 0],
-        [0, 0, (far + near) / (near - far), 2 * far * near / (near - far)],
+        depth_row(near, far, perspective=True, reversed_z=reversed_z),
         [0, 0, -1, 0],
     ], dtype=float)
 
 
-def orthographic(height: float, aspect: float, near: float, far: float) -> np.ndarray:
-    """GL's parallel projection (glOrtho) of a view volume `height` tall, `height*aspect` wide."""
+def orthographic(height: float, aspect: float, near: float, far: float,
+                 reversed_z: bool = False) -> np.ndarray:
+    """GL's parallel projection (glOrtho) of a view volume `height` tall, `height*aspect` wide;
+    depth mapped by `depth_row`."""
     half_h = height / 2.0
     half_w = half_h * aspect
     return np.array([
         [1 / half_w, 0, 0, 0],
         [0, 1 / half_h, 0, 0],
-        [0, 0, -2 / (far - near), -(far + near) / (far - near)],
+        depth_row(near, far, perspective=False, reversed_z=reversed_z),
         [0, 0, 0, 1],
     ], dtype=float)
 

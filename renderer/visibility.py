@@ -7,7 +7,8 @@ visible: the box's 8 corners are taken to clip space (p_clip = P V M p, float64)
 object is dropped only when all 8 lie outside one and the same clip plane (GL keeps
 -w <= x, y, z <= w, docs/conventions.md). Each plane's inequality is linear in clip
 coordinates, so when the corners fail it so does every point of the box, whatever w is
-(this holds for corners behind the eye too).
+(this holds for corners behind the eye too). Under reversed-Z the depth range is
+0 <= z <= w, inside -w <= z <= w, so the same planes stay conservative there.
 """
 
 from __future__ import annotations

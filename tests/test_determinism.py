@@ -9,8 +9,10 @@ each context and prints {"scene/context": sha256 of the frame's RGBA8 bytes} as 
 import functools
 import hashlib
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -27,6 +29,12 @@ REUSED_FRAMES = 5              # frames 0-4: one renderer, drawing again and aga
 FRESH_RENDERERS = 5            # frames 5-9: a new renderer (buffers, programs) for each
 WORKER_PROCESSES = 2
 WORKER_TIMEOUT_S = 120
+# The workers run this file as a script, so their sys.path starts at tests/, not at the
+# checkout: put the checkout first, so that they import the renderer this process tests
+# (not another copy installed in the environment, e.g. an editable install of another tree).
+REPO = Path(__file__).resolve().parents[1]
+WORKER_ENV = dict(os.environ, PYTHONPATH=os.pathsep.join(
+    filter(None, (str(REPO), os.environ.get("PYTHONPATH")))))
 
 
 @functools.lru_cache(maxsize=None)
@@ -102,7 +110,7 @@ def test_every_frame_of_a_scene_is_byte_identical(name, context_kind, gl_context
 def worker_digests():
     """The digests printed by WORKER_PROCESSES runs of this module as a script, started together."""
     workers = [subprocess.Popen([sys.executable, __file__], stdout=subprocess.PIPE,
-                                stderr=subprocess.PIPE, text=True)
+                                stderr=subprocess.PIPE, text=True, env=WORKER_ENV)
                for _ in range(WORKER_PROCESSES)]
     results = []
     try:

@@ -311,6 +311,23 @@ height = 3.0
     assert (scene.camera.projection, scene.camera.near, scene.camera.height) == ("parallel", -5.0, 3.0)
 
 
+def test_extreme_but_renderable_values_load(tmp_path):
+    """Up along the view (look_at's fallback), a zero scale (a singular model matrix, the
+    cofactor normal matrix), Phong exponent 0 and reversed-Z: allowed, see conventions.md."""
+    scene = load_scene(write(tmp_path, "x.toml", """
+[camera]
+eye = [0, 5, 0]
+reversed_z = true
+[[objects]]
+mesh = { primitive = "cube" }
+scale = [1, 0, 1]
+material = { n = 0 }
+"""))
+    assert scene.camera.up == (0.0, 1.0, 0.0) and scene.camera.reversed_z is True
+    assert scene.objects[0].transform.scale == (1.0, 0.0, 1.0)
+    assert scene.objects[0].material.n == 0.0
+
+
 def test_mesh_file_relative_to_the_scene_folder(tmp_path):
     (tmp_path / "meshes").mkdir()
     mesh_path = write(tmp_path / "meshes", "tri.obj", OBJ_TRIANGLE)
@@ -339,7 +356,7 @@ BAD_SCENES = [
     ("unknown top-level key", "objcts = []\n", "objcts: unknown key; did you mean 'objects'?"),
     ("unknown camera key", "[camera]\nfovy = 40\n", "camera.fovy: unknown key; did you mean 'fov_y'?"),
     ("unknown key, no close match", "[camera]\nzoom = 2\n",
-     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far"),
+     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far, reversed_z"),
     ("unknown inline material key", OBJECT + 'material = { kdd = [1, 0, 0] }\n',
      "objects[0].material.kdd: unknown key; did you mean 'kd'?"),
     ("unknown light key for its type", '[[lights]]\ntype = "directional"\nposition = [0, 1, 0]\n',
@@ -395,12 +412,8 @@ BAD_SCENES = [
     # the camera
     ("zero up", "[camera]\nup = [0, 0, 0]\n",
      "camera.up: must not be zero length; up says which way is up in the image"),
-    ("up parallel to the view", "[camera]\neye = [0, 5, 0]\nup = [0, -2, 0]\n",
-     "camera.up: [0, -2, 0] is parallel to the view direction (eye - look = [0, 5, 0]); "
-     "up must point across the view"),
-    ("default up parallel to the view", "[camera]\neye = [0, 5, 0]\n",
-     "camera.up: [0, 1, 0] (the default) is parallel to the view direction (eye - look = "
-     "[0, 5, 0]); up must point across the view"),
+    ("reversed_z as a string", '[camera]\nreversed_z = "yes"\n',
+     "camera.reversed_z: expected true or false, got a string ('yes')"),
     ("eye equals look", "[camera]\neye = [1, 2, 3]\nlook = [1, 2, 3]\n",
      "camera.look: is the same point as camera.eye; the camera needs eye - look to be a direction"),
     ("zero near", "[camera]\nnear = 0\n",
@@ -424,15 +437,9 @@ BAD_SCENES = [
     ("unknown projection", '[camera]\nprojection = "orthographic"\n',
      "camera.projection: unknown projection 'orthographic'; expected one of: perspective, parallel"),
     # transforms
-    ("zero scale", OBJECT + "scale = [1, 0, 1]\n",
-     "objects[0].scale: must be > 0 in every component, got [1, 0, 1]: a zero scale makes the "
-     "model matrix singular and a negative one turns the object inside out"),
-    ("zero uniform scale", OBJECT + "scale = 0\n",
-     "objects[0].scale: must be > 0 in every component, got [0, 0, 0]: a zero scale makes the "
-     "model matrix singular and a negative one turns the object inside out"),
     ("negative scale", OBJECT + "scale = [-1, 1, 1]\n",
-     "objects[0].scale: must be > 0 in every component, got [-1, 1, 1]: a zero scale makes the "
-     "model matrix singular and a negative one turns the object inside out"),
+     "objects[0].scale: must be >= 0 in every component, got [-1, 1, 1]: a negative scale turns "
+     "the object inside out"),
     ("singular shear", OBJECT + "shear = { xy = 1.0, yx = 1.0 }\n",
      "objects[0].shear: makes the model matrix singular: its determinant is 0; it must stay > 0"),
     ("mirroring shear", OBJECT + "shear = { xy = 2.0, yx = 1.0 }\n",
@@ -491,7 +498,7 @@ BAD_SCENES = [
      "objects[0].material.ka: must be >= 0 in every component, item 0 is -0.1"),
     ("negative ks", "[materials.m]\nks = [-1, 0, 0]\n",
      "materials.m.ks: must be >= 0 in every component, item 0 is -1"),
-    ("zero exponent", "[materials.m]\nn = 0\n", "materials.m.n: must be > 0, got 0"),
+    ("negative exponent", "[materials.m]\nn = -1\n", "materials.m.n: must be >= 0, got -1"),
     ("unknown shading", '[materials.red]\nshading = "smooth"\n',
      "materials.red.shading: unknown shading 'smooth'; expected one of: flat, gouraud, phong"),
     ("unknown inline shading", OBJECT + 'material = { shading = "phongg" }\n',

@@ -1,0 +1,283 @@
+"""Stiff and extreme cases (docs/conventions.md): a hand-checked case per rule, then every
+scene of assets/extreme/ through the GPU on EGL and OSMesa and through the reference:
+finite everywhere, and within the pipeline tolerance of tests/test_gpu_vs_reference.py."""
+
+import ctypes
+import functools
+import json
+import math
+import subprocess
+import sys
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+import reference
+from reference.clipping import clip_triangles
+from reference.depth_test import DepthBuffer
+from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero, specular_term
+from renderer import transforms as tf
+from renderer.compare import compare_frames, depth_tie_pixels
+from renderer.context import activate, gl_function
+from renderer.extremes import STABILITY, extreme_scenes, is_finite_frame, passes
+from renderer.gpu import GL_NEGATIVE_ONE_TO_ONE, GpuRenderer
+from renderer.primitives import plane
+from renderer.scene import Camera, Material, PointLight, Scene, SceneObject, Transform
+from renderer.scene_file import load_scene
+
+SIZE = (160, 120)
+REFUSED = ("nan_mesh",)
+RENDERED = sorted(name for name in extreme_scenes() if name not in REFUSED)
+GL_CLIP_DEPTH_MODE = 0x935D
+
+
+# -- reversed-Z -------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("projection", ("perspective", "parallel"))
+def test_reversed_projection_maps_near_to_1_and_far_to_0(projection):
+    near, far = 0.01, 1e6
+    for reversed_z, (at_near, at_far) in ((False, (-1.0, 1.0)), (True, (1.0, 0.0))):
+        camera = Camera(projection=projection, near=near, far=far, reversed_z=reversed_z)
+        p = camera.projection_matrix(4 / 3)
+        for distance, expected in ((near, at_near), (far, at_far)):
+            clip = p @ [0.0, 0.0, -distance, 1.0]
+            assert clip[2] / clip[3] == pytest.approx(expected, abs=1e-12)
+
+
+def test_reversed_z_clips_to_0_le_z_le_w():
+    # One triangle from behind the near plane (z > w) to beyond the far plane (z < 0).
+    triangle = np.array([[[0.0, 0.0, 2.0, 1.0], [0.5, 0.0, -1.0, 1.0], [0.0, 0.5, 0.5, 1.0]]])
+    clipped = clip_triangles(triangle, reversed_z=True).gl_Position
+    z, w = clipped[..., 2], clipped[..., 3]
+    assert len(clipped) and np.all(z >= -1e-12) and np.all(z <= w + 1e-12)
+    assert np.isclose(z, 0).any() and np.isclose(z, w).any()
+
+
+def test_reversed_depth_test_keeps_the_greater_window_depth_and_first_of_exact_ties():
+    depth = DepthBuffer(2, 1, reversed_z=True)
+    pixel = np.array([0, 0, 0, 1])
+    depth.test_and_write(pixel, np.array([0.3, 0.6, 0.6, 0.0]), np.arange(4),
+                         tag=np.array([10, 11, 12, 13]))
+    assert depth.payload["tag"][0] == 11                   # nearest is the greater z_w; 11 before 12
+    assert depth.payload_second["tag"][0] == 12            # the exact tie is the runner-up
+    assert list(depth.drawn) == [True, False]              # z_w = 0 fails GREATER against the clear 0
+    assert depth.depth_ties()[0]
+
+
+def test_reversed_z_depth_comes_back_as_the_distance(gl_contexts):
+    scene = Scene(camera=Camera(eye=(0, 0, 0), look=(0, 0, -1), near=1e-3, far=1e5, reversed_z=True),
+                  objects=[SceneObject("wall", plane(2000.0), transform=Transform(
+                      rotate=(90.0, 0.0, 0.0), translate=(0.0, 0.0, -777.0)))])
+    for ctx in gl_contexts.values():
+        with GpuRenderer(scene, 32, 24, context=ctx) as gpu:
+            depth = gpu.render().depth
+        assert np.allclose(depth, 777.0, rtol=1e-6)
+    assert np.allclose(reference.render(scene, 32, 24).depth, 777.0, rtol=1e-12)
+
+
+def _clip_depth_mode(ctx) -> int:
+    get = gl_function(ctx, "glGetIntegerv", None, ctypes.c_uint, ctypes.POINTER(ctypes.c_int))
+    value = ctypes.c_int(0)
+    get(GL_CLIP_DEPTH_MODE, ctypes.byref(value))
+    return value.value
+
+
+def test_clip_control_is_restored_for_whoever_draws_next(gl_contexts):
+    scene = load_scene(extreme_scenes()["depth_ratio_1e5"])
+    standard = replace(scene, camera=replace(scene.camera, reversed_z=False))
+    for ctx in gl_contexts.values():
+        with GpuRenderer(standard, 64, 48, context=ctx) as gpu:
+            before = gpu.render().rgba8
+        with GpuRenderer(scene, 64, 48, context=ctx) as gpu:
+            gpu.render()
+            activate(ctx)
+            assert _clip_depth_mode(ctx) == GL_NEGATIVE_ONE_TO_ONE
+        with GpuRenderer(standard, 64, 48, context=ctx) as gpu:
+            assert np.array_equal(gpu.render().rgba8, before)
+
+
+@pytest.mark.parametrize("name", ("depth_ratio_1e5", "depth_ratio_1e8"))
+def test_reversed_z_removes_the_depth_error_of_a_large_far_near_ratio(name, gl_contexts):
+    scene = load_scene(extreme_scenes()[name])
+    assert scene.camera.reversed_z                        # authored with the fix
+    standard = replace(scene, camera=replace(scene.camera, reversed_z=False))
+    figures = {}
+    for label, s in (("before", standard), ("after", scene)):
+        truth = reference.render(s, 64, 48)
+        with GpuRenderer(s, 64, 48, context=gl_contexts["egl"]) as gpu:
+            frame = gpu.render()
+        figures[label] = (compare_frames(frame.rgba8, truth.rgba8, frame.depth, truth.depth).depth_max_rel,
+                          depth_tie_pixels(truth))
+    (error_before, ties_before), (error_after, ties_after) = figures["before"], figures["after"]
+    assert error_before > 5e-4 and ties_before > 100     # decal and wall cannot be ordered
+    assert error_after < 1e-5 and ties_after == 0
+
+
+# -- camera-relative coordinates ----------------------------------------------------------------
+
+def test_matrices_are_camera_relative_and_compose_to_the_same_transform():
+    eye = (1e6, 1e6 + 2.0, 1e6 + 6.0)
+    scene = Scene(camera=Camera(eye=eye, look=(1e6, 1e6, 1e6)),
+                  objects=[SceneObject("o", plane(), transform=Transform(translate=(1e6, 1e6, 1e6)))],
+                  point_lights=[PointLight(position=(1e6 + 1.0, 1e6, 1e6))])
+    m = scene.matrices(64, 48)
+    assert np.array_equal(m.origin, eye)
+    assert np.array_equal(m.view[:3, 3], [0.0, 0.0, 0.0])               # a rotation only
+    world = scene.world_matrices()[0]
+    np.testing.assert_allclose(m.view @ m.objects[0].model, scene.camera.view() @ world, atol=1e-9)
+    assert np.array_equal(m.objects[0].model[:3, 3], [0.0, -2.0, -6.0])  # small: float32 keeps it
+    np.testing.assert_array_equal(m.relative([l.position for l in scene.point_lights]), [[1.0, -2.0, -6.0]])
+
+
+# -- normal matrix ------------------------------------------------------------------------------
+
+def test_normal_matrix_is_the_cofactor_matrix_and_defined_for_a_singular_model():
+    # scale(1, 1, 0) flattens z: the cofactor matrix is diag(0, 0, 1): normals keep only z.
+    n = tf.normal_matrix(tf.scale(1.0, 1.0, 0.0))
+    np.testing.assert_allclose(n / n[2, 2], np.diag([0.0, 0.0, 1.0]))
+    # invertible: a positive multiple of the inverse-transpose, mirrors included
+    for model in (tf.scale(1000.0, 1.0, 0.001), tf.scale(-2.0, 1.0, 1.0) @ tf.rotate_x(0.3)):
+        inverse_transpose = np.linalg.inv(model[:3, :3]).T
+        nonzero = inverse_transpose != 0
+        ratio = tf.normal_matrix(model)[nonzero] / inverse_transpose[nonzero]
+        assert np.all(ratio > 0) and np.allclose(ratio, ratio[0])
+        assert np.array_equal(tf.normal_matrix(model) == 0, ~nonzero)
+    # extreme scale: the float32 upload keeps every entry a normal float
+    assert np.all(np.abs(tf.normal_matrix(tf.scale(1000.0, 1.0, 0.001)).astype(np.float32)[np.diag_indices(3)]) > 1e-7)
+
+
+def test_a_zero_normal_stays_zero_and_lights_as_ambient():
+    assert np.array_equal(normalize_or_zero(np.zeros((1, 3))), np.zeros((1, 3)))
+    scene = Scene(ambient=(0.2, 0.2, 0.2), point_lights=[PointLight(position=(0, 1, 0))])
+    color = lighting(np.zeros((1, 3)), np.zeros((1, 3)), np.array([0.0, 0.0, 5.0]),
+                     MaterialUniforms.from_material(Material(ka=(1, 1, 1), ks=(1, 1, 1))),
+                     Lights.from_scene(scene))
+    np.testing.assert_allclose(color, [[0.2, 0.2, 0.2]])
+
+
+# -- look-at fallback ---------------------------------------------------------------------------
+
+@pytest.mark.parametrize("up", ((0, 1, 0), (0, -3, 0), (0, 1, 1e-9)))
+def test_look_at_along_up_falls_back_to_an_orthonormal_view(up):
+    view = tf.look_at((0, 6, 0), (0, 0, 0), up)
+    rotation = view[:3, :3]
+    np.testing.assert_allclose(rotation @ rotation.T, np.eye(3), atol=1e-12)
+    assert np.linalg.det(rotation) == pytest.approx(1.0)
+    np.testing.assert_allclose(view @ [0, 0, 0, 1], [0, 0, -6, 1], atol=1e-12)   # look on -z
+    # the fallback up is +z, the world axis least aligned with the view (ties: z first)
+    np.testing.assert_allclose(rotation @ [0, 0, 1], [0, 1, 0], atol=1e-12)
+
+
+def test_look_at_is_unchanged_away_from_the_fallback():
+    # eye on +z looking at the origin with up +y: the identity rotation, eye moved to 0
+    np.testing.assert_allclose(tf.look_at((0, 0, 5), (0, 0, 0), (0, 1, 0)), tf.translate(0, 0, -5))
+    # ties between world axes go to the later axis: looking along z, y (not x) is up
+    np.testing.assert_allclose(tf.fallback_up(np.array([0.0, 0.0, -1.0])), [0, 1, 0])
+
+
+# -- lighting -----------------------------------------------------------------------------------
+
+def test_specular_factor_for_exponents_0_1_and_10000():
+    n_dot_l = np.array([[1.0], [1.0], [1.0], [1.0], [0.0], [1.0]])
+    r_dot_v = np.array([[0.5], [1.0], [1e-30], [0.0], [0.7], [-0.2]])
+    expected = {0.0: [1, 1, 1, 0, 0, 0], 1.0: [0.5, 1, 1e-30, 0, 0, 0],
+                10000.0: [0.0, 1, 0, 0, 0, 0]}       # 0.5^10000 underflows to 0
+    for n, values in expected.items():
+        spec = specular_term(n_dot_l, r_dot_v, np.float64(n))
+        assert np.all(np.isfinite(spec))
+        np.testing.assert_allclose(spec[:, 0], values, rtol=1e-12, atol=0)
+
+
+def test_point_light_at_distance_0_is_fully_incident_with_attenuation_1_over_c():
+    c = 0.5
+    scene = Scene(ambient=(0.1, 0.1, 0.1),
+                  point_lights=[PointLight(position=(2.0, -1.0, 0.0), attenuation=(c, 3.0, 7.0))])
+    material = Material(ka=(1, 1, 1), kd=(0.8, 0.8, 0.8), ks=(0.5, 0.5, 0.5), n=10.0)
+    color = lighting(np.array([[2.0, -1.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]),
+                     np.array([2.0, 5.0, 0.0]), MaterialUniforms.from_material(material),
+                     Lights.from_scene(scene))
+    # L = N: N.L = 1, R = N, R.V = 1 (the eye straight above): I = 0.1 + (0.8 + 0.5) / c
+    np.testing.assert_allclose(color, [[0.1 + 1.3 / c] * 3])
+
+
+# -- every extreme scene through both pipelines ---------------------------------------------------
+
+@functools.lru_cache(maxsize=None)
+def extreme_scene(name):
+    return load_scene(extreme_scenes()[name])
+
+
+@functools.lru_cache(maxsize=None)
+def reference_frame(name):
+    return reference.render(extreme_scene(name), *SIZE, linear=True)
+
+
+def test_every_case_is_documented_and_there_are_at_least_14():
+    assert len(RENDERED) >= 14
+    assert set(extreme_scenes()) == set(STABILITY)
+
+
+@pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
+@pytest.mark.parametrize("name", RENDERED)
+def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts):
+    with GpuRenderer(extreme_scene(name), *SIZE, context=gl_contexts[context_kind]) as gpu:
+        frame = gpu.render(linear=True, depth=True)
+    expected = reference_frame(name)
+    assert is_finite_frame(frame) and is_finite_frame(expected)
+    figures = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
+                             reference_tie=expected.rgba8_tie).as_dict()
+    assert passes(figures), figures          # the pipeline tolerance (renderer/extremes.py)
+    assert (frame.rgba8[..., 3] == 255).mean() > 0.005        # something was drawn
+
+
+def test_the_pass_rule_is_the_pipeline_tolerance():
+    exact = {"mismatched_pixels": 0, "raw_mismatched_fraction": 0.001, "depth_max_rel": 1e-3}
+    assert passes(exact)
+    for key, over in (("mismatched_pixels", 1), ("raw_mismatched_fraction", 0.0011),
+                      ("depth_max_rel", 1.1e-3)):
+        assert not passes(exact | {key: over})
+
+
+def test_is_finite_frame_sees_nan_and_inf():
+    frame = reference_frame("singular_model")
+    broken = replace(frame, linear=frame.linear.copy())
+    broken.linear[0, 0, 0] = np.nan
+    assert not is_finite_frame(broken)
+    drawn = np.argwhere(frame.rgba8[..., 3] == 255)[0]
+    broken = replace(frame, depth=frame.depth.copy())
+    broken.depth[tuple(drawn)] = np.inf
+    assert not is_finite_frame(broken)
+
+
+# -- the command line -----------------------------------------------------------------------------
+
+def run(*args):
+    return subprocess.run([sys.executable, "-m", "renderer", *args], capture_output=True, text=True)
+
+
+def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path):
+    out = tmp_path / "x.png"
+    result = run("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
+    assert result.returncode == 2 and not out.exists()
+    [line] = result.stderr.strip().splitlines()
+    assert "nan_mesh.toml: objects[0].mesh.file:" in line
+    assert "vertex 2 is not finite (nan, 1, 0)" in line and "Traceback" not in result.stderr
+
+
+def test_renderer_extremes_writes_the_json_and_the_table(tmp_path):
+    result = run("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa")
+    assert result.returncode == 0, result.stdout + result.stderr
+    document = json.loads((tmp_path / "extremes.json").read_text())
+    table = (tmp_path / "extremes.md").read_text()
+    cases = {case["case"]: case for case in document["cases"]}
+    reversed_scenes = [n for n in RENDERED if extreme_scene(n).camera.reversed_z]
+    assert set(cases) == set(extreme_scenes()) | {f"{n} (reversed_z off)" for n in reversed_scenes}
+    for name, case in cases.items():
+        assert f"| {name} |" in table
+        if name in REFUSED:
+            assert "not finite" in case["refused"]
+        else:
+            assert all(case["finite"].values()) and set(case["finite"]) == {"osmesa", "reference"}
+            assert case["passes"] or case.get("before")
+    assert document["size"] == [64, 48] and math.isfinite(cases["far_from_origin"]["worst"]["rmse"])

@@ -32,7 +32,7 @@ from renderer.context import activate, context_kind, gl_function, make_context, 
 from renderer.frame import Frame
 from renderer.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
 from renderer.shaders import ProgramCache, ShaderVariant
-from renderer.transforms import to_glsl
+from renderer.transforms import jitter, to_glsl
 
 GL_DITHER = 0x0BD0
 GL_RENDERBUFFER = 0x8D41
@@ -93,12 +93,19 @@ def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
     return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])
 
 
-def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int) -> str:
+def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int,
+                     samples: int = 0) -> str:
     """Re-specify moderngl's 24-bit depth renderbuffer as DEPTH_COMPONENT32F where GL lets
-    us; returns the format in use."""
+    us (multisampled when `samples` > 0); returns the format in use."""
     c_uint, c_int = ctypes.c_uint, ctypes.c_int
     bind = gl_function(ctx, "glBindRenderbuffer", None, c_uint, c_uint)
-    storage = gl_function(ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
+    if samples:
+        multisample = gl_function(ctx, "glRenderbufferStorageMultisample", None,
+                                  c_uint, c_int, c_uint, c_int, c_int)
+        storage = None if multisample is None else (
+            lambda target, fmt, w, h: multisample(target, samples, fmt, w, h))
+    else:
+        storage = gl_function(ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
     query = gl_function(ctx, "glGetRenderbufferParameteriv", None, c_uint, c_uint,
                         ctypes.POINTER(c_int))
     if bind is None or storage is None or query is None:
@@ -150,6 +157,8 @@ class GpuRenderer:
         self._framebuffers: dict[bool, moderngl.Framebuffer] = {}
         self._plans: dict[bool, list[_Draw]] = {}
         self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
+        self._multisample: dict[int, moderngl.Framebuffer] = {}   # samples -> MSAA target
+        self._jittered: dict[bool, tuple] = {}           # plan -> sample offset its programs hold
         try:
             activate(self.ctx)
             self._check_size()
@@ -183,6 +192,22 @@ class GpuRenderer:
             linear = self.ctx.renderbuffer((self.width, self.height), 4, dtype="f4")  # RGBA32F
             self._renderbuffers.append(linear)
             fbo = self._framebuffers[True] = self.ctx.framebuffer([self._color, linear], self._depth)
+        return fbo
+
+    def _multisample_framebuffer(self, samples: int) -> moderngl.Framebuffer:
+        """An RGBA8 colour and float depth target with `samples` samples per pixel, made the
+        first time it is asked for; render() resolves it into the single-sample one."""
+        fbo = self._multisample.get(samples)
+        if fbo is None:
+            limit = self.max_samples
+            if not 1 < samples <= limit:
+                raise ValueError(f"samples must be 1 or 2 to {limit} (GL_MAX_SAMPLES), got {samples}")
+            size = (self.width, self.height)
+            color = self.ctx.renderbuffer(size, 4, samples=samples)
+            depth = self.ctx.depth_renderbuffer(size, samples=samples)
+            make_float_depth(self.ctx, depth, self.width, self.height, samples=samples)
+            self._renderbuffers += [color, depth]
+            fbo = self._multisample[samples] = self.ctx.framebuffer([color], depth)
         return fbo
 
     def _build_objects(self) -> None:
@@ -243,7 +268,9 @@ class GpuRenderer:
         for item, object_matrices in zip(self._objects, matrices.objects):
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
         self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width))
+        self._projection = matrices.projection
         self._plans.clear()
+        self._jittered.clear()
 
     def _plan(self, linear: bool) -> list[_Draw]:
         """The frame's draw calls; made once per update() for each kind of output."""
@@ -271,8 +298,15 @@ class GpuRenderer:
         return plan
 
     # -- rendering ---------------------------------------------------------------------------
-    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None) -> Frame:
+    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None,
+               sample_offset: tuple = (0.0, 0.0), samples: int = 1) -> Frame:
         """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked.
+
+        `sample_offset` (dx, dy) samples each pixel that far from its centre (pixels, GL window
+        coordinates; docs/conventions.md): only u_projection is uploaded again, as
+        transforms.jitter(dx, dy, W, H) @ P. `samples` > 1 draws with MSAA into a multisample
+        target (made once per sample count) resolved into rgba8; linear colour is then not
+        available, and depth is the resolved sample GL picks.
 
         Each frame's arrays are new unless `out` names an earlier frame of this renderer:
         then they are written into that frame's arrays, which a loop over many frames (a
@@ -286,11 +320,15 @@ class GpuRenderer:
         activate(ctx)
         if self._glDisable is not None:
             self._glDisable(GL_DITHER)              # unorm8 output must be the plain rounding
+        if samples > 1 and linear:
+            raise ValueError("linear colour is not available with MSAA (samples > 1)")
         fbo = self._linear_framebuffer() if linear else self._framebuffers[False]
         plan = self._plan(linear)
-        fbo.use()
+        self._set_sample_offset(linear, tuple(sample_offset))
+        target = self._multisample_framebuffer(samples) if samples > 1 else fbo
+        target.use()
         red, green, blue = self.scene.background
-        fbo.clear(red, green, blue, 0.0, depth=1.0)
+        target.clear(red, green, blue, 0.0, depth=1.0)
         ctx.depth_func = "<"
         ctx.front_face = "ccw"
         ctx.wireframe = False
@@ -301,6 +339,8 @@ class GpuRenderer:
             for uniform, data in draw.uploads:
                 uniform.write(data)
             draw.vertex_array.render(moderngl.TRIANGLES)
+        if target is not fbo:
+            ctx.copy_framebuffer(fbo, target)        # the MSAA resolve (glBlitFramebuffer)
 
         # GL returns rows bottom-up: read into staging arrays made once, then write each
         # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
@@ -313,6 +353,19 @@ class GpuRenderer:
             depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
         return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
                      gl_info=self._gl_info)
+
+    def _set_sample_offset(self, linear: bool, offset: tuple) -> None:
+        """Upload u_projection jittered for `offset` to the plan's programs, if they hold
+        another one (after _plan() they hold the unjittered projection)."""
+        if self._jittered.get(linear, (0.0, 0.0)) == offset:
+            return
+        data = to_glsl(jitter(*offset, self.width, self.height) @ self._projection)
+        for program in {id(d.vertex_array.program): d.vertex_array.program
+                        for d in self._plans[linear]}.values():
+            uniform = program.get("u_projection", None)
+            if uniform is not None:
+                uniform.write(data)
+        self._jittered[linear] = offset
 
     def _read(self, fbo, attachment: int, dtype) -> np.ndarray:
         """The attachment's pixels, bottom row first, in a staging array reused every frame."""
@@ -343,6 +396,11 @@ class GpuRenderer:
         return int(self.ctx.info["GL_SUBPIXEL_BITS"])
 
     @property
+    def max_samples(self) -> int:
+        """GL_MAX_SAMPLES: the most MSAA samples per pixel this context offers (4 on llvmpipe)."""
+        return int(self.ctx.info["GL_MAX_SAMPLES"])
+
+    @property
     def framebuffer(self) -> moderngl.Framebuffer:
         return self._framebuffers[False]
 
@@ -365,6 +423,8 @@ class GpuRenderer:
         self._plans.clear()
         try:
             activate(self.ctx)
+            for fbo in self._multisample.values():
+                fbo.release()
             for item in self._objects:
                 self._release_buffers(item)
             for fbo in self._framebuffers.values():
@@ -374,6 +434,7 @@ class GpuRenderer:
             self._programs.release()
         finally:
             self._objects, self._framebuffers, self._renderbuffers = [], {}, []
+            self._multisample = {}
             if self._owns_context:
                 release_context(self.ctx)
 

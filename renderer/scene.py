@@ -64,6 +64,10 @@ class Mesh:
     normals: np.ndarray
     faces: np.ndarray
     source: str = ""             # where it came from, for messages
+    # How a primitive was made: (name in renderer.primitives.PRIMITIVES, its arguments), so
+    # that it can be rebuilt at another tessellation (renderer/tessellation.py); None for
+    # mesh files.
+    recipe: tuple[str, dict] | None = None
 
     @property
     def triangle_count(self) -> int:
@@ -151,11 +155,16 @@ class Scene:
 
         return [world(obj) for obj in self.objects]
 
-    def matrices(self, width: int, height: int) -> FrameMatrices:
+    def matrices(self, width: int, height: int, sample_offset=(0.0, 0.0)) -> FrameMatrices:
+        """`sample_offset` (dx, dy): where in each pixel to sample, in pixels from its centre
+        (GL window coordinates); the projection becomes transforms.jitter(dx, dy, W, H) @ P."""
         models = self.world_matrices()
+        projection = self.camera.projection_matrix(width / height)
+        if tuple(sample_offset) != (0.0, 0.0):
+            projection = transforms.jitter(*sample_offset, width, height) @ projection
         return FrameMatrices(
             view=self.camera.view(),
-            projection=self.camera.projection_matrix(width / height),
+            projection=projection,
             objects=[ObjectMatrices(m, transforms.normal_matrix(m)) for m in models],
         )
 

@@ -39,6 +39,9 @@ GL_RENDERBUFFER = 0x8D41
 GL_RENDERBUFFER_INTERNAL_FORMAT = 0x8D44
 GL_DEPTH_COMPONENT24 = 0x81A6
 GL_DEPTH_COMPONENT32F = 0x8CAC
+GL_RGBA8 = 0x8058
+GL_SAMPLES = 0x80A9
+GL_NUM_SAMPLE_COUNTS = 0x9380
 DEPTH_FORMAT_NAMES = {GL_DEPTH_COMPONENT24: "DEPTH_COMPONENT24",
                       GL_DEPTH_COMPONENT32F: "DEPTH_COMPONENT32F"}
 
@@ -117,6 +120,23 @@ def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: in
     query(GL_RENDERBUFFER, GL_RENDERBUFFER_INTERNAL_FORMAT, ctypes.byref(value))
     bind(GL_RENDERBUFFER, 0)
     return DEPTH_FORMAT_NAMES.get(value.value, hex(value.value))
+
+
+def multisample_counts(ctx: moderngl.Context) -> list[int]:
+    """The MSAA sample counts GL offers for an RGBA8 colour buffer, ascending, 1 included
+    (glGetInternalformativ GL_SAMPLES; llvmpipe offers only 4: a request for 2 gets 4)."""
+    c_uint, c_int = ctypes.c_uint, ctypes.c_int
+    query = gl_function(ctx, "glGetInternalformativ", None, c_uint, c_uint, c_uint, c_int,
+                        ctypes.POINTER(c_int))
+    if query is None:
+        return [1]
+    count = c_int(0)
+    activate(ctx)
+    query(GL_RENDERBUFFER, GL_RGBA8, GL_NUM_SAMPLE_COUNTS, 1, ctypes.byref(count))
+    values = (c_int * max(count.value, 1))()
+    query(GL_RENDERBUFFER, GL_RGBA8, GL_SAMPLES, len(values), values)
+    limit = int(ctx.info["GL_MAX_SAMPLES"])
+    return sorted({1, *(v for v in values[:count.value] if 1 < v <= limit)})
 
 
 @dataclass
@@ -199,9 +219,10 @@ class GpuRenderer:
         first time it is asked for; render() resolves it into the single-sample one."""
         fbo = self._multisample.get(samples)
         if fbo is None:
-            limit = self.max_samples
-            if not 1 < samples <= limit:
-                raise ValueError(f"samples must be 1 or 2 to {limit} (GL_MAX_SAMPLES), got {samples}")
+            offered = self.sample_counts
+            if samples not in offered:
+                raise ValueError(f"this GL offers MSAA with {', '.join(map(str, offered))} "
+                                 f"samples per pixel, not {samples}")
             size = (self.width, self.height)
             color = self.ctx.renderbuffer(size, 4, samples=samples)
             depth = self.ctx.depth_renderbuffer(size, samples=samples)
@@ -399,6 +420,11 @@ class GpuRenderer:
     def max_samples(self) -> int:
         """GL_MAX_SAMPLES: the most MSAA samples per pixel this context offers (4 on llvmpipe)."""
         return int(self.ctx.info["GL_MAX_SAMPLES"])
+
+    @property
+    def sample_counts(self) -> list[int]:
+        """The MSAA sample counts render(samples=...) can use: multisample_counts(ctx)."""
+        return multisample_counts(self.ctx)
 
     @property
     def framebuffer(self) -> moderngl.Framebuffer:

@@ -43,7 +43,7 @@ from renderer.tessellation import FINEST, LEVELS, scene_at_level
 
 DEFAULT_SIZE = (160, 120)
 QUICK_SIZE = (64, 48)
-QUICK_SCENES = ("flat_shading", "sphere")
+QUICK_SCENES = ("flat_shading", "gouraud_vs_phong")
 TARGET_RMSE = 0.01                   # the error the "cheapest setting" must reach (~2.5/255)
 MISMATCH_LEVELS = 2                  # of 255: a pixel further off than this is mismatched
 BASE_SAMPLES = 4                     # regular grid for the knobs other than antialiasing
@@ -184,6 +184,7 @@ class ReportResult:
     rows: list = field(default_factory=list)
     seconds: float = 0.0
     truth_hits: int = 0
+    triangles: dict = field(default_factory=dict)     # scene -> (authored, at the finest level)
     gl_renderer: str = ""
     files: list = field(default_factory=list)
 
@@ -218,6 +219,9 @@ def run_report(scenes: list, out: Path, *, quick: bool = False, size=None, cache
                 bar.set_description(f"{scene.name}: ground truth")
                 truth, hit = ground_truth(scene, width, height, cache_dir)
                 result.truth_hits += hit
+                result.triangles[scene.name] = tuple(
+                    sum(obj.mesh.triangle_count for obj in drawn.objects)
+                    for drawn in (scene, truth_scene(scene)))
                 bar.update()
                 run = SceneRun(scene, width, height, ctx)
                 try:

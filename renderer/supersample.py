@@ -26,9 +26,14 @@ Pass = Callable[[tuple], np.ndarray]          # (dx, dy) -> (H, W, 3) linear col
 
 
 def gpu_pass(gpu) -> Pass:
-    """Passes through a GpuRenderer: only u_projection changes between them."""
+    """Passes through a GpuRenderer: only u_projection changes between them, and each pass
+    reads back into the previous pass's arrays (so a pass's result is valid until the next)."""
+    frame = None
+
     def render(offset) -> np.ndarray:
-        return gpu.render(linear=True, depth=False, sample_offset=tuple(offset)).linear[..., :3]
+        nonlocal frame
+        frame = gpu.render(linear=True, depth=False, sample_offset=tuple(offset), out=frame)
+        return frame.linear[..., :3]
     return render
 
 

@@ -9,10 +9,14 @@ array per object, and a single-sample framebuffer with an RGBA8 colour buffer an
 float depth buffer (DEPTH_COMPONENT32F, so the stored depth is the rasteriser's float z_w with
 no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-specified through
 glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
-variants that write it, are made the first time `render(linear=True)` asks for them.
+variants that write it, are made the first time `render(linear=True)` asks for them; so are
+the multisample targets of `render(samples=N)` (RGBA8 colour and DEPTH_COMPONENT32F depth
+through glRenderbufferStorageMultisample, one pair per sample count, resolved into the
+single-sample framebuffer by a blit).
 
 Uniform values are computed once, as bytes, from `Scene.matrices()` and the scene's lights
-and materials, and `render()` only hands them to GL. After changing the scene (camera, lights,
+and materials, and `render()` only hands them to GL; a pass at a sample offset
+(`render(sample_offset=(dx, dy))`, docs/conventions.md) uploads u_projection alone again. After changing the scene (camera, lights,
 materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
 list of objects needs a new renderer.
 Conventions (matrices, window, depth, colour, lighting): docs/conventions.md.

@@ -8,14 +8,18 @@ import io
 import math
 import os
 import platform
+import time
 from collections import defaultdict
+from dataclasses import dataclass
 
 import numpy as np
 
 from renderer import sampling
 
 BACKENDS = ("gpu", "reference")
-MARKERS = {"gpu": "o", "reference": "s"}
+STYLES = {"gpu": ("o", "-"), "reference": ("s", "--")}          # marker, line per backend
+COLOURS = {name: f"C{i}" for i, name in
+           enumerate(("regular", "random", "jittered", "poisson", "adaptive", "msaa"))}
 
 
 def csv_text(rows: list[dict]) -> str:
@@ -61,9 +65,15 @@ def plot_png(rows: list[dict], title: str) -> bytes:
             series[series_key(row)].append(row)
     for index, (name, members) in enumerate(series.items()):
         members.sort(key=lambda r: (r["samples"], r["median_ms"]))
-        axes.plot([r["median_ms"] for r in members], [r["rmse"] for r in members],
-                  marker=MARKERS.get(members[0]["backend"], "o"), markersize=4,
-                  linewidth=1, color=f"C{index % 10}", label=name)
+        first = members[0]
+        marker, line = STYLES[first["backend"]]
+        colour = COLOURS[first["pattern"]] if first["knob"] == "antialiasing" else f"C{index}"
+        axes.plot([r["median_ms"] for r in members], [r["rmse"] for r in members], marker=marker,
+                  linestyle=line, markersize=4, linewidth=1, color=colour, label=name)
+        if first["knob"] != "antialiasing":              # few points: name each one
+            for r in members:
+                axes.annotate(r["setting"], (r["median_ms"], r["rmse"]), fontsize=6,
+                              xytext=(4, -8), textcoords="offset points", color=colour)
     points = [row for members in series.values() for row in members]
     front = [points[i] for i in pareto_front([(r["median_ms"], r["rmse"]) for r in points])]
     if front:
@@ -71,7 +81,7 @@ def plot_png(rows: list[dict], title: str) -> bytes:
                   color="black", linestyle="--", linewidth=0.8)
         axes.scatter([r["median_ms"] for r in front], [r["rmse"] for r in front], s=90,
                      facecolors="none", edgecolors="black", label="Pareto front", zorder=3)
-        for r in front:
+        for r in front if front[0]["knob"] == "antialiasing" else ():
             axes.annotate(f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r["rmse"]),
                           fontsize=6, xytext=(4, 3), textcoords="offset points")
     axes.set_xscale("log")
@@ -86,9 +96,22 @@ def plot_png(rows: list[dict], title: str) -> bytes:
     return buffer.getvalue()
 
 
+@dataclass
+class Slope:
+    """A pattern's convergence on one backend: log RMSE against log N."""
+    slope: float                     # least squares over all scenes, each its own intercept
+    points: int
+    samples: tuple                   # (smallest N, largest N)
+    per_scene: list                  # each scene's own least-squares slope
+
+
+def _fit(x: np.ndarray, y: np.ndarray) -> float:
+    """Least-squares slope of already centred data."""
+    return float(np.sum(x * y) / np.sum(x * x))
+
+
 def convergence_slopes(rows: list[dict]) -> dict:
-    """(pattern, backend) -> (slope, points, smallest N, largest N): the least-squares slope
-    of log RMSE against log N over all scenes, each scene with its own intercept."""
+    """(pattern, backend) -> Slope, for the anti-aliasing rows of each sampling pattern."""
     slopes = {}
     for pattern in sampling.PATTERNS:
         for backend in BACKENDS:
@@ -96,20 +119,16 @@ def convergence_slopes(rows: list[dict]) -> dict:
             for row in rows:
                 if (row["knob"], row["pattern"], row["backend"]) == ("antialiasing", pattern, backend) \
                         and row["rmse"] > 0:
-                    by_scene[row["scene"]].append((math.log(row["samples"]), math.log(row["rmse"])))
-            x, y = [], []
+                    by_scene[row["scene"]].append((row["samples"], math.log(row["rmse"])))
+            centred = []
             for points in by_scene.values():
-                if len(points) > 1:
-                    px, py = np.array(points).T
-                    x.append(px - px.mean())
-                    y.append(py - py.mean())
-            if not x:
-                continue
-            x, y = np.concatenate(x), np.concatenate(y)
-            if np.sum(x * x) > 0:
-                n = [r["samples"] for r in rows if r["knob"] == "antialiasing" and r["pattern"] == pattern]
-                slopes[(pattern, backend)] = (float(np.sum(x * y) / np.sum(x * x)), len(x),
-                                              int(min(n)), int(max(n)))
+                n, log_rmse = np.array(points).T
+                if np.ptp(n) > 0:
+                    centred.append((np.log(n) - np.log(n).mean(), log_rmse - log_rmse.mean(), n))
+            if centred:
+                x, y, n = (np.concatenate(parts) for parts in zip(*centred))
+                slopes[(pattern, backend)] = Slope(_fit(x, y), len(x), (int(n.min()), int(n.max())),
+                                                   [_fit(cx, cy) for cx, cy, _ in centred])
     return slopes
 
 
@@ -132,7 +151,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     lines = [
         "# Error against run time",
         "",
-        f"Generated by `renderer report{' --quick' if quick else ''}` at {width}x{height} pixels "
+        f"Generated by `renderer report{' --quick' if quick else ''}` on "
+        f"{time.strftime('%Y-%m-%d', time.gmtime())} at {width}x{height} pixels "
         f"on {platform.machine()} with {os.cpu_count()} CPUs, GL renderer `{result.gl_renderer}`; "
         f"{len(scenes)} scene(s), {len(rows)} rows, {result.seconds / 60:.1f} minutes "
         f"({result.truth_hits} ground truth(s) from the cache). Every time is the median of "
@@ -181,14 +201,19 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "Least-squares slope of log RMSE against log N (samples per pixel) over all scenes, each "
         "scene with its own intercept, beside the textbook rate (Mitchell 1996). The textbook "
         "rates are asymptotic and for edge pixels; a scene's RMSE also holds smooth shading, "
-        "which every pattern resolves at N = 1 already, and the fitted range starts at N = 1.",
+        "which every pattern resolves at N = 1 already, and the fitted range starts at N = 1. "
+        "Each N is one realisation of its pattern (fixed seeds; at N = 1 random, jittered and "
+        "Poisson are the same single uniform sample), so a slope carries that pattern's noise.",
         "",
-        "| pattern | backend | fitted slope | points | N range | textbook | why |",
-        "| --- | --- | ---: | ---: | --- | --- | --- |",
+        "| pattern | backend | fitted slope | per scene: median (range) | points | N | textbook | why |",
+        "| --- | --- | ---: | --- | ---: | --- | --- | --- |",
     ]
-    for (pattern, backend), (slope, count, low, high) in convergence_slopes(rows).items():
+    for (pattern, backend), fit in convergence_slopes(rows).items():
         rate, why = TEXTBOOK_SLOPES[pattern]
-        lines.append(f"| {pattern} | {backend} | {slope:.2f} | {count} | {low}-{high} | {rate} | {why} |")
+        spread = (f"{np.median(fit.per_scene):.2f} ({min(fit.per_scene):.2f} to "
+                  f"{max(fit.per_scene):.2f})")
+        lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread} | {fit.points} | "
+                     f"{fit.samples[0]}-{fit.samples[1]} | {rate} | {why} |")
     lines += [
         "",
         f"## Cheapest setting reaching RMSE <= {TARGET_RMSE:g} (about {TARGET_RMSE * 255:.1f}/255)",

@@ -57,8 +57,9 @@ def test_convergence_slope_is_fitted_across_scenes_with_their_own_intercepts():
     rows = [{"scene": scene, "knob": "antialiasing", "pattern": "random", "backend": "gpu",
              "samples": n, "rmse": scale * n ** -0.5}
             for scene, scale in (("a", 0.1), ("b", 0.02)) for n in (1, 4, 16, 64)]
-    slope, points, low, high = convergence_slopes(rows)[("random", "gpu")]
-    assert slope == pytest.approx(-0.5) and (points, low, high) == (8, 1, 64)
+    fit = convergence_slopes(rows)[("random", "gpu")]
+    assert fit.slope == pytest.approx(-0.5) and fit.points == 8 and fit.samples == (1, 64)
+    assert fit.per_scene == pytest.approx([-0.5, -0.5])
 
 
 def test_every_knob_runs_on_its_backends():
@@ -69,7 +70,7 @@ def test_every_knob_runs_on_its_backends():
                         ("shading", "gpu"), ("shading", "reference"), ("precision", "reference")}
     assert {s.setting for s in plan if s.pattern == "msaa"} == {"msaa 1", "msaa 4"}
     assert {s.setting for s in plan if s.pattern == "regular" and s.knob == "antialiasing"} == \
-        {"regular 1", "regular 4", "regular 16"}                     # the squares only
+        {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
 
 
 def test_report_command_writes_csv_plots_and_markdown(tmp_path):

@@ -65,11 +65,12 @@ def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, 
 
 
 def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: int = SUBPIXEL_BITS,
-           linear: bool = False, depth: bool = True) -> Frame:
-    """Render `scene` at width x height with the NumPy reference pipeline."""
+           linear: bool = False, depth: bool = True, sample_offset=(0.0, 0.0)) -> Frame:
+    """Render `scene` at width x height with the NumPy reference pipeline, each pixel sampled
+    at `sample_offset` (dx, dy) pixels from its centre (Scene.matrices)."""
     start = time.perf_counter()
     dtype = np.dtype(dtype)
-    frame_matrices = scene.matrices(width, height)
+    frame_matrices = scene.matrices(width, height, sample_offset)
     # Camera-relative positions, as the GPU gets them (renderer.scene.FrameMatrices).
     lights = Lights.from_scene(scene, dtype, origin=frame_matrices.origin)
     eye = frame_matrices.relative(scene.camera.eye).astype(dtype)

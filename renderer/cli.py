@@ -1,4 +1,5 @@
-"""The command line: `renderer render | compare | shaders | scenes | extremes` (also `python -m renderer`).
+"""The command line: `renderer render | compare | shaders | report | scenes | extremes`
+(also `python -m renderer`).
 
 A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
 with nothing written; a bug keeps its traceback.
@@ -62,6 +63,21 @@ def build_parser() -> argparse.ArgumentParser:
     shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
     shaders.add_argument("--out", type=Path, help="folder for VARIANT.vert/.geom/.frag "
                                                    "(default: shaders-SCENE_NAME)")
+
+    report = sub.add_parser("report", help="error against run time over quality settings "
+                                           "(results.csv, plots, report.md)")
+    report.add_argument("scenes", nargs="*", metavar="SCENE",
+                        help="scene files or built-in names (default: every built-in scene; "
+                             "with --quick, two small ones)")
+    report.add_argument("--out", type=Path, required=True, help="folder for the report")
+    report.add_argument("--quick", action="store_true",
+                        help="a reduced sweep at 64x48 that takes about a minute (for CI)")
+    report.add_argument("--size", type=parse_size, metavar="WxH",
+                        help="image size (default 160x120; 64x48 with --quick)")
+    report.add_argument("--cache", type=Path, metavar="DIR",
+                        help="ground-truth cache (default ~/.cache/checked-renderer/truth)")
+    report.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
+                        help="headless GL context (default: EGL, then OSMesa)")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -156,6 +172,18 @@ def cmd_shaders(args) -> int:
     return 0
 
 
+def cmd_report(args) -> int:
+    from renderer.builtin import builtin_scenes
+    from renderer.report import QUICK_SCENES, run_report
+    names = args.scenes or (list(QUICK_SCENES) if args.quick else list(builtin_scenes()))
+    scenes = [_load(name) for name in names]
+    result = run_report(scenes, args.out, quick=args.quick, size=args.size, cache_dir=args.cache,
+                        context_kind=args.context)
+    print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "
+          f"{len(result.files) - 2} plots in {result.seconds:.0f} s")
+    return 0
+
+
 def cmd_scenes(args) -> int:
     from renderer.builtin import builtin_scenes, describe
     for name in builtin_scenes():
@@ -191,8 +219,8 @@ def cmd_extremes(args) -> int:
     return 0 if all_pass(cases) else 1
 
 
-COMMANDS = {"render": cmd_render, "compare": cmd_compare, "shaders": cmd_shaders, "scenes": cmd_scenes,
-            "extremes": cmd_extremes}
+COMMANDS = {"render": cmd_render, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
+            "scenes": cmd_scenes, "extremes": cmd_extremes}
 
 
 def main(argv=None) -> int:

@@ -9,7 +9,10 @@ array per object, and a single-sample framebuffer with an RGBA8 colour buffer an
 float depth buffer (DEPTH_COMPONENT32F, so the stored depth is the rasteriser's float z_w with
 no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-specified through
 glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
-variants that write it, are made the first time `render(linear=True)` asks for them.
+variants that write it, are made the first time `render(linear=True)` asks for them; so are
+the multisample targets of `render(samples=N)` (RGBA8 colour and DEPTH_COMPONENT32F depth
+through glRenderbufferStorageMultisample, one pair per sample count, resolved into the
+single-sample framebuffer by a blit).
 
 Each frame is planned from its scene: a program per material is specialised to what that
 material and the scene use (renderer/shaders.py: light counts as constants, the specular term
@@ -21,8 +24,10 @@ A camera with `reversed_z` draws with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ON
 cleared to 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
 frame puts GL's default back, so renderers sharing a context never see each other's.
 
-Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the scene's lights
-and materials, and `render()` only hands them to GL. After changing the scene (camera, lights,
+Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the
+scene's lights and materials, and `render()` only hands them to GL; a pass at a sample offset
+(`render(sample_offset=(dx, dy))`, docs/conventions.md) uploads u_projection alone again.
+After changing the scene (camera, lights,
 materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
 list of objects needs a new renderer.
 Conventions (matrices, window, depth, colour, lighting): docs/conventions.md.
@@ -43,7 +48,7 @@ from renderer.errors import ContextError
 from renderer.frame import Frame
 from renderer.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
 from renderer.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
-from renderer.transforms import to_glsl
+from renderer.transforms import jitter, to_glsl
 from renderer.visibility import visible_objects
 
 GL_DITHER = 0x0BD0
@@ -54,6 +59,9 @@ GL_RENDERBUFFER = 0x8D41
 GL_RENDERBUFFER_INTERNAL_FORMAT = 0x8D44
 GL_DEPTH_COMPONENT24 = 0x81A6
 GL_DEPTH_COMPONENT32F = 0x8CAC
+GL_RGBA8 = 0x8058
+GL_SAMPLES = 0x80A9
+GL_NUM_SAMPLE_COUNTS = 0x9380
 DEPTH_FORMAT_NAMES = {GL_DEPTH_COMPONENT24: "DEPTH_COMPONENT24",
                       GL_DEPTH_COMPONENT32F: "DEPTH_COMPONENT32F"}
 
@@ -130,12 +138,19 @@ def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
     return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])
 
 
-def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int) -> str:
+def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int,
+                     samples: int = 0) -> str:
     """Re-specify moderngl's 24-bit depth renderbuffer as DEPTH_COMPONENT32F where GL lets
-    us; returns the format in use."""
+    us (multisampled when `samples` > 0); returns the format in use."""
     c_uint, c_int = ctypes.c_uint, ctypes.c_int
     bind = gl_function(ctx, "glBindRenderbuffer", None, c_uint, c_uint)
-    storage = gl_function(ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
+    if samples:
+        multisample = gl_function(ctx, "glRenderbufferStorageMultisample", None,
+                                  c_uint, c_int, c_uint, c_int, c_int)
+        storage = None if multisample is None else (
+            lambda target, fmt, w, h: multisample(target, samples, fmt, w, h))
+    else:
+        storage = gl_function(ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
     query = gl_function(ctx, "glGetRenderbufferParameteriv", None, c_uint, c_uint,
                         ctypes.POINTER(c_int))
     if bind is None or storage is None or query is None:
@@ -147,6 +162,23 @@ def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: in
     query(GL_RENDERBUFFER, GL_RENDERBUFFER_INTERNAL_FORMAT, ctypes.byref(value))
     bind(GL_RENDERBUFFER, 0)
     return DEPTH_FORMAT_NAMES.get(value.value, hex(value.value))
+
+
+def multisample_counts(ctx: moderngl.Context) -> list[int]:
+    """The MSAA sample counts GL offers for an RGBA8 colour buffer, ascending, 1 included
+    (glGetInternalformativ GL_SAMPLES; llvmpipe offers only 4: a request for 2 gets 4)."""
+    c_uint, c_int = ctypes.c_uint, ctypes.c_int
+    query = gl_function(ctx, "glGetInternalformativ", None, c_uint, c_uint, c_uint, c_int,
+                        ctypes.POINTER(c_int))
+    if query is None:
+        return [1]
+    count = c_int(0)
+    activate(ctx)
+    query(GL_RENDERBUFFER, GL_RGBA8, GL_NUM_SAMPLE_COUNTS, 1, ctypes.byref(count))
+    values = (c_int * max(count.value, 1))()
+    query(GL_RENDERBUFFER, GL_RGBA8, GL_SAMPLES, len(values), values)
+    limit = int(ctx.info["GL_MAX_SAMPLES"])
+    return sorted({1, *(v for v in values[:count.value] if 1 < v <= limit)})
 
 
 @dataclass
@@ -189,6 +221,8 @@ class GpuRenderer:
         self._framebuffers: dict[bool, moderngl.Framebuffer] = {}
         self._plans: dict[bool, list[_Draw]] = {}
         self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
+        self._multisample: dict[int, moderngl.Framebuffer] = {}   # samples -> MSAA target
+        self._jittered: dict[bool, tuple] = {}           # plan -> sample offset its programs hold
         try:
             activate(self.ctx)
             self._check_size()
@@ -224,6 +258,23 @@ class GpuRenderer:
             linear = self.ctx.renderbuffer((self.width, self.height), 4, dtype="f4")  # RGBA32F
             self._renderbuffers.append(linear)
             fbo = self._framebuffers[True] = self.ctx.framebuffer([self._color, linear], self._depth)
+        return fbo
+
+    def _multisample_framebuffer(self, samples: int) -> moderngl.Framebuffer:
+        """An RGBA8 colour and float depth target with `samples` samples per pixel, made the
+        first time it is asked for; render() resolves it into the single-sample one."""
+        fbo = self._multisample.get(samples)
+        if fbo is None:
+            offered = self.sample_counts
+            if samples not in offered:
+                raise ValueError(f"this GL offers MSAA with {', '.join(map(str, offered))} "
+                                 f"samples per pixel, not {samples}")
+            size = (self.width, self.height)
+            color = self.ctx.renderbuffer(size, 4, samples=samples)
+            depth = self.ctx.depth_renderbuffer(size, samples=samples)
+            make_float_depth(self.ctx, depth, self.width, self.height, samples=samples)
+            self._renderbuffers += [color, depth]
+            fbo = self._multisample[samples] = self.ctx.framebuffer([color], depth)
         return fbo
 
     def _build_objects(self) -> None:
@@ -290,7 +341,9 @@ class GpuRenderer:
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
         self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width),
                                                     scene.camera.reversed_z)
+        self._projection = matrices.projection
         self._plans.clear()
+        self._jittered.clear()
 
     def _plan(self, linear: bool) -> list[_Draw]:
         """The frame's draw calls; made once per update() for each kind of output."""
@@ -318,8 +371,15 @@ class GpuRenderer:
         return plan
 
     # -- rendering ---------------------------------------------------------------------------
-    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None) -> Frame:
+    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None,
+               sample_offset: tuple = (0.0, 0.0), samples: int = 1) -> Frame:
         """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked.
+
+        `sample_offset` (dx, dy) samples each pixel that far from its centre (pixels, GL window
+        coordinates; docs/conventions.md): only u_projection is uploaded again, as
+        transforms.jitter(dx, dy, W, H) @ P. `samples` > 1 draws with MSAA into a multisample
+        target (made once per sample count) resolved into rgba8; linear colour is then not
+        available, and depth is the resolved sample GL picks.
 
         Each frame's arrays are new unless `out` names an earlier frame of this renderer:
         then they are written into that frame's arrays, which a loop over many frames (a
@@ -333,16 +393,20 @@ class GpuRenderer:
         activate(ctx)
         if self._glDisable is not None:
             self._glDisable(GL_DITHER)              # unorm8 output must be the plain rounding
+        if samples > 1 and linear:
+            raise ValueError("linear colour is not available with MSAA (samples > 1)")
         fbo = self._linear_framebuffer() if linear else self._framebuffers[False]
         plan = self._plan(linear)
-        fbo.use()
+        self._set_sample_offset(linear, tuple(sample_offset))
+        target = self._multisample_framebuffer(samples) if samples > 1 else fbo
+        target.use()
         red, green, blue = self.scene.background
         reversed_z = self.scene.camera.reversed_z
         # The context may be shared: set the clip control for this frame either way, and
         # leave GL's default behind for whoever draws next.
         self._clip_control(reversed_z)
         try:
-            fbo.clear(red, green, blue, 0.0, depth=0.0 if reversed_z else 1.0)
+            target.clear(red, green, blue, 0.0, depth=0.0 if reversed_z else 1.0)
             ctx.depth_func = ">" if reversed_z else "<"
             ctx.front_face = "ccw"
             ctx.wireframe = False
@@ -353,6 +417,8 @@ class GpuRenderer:
                 for uniform, data in draw.uploads:
                     uniform.write(data)
                 draw.vertex_array.render(moderngl.TRIANGLES)
+            if target is not fbo:
+                ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
         finally:
             if reversed_z:
                 self._clip_control(False)
@@ -377,6 +443,19 @@ class GpuRenderer:
                                    "ARB_clip_control), which this GL does not have")
             return
         self._glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE if reversed_z else GL_NEGATIVE_ONE_TO_ONE)
+
+    def _set_sample_offset(self, linear: bool, offset: tuple) -> None:
+        """Upload u_projection jittered for `offset` to the plan's programs, if they hold
+        another one (after _plan() they hold the unjittered projection)."""
+        if self._jittered.get(linear, (0.0, 0.0)) == offset:
+            return
+        data = to_glsl(jitter(*offset, self.width, self.height) @ self._projection)
+        for program in {id(d.vertex_array.program): d.vertex_array.program
+                        for d in self._plans[linear]}.values():
+            uniform = program.get("u_projection", None)
+            if uniform is not None:
+                uniform.write(data)
+        self._jittered[linear] = offset
 
     def _read(self, fbo, attachment: int, dtype) -> np.ndarray:
         """The attachment's pixels, bottom row first, in a staging array reused every frame."""
@@ -405,6 +484,16 @@ class GpuRenderer:
     def subpixel_bits(self) -> int:
         """GL_SUBPIXEL_BITS: vertices snap to 1 / 2^bits of a pixel (8 on llvmpipe)."""
         return int(self.ctx.info["GL_SUBPIXEL_BITS"])
+
+    @property
+    def max_samples(self) -> int:
+        """GL_MAX_SAMPLES: the most MSAA samples per pixel this context offers (4 on llvmpipe)."""
+        return int(self.ctx.info["GL_MAX_SAMPLES"])
+
+    @property
+    def sample_counts(self) -> list[int]:
+        """The MSAA sample counts render(samples=...) can use: multisample_counts(ctx)."""
+        return multisample_counts(self.ctx)
 
     @property
     def framebuffer(self) -> moderngl.Framebuffer:
@@ -436,6 +525,8 @@ class GpuRenderer:
         self._plans.clear()
         try:
             activate(self.ctx)
+            for fbo in self._multisample.values():
+                fbo.release()
             for item in self._objects:
                 self._release_buffers(item)
             for fbo in self._framebuffers.values():
@@ -445,6 +536,7 @@ class GpuRenderer:
             self._programs.release()
         finally:
             self._objects, self._framebuffers, self._renderbuffers = [], {}, []
+            self._multisample = {}
             if self._owns_context:
                 release_context(self.ctx)
 

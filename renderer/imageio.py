@@ -41,7 +41,11 @@ def write_npy(path, array: np.ndarray) -> None:
 
 
 def write_text(path, text: str) -> None:
-    _atomic_write(path, lambda handle: handle.write(text.encode()))
+    write_bytes(path, text.encode())
+
+
+def write_bytes(path, data: bytes) -> None:
+    _atomic_write(path, lambda handle: handle.write(data))
 
 
 def read_png(path) -> np.ndarray:

@@ -72,6 +72,10 @@ class Mesh:
     normals: np.ndarray
     faces: np.ndarray
     source: str = ""             # where it came from, for messages
+    # How a primitive was made: (name in renderer.primitives.PRIMITIVES, its arguments), so
+    # that it can be rebuilt at another tessellation (renderer/tessellation.py); None for
+    # mesh files.
+    recipe: tuple[str, dict] | None = None
 
     @property
     def triangle_count(self) -> int:
@@ -170,14 +174,19 @@ class Scene:
 
         return [world(obj) for obj in self.objects]
 
-    def matrices(self, width: int, height: int) -> FrameMatrices:
-        """View, projection and per-object matrices, camera-relative (FrameMatrices), in float64."""
+    def matrices(self, width: int, height: int, sample_offset=(0.0, 0.0)) -> FrameMatrices:
+        """View, projection and per-object matrices, camera-relative (FrameMatrices), in float64.
+        `sample_offset` (dx, dy): where in each pixel to sample, in pixels from its centre
+        (GL window coordinates); the projection becomes transforms.jitter(dx, dy, W, H) @ P."""
         origin = np.asarray(self.camera.eye, dtype=np.float64)
         to_origin = transforms.translate(*(-origin))
         cam = self.camera
+        projection = cam.projection_matrix(width / height)
+        if tuple(sample_offset) != (0.0, 0.0):
+            projection = transforms.jitter(*sample_offset, width, height) @ projection
         return FrameMatrices(
             view=transforms.look_at_rotation(cam.eye, cam.look, cam.up),
-            projection=cam.projection_matrix(width / height),
+            projection=projection,
             objects=[ObjectMatrices(to_origin @ m, transforms.normal_matrix(m))
                      for m in self.world_matrices()],
             origin=origin,

@@ -479,6 +479,7 @@ class _Reader:
         mesh = build(**kwargs)
         if mesh.triangle_count == 0:
             self.fail(path, "the primitive has no triangles with these arguments")
+        mesh.recipe = (name, kwargs)
         return mesh
 
     def mesh_file(self, value: Any, path: str) -> Mesh:

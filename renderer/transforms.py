@@ -184,6 +184,18 @@ def orthographic(height: float, aspect: float, near: float, far: float,
     ], dtype=float)
 
 
+def jitter(dx: float, dy: float, width: int, height: int) -> np.ndarray:
+    """The projection jitter J for a sample offset (dx, dy) pixels from the pixel centre, in
+    GL window coordinates (x right, y up): J P samples pixel (i, j) at (i + 0.5 + dx,
+    j + 0.5 + dy) of the image P gives. J is the clip-space translation
+    x -= (2 dx / W) w, y -= (2 dy / H) w, i.e. the image moves by (-dx, -dy) pixels
+    (docs/conventions.md, "Sample positions")."""
+    m = np.eye(4)
+    m[0, 3] = -2.0 * dx / width
+    m[1, 3] = -2.0 * dy / height
+    return m
+
+
 def to_glsl(m: np.ndarray) -> bytes:
     """Bytes for a GLSL matN uniform (column-major float32), so GLSL `M * v` equals `M @ v`."""
     return np.ascontiguousarray(np.asarray(m, dtype=np.float64).T, dtype=np.float32).tobytes()

@@ -9,7 +9,6 @@ in one run (the renderer and the bare program alternate frame by frame).
 
 from __future__ import annotations
 
-import argparse
 import statistics
 import time
 
@@ -18,13 +17,14 @@ import numpy as np
 import reference
 from renderer import transforms
 from renderer.builtin import builtin_scenes
-from renderer.cli import parse_size
 from renderer.context import activate, make_context
 from renderer.gpu import GpuRenderer, make_float_depth, uniform_values
 from renderer.primitives import icosphere
 from renderer.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject
 from renderer.scene_file import load_scene
 from renderer.shaders import program_source
+
+from common import arguments          # benchmarks/common.py
 
 
 def sphere_scene() -> Scene:
@@ -122,11 +122,7 @@ def bench_overhead(ctx, size, frames):
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=parse_size, default=(640, 480))
-    parser.add_argument("--frames", type=int, default=30)
-    parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
-    args = parser.parse_args()
+    args = arguments(__doc__, "frames", 30)
     ctx = make_context(args.context)
     print(f"GL: {ctx.info['GL_RENDERER']} | {ctx.info['GL_VERSION']} | context {args.context}")
     bench_overhead(ctx, args.size, args.frames)

@@ -16,19 +16,19 @@ geometric mean of the ratios. Not a test: this machine is shared and noisy.
 
 from __future__ import annotations
 
-import argparse
 import math
 import statistics
 
 import numpy as np
 
 from renderer.builtin import builtin_scenes
-from renderer.cli import parse_size
 from renderer.context import make_context
 from renderer.gpu import GpuRenderer
 from renderer.primitives import icosphere
 from renderer.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
 from renderer.scene_file import load_scene
+
+from common import arguments          # benchmarks/common.py
 
 
 def crowd_scene() -> Scene:
@@ -67,11 +67,7 @@ def measure(ctx, scene: Scene, size, rounds: int) -> dict:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--size", type=parse_size, default=(640, 480))
-    parser.add_argument("--rounds", type=int, default=15)
-    parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
-    args = parser.parse_args()
+    args = arguments(__doc__, "rounds", 15)
     ctx = make_context(args.context)
     info = ctx.info
     print(f"{info['GL_RENDERER']} | {args.context} | {args.size[0]}x{args.size[1]} | "

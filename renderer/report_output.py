@@ -142,8 +142,35 @@ def _ms(value: float) -> str:
     return f"{value:.3g}"
 
 
+def _cheapest_section(rows: list[dict], scenes: list[str], target: float) -> list[str]:
+    """The markdown lines naming, per scene and backend, the cheapest setting reaching `target`."""
+    lines = [
+        "",
+        f"## Cheapest setting reaching RMSE <= {target:g} (about {target * 255:.1f}/255)",
+        "",
+        "The fastest setting (median time per image) whose RMSE against the ground truth is at "
+        "most the target, first over every knob's settings, then among the anti-aliasing "
+        "settings alone (which draw the truth's geometry and shading).",
+        "",
+    ]
+    for title, knob in (("Any knob", None), ("Anti-aliasing only", "antialiasing")):
+        lines += [f"{title}:", "",
+                  "| scene | GPU | ms | RMSE | reference | ms | RMSE |",
+                  "| --- | --- | ---: | ---: | --- | ---: | ---: |"]
+        for scene in scenes:
+            cells = [scene]
+            for backend in BACKENDS:
+                best = cheapest([r for r in rows if knob in (None, r["knob"])], scene, backend, target)
+                cells += (["none reaches it", "", ""] if best is None else
+                          [f"{best['knob']}: {best['setting']}", _ms(best["median_ms"]),
+                           f"{best['rmse']:.4f}"])
+            lines.append("| " + " | ".join(cells) + " |")
+        lines.append("")
+    return lines
+
+
 def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
-    from renderer.report import BASE_SAMPLES, MISMATCH_LEVELS, TARGET_RMSE, TEXTBOOK_SLOPES
+    from renderer.report import BASE_SAMPLES, MISMATCH_LEVELS, TARGETS_RMSE, TEXTBOOK_SLOPES
     from renderer.ground_truth import TRUTH_GRID
     rows = result.rows
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
@@ -214,29 +241,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
                   f"{max(fit.per_scene):.2f})")
         lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread} | {fit.points} | "
                      f"{fit.samples[0]}-{fit.samples[1]} | {rate} | {why} |")
-    lines += [
-        "",
-        f"## Cheapest setting reaching RMSE <= {TARGET_RMSE:g} (about {TARGET_RMSE * 255:.1f}/255)",
-        "",
-        "The fastest setting (median time per image) whose RMSE against the ground truth is at "
-        "most the target, first over every knob's settings, then among the anti-aliasing "
-        "settings alone (which draw the truth's geometry and shading).",
-        "",
-    ]
-    for title, knob in (("Any knob", None), ("Anti-aliasing only", "antialiasing")):
-        lines += [f"{title}:", "",
-                  "| scene | GPU | ms | RMSE | reference | ms | RMSE |",
-                  "| --- | --- | ---: | ---: | --- | ---: | ---: |"]
-        for scene in scenes:
-            cells = [scene]
-            for backend in BACKENDS:
-                best = cheapest([r for r in rows if knob in (None, r["knob"])], scene, backend,
-                                TARGET_RMSE)
-                cells += (["none reaches it", "", ""] if best is None else
-                          [f"{best['knob']}: {best['setting']}", _ms(best["median_ms"]),
-                           f"{best['rmse']:.4f}"])
-            lines.append("| " + " | ".join(cells) + " |")
-        lines.append("")
+    for target in TARGETS_RMSE:
+        lines += _cheapest_section(rows, scenes, target)
     lines += ["## Plots", "",
               "RMSE against the median time per image, log-log; circled points joined by the "
               "dashed staircase are the Pareto front (no other setting is both faster and more "

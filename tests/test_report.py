@@ -96,7 +96,8 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path):
     assert all((out / "plots" / name).read_bytes().startswith(b"\x89PNG") for name in plots)
     report = (out / "report.md").read_text()
     for heading in ("# Error against run time", "## Method", "## Convergence of the sampling patterns",
-                    "## Cheapest setting reaching RMSE", "## Plots"):
+                    "## Cheapest setting reaching RMSE <= 0.01 ", "## Cheapest setting reaching RMSE <= 0.003 ",
+                    "## Plots"):
         assert heading in report
     for name in plots:
         assert f"](plots/{name})" in report

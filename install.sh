@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")"
 
-packages=(libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6)
+packages=(libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 libgl1 libglx-mesa0 libx11-6 xvfb xdotool)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

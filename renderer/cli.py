@@ -1,4 +1,4 @@
-"""The command line: `renderer render | compare | shaders | report | scenes | extremes`
+"""The command line: `renderer render | view | compare | shaders | report | scenes | extremes`
 (also `python -m renderer`).
 
 A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
@@ -30,6 +30,16 @@ def parse_size(text: str) -> tuple[int, int]:
     return width, height
 
 
+def positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a whole number of at least 1, got {text!r}")
+    return value
+
+
 class _Parser(argparse.ArgumentParser):
     def error(self, message):          # argparse's own two-line usage + message, but exit 2 anyway
         raise UserError(f"{self.prog}: {message}")
@@ -52,6 +62,27 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
     render.add_argument("--depth", type=Path, metavar="OUT.npy",
                         help="also write camera-space depth (float32, +inf where empty)")
+
+    view = sub.add_parser("view", help="open a scene in a window (glfw): orbit, pan, zoom, "
+                                       "switch shading, compare with the reference; H for help")
+    view.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
+    view.add_argument("--size", type=parse_size, default=DEFAULT_SIZE, metavar="WxH",
+                      help="window size in pixels (default 640x480)")
+    view.add_argument("--frames", type=positive_int, metavar="N",
+                      help="scripted: render N frames, save --screenshot, print frame-time "
+                           "statistics and exit")
+    view.add_argument("--screenshot", type=Path, metavar="OUT.png",
+                      help="with --frames: what the window shows after the last frame; "
+                           "otherwise the file the S key writes (default view-SCENE-NNN.png)")
+    view.add_argument("--stats", type=Path, metavar="OUT.json",
+                      help="with --frames: also write the frame-time statistics as JSON")
+    view.add_argument("--orbit", type=float, default=0.0, metavar="DEGREES_PER_FRAME",
+                      help="turn the camera about its look point every frame")
+    view.add_argument("--reference", choices=("off", "side-by-side", "difference"), default="off",
+                      help="start with the reference view shown (the C key cycles it)")
+    view.add_argument("--triple-buffering", action="store_true",
+                      help="start with triple buffering (the B key toggles it)")
+    view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
 
     compare = sub.add_parser("compare", help="render through the GPU and the reference and compare")
     common(compare)
@@ -123,6 +154,33 @@ def cmd_render(args) -> int:
     if args.depth:
         write_npy(args.depth, frame.depth)
     print(f"wrote {output} ({args.size[0]}x{args.size[1]}, {args.backend}, {frame.milliseconds:.1f} ms)")
+    return 0
+
+
+def cmd_view(args) -> int:
+    """The window viewer (renderer/viewer.py); without a display, one line and status 2."""
+    from renderer.imageio import write_text
+    from renderer.reference_view import figures_line
+    from renderer.viewer import Viewer
+    scene = _load(args.scene)
+    if args.frames is None and args.stats is not None:
+        raise UserError("renderer view: --stats needs --frames (the scripted mode)")
+    scripted = args.frames is not None
+    with Viewer(scene, *args.size, vsync=not args.no_vsync,
+                buffering=3 if args.triple_buffering else 2, reference=args.reference,
+                screenshot=None if scripted else args.screenshot) as viewer:
+        if not scripted:
+            print(f"renderer view: {scene.name}; H for help, Esc to quit")
+        stats = viewer.run(args.frames, args.orbit, args.screenshot if scripted else None)
+        figures = viewer.figures
+    if scripted:
+        if args.stats is not None:
+            write_text(args.stats, json.dumps(stats.summary() | {"reference": figures}, indent=1))
+        print(stats.line())
+        if figures is not None:
+            print(figures_line(figures))
+        if args.screenshot is not None:
+            print(f"wrote {args.screenshot}")
     return 0
 
 
@@ -219,7 +277,7 @@ def cmd_extremes(args) -> int:
     return 0 if all_pass(cases) else 1
 
 
-COMMANDS = {"render": cmd_render, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
+COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
             "scenes": cmd_scenes, "extremes": cmd_extremes}
 
 

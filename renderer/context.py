@@ -1,7 +1,7 @@
 """Headless OpenGL contexts for moderngl: EGL (glcontext) or OSMesa (renderer/osmesa.py).
 
     ctx = make_context("auto")        # EGL if it starts, else OSMesa; ContextError if neither
-    context_kind(ctx)                 # "egl", "osmesa", or "external" for a context made elsewhere
+    context_kind(ctx)                 # "egl", "osmesa", "window" (adopt_context), or "external"
     activate(ctx)                     # make ctx current before drawing with it
     release_context(ctx)
 
@@ -48,6 +48,7 @@ class _EglBinding:
             raise RuntimeError("glcontext made an EGL context that is not current")
 
     def make_current(self) -> None:
+        _release_window()
         # Unbind first: libglvnd skips a make-current of the context it thinks is current,
         # which would leave Mesa's dispatch pointing at an OSMesa context.
         self._egl.eglMakeCurrent(self.display, None, None, None)
@@ -72,6 +73,7 @@ class _OSMesaBinding:
         self.loader = loader
 
     def make_current(self) -> None:
+        _release_window()
         if not self.loader.make_current():
             raise ContextError("OSMesaMakeCurrent failed for the renderer's OSMesa context")
 
@@ -83,6 +85,61 @@ class _OSMesaBinding:
 
     def after_release(self) -> None:
         pass                              # the loader's release() unbound and destroyed it
+
+
+class _WindowBinding:
+    """A context a window library made (renderer/window.py: glfw, so GLX here), adopted so
+    that activate() and gl_function() treat it like ours.
+
+    libglvnd lets one thread have a current context of one API only: an EGL context cannot
+    be made current while a GLX one is (eglMakeCurrent fails), nor the reverse. So binding
+    this context first releases any current EGL context, and binding or making one of ours
+    first releases this one (_release_window). glfw's own record of the current context
+    does not see EGL or OSMesa take over, so every activate() binds again, release first,
+    as for EGL."""
+    kind = "window"
+
+    def __init__(self, make_current, release, get_proc_address):
+        self._make_current, self._release = make_current, release
+        self._get_proc_address = get_proc_address
+
+    def make_current(self) -> None:
+        global _current_window
+        _release_egl()
+        self._release()
+        self._make_current()
+        _current_window = self
+
+    def release_current(self) -> None:
+        global _current_window
+        self._release()
+        _current_window = None
+
+    def needs_binding(self) -> bool:
+        return True
+
+    def get_proc_address(self, name: str) -> int:
+        return self._get_proc_address(name) or 0
+
+    def after_release(self) -> None:
+        self.release_current()            # the window library destroys it with the window
+
+
+_current_window: _WindowBinding | None = None
+
+
+def _release_window() -> None:
+    """Before an EGL or OSMesa context is made or bound: release a current window context."""
+    if _current_window is not None:
+        _current_window.release_current()
+
+
+def _release_egl() -> None:
+    """Before a window context is bound: release a current EGL context, if EGL is loaded."""
+    if _egl_library is not None:
+        display = _egl_library.eglGetCurrentDisplay()
+        if display:
+            _egl_library.eglMakeCurrent(display, None, None, None)
 
 
 _bindings: "weakref.WeakKeyDictionary[moderngl.Context, object]" = weakref.WeakKeyDictionary()
@@ -111,6 +168,7 @@ def _one_line(exc: BaseException) -> str:
 
 
 def _make_egl() -> moderngl.Context:
+    _release_window()
     ctx = moderngl.create_standalone_context(require=REQUIRED_GL, backend="egl")
     try:
         _bindings[ctx] = _EglBinding()
@@ -121,6 +179,7 @@ def _make_egl() -> moderngl.Context:
 
 
 def _make_osmesa() -> moderngl.Context:
+    _release_window()
     loader = OSMesaLoader()
     try:
         ctx = moderngl.create_context(require=REQUIRED_GL, standalone=True, context=loader)
@@ -155,8 +214,19 @@ def make_context(kind: str = "auto") -> moderngl.Context:
                        f"could be made ({'; '.join(failures)}); install the Debian packages {hint}")
 
 
+def adopt_context(ctx: moderngl.Context, make_current, release, get_proc_address) -> None:
+    """Treat `ctx`, made and made current by a window library, as one of ours (kind "window"):
+    `make_current()`, `release()` (no context current) and `get_proc_address(name) -> int`
+    are that library's (glfw.make_context_current(window), glfw.make_context_current(None),
+    glfw.get_proc_address)."""
+    global _current_window
+    binding = _bindings[ctx] = _WindowBinding(make_current, release, get_proc_address)
+    _current_window = binding
+
+
 def context_kind(ctx: moderngl.Context) -> str:
-    """"egl" or "osmesa" for a context from make_context(), "external" for any other."""
+    """"egl" or "osmesa" for a context from make_context(), "window" for one adopted from a
+    window library (adopt_context), "external" for any other."""
     binding = _bindings.get(ctx)
     return binding.kind if binding is not None else "external"
 

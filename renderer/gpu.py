@@ -212,6 +212,7 @@ class GpuRenderer:
         self.scene = scene
         self.width, self.height = int(width), int(height)
         self.specialise = bool(specialise)
+        self.wireframe = False           # draw() draws edges only (a viewer's toggle)
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._released = False
@@ -345,6 +346,27 @@ class GpuRenderer:
         self._plans.clear()
         self._jittered.clear()
 
+    def resize(self, width: int, height: int) -> None:
+        """Render at another size from now on (a viewer's window was resized): the framebuffers
+        are made again at that size and update() recomputes the projection for the new aspect.
+        Programs, meshes and vertex arrays are kept."""
+        width, height = int(width), int(height)
+        if width < 1 or height < 1:
+            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        if (width, height) == (self.width, self.height):
+            return
+        activate(self.ctx)
+        for fbo in [*self._multisample.values(), *self._framebuffers.values()]:
+            fbo.release()
+        for renderbuffer in self._renderbuffers:
+            renderbuffer.release()
+        self._multisample, self._framebuffers, self._renderbuffers = {}, {}, []
+        self._staging.clear()
+        self.width, self.height = width, height
+        self._check_size()
+        self._build_targets()
+        self.update()
+
     def _plan(self, linear: bool) -> list[_Draw]:
         """The frame's draw calls; made once per update() for each kind of output."""
         plan = self._plans.get(linear)
@@ -386,9 +408,28 @@ class GpuRenderer:
         viewer, a batch, a benchmark) can reuse to skip allocating (and page-faulting in)
         a few megabytes per frame.
         """
+        start = time.perf_counter()
+        fbo = self.draw(linear=linear, sample_offset=sample_offset, samples=samples)
+        # GL returns rows bottom-up: read into staging arrays made once, then write each
+        # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
+        reuse = (out.rgba8, out.linear, out.depth) if out is not None else (None, None, None)
+        rgba8 = _flip_into(self._read(fbo, 0, np.uint8), reuse[0])
+        linear_color = depth_map = None
+        if linear:
+            linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
+        if depth:
+            depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
+        return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
+                     gl_info=self._gl_info)
+
+    def draw(self, *, linear: bool = False, sample_offset: tuple = (0.0, 0.0),
+             samples: int = 1) -> moderngl.Framebuffer:
+        """Draw the scene into this renderer's single-sample framebuffer (returned) and read
+        nothing back: render() is draw() plus the read-back; a window viewer blits the
+        framebuffer to the screen instead (renderer/presenter.py). Arguments as render()'s.
+        With `wireframe` set, triangles are drawn as their edges (glPolygonMode GL_LINE)."""
         if self._released:
             raise RuntimeError("this GpuRenderer was released")
-        start = time.perf_counter()
         ctx = self.ctx
         activate(ctx)
         if self._glDisable is not None:
@@ -409,7 +450,7 @@ class GpuRenderer:
             target.clear(red, green, blue, 0.0, depth=0.0 if reversed_z else 1.0)
             ctx.depth_func = ">" if reversed_z else "<"
             ctx.front_face = "ccw"
-            ctx.wireframe = False
+            ctx.wireframe = self.wireframe
             for draw in plan:
                 ctx.enable_only(draw.enable)
                 if draw.cull_face:
@@ -420,20 +461,10 @@ class GpuRenderer:
             if target is not fbo:
                 ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
         finally:
+            ctx.wireframe = False
             if reversed_z:
                 self._clip_control(False)
-
-        # GL returns rows bottom-up: read into staging arrays made once, then write each
-        # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
-        reuse = (out.rgba8, out.linear, out.depth) if out is not None else (None, None, None)
-        rgba8 = _flip_into(self._read(fbo, 0, np.uint8), reuse[0])
-        linear_color = depth_map = None
-        if linear:
-            linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
-        if depth:
-            depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
-        return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
-                     gl_info=self._gl_info)
+        return fbo
 
     def _clip_control(self, reversed_z: bool) -> None:
         """glClipControl: ZERO_TO_ONE depth for reversed-Z, GL's NEGATIVE_ONE_TO_ONE otherwise."""

@@ -1,4 +1,5 @@
-"""Shared fixtures: one headless GL context of each kind for the whole test session."""
+"""Shared fixtures: one headless GL context of each kind for the whole test session, and a
+virtual X display for the window viewer."""
 
 import pytest
 
@@ -14,3 +15,20 @@ def gl_contexts():
     yield contexts
     for ctx in contexts.values():
         ctx.release()
+
+
+@pytest.fixture(scope="session")
+def x_display():
+    """A virtual X display (Xvfb) for the window viewer's tests, ":N". It must start: CI
+    installs xvfb (install.sh)."""
+    from renderer.virtual_display import virtual_display
+    with virtual_display() as display:
+        yield display
+
+
+@pytest.fixture
+def on_x_display(x_display, monkeypatch):
+    """DISPLAY set to the virtual display for this test (glfw reads it when it starts)."""
+    monkeypatch.setenv("DISPLAY", x_display)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    return x_display

@@ -1,0 +1,292 @@
+"""The window viewer (`renderer view`, renderer/viewer.py) in a real window on a virtual X
+display (Xvfb): what the window shows is the headless render of the same camera and size;
+the controls act on it; the scripted mode, the reference view and double/triple buffering
+work end to end; without a display it says so in one line and exits with status 2."""
+
+import os
+import subprocess
+import sys
+from dataclasses import replace
+
+import glfw
+import numpy as np
+import pytest
+
+from renderer.builtin import resolve_scene
+from renderer.compare import compare_frames
+from renderer.extremes import RAW_MISMATCH_LIMIT
+from renderer.gpu import GpuRenderer
+from renderer.imageio import read_png
+from renderer.orbit import OrbitCamera
+from renderer.scene_file import load_scene
+from renderer.viewer import SCREEN_CLEAR, Viewer
+
+SIZE = (160, 120)
+
+
+def scene(name="sphere"):
+    return load_scene(resolve_scene(name))
+
+
+def headless(scene_, size=SIZE, context=None):
+    with GpuRenderer(scene_, *size, context=context) as gpu:
+        return gpu.render(depth=False).rgba8
+
+
+def assert_matches(window_rgb, headless_rgba8):
+    """The pipeline's tolerance (the same as the extreme cases'): no pixel fails the ±1 px
+    threshold compare, and at most 0.1 % differ by more than 2/255 in place. The window has
+    no alpha to show, so both are compared opaque."""
+    shown = np.concatenate([window_rgb, np.full(window_rgb.shape[:2] + (1,), 255, np.uint8)], axis=2)
+    expected = headless_rgba8.copy()
+    expected[..., 3] = 255
+    result = compare_frames(shown, expected)
+    assert result.mismatched_pixels == 0, result
+    assert result.raw_mismatched_fraction <= RAW_MISMATCH_LIMIT, result
+
+
+def run_cli(*args, display=None, cwd=None, timeout=120):
+    env = {key: value for key, value in os.environ.items() if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    if display is not None:
+        env["DISPLAY"] = display
+    return subprocess.run([sys.executable, "-m", "renderer", "view", *args], capture_output=True,
+                          text=True, env=env, cwd=cwd, timeout=timeout)
+
+
+# -- no display ---------------------------------------------------------------------------------
+def test_without_a_display_one_line_suggests_xvfb_run_and_exits_2(tmp_path):
+    shot = tmp_path / "shot.png"
+    result = run_cli("sphere", "--frames", "2", "--screenshot", str(shot))
+    assert result.returncode == 2
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and "xvfb-run" in lines[0] and "DISPLAY" in lines[0], result.stderr
+    assert "Traceback" not in result.stderr and not shot.exists()
+
+
+def test_a_bad_option_is_one_line_and_status_2():
+    result = run_cli("sphere", "--frames", "0")
+    assert result.returncode == 2 and "at least 1" in result.stderr
+
+
+# -- the scripted mode, through the command line --------------------------------------------------
+def test_scripted_screenshot_is_the_headless_render(x_display, tmp_path):
+    shot = tmp_path / "shot.png"
+    result = run_cli("sphere", "--size", "160x120", "--frames", "3", "--screenshot", str(shot),
+                     display=x_display)
+    assert result.returncode == 0, result.stderr
+    assert "frame time median" in result.stdout and "fps" in result.stdout
+    assert_matches(read_png(shot)[..., :3], headless(scene()))
+
+
+@pytest.mark.parametrize("buffering, frames_late", [("double", 0), ("triple", 1)])
+def test_orbiting_shows_the_camera_of_the_frame_on_the_screen(x_display, tmp_path, buffering,
+                                                              frames_late):
+    """--orbit turns the camera before each frame is drawn; with triple buffering the window
+    shows the frame before the last one drawn."""
+    shot = tmp_path / "shot.png"
+    args = ["hierarchy", "--size", "160x120", "--frames", "4", "--orbit", "10",
+            "--screenshot", str(shot)]
+    result = run_cli(*args, *(["--triple-buffering"] if buffering == "triple" else []),
+                     display=x_display)
+    assert result.returncode == 0, result.stderr
+    authored = scene("hierarchy")
+    orbit = OrbitCamera(authored.camera)
+    for _ in range(4 - frames_late):
+        orbit.orbit(10.0, 0.0)
+    assert_matches(read_png(shot)[..., :3], headless(replace(authored, camera=orbit.camera)))
+    if buffering == "triple":
+        assert "latency" in result.stdout
+
+
+def test_reference_side_by_side_shows_both_pipelines_alike(x_display, tmp_path):
+    shot = tmp_path / "shot.png"
+    result = run_cli("gouraud_vs_phong", "--size", "240x120", "--frames", "2", "--reference",
+                     "side-by-side", "--screenshot", str(shot), display=x_display)
+    assert result.returncode == 0, result.stderr
+    assert "GPU vs reference" in result.stdout and "0 mismatched px" in result.stdout
+    image = read_png(shot)[..., :3].astype(int)
+    # Each half holds its 240x120 image at half size, letterboxed: rows 30-89.
+    left, right = image[30:90, :120], image[30:90, 120:]
+    assert np.abs(left - right).mean() < 1.0
+    clear = np.round(np.array(SCREEN_CLEAR) * 255)
+    assert (image[100:, :] == clear).all()         # the letterbox below the images
+
+
+def test_reference_difference_is_a_dark_heat_map(x_display, tmp_path):
+    shot = tmp_path / "shot.png"
+    result = run_cli("sphere", "--size", "160x120", "--frames", "2", "--reference", "difference",
+                     "--screenshot", str(shot), display=x_display)
+    assert result.returncode == 0, result.stderr
+    image = read_png(shot)[..., :3]
+    below_overlay = image[40:]                      # the figures' panel is at the top left
+    assert (below_overlay.max(axis=-1) < 100).mean() > 0.99
+
+
+# -- the viewer in this process: controls and resizing -------------------------------------------
+@pytest.fixture
+def viewer(on_x_display):
+    messages = []
+    with Viewer(scene("coloured_lights"), *SIZE, on_message=messages.append) as v:
+        v.messages = messages
+        yield v
+
+
+def press(viewer, key, mods=0):
+    viewer.controls.key(key, 0, glfw.PRESS, mods)
+
+
+def shown_after_a_frame(viewer):
+    viewer.frame()
+    viewer._compose(viewer.presenter.shown)         # the frame again, in the back buffer
+    return viewer.window_image()
+
+
+def test_first_frame_is_the_headless_render(viewer):
+    assert_matches(shown_after_a_frame(viewer), headless(scene("coloured_lights")))
+
+
+def test_shading_keys_switch_every_object(viewer):
+    press(viewer, glfw.KEY_F)
+    assert_matches(shown_after_a_frame(viewer), headless(scene("coloured_lights").with_shading("flat")))
+    assert any("flat" in line for line in viewer.messages)
+    press(viewer, glfw.KEY_G)
+    assert_matches(shown_after_a_frame(viewer), headless(scene("coloured_lights").with_shading("gouraud")))
+
+
+def test_light_key_turns_that_light_off(viewer):
+    authored = scene("coloured_lights")
+    press(viewer, glfw.KEY_1)
+    lights_left = replace(authored, directional_lights=authored.directional_lights[1:]) \
+        if authored.directional_lights else replace(authored, point_lights=authored.point_lights[1:])
+    assert_matches(shown_after_a_frame(viewer), headless(lights_left))
+    press(viewer, glfw.KEY_1)
+    assert_matches(shown_after_a_frame(viewer), headless(authored))
+
+
+def test_wireframe_key_draws_edges_only(viewer):
+    solid = shown_after_a_frame(viewer)
+    press(viewer, glfw.KEY_W)
+    edges = shown_after_a_frame(viewer)
+    assert viewer.gpu.wireframe
+    background = np.round(np.array(scene("coloured_lights").background) * 255)
+    # Edges leave most of what was covered showing the background.
+    covered = (solid != background).any(axis=-1)
+    still = (edges != background).any(axis=-1)
+    assert still.sum() < 0.8 * covered.sum() and still.any()
+
+
+def test_dragging_orbits_and_r_resets(viewer):
+    start = shown_after_a_frame(viewer)
+    viewer.controls.cursor(80, 60)
+    viewer.controls.mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.PRESS, 0)
+    viewer.controls.cursor(120, 60)
+    viewer.controls.mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    moved = shown_after_a_frame(viewer)
+    assert np.abs(moved.astype(int) - start).mean() > 1.0
+    assert_matches(moved, headless(replace(scene("coloured_lights"), camera=viewer.orbit.camera)))
+    press(viewer, glfw.KEY_R)
+    assert_matches(shown_after_a_frame(viewer), headless(scene("coloured_lights")))
+
+
+def test_wheel_zooms_in(viewer):
+    distance = np.linalg.norm(np.subtract(viewer.orbit.camera.eye, viewer.orbit.camera.look))
+    viewer.controls.scroll(0.0, 2.0)
+    viewer.frame()
+    after = np.linalg.norm(np.subtract(viewer.orbit.camera.eye, viewer.orbit.camera.look))
+    assert after < distance
+
+
+def test_resizing_keeps_the_aspect_ratio_right(viewer):
+    viewer.window.set_size(200, 100)
+    for _ in range(20):                              # the new size arrives with the events
+        viewer.frame()
+        if viewer.window.framebuffer_size == (200, 100):
+            break
+    image = shown_after_a_frame(viewer)
+    assert image.shape == (100, 200, 3) and (viewer.gpu.width, viewer.gpu.height) == (200, 100)
+    assert_matches(image, headless(scene("coloured_lights"), size=(200, 100)))
+
+
+def test_buffering_and_vsync_keys(viewer):
+    press(viewer, glfw.KEY_B)
+    for _ in range(3):
+        viewer.frame()
+    assert viewer.presenter.buffering == 3 and viewer.presenter.latency_ms is not None
+    assert "triple buffering" in viewer.title()
+    press(viewer, glfw.KEY_V)
+    viewer.frame()
+    assert not viewer.state.vsync and "v-sync off" in viewer.title()
+
+
+def test_help_is_printed_and_drawn(viewer):
+    plain = shown_after_a_frame(viewer)
+    press(viewer, glfw.KEY_H)
+    with_help = shown_after_a_frame(viewer)
+    assert any("Esc" in line for line in viewer.messages)
+    assert (with_help != plain).any(axis=-1)[:20, :40].mean() > 0.5     # a panel at the top left
+
+
+def test_s_saves_a_screenshot(viewer, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    press(viewer, glfw.KEY_S)
+    viewer.frame()
+    saved = sorted(tmp_path.glob("view-coloured_lights-*.png"))
+    assert len(saved) == 1
+    assert_matches(read_png(saved[0])[..., :3], headless(scene("coloured_lights")))
+
+
+def test_escape_quits(viewer):
+    press(viewer, glfw.KEY_ESCAPE)
+    stats = viewer.run()                             # returns at once: quit was asked for
+    assert viewer.state.quit and stats.frame_ms == []
+
+
+# -- end to end: a user's keys and mouse, typed by xdotool -------------------------------------
+def test_keys_and_mouse_end_to_end_with_xdotool(x_display, tmp_path):
+    """The interactive viewer in its own process: xdotool focuses its window, types W
+    (wireframe), drags with the left button (orbit), types S (screenshot) and Esc."""
+    from renderer.controls import Controls, ViewState
+    shot = tmp_path / "shot.png"
+    env = {**os.environ, "DISPLAY": x_display}
+    viewer = subprocess.Popen([sys.executable, "-m", "renderer", "view", "coloured_lights", "--size",
+                               "160x120", "--screenshot", str(shot)], env=env,
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+    def xdotool(*args):
+        return subprocess.run(["xdotool", *args], env=env, check=True, capture_output=True,
+                              text=True, timeout=30).stdout
+
+    try:
+        window = xdotool("search", "--sync", "--name", "renderer view: coloured_lights").split()[0]
+        xdotool("windowfocus", "--sync", window)
+        xdotool("key", "w")
+        xdotool("mousemove", "--window", window, "--sync", "80", "60")
+        xdotool("mousedown", "1")
+        xdotool("mousemove", "--window", window, "--sync", "120", "60")
+        xdotool("mouseup", "1")
+        xdotool("key", "s")
+        for _ in range(100):                          # the screenshot is taken at the next frame
+            if shot.exists():
+                break
+            subprocess.run(["sleep", "0.1"])
+        xdotool("key", "Escape")
+        out, err = viewer.communicate(timeout=30)
+    finally:
+        if viewer.poll() is None:
+            viewer.kill()
+    assert viewer.returncode == 0, err
+    assert "wireframe: on" in out and f"screenshot: {shot}" in out
+
+    # The same events fed to the handlers give the camera the window must show.
+    authored = scene("coloured_lights")
+    orbit = OrbitCamera(authored.camera)
+    controls = Controls(ViewState(), orbit, ["light"] * 4, on_message=lambda line: None)
+    controls.resize(160, 120)
+    controls.cursor(80, 60)
+    controls.mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.PRESS, 0)
+    controls.cursor(120, 60)
+    controls.mouse_button(glfw.MOUSE_BUTTON_LEFT, glfw.RELEASE, 0)
+    with GpuRenderer(replace(authored, camera=orbit.camera), *SIZE) as gpu:
+        gpu.wireframe = True
+        expected = gpu.render(depth=False).rgba8
+    assert_matches(read_png(shot)[..., :3], expected)

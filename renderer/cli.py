@@ -171,7 +171,10 @@ def cmd_view(args) -> int:
                 screenshot=None if scripted else args.screenshot) as viewer:
         if not scripted:
             print(f"renderer view: {scene.name}; H for help, Esc to quit")
-        stats = viewer.run(args.frames, args.orbit, args.screenshot if scripted else None)
+        try:
+            stats = viewer.run(args.frames, args.orbit, args.screenshot if scripted else None)
+        except KeyboardInterrupt:              # Ctrl-C in the terminal: as good as Esc
+            return 0
         figures = viewer.figures
     if scripted:
         if args.stats is not None:

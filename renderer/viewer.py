@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from renderer.controls import Controls, ViewState, apply_view, help_lines, working_copy
+from renderer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
 from renderer.gpu import GpuRenderer
 from renderer.imageio import write_png
 from renderer.orbit import OrbitCamera
@@ -35,12 +35,6 @@ from renderer.window import Window
 
 SCREEN_CLEAR = (0.12, 0.12, 0.14)          # the window around a letterboxed image
 TITLE_EVERY_S = 0.25                       # how often the title's figures are refreshed
-
-
-def light_names(scene: Scene) -> list[str]:
-    """The lights in the order the number keys toggle them: directional, then point."""
-    return ([f"directional light {i + 1}" for i in range(len(scene.directional_lights))]
-            + [f"point light {i + 1}" for i in range(len(scene.point_lights))])
 
 
 @dataclass
@@ -88,7 +82,8 @@ class Viewer:
         self._screenshots = 0
         self.state = ViewState(vsync=vsync, buffering=buffering, reference=reference)
         self.orbit = OrbitCamera(scene.camera)
-        self.controls = Controls(self.state, self.orbit, light_names(scene), on_message=on_message)
+        self.controls = Controls(self.state, self.orbit, light_names_of(scene), on_message=on_message,
+                                 scene=scene)
         self.window = Window(width, height, f"renderer view: {scene.name}", vsync=vsync)
         try:
             self.ctx = self.window.ctx
@@ -198,6 +193,8 @@ class Viewer:
 
     def _overlay_text(self) -> tuple:
         lines = []
+        if self.state.reference == "side-by-side":
+            lines.append("left: GPU (GLSL)    right: NumPy reference")
         if self.state.reference != "off":
             current = self._reference_version == self._version
             if self._figures is not None and self._reference_version >= 0:
@@ -205,7 +202,7 @@ class Viewer:
             elif self.background.busy:
                 lines.append("reference view: computing...")
         if self.state.help:
-            lines += help_lines(self.state, light_names(self.authored))
+            lines += help_lines(self.state, light_names_of(self.authored))
         return tuple(lines)
 
     def frame(self, orbit_degrees: float = 0.0) -> None:
@@ -289,6 +286,7 @@ class Viewer:
                 result = self.background.wait()
                 if result is not None and result.version == self._version:
                     self._take_reference(result)
+                self._last_swap = None        # the wait is not a frame time
             self.frame(orbit)
             if last and screenshot is not None:
                 # The image just swapped in is the front buffer now; draw it again (the

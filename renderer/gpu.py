@@ -2,6 +2,13 @@
 
     with GpuRenderer(scene, 640, 480) as gpu:        # EGL, else OSMesa
         frame = gpu.render()                         # Frame: rgba8, depth (and linear if asked)
+        fbo = gpu.draw()                             # the same drawing, nothing read back
+        gpu.resize(800, 600)                         # another size, same programs and meshes
+
+`render()` is `draw()` plus the read-back; the window viewer (renderer/viewer.py) calls
+`draw()` on a window's context (`context=`) and copies the framebuffer to the screen, so that
+it shows exactly what the headless path renders. `wireframe = True` draws triangle edges only
+(the viewer's W key).
 
 Everything GL is made once per renderer: one program per shader variant the scene's materials
 use, one vertex buffer (positions and normals, float32, interleaved), index buffer and vertex

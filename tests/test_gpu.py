@@ -246,3 +246,40 @@ def test_render_into_an_earlier_frame_reuses_its_arrays(gl_contexts):
             assert np.array_equal(a, b)
         third = gpu.render()                                # without out: new arrays
         assert third.rgba8 is not first.rgba8 and np.array_equal(third.rgba8, kept[0])
+
+
+def test_resize_renders_as_a_renderer_made_at_that_size(egl):
+    scene = sphere_scene()
+    with GpuRenderer(scene, W, H, context=egl) as gpu:
+        gpu.render(samples=4)                        # a multisample target to remake too
+        gpu.resize(2 * W, H)                         # another aspect ratio
+        resized = gpu.render(linear=True)
+        resized_msaa = gpu.render(samples=4)
+    with GpuRenderer(scene, 2 * W, H, context=egl) as fresh:
+        expected = fresh.render(linear=True)
+        expected_msaa = fresh.render(samples=4)
+    assert resized.size == (2 * W, H)
+    assert np.array_equal(resized.rgba8, expected.rgba8)
+    assert np.array_equal(resized.depth, expected.depth)
+    assert np.array_equal(resized_msaa.rgba8, expected_msaa.rgba8)
+
+
+def test_draw_is_render_without_the_read_back(egl):
+    with GpuRenderer(sphere_scene(), W, H, context=egl) as gpu:
+        fbo = gpu.draw()
+        drawn = np.frombuffer(fbo.read(components=4, alignment=1), np.uint8).reshape(H, W, 4)
+        assert np.array_equal(drawn[::-1], gpu.render().rgba8)
+
+
+def test_wireframe_draws_edges_only(egl):
+    """A square of two triangles, as edges: its outline and one diagonal, one pixel wide."""
+    with GpuRenderer(plane_scene(size=2.0, z=0.0), W, H, context=egl) as gpu:
+        solid = gpu.render().rgba8[..., 3] == 255
+        gpu.wireframe = True
+        edges = gpu.render().rgba8[..., 3] == 255
+        gpu.wireframe = False
+        again = gpu.render().rgba8[..., 3] == 255
+    side = np.sqrt(solid.sum())                      # the square's side in pixels
+    # Four sides and a diagonal, give or take the corners and GL's line rule at the ends.
+    assert 0.8 * (4 + np.sqrt(2)) * side < edges.sum() < 1.2 * (4 + np.sqrt(2)) * side
+    assert np.array_equal(again, solid)

@@ -77,40 +77,45 @@ def test_blit_into_a_rectangle_leaves_the_rest(ctx):
 
 
 # -- double and triple buffering ------------------------------------------------------------------
-def _frames(ctx, count, size=(4, 4)):
-    """`count` framebuffers, frame k filled with the grey level 10 k."""
+@pytest.fixture
+def frames(ctx):
+    """frames(count): `count` framebuffers, frame k filled with the grey level 10 k;
+    released after the test."""
     made = []
-    for k in range(count):
-        fbo, colour = _framebuffer(ctx, size)
-        fbo.use()
-        fbo.clear(10 * k / 255, 10 * k / 255, 10 * k / 255, 1.0)
-        made.append((fbo, colour))
-    return made
+
+    def make(count, size=(4, 4)):
+        fbos = []
+        for k in range(count):
+            fbo, colour = _framebuffer(ctx, size)
+            fbo.use()
+            fbo.clear(10 * k / 255, 10 * k / 255, 10 * k / 255, 1.0)
+            made.extend((fbo, colour))
+            fbos.append(fbo)
+        return fbos
+
+    yield make
+    for item in made:
+        item.release()
 
 
 def _level(fbo):
     return int(_read_top_down(fbo)[0, 0, 0])
 
 
-def test_double_buffering_shows_the_frame_just_drawn(ctx):
+def test_double_buffering_shows_the_frame_just_drawn(ctx, frames):
     presenter = Presenter(ctx, buffering=2)
-    frames = _frames(ctx, 3)
-    for k, (fbo, _) in enumerate(frames):
+    for k, fbo in enumerate(frames(3)):
         presenter.submit(fbo, started=float(k))
         assert _level(presenter.shown) == 10 * k
         presenter.swapped(now=k + 0.004)
     assert presenter.latency_ms == pytest.approx(4.0)
     presenter.release()
-    for pair in frames:
-        for item in pair:
-            item.release()
 
 
-def test_triple_buffering_shows_the_frame_before_one_frame_later(ctx):
+def test_triple_buffering_shows_the_frame_before_one_frame_later(ctx, frames):
     presenter = Presenter(ctx, buffering=3)
-    frames = _frames(ctx, 5)
     shown = []
-    for k, (fbo, _) in enumerate(frames):
+    for k, fbo in enumerate(frames(5)):
         presenter.submit(fbo, started=float(k))
         shown.append(_level(presenter.shown))
         presenter.swapped(now=k + 0.004)            # each frame takes 1 s here
@@ -120,24 +125,18 @@ def test_triple_buffering_shows_the_frame_before_one_frame_later(ctx):
     assert presenter.latency_ms == pytest.approx(1004.0)
     assert presenter.name == "triple"
     presenter.release()
-    for pair in frames:
-        for item in pair:
-            item.release()
 
 
-def test_switching_buffering_starts_afresh(ctx):
+def test_switching_buffering_starts_afresh(ctx, frames):
     presenter = Presenter(ctx, buffering=3)
-    frames = _frames(ctx, 2)
-    presenter.submit(frames[0][0], 0.0)
+    first, second = frames(2)
+    presenter.submit(first, 0.0)
     presenter.set_buffering(2)
-    presenter.submit(frames[1][0], 1.0)
+    presenter.submit(second, 1.0)
     assert _level(presenter.shown) == 10 and presenter.latency_ms is None
     with pytest.raises(ValueError, match="2 .double. or 3 .triple."):
         presenter.set_buffering(4)
     presenter.release()
-    for pair in frames:
-        for item in pair:
-            item.release()
 
 
 # -- text ---------------------------------------------------------------------------------------

@@ -164,10 +164,12 @@ class Viewer:
         screen = self.ctx.screen
         width, height = self.window.framebuffer_size
         screen.use()
-        screen.clear(*SCREEN_CLEAR, 1.0)
         blit = self.presenter.blitter.copy
         mode = self.state.reference
         have_reference = self._reference_version >= 0
+        whole = (0, 0, width, height)
+        if mode != "off" or fit(shown.size, whole) != whole:
+            screen.clear(*SCREEN_CLEAR, 1.0)           # letterbox bars; else all is covered
         if mode == "side-by-side":
             blit(shown, screen, fit(shown.size, (0, 0, width // 2, height)))
             if have_reference:
@@ -175,9 +177,9 @@ class Viewer:
                 blit(reference, screen, fit(reference.size, (width // 2, 0, width, height)))
         elif mode == "difference" and have_reference:
             difference = self._difference_image.framebuffer
-            blit(difference, screen, fit(difference.size, (0, 0, width, height)))
+            blit(difference, screen, fit(difference.size, whole))
         else:
-            blit(shown, screen, fit(shown.size, (0, 0, width, height)))
+            blit(shown, screen, fit(shown.size, whole))
         lines = self._overlay_text()
         if lines != self._overlay_lines:
             panel = text_panel(list(lines), width, height)

@@ -291,3 +291,18 @@ def test_keys_and_mouse_end_to_end_with_xdotool(x_display, tmp_path):
         gpu.wireframe = True
         expected = gpu.render(depth=False).rgba8
     assert_matches(read_png(shot)[..., :3], expected)
+
+
+def test_t_toggles_two_sided_lighting_for_every_object(viewer):
+    press(viewer, glfw.KEY_T)
+    authored = scene("coloured_lights")
+    two_sided = replace(authored, objects=[replace(obj, material=replace(obj.material, two_sided=True))
+                                           for obj in authored.objects])
+    assert_matches(shown_after_a_frame(viewer), headless(two_sided))
+    assert all(obj.material.two_sided for obj in viewer.shown.objects)
+
+
+def test_closing_the_window_ends_the_run(viewer):
+    glfw.set_window_should_close(viewer.window._handle, True)   # what the close button does
+    stats = viewer.run()
+    assert stats.frame_ms == [] and not viewer.state.quit

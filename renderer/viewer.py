@@ -98,7 +98,8 @@ class Viewer:
             self._difference_image = CpuImage(self.ctx)  # the heat map
             self._overlay = CpuImage(self.ctx)
             self._overlay_lines: tuple = ()
-            self._version = 0                 # bumped whenever the image would change
+            self._version = 0                 # bumped whenever the shaded image would change
+            self._view: tuple | None = None   # what the version stands for
             self._requested = -1              # the version the reference was asked for
             self._reference_version = -1      # the version the reference images show
             self._figures: dict | None = None
@@ -116,24 +117,26 @@ class Viewer:
         """Bring the renderer up to date with the window's size and the controls' changes."""
         state = self.state
         size = self.window.framebuffer_size
-        changed = False
         if size != (self.gpu.width, self.gpu.height) and min(size) > 0:   # 0 when minimised
             self.gpu.resize(*size)
             self.controls.resize(*size)
-            changed = True
         if state.camera_changed or state.scene_changed:
             apply_view(state, self.authored, self.shown, self.orbit.camera)
             self.gpu.update()
             state.camera_changed = state.scene_changed = False
-            changed = True
+        # The version names what the shaded image depends on (not wireframe, help or the
+        # reference mode), so that only a new image asks the reference again.
+        view = (self.gpu.width, self.gpu.height, repr(self.orbit.camera), state.shading,
+                state.two_sided, tuple(state.lights_on))
+        if view != self._view:
+            self._view = view
+            self._version += 1
         self.gpu.wireframe = state.wireframe
         if state.vsync != self._vsync_set:
             self.window.set_vsync(state.vsync)
             self._vsync_set = state.vsync
         if state.buffering != self.presenter.buffering:
             self.presenter.set_buffering(state.buffering)
-        if changed:
-            self._version += 1
 
     def _follow_reference(self) -> None:
         """Ask for the reference of the current view when it is wanted and not asked for yet,

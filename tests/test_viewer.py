@@ -306,3 +306,18 @@ def test_closing_the_window_ends_the_run(viewer):
     glfw.set_window_should_close(viewer.window._handle, True)   # what the close button does
     stats = viewer.run()
     assert stats.frame_ms == [] and not viewer.state.quit
+
+
+def test_the_reference_is_asked_again_only_for_a_new_image(on_x_display):
+    with Viewer(scene("point_light_plane"), *SIZE, reference="difference",
+                on_message=lambda line: None) as viewer:
+        viewer.run(frames=2)                          # the last frame waits for the reference
+        assert viewer.figures is not None and viewer.figures["mismatched"] == 0
+        for key in (glfw.KEY_W, glfw.KEY_H):          # wireframe and help: the same image
+            press(viewer, key)
+            viewer.frame()
+        assert not viewer.background.busy and viewer.figures is not None
+        press(viewer, glfw.KEY_F)                     # flat shading: a new image
+        viewer.frame()
+        assert viewer.figures is None                 # none yet for the view on the screen
+        assert viewer.background.wait(timeout=60) is not None

@@ -89,9 +89,19 @@ class BackgroundReference:
         return self.poll()
 
     def close(self) -> None:
+        """Stop the worker at once, even in the middle of a render: otherwise the process
+        would wait for it at exit (seconds, for a large window)."""
         if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
-            self._pool = None
+            pool, self._pool = self._pool, None
+            if hasattr(pool, "terminate_workers"):           # Python 3.14
+                pool.terminate_workers()
+            else:
+                workers = list(getattr(pool, "_processes", {}).values())
+                pool.shutdown(wait=False, cancel_futures=True)
+                for process in workers:
+                    process.terminate()
+                for process in workers:
+                    process.join(5)
         self._running = self._waiting = None
 
 

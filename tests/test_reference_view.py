@@ -67,3 +67,20 @@ def test_a_pixel_far_off_is_counted_and_shown_magenta():
     heat, figures = difference_view(image, ReferenceResult(1, other, None, 1.0))
     assert figures["max_abs"] == 255 and figures["mismatched"] == 1
     assert tuple(heat[3, 4]) == (255, 0, 255)
+
+
+def test_close_stops_a_render_in_progress():
+    """Closing the viewer must not leave a worker rendering for seconds (the process would
+    wait for it at exit)."""
+    import multiprocessing
+    import time
+    before = {p.pid for p in multiprocessing.active_children()}
+    worker = BackgroundReference()
+    worker.request(load_scene(resolve_scene("near_plane")), 1600, 1200, version=1)   # seconds
+    time.sleep(1.0)                                  # the worker has started and is rendering
+    ours = [p for p in multiprocessing.active_children() if p.pid not in before]
+    assert ours and all(p.is_alive() for p in ours)
+    worker.close()
+    assert not worker.busy
+    time.sleep(0.2)
+    assert not any(p.is_alive() for p in ours)

@@ -90,14 +90,23 @@ class Window:
     # -- events ------------------------------------------------------------------------------
     def connect(self, handler) -> None:
         """Forward glfw's events to `handler`: key(key, scancode, action, mods),
-        mouse_button(button, action, mods), cursor(x, y), scroll(dx, dy) and
-        resize(width, height) (framebuffer pixels)."""
+        mouse_button(button, action, mods), cursor(x, y) (framebuffer pixels, y down),
+        scroll(dx, dy) and resize(width, height) (framebuffer pixels)."""
         handle = self._handle
         glfw.set_key_callback(handle, lambda _w, *args: handler.key(*args))
         glfw.set_mouse_button_callback(handle, lambda _w, *args: handler.mouse_button(*args))
-        glfw.set_cursor_pos_callback(handle, lambda _w, x, y: handler.cursor(x, y))
+        glfw.set_cursor_pos_callback(handle, lambda _w, x, y: handler.cursor(*self._to_pixels(x, y)))
         glfw.set_scroll_callback(handle, lambda _w, dx, dy: handler.scroll(dx, dy))
         glfw.set_framebuffer_size_callback(handle, lambda _w, w, h: handler.resize(w, h))
+
+    def _to_pixels(self, x: float, y: float) -> tuple[float, float]:
+        """Cursor positions come in screen coordinates; pan must follow the cursor in the
+        framebuffer's pixels. On X11 they are the same; on a HiDPI screen they are not."""
+        window_w, window_h = glfw.get_window_size(self._handle)
+        pixels_w, pixels_h = self.framebuffer_size
+        if window_w <= 0 or window_h <= 0:
+            return x, y
+        return x * pixels_w / window_w, y * pixels_h / window_h
 
     def poll(self) -> None:
         glfw.poll_events()

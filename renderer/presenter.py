@@ -8,9 +8,10 @@ pixel, when it is shown at its own size.
 - Double buffering: frame N is drawn, copied to the back buffer and swapped in: it is on the
   screen after one swap.
 - Triple buffering: a ring of three offscreen framebuffers. Frame N is drawn and copied into
-  slot N mod 3 while the window shows slot N-1, the frame before: the renderer never waits for
-  the frame on the screen to be taken, at the price of one frame of latency. `latency_ms`
-  measures it: from the start of drawing a frame to the swap that shows it.
+  slot N mod 3 while the window shows slot N-1, the frame before: the image on the screen is
+  never the one being written, at the price of one frame of latency. `latency_ms` measures
+  it: from the start of drawing a frame to the swap that shows it. (The viewer's loop is one
+  thread, so with v-sync on its swap still waits for the screen.)
 
 Images the CPU makes (the reference view, the difference heat map, the help and figures
 overlay) are uploaded to textures attached to framebuffers (`CpuImage`) and copied the same way.

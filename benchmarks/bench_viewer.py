@@ -54,24 +54,28 @@ def viewer_run(scene: str, size, frames: int, display: str, triple: bool) -> dic
 def headless_run(gpu: GpuRenderer, authored, frames: int) -> tuple[list[float], list[float]]:
     """(render ms, draw ms) per frame, the camera turning 1 degree a frame."""
     orbit = OrbitCamera(authored.camera)
-    render_ms, draw_ms = [], []
     frame = None
-    for _ in range(frames):
-        orbit.orbit(1.0, 0.0)
-        gpu.scene.camera = orbit.camera
-        start = time.perf_counter()
-        gpu.update()
+
+    def render():
+        nonlocal frame
         frame = gpu.render(depth=False, out=frame)
-        render_ms.append((time.perf_counter() - start) * 1000.0)
-    for _ in range(frames):
-        orbit.orbit(1.0, 0.0)
-        gpu.scene.camera = orbit.camera
-        start = time.perf_counter()
-        gpu.update()
+
+    def draw():
         gpu.draw()
         gpu.ctx.finish()
-        draw_ms.append((time.perf_counter() - start) * 1000.0)
-    return render_ms, draw_ms
+
+    def timed(work) -> list[float]:
+        milliseconds = []
+        for _ in range(frames):
+            orbit.orbit(1.0, 0.0)
+            gpu.scene.camera = orbit.camera
+            start = time.perf_counter()
+            gpu.update()
+            work()
+            milliseconds.append((time.perf_counter() - start) * 1000.0)
+        return milliseconds
+
+    return timed(render), timed(draw)
 
 
 def main() -> None:

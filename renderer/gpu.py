@@ -363,16 +363,20 @@ class GpuRenderer:
         if (width, height) == (self.width, self.height):
             return
         activate(self.ctx)
-        for fbo in [*self._multisample.values(), *self._framebuffers.values()]:
-            fbo.release()
-        for renderbuffer in self._renderbuffers:
-            renderbuffer.release()
-        self._multisample, self._framebuffers, self._renderbuffers = {}, {}, []
+        self._release_targets()
         self._staging.clear()
         self.width, self.height = width, height
         self._check_size()
         self._build_targets()
         self.update()
+
+    def _release_targets(self) -> None:
+        """Free the framebuffers and their renderbuffers (single-sample, linear, MSAA)."""
+        for fbo in [*self._multisample.values(), *self._framebuffers.values()]:
+            fbo.release()
+        for renderbuffer in self._renderbuffers:
+            renderbuffer.release()
+        self._multisample, self._framebuffers, self._renderbuffers = {}, {}, []
 
     def _plan(self, linear: bool) -> list[_Draw]:
         """The frame's draw calls; made once per update() for each kind of output."""
@@ -563,14 +567,9 @@ class GpuRenderer:
         self._plans.clear()
         try:
             activate(self.ctx)
-            for fbo in self._multisample.values():
-                fbo.release()
             for item in self._objects:
                 self._release_buffers(item)
-            for fbo in self._framebuffers.values():
-                fbo.release()
-            for renderbuffer in self._renderbuffers:
-                renderbuffer.release()
+            self._release_targets()
             self._programs.release()
         finally:
             self._objects, self._framebuffers, self._renderbuffers = [], {}, []

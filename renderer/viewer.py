@@ -118,8 +118,7 @@ class Viewer:
         state = self.state
         size = self.window.framebuffer_size
         if size != (self.gpu.width, self.gpu.height) and min(size) > 0:   # 0 when minimised
-            self.gpu.resize(*size)
-            self.controls.resize(*size)
+            self.gpu.resize(*size)             # (the controls hear of it from the window)
         if state.camera_changed or state.scene_changed:
             apply_view(state, self.authored, self.shown, self.orbit.camera)
             self.gpu.update()
@@ -138,16 +137,17 @@ class Viewer:
         if state.buffering != self.presenter.buffering:
             self.presenter.set_buffering(state.buffering)
 
-    def _follow_reference(self) -> None:
+    def _follow_reference(self, wait: bool = False) -> None:
         """Ask for the reference of the current view when it is wanted and not asked for yet,
-        and take a finished one: its heat map against a GPU image of the same view."""
+        and take a finished one (`wait`: wait for it): its heat map against a GPU image of
+        the same view."""
         if self.state.reference == "off":
             return
         if self._requested != self._version:
             self.background.request(working_copy(self.shown), self.gpu.width, self.gpu.height,
                                     self._version)
             self._requested = self._version
-        result = self.background.poll()
+        result = self.background.wait() if wait else self.background.poll()
         if result is not None and result.version == self._version:
             self._take_reference(result)
 
@@ -210,12 +210,9 @@ class Viewer:
             lines += help_lines(self.state, light_names_of(self.authored))
         return tuple(lines)
 
-    def frame(self, orbit_degrees: float = 0.0) -> None:
+    def frame(self) -> None:
         """One frame: events, changes, draw, present, swap."""
         self.window.poll()
-        if orbit_degrees:
-            self.orbit.orbit(orbit_degrees, 0.0)
-            self.state.camera_changed = True
         self._follow_changes()
         self._follow_reference()
         started = time.perf_counter()
@@ -285,14 +282,14 @@ class Viewer:
             if frames is not None and count >= frames:
                 break
             last = frames is not None and count == frames - 1
+            if orbit:
+                self.orbit.orbit(orbit, 0.0)
+                self.state.camera_changed = True
             if last and self.state.reference != "off":
-                self._follow_changes()
-                self._follow_reference()
-                result = self.background.wait()
-                if result is not None and result.version == self._version:
-                    self._take_reference(result)
+                self._follow_changes()        # the last frame's view, orbit step included
+                self._follow_reference(wait=True)
                 self._last_swap = None        # the wait is not a frame time
-            self.frame(orbit)
+            self.frame()
             if last and screenshot is not None:
                 # The image just swapped in is the front buffer now; draw it again (the
                 # same frame, no orbit step) to read it from the back buffer.

@@ -113,6 +113,13 @@ def test_reference_side_by_side_shows_both_pipelines_alike(x_display, tmp_path):
     assert (image[100:, :] == clear).all()         # the letterbox below the images
 
 
+def test_scripted_reference_is_of_the_last_frames_view_when_orbiting(x_display):
+    result = run_cli("sphere", "--size", "80x60", "--frames", "3", "--orbit", "15",
+                     "--reference", "difference", display=x_display)
+    assert result.returncode == 0, result.stderr
+    assert "GPU vs reference" in result.stdout and "0 mismatched px" in result.stdout
+
+
 def test_reference_difference_is_a_dark_heat_map(x_display, tmp_path):
     shot = tmp_path / "shot.png"
     result = run_cli("sphere", "--size", "160x120", "--frames", "2", "--reference", "difference",

@@ -15,14 +15,14 @@ import time
 import numpy as np
 
 import reference
-from renderer import transforms
-from renderer.builtin import builtin_scenes
-from renderer.context import activate, make_context
-from renderer.gpu import GpuRenderer, make_float_depth, uniform_values
-from renderer.primitives import icosphere
-from renderer.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject
-from renderer.scene_file import load_scene
-from renderer.shaders import program_source
+from renderer.core import transforms
+from renderer.core.builtin import builtin_scenes
+from renderer.gpu.context import activate, make_context
+from renderer.gpu.pipeline import GpuRenderer, make_float_depth, uniform_values
+from renderer.core.primitives import icosphere
+from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject
+from renderer.core.scene_file import load_scene
+from renderer.gpu.shaders import program_source
 
 from common import arguments          # benchmarks/common.py
 

@@ -21,12 +21,12 @@ import statistics
 
 import numpy as np
 
-from renderer.builtin import builtin_scenes
-from renderer.context import make_context
+from renderer.core.builtin import builtin_scenes
+from renderer.gpu.context import make_context
 from renderer.gpu import GpuRenderer
-from renderer.primitives import icosphere
-from renderer.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
-from renderer.scene_file import load_scene
+from renderer.core.primitives import icosphere
+from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
+from renderer.core.scene_file import load_scene
 
 from common import arguments          # benchmarks/common.py
 

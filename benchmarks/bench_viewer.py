@@ -30,12 +30,12 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from renderer.builtin import resolve_scene
+from renderer.core.builtin import resolve_scene
 from renderer.cli import parse_size
 from renderer.gpu import GpuRenderer
-from renderer.orbit import OrbitCamera
-from renderer.scene_file import load_scene
-from renderer.virtual_display import virtual_display
+from renderer.viewer.orbit import OrbitCamera
+from renderer.core.scene_file import load_scene
+from renderer.viewer.virtual_display import virtual_display
 
 SCENES = ("sphere", "coloured_lights", "hierarchy", "point_light_plane")
 

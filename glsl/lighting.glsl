@@ -1,10 +1,10 @@
 // Twin: reference/lighting.py
 // The lighting equation of docs/conventions.md (section 2.1 of the notes), in world space:
 //   I = I_a k_a + sum_l att_l I_l k_d max(N.L, 0) + sum_l att_l I_l k_s spec_l
-// Compile-time constants (renderer/shaders.py injects them): NUM_DIRECTIONAL_LIGHTS and
+// Compile-time constants (renderer/gpu/shaders.py injects them): NUM_DIRECTIONAL_LIGHTS and
 // NUM_POINT_LIGHTS size the light arrays; an array is left out when its count is 0.
 // SPECULAR compiles the k_s term in; without it (every k_s is 0) neither R, V nor pow exist.
-// ALL_FEATURES (the build that does not specialise, renderer/shaders.py) keeps the arrays at
+// ALL_FEATURES (the build that does not specialise, renderer/gpu/shaders.py) keeps the arrays at
 // their full size and reads how many lights there are from uniforms at run time.
 
 #ifndef NUM_DIRECTIONAL_LIGHTS

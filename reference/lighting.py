@@ -6,7 +6,7 @@ world space, vectorised over any number of surface points:
     I = I_a k_a + sum_l att_l I_l k_d max(N.L, 0) + sum_l att_l I_l k_s spec_l
 
 Inputs:  P (..., 3) surface points and N (..., 3) unit normals in world space, E (3,) the
-         eye, a `renderer.scene.Material` and the scene's lights packed as `Lights`
+         eye, a `renderer.core.scene.Material` and the scene's lights packed as `Lights`
          (the NumPy twin of the GLSL light uniforms). Everything in one float dtype.
 Output:  I (..., 3) linear RGB in that dtype, unclamped.
 

@@ -6,7 +6,7 @@ alpha 0; rows flipped once so that row 0 is the top (GL's row 0 is the bottom).
 
 Inputs:  color (H*W, 4) linear colour of the surviving fragment per pixel (GL row order,
          bottom row first), drawn (H*W,) bool, view_depth (H*W,) -z_eye, background (3,).
-Outputs: `renderer.frame.Frame`: rgba8 (H, W, 4) uint8, linear (H, W, 4) float32 or None,
+Outputs: `renderer.core.frame.Frame`: rgba8 (H, W, 4) uint8, linear (H, W, 4) float32 or None,
          depth (H, W) float32 (+inf where nothing was drawn) or None.
 """
 
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from renderer.frame import Frame
+from renderer.core.frame import Frame
 
 
 def to_unorm8(c: np.ndarray) -> np.ndarray:

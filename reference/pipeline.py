@@ -1,14 +1,14 @@
-"""# Twin: renderer/gpu.py (the draw as a whole; each stage's twin is named in its module)
+"""# Twin: renderer/gpu/pipeline.py (the draw as a whole; each stage's twin is named in its module)
 
 The reference draw, stage by stage as dEQP's drawBasicPrimitives reads: for each object in
 scene order, vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping
 -> viewport transform and snapping -> facing and culling -> rasterisation -> depth test;
 then fragment shading for the one surviving fragment per pixel, and output conversion.
-Objects wholly outside the view volume are skipped (renderer/visibility.py, as the GPU path).
+Objects wholly outside the view volume are skipped (renderer/core/visibility.py, as the GPU path).
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 
-Input:  a `renderer.scene.Scene` and the image size. Output: a `renderer.frame.Frame`
+Input:  a `renderer.core.scene.Scene` and the image size. Output: a `renderer.core.frame.Frame`
 (rgba8 (H, W, 4) uint8 row 0 at the top, optional linear (H, W, 4) float32, depth (H, W)
 float32 -z_eye with +inf background). Conventions: docs/conventions.md.
 """
@@ -20,15 +20,15 @@ import time
 import numpy as np
 
 from reference.clipping import clip_triangles
-from reference.depth_test import DepthBuffer
+from reference.depth_buffer import DepthBuffer
 from reference.fragment import ObjectVaryings, shade_fragments
 from reference.geometry import shade_triangles
 from reference.lighting import Lights
 from reference.output import compose_frame
 from reference.rasterizer import SUBPIXEL_BITS, is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
-from renderer.frame import Frame
-from renderer.visibility import visible_objects
+from renderer.core.frame import Frame
+from renderer.core.visibility import visible_objects
 
 
 def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, depth: DepthBuffer,
@@ -71,7 +71,7 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     start = time.perf_counter()
     dtype = np.dtype(dtype)
     frame_matrices = scene.matrices(width, height, sample_offset)
-    # Camera-relative positions, as the GPU gets them (renderer.scene.FrameMatrices).
+    # Camera-relative positions, as the GPU gets them (renderer.core.scene.FrameMatrices).
     lights = Lights.from_scene(scene, dtype, origin=frame_matrices.origin)
     eye = frame_matrices.relative(scene.camera.eye).astype(dtype)
     depth_buffer = DepthBuffer(width, height, dtype, scene.camera.reversed_z)
@@ -90,7 +90,7 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     frame = compose_frame(color, drawn, view_depth if depth else None, scene.background,
                           width, height, linear=linear)
     # Where two surfaces are closer in depth than GL can order, the other one may show: its
-    # colour goes beside the winner's, for comparisons to accept either (renderer/compare.py).
+    # colour goes beside the winner's, for comparisons to accept either (renderer/checks/compare.py).
     ties = depth_buffer.depth_ties()
     if ties.any():
         other, _ = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype)

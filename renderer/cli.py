@@ -125,13 +125,13 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _load(scene_arg):
-    from renderer.builtin import resolve_scene
-    from renderer.scene_file import load_scene
+    from renderer.core.builtin import resolve_scene
+    from renderer.core.scene_file import load_scene
     return load_scene(resolve_scene(scene_arg))
 
 
 def _render_gpu(scene, size, context_kind, frames=1):
-    from renderer.gpu import GpuRenderer
+    from renderer.gpu.pipeline import GpuRenderer
     with GpuRenderer(scene, *size, context_kind=context_kind) as gpu:
         timings, frame = [], None
         for _ in range(frames):
@@ -142,7 +142,7 @@ def _render_gpu(scene, size, context_kind, frames=1):
 
 
 def cmd_render(args) -> int:
-    from renderer.imageio import write_npy, write_png
+    from renderer.core.imageio import write_npy, write_png
     scene = _load(args.scene)
     output = args.output or Path(f"{scene.name}.png")
     if args.backend == "gpu":
@@ -158,10 +158,10 @@ def cmd_render(args) -> int:
 
 
 def cmd_view(args) -> int:
-    """The window viewer (renderer/viewer.py); without a display, one line and status 2."""
-    from renderer.imageio import write_text
-    from renderer.reference_view import figures_line
-    from renderer.viewer import Viewer
+    """The window viewer (renderer/viewer/viewer.py); without a display, one line and status 2."""
+    from renderer.core.imageio import write_text
+    from renderer.viewer.reference_view import figures_line
+    from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     if args.frames is None and args.stats is not None:
         raise UserError("renderer view: --stats needs --frames (the scripted mode)")
@@ -189,8 +189,8 @@ def cmd_view(args) -> int:
 
 def cmd_compare(args) -> int:
     import reference
-    from renderer.compare import compare_frames, depth_tie_pixels, heat_map
-    from renderer.imageio import write_png
+    from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
+    from renderer.core.imageio import write_png
     scene = _load(args.scene)
     # Median of a few frames: the first one pays for shader compilation.
     gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
@@ -214,8 +214,8 @@ def cmd_compare(args) -> int:
 def cmd_shaders(args) -> int:
     """One set of files per shader variant the scene draws with, named after the variant,
     and a line per variant naming the objects that use it."""
-    from renderer.imageio import write_text
-    from renderer.shaders import ShaderVariant, program_sources
+    from renderer.core.imageio import write_text
+    from renderer.gpu.shaders import ShaderVariant, program_sources
     scene = _load(args.scene)
     out = args.out or Path(f"shaders-{scene.name}")
     users: dict[ShaderVariant, list[str]] = {}
@@ -234,8 +234,8 @@ def cmd_shaders(args) -> int:
 
 
 def cmd_report(args) -> int:
-    from renderer.builtin import builtin_scenes
-    from renderer.report import QUICK_SCENES, run_report
+    from renderer.core.builtin import builtin_scenes
+    from renderer.study.report import QUICK_SCENES, run_report
     names = args.scenes or (list(QUICK_SCENES) if args.quick else list(builtin_scenes()))
     scenes = [_load(name) for name in names]
     result = run_report(scenes, args.out, quick=args.quick, size=args.size, cache_dir=args.cache,
@@ -246,7 +246,7 @@ def cmd_report(args) -> int:
 
 
 def cmd_scenes(args) -> int:
-    from renderer.builtin import builtin_scenes, describe
+    from renderer.core.builtin import builtin_scenes, describe
     for name in builtin_scenes():
         print(f"{name}\t{describe(name)}")
     return 0
@@ -254,10 +254,10 @@ def cmd_scenes(args) -> int:
 
 def cmd_extremes(args) -> int:
     """extremes.json and extremes.md in --out; status 1 when a case fails (as authored)."""
-    from renderer.builtin import resolve_scene
-    from renderer.context import make_context, release_context
-    from renderer.extremes import all_pass, extreme_scenes, measure_extremes, write_report
-    from renderer.scene_file import load_scene
+    from renderer.core.builtin import resolve_scene
+    from renderer.gpu.context import make_context, release_context
+    from renderer.study.extremes import all_pass, extreme_scenes, measure_extremes, write_report
+    from renderer.core.scene_file import load_scene
     extra = [resolve_scene(arg) for arg in args.scenes]
     for path in extra:
         load_scene(path)                     # a bad extra scene: its one line before any work

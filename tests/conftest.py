@@ -3,7 +3,7 @@ virtual X display for the window viewer."""
 
 import pytest
 
-from renderer.context import make_context
+from renderer.gpu.context import make_context
 
 CONTEXT_KINDS = ("egl", "osmesa")
 
@@ -21,7 +21,7 @@ def gl_contexts():
 def x_display():
     """A virtual X display (Xvfb) for the window viewer's tests, ":N". It must start: CI
     installs xvfb (install.sh)."""
-    from renderer.virtual_display import virtual_display
+    from renderer.viewer.virtual_display import virtual_display
     with virtual_display() as display:
         yield display
 

@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-from renderer.imageio import read_png
+from renderer.core.imageio import read_png
 
 
 def run(*args, cwd=None):
@@ -76,11 +76,11 @@ def test_written_files_get_the_usual_permissions(tmp_path):
 def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path, gl_contexts):
     """hierarchy draws with three variants (phong, gouraud, flat with its geometry stage);
     each file is the text the renderer compiles, and it compiles as it is."""
-    from renderer.builtin import builtin_scenes
-    from renderer.context import activate
-    from renderer.gpu import GpuRenderer
-    from renderer.scene_file import load_scene
-    from renderer.shaders import ShaderVariant, program_sources
+    from renderer.core.builtin import builtin_scenes
+    from renderer.gpu.context import activate
+    from renderer.gpu.pipeline import GpuRenderer
+    from renderer.core.scene_file import load_scene
+    from renderer.gpu.shaders import ShaderVariant, program_sources
 
     result = run("shaders", "hierarchy", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr

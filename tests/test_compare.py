@@ -1,10 +1,10 @@
-"""The comparison rules of renderer/compare.py on hand-made images."""
+"""The comparison rules of renderer/checks/compare.py on hand-made images."""
 
 import math
 
 import numpy as np
 
-from renderer.compare import (compare_frames, depth_max_rel, heat_map,
+from renderer.checks.compare import (compare_frames, depth_max_rel, heat_map,
                               position_deviation_mismatch, raw_mismatch)
 
 

@@ -1,13 +1,13 @@
-"""renderer/context.py and renderer/osmesa.py: headless contexts of both kinds, one process."""
+"""renderer/gpu/context.py and renderer/gpu/osmesa.py: headless contexts of both kinds, one process."""
 
 import numpy as np
 import pytest
 
-from renderer import context as context_module
-from renderer.context import activate, context_kind, make_context, release_context
+from renderer.gpu import context as context_module
+from renderer.gpu.context import activate, context_kind, make_context, release_context
 from renderer.errors import ContextError
 from renderer.gpu import GpuRenderer
-from renderer.scene import Camera, Material, Mesh, Scene, SceneObject
+from renderer.core.scene import Camera, Material, Mesh, Scene, SceneObject
 
 SIZE = (40, 30)
 

@@ -1,4 +1,4 @@
-"""renderer/controls.py: the viewer's keys and mouse, fed events directly (no GL, no window).
+"""renderer/viewer/controls.py: the viewer's keys and mouse, fed events directly (no GL, no window).
 
 The scene below has two objects (one authored two-sided, one not) and three lights: one
 directional and two point lights, so keys 1, 2, 3 are "directional light 1",
@@ -11,11 +11,11 @@ import glfw
 import numpy as np
 import pytest
 
-from renderer.controls import (KEY_BINDINGS, MOUSE_BINDINGS, ORBIT_DEGREES_PER_PIXEL,
+from renderer.viewer.controls import (KEY_BINDINGS, MOUSE_BINDINGS, ORBIT_DEGREES_PER_PIXEL,
                                Controls, ViewState, apply_view, help_lines, light_names_of,
                                working_copy)
-from renderer.orbit import OrbitCamera
-from renderer.scene import (Camera, DirectionalLight, Material, Mesh, PointLight, Scene,
+from renderer.viewer.orbit import OrbitCamera
+from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, PointLight, Scene,
                             SceneObject)
 
 WIDTH, HEIGHT = 640, 480

@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from renderer.builtin import builtin_scenes
-from renderer.context import make_context
+from renderer.core.builtin import builtin_scenes
+from renderer.gpu.context import make_context
 from renderer.gpu import GpuRenderer
-from renderer.scene_file import load_scene
+from renderer.core.scene_file import load_scene
 
 SIZE = (256, 256)
 CONTEXT_KINDS = ("egl", "osmesa")

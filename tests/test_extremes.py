@@ -15,16 +15,16 @@ import pytest
 
 import reference
 from reference.clipping import clip_triangles
-from reference.depth_test import DepthBuffer
+from reference.depth_buffer import DepthBuffer
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero, specular_term
-from renderer import transforms as tf
-from renderer.compare import compare_frames, depth_tie_pixels
-from renderer.context import activate, gl_function
-from renderer.extremes import STABILITY, extreme_scenes, is_finite_frame, passes
-from renderer.gpu import GL_NEGATIVE_ONE_TO_ONE, GpuRenderer
-from renderer.primitives import plane
-from renderer.scene import Camera, Material, PointLight, Scene, SceneObject, Transform
-from renderer.scene_file import load_scene
+from renderer.core import transforms as tf
+from renderer.checks.compare import compare_frames, depth_tie_pixels
+from renderer.gpu.context import activate, gl_function
+from renderer.study.extremes import STABILITY, extreme_scenes, is_finite_frame, passes
+from renderer.gpu.pipeline import GL_NEGATIVE_ONE_TO_ONE, GpuRenderer
+from renderer.core.primitives import plane
+from renderer.core.scene import Camera, Material, PointLight, Scene, SceneObject, Transform
+from renderer.core.scene_file import load_scene
 
 SIZE = (160, 120)
 REFUSED = ("nan_mesh",)
@@ -227,7 +227,7 @@ def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, g
     assert is_finite_frame(frame) and is_finite_frame(expected)
     figures = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
                              reference_tie=expected.rgba8_tie).as_dict()
-    assert passes(figures), figures          # the pipeline tolerance (renderer/extremes.py)
+    assert passes(figures), figures          # the pipeline tolerance (renderer/study/extremes.py)
     assert (frame.rgba8[..., 3] == 255).mean() > 0.005        # something was drawn
 
 

@@ -1,4 +1,4 @@
-"""Specification of the golden-image pytest plugin (renderer/pytest_plugin.py), one hand-checked
+"""Specification of the golden-image pytest plugin (renderer/checks/pytest_plugin.py), one hand-checked
 case per rule.
 
 Each case writes a small test file into a `pytester` folder and runs pytest on it in this
@@ -28,8 +28,8 @@ import pytest
 from PIL import Image
 
 import renderer
-from renderer.goldens import check_golden, pixels_sha256, read_golden
-from renderer.perceptual import flip_error
+from renderer.checks.goldens import check_golden, pixels_sha256, read_golden
+from renderer.checks.perceptual import flip_error
 
 pytest_plugins = ["pytester"]
 
@@ -82,7 +82,7 @@ class Spec:
         # In process, the inner run inherits this run's warning filters: keep GoldenWarning a
         # warning even under `pytest -W error`, as it is in a run of its own.
         return self.pytester.runpytest_inprocess(
-            "-p", "no:cacheprovider", "-W", "default::renderer.pytest_plugin.GoldenWarning", *args)
+            "-p", "no:cacheprovider", "-W", "default::renderer.checks.pytest_plugin.GoldenWarning", *args)
 
 
 def outcomes(result) -> dict[str, str]:
@@ -629,10 +629,10 @@ def test_update_interrupted_between_png_and_sidecar_is_noticed(tmp_path, monkeyp
     changed = GREY.copy()
     changed[0, 0, :3] = 0
 
-    import renderer.goldens
+    import renderer.checks.goldens
     def write_text(path, text):
         raise KeyboardInterrupt
-    monkeypatch.setattr(renderer.goldens, "write_text", write_text)
+    monkeypatch.setattr(renderer.checks.goldens, "write_text", write_text)
     with pytest.raises(KeyboardInterrupt):
         check_golden(tmp_path, "sky", changed, update=True)
     monkeypatch.undo()

@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
-from renderer.goldens import read_golden
+from renderer.checks.goldens import read_golden
 
 REPO = Path(__file__).resolve().parents[1]
 GOLDEN = "sphere-phong"

@@ -1,7 +1,7 @@
 """This project's golden images: every built-in scene in each shading mode, at 256x256.
 
 Each golden is held two ways. The GPU's frame is held against it on EGL and on OSMesa (the
-`golden` fixture from renderer/pytest_plugin.py, default policy "threshold"). The golden is
+`golden` fixture from renderer/checks/pytest_plugin.py, default policy "threshold"). The golden is
 held against the NumPy reference under the rule of tests/test_gpu_vs_reference.py, so a
 golden can never drift from the reference unnoticed, not even by `--update-goldens`.
 
@@ -17,11 +17,11 @@ from pathlib import Path
 import pytest
 
 import reference
-from renderer.builtin import builtin_scenes
-from renderer.compare import compare_frames
-from renderer.goldens import read_golden
-from renderer.scene import SHADING_MODES
-from renderer.scene_file import load_scene
+from renderer.core.builtin import builtin_scenes
+from renderer.checks.compare import compare_frames
+from renderer.checks.goldens import read_golden
+from renderer.core.scene import SHADING_MODES
+from renderer.core.scene_file import load_scene
 
 SIZE = (256, 256)
 GOLDENS = Path(__file__).parent / "goldens"

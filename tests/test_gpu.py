@@ -1,11 +1,11 @@
-"""renderer/gpu.py: what a frame holds, where things land in it, and tiny hand-checked oracles."""
+"""renderer/gpu/pipeline.py: what a frame holds, where things land in it, and tiny hand-checked oracles."""
 
 import numpy as np
 import pytest
 
 from renderer.gpu import GpuRenderer
-from renderer.primitives import icosphere, plane
-from renderer.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
+from renderer.core.primitives import icosphere, plane
+from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
                             Transform)
 
 W, H = 64, 48

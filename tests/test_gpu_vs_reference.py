@@ -9,10 +9,10 @@ import functools
 import pytest
 
 import reference
-from renderer.builtin import builtin_scenes
-from renderer.compare import compare_frames
+from renderer.core.builtin import builtin_scenes
+from renderer.checks.compare import compare_frames
 from renderer.gpu import GpuRenderer
-from renderer.scene_file import load_scene
+from renderer.core.scene_file import load_scene
 
 SIZES = ((320, 240), (640, 480))
 RAW_MISMATCH_LIMIT = 0.001

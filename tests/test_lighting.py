@@ -17,9 +17,9 @@ from reference import render
 from reference.geometry import shade_triangles
 from reference.lighting import Lights, MaterialUniforms, lighting
 from reference.vertex import shade_vertices
-from renderer.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
+from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
                             Transform)
-from renderer import primitives
+from renderer.core import primitives
 
 ORIGIN = np.zeros(3)
 UP_Z = np.array([0.0, 0.0, 1.0])

@@ -1,4 +1,4 @@
-"""renderer/meshio.py: OBJ, PLY and STL files in, checked meshes out, bad files refused."""
+"""renderer/core/meshio.py: OBJ, PLY and STL files in, checked meshes out, bad files refused."""
 
 from pathlib import Path
 
@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from renderer.builtin import assets_dir
+from renderer.core.builtin import assets_dir
 from renderer.errors import SceneError
-from renderer.meshio import load_mesh
+from renderer.core.meshio import load_mesh
 
 TRIANGLE_OBJ = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 

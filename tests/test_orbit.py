@@ -1,4 +1,4 @@
-"""renderer/orbit.py: the viewer's turntable camera, a hand-checked case per rule.
+"""renderer/viewer/orbit.py: the viewer's turntable camera, a hand-checked case per rule.
 
 The standard camera below looks from (0, 0, 5) at the origin with up +y, so its right is +x
 and its screen up +y. Pan is checked by projecting with the project's own matrices
@@ -11,11 +11,12 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from renderer import builtin, transforms
-from renderer.orbit import (FAR_MARGIN, NEAR_MARGIN, PARALLEL_ZOOM_RANGE, ZOOM_FACTOR,
+from renderer.core import builtin
+from renderer.core import transforms
+from renderer.viewer.orbit import (FAR_MARGIN, NEAR_MARGIN, PARALLEL_ZOOM_RANGE, ZOOM_FACTOR,
                             OrbitCamera)
-from renderer.scene import Camera, Scene
-from renderer.scene_file import load_scene
+from renderer.core.scene import Camera, Scene
+from renderer.core.scene_file import load_scene
 
 C1, S1 = math.cos(math.radians(1.0)), math.sin(math.radians(1.0))
 

@@ -1,12 +1,12 @@
-"""How the viewer puts images on the screen (renderer/presenter.py, renderer/overlay.py):
+"""How the viewer puts images on the screen (renderer/viewer/presenter.py, renderer/viewer/overlay.py):
 letterboxing, copies between framebuffers, CPU images, double and triple buffering. All of it
 runs on a headless context: a window's default framebuffer is one more target."""
 
 import numpy as np
 import pytest
 
-from renderer.overlay import BACKGROUND, text_panel
-from renderer.presenter import Blitter, CpuImage, Presenter, fit
+from renderer.viewer.overlay import BACKGROUND, text_panel
+from renderer.viewer.presenter import Blitter, CpuImage, Presenter, fit
 
 
 # -- letterboxing -------------------------------------------------------------------------------
@@ -39,7 +39,7 @@ def _read_top_down(fbo):
 
 @pytest.fixture
 def ctx(gl_contexts):
-    from renderer.context import activate
+    from renderer.gpu.context import activate
     ctx = gl_contexts["egl"]
     activate(ctx)
     return ctx

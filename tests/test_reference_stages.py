@@ -1,7 +1,7 @@
 """The reference pipeline stage by stage, each case worked out by hand.
 
 Clipping (reference/clipping.py), rasterisation (reference/rasterizer.py), depth test
-(reference/depth_test.py), output conversion (reference/output.py) and the whole draw
+(reference/depth_buffer.py), output conversion (reference/output.py) and the whole draw
 (reference/pipeline.py). The llvmpipe comparisons of the fill rule and snapping are in
 tests/test_rasterizer.py; the lighting equation in tests/test_lighting.py.
 """
@@ -15,13 +15,14 @@ import pytest
 
 from reference import render
 from reference.clipping import clip_triangles
-from reference.depth_test import DEPTH_TIE_TOLERANCE, DepthBuffer
+from reference.depth_buffer import DEPTH_TIE_TOLERANCE, DepthBuffer
 from reference.fragment import interpolate
 from reference.output import to_unorm8
 from reference.rasterizer import is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
-from renderer import primitives, transforms
-from renderer.scene import (Camera, DirectionalLight, Material, Mesh, Scene, SceneObject,
+from renderer.core import primitives
+from renderer.core import transforms
+from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, Scene, SceneObject,
                             Transform)
 
 # A camera at the origin looking down -z, 90 degree field of view, square image, near 1:

@@ -1,4 +1,4 @@
-"""The viewer's reference view (renderer/reference_view.py): the NumPy reference of the view
+"""The viewer's reference view (renderer/viewer/reference_view.py): the NumPy reference of the view
 made in a background process, only the newest request kept, and the difference figures."""
 
 from dataclasses import replace
@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 import reference
-from renderer.builtin import resolve_scene
-from renderer.reference_view import BackgroundReference, ReferenceResult, difference_view
-from renderer.scene_file import load_scene
+from renderer.core.builtin import resolve_scene
+from renderer.viewer.reference_view import BackgroundReference, ReferenceResult, difference_view
+from renderer.core.scene_file import load_scene
 
 
 @pytest.fixture(scope="module")

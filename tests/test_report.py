@@ -1,5 +1,5 @@
-"""`renderer report` (renderer/report.py, report_output.py) and its ground truth
-(renderer/ground_truth.py)."""
+"""`renderer report` (renderer/study/report.py, report_output.py) and its ground truth
+(renderer/study/ground_truth.py)."""
 
 import csv
 import math
@@ -10,11 +10,11 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from renderer.builtin import builtin_scenes
-from renderer.ground_truth import ground_truth
-from renderer.report import CSV_COLUMNS, QUICK, metrics, settings
-from renderer.report_output import convergence_slopes, pareto_front
-from renderer.scene_file import load_scene
+from renderer.core.builtin import builtin_scenes
+from renderer.study.ground_truth import ground_truth
+from renderer.study.report import CSV_COLUMNS, QUICK, metrics, settings
+from renderer.study.report_output import convergence_slopes, pareto_front
+from renderer.core.scene_file import load_scene
 
 
 def run(*args):

@@ -1,11 +1,11 @@
-"""Sample patterns (renderer/sampling.py): offsets from the pixel centre in [-0.5, 0.5)^2."""
+"""Sample patterns (renderer/core/sampling.py): offsets from the pixel centre in [-0.5, 0.5)^2."""
 
 import math
 
 import numpy as np
 import pytest
 
-from renderer.sampling import (PATTERNS, jittered, pattern, poisson_disk, poisson_radius,
+from renderer.core.sampling import (PATTERNS, jittered, pattern, poisson_disk, poisson_radius,
                                random_samples, regular_grid, strata)
 
 COUNTS = (1, 2, 3, 4, 8, 16, 32, 64)

@@ -14,13 +14,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from renderer.builtin import (DEFAULT_SCENE, assets_dir, builtin_scenes, resolve_scene,
+from renderer.core.builtin import (DEFAULT_SCENE, assets_dir, builtin_scenes, resolve_scene,
                               scene_descriptions)
 from renderer.errors import SceneError
-from renderer.primitives import cube, plane, uv_sphere
-from renderer.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
+from renderer.core.primitives import cube, plane, uv_sphere
+from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
                             Transform)
-from renderer.scene_file import load_scene, scene_from_dict
+from renderer.core.scene_file import load_scene, scene_from_dict
 
 REPO = Path(__file__).resolve().parent.parent
 BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_plane",

@@ -1,12 +1,12 @@
-"""renderer/shaders.py: include expansion, #define placement, variants; the glsl/ files' headers."""
+"""renderer/gpu/shaders.py: include expansion, #define placement, variants; the glsl/ files' headers."""
 
 import re
 
 import pytest
 
-from renderer.resources import assets_dir, glsl_dir
-from renderer.scene import DirectionalLight, Material, PointLight, Scene
-from renderer.shaders import (ProgramCache, ShaderSourceError, ShaderVariant, program_source,
+from renderer.core.resources import assets_dir, glsl_dir
+from renderer.core.scene import DirectionalLight, Material, PointLight, Scene
+from renderer.gpu.shaders import (ProgramCache, ShaderSourceError, ShaderVariant, program_source,
                               program_sources, shader_source)
 
 TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geometry.py",
@@ -128,7 +128,7 @@ def test_unknown_shading_mode_is_rejected():
 
 
 def test_every_variant_compiles_and_is_cached(gl_contexts):
-    from renderer.context import activate
+    from renderer.gpu.context import activate
     ctx = gl_contexts["egl"]
     activate(ctx)
     cache = ProgramCache(ctx)

@@ -14,15 +14,15 @@ import pytest
 
 import reference
 import reference.pipeline
-from renderer.builtin import builtin_scenes
-from renderer.compare import compare_frames
-from renderer.context import activate
+from renderer.core.builtin import builtin_scenes
+from renderer.checks.compare import compare_frames
+from renderer.gpu.context import activate
 from renderer.gpu import GpuRenderer
-from renderer.primitives import cube
-from renderer.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
-from renderer.scene_file import load_scene
-from renderer.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant, program_sources
-from renderer.visibility import outside_view_volume, visible_objects
+from renderer.core.primitives import cube
+from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
+from renderer.core.scene_file import load_scene
+from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant, program_sources
+from renderer.core.visibility import outside_view_volume, visible_objects
 
 SIZE = (96, 72)
 
@@ -33,7 +33,7 @@ def scene_named(name):
 
 
 def defines_of(variant):
-    """The #defines renderer/shaders.py put after the #version line of the variant's
+    """The #defines renderer/gpu/shaders.py put after the #version line of the variant's
     fragment shader (they end where the author's text resumes, at a #line directive)."""
     lines = program_sources(variant)["fragment_shader"].text.splitlines()
     start = next(i for i, line in enumerate(lines) if line.startswith("#version")) + 1

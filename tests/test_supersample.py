@@ -1,4 +1,4 @@
-"""Supersampling (renderer/supersample.py): the projection jitter, GPU and reference
+"""Supersampling (renderer/study/supersample.py): the projection jitter, GPU and reference
 accumulating the same offsets, adaptive supersampling and MSAA."""
 
 import functools
@@ -8,13 +8,13 @@ import pytest
 
 import reference
 from reference.output import to_unorm8
-from renderer import transforms
-from renderer.builtin import builtin_scenes
-from renderer.compare import compare_frames
+from renderer.core import transforms
+from renderer.core.builtin import builtin_scenes
+from renderer.checks.compare import compare_frames
 from renderer.gpu import GpuRenderer, multisample_counts
-from renderer.sampling import jittered, regular_grid
-from renderer.scene_file import load_scene
-from renderer.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
+from renderer.core.sampling import jittered, regular_grid
+from renderer.core.scene_file import load_scene
+from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
 from test_gpu_vs_reference import RAW_MISMATCH_LIMIT
 

@@ -1,10 +1,10 @@
-"""Re-tessellation of curved primitives (renderer/tessellation.py) from Mesh.recipe."""
+"""Re-tessellation of curved primitives (renderer/study/tessellation.py) from Mesh.recipe."""
 
-from renderer.builtin import builtin_scenes
-from renderer.primitives import icosphere
-from renderer.scene import Scene, SceneObject
-from renderer.scene_file import MAX_SEGMENTS, load_scene, scene_from_dict
-from renderer.tessellation import FINEST, LEVELS, retessellate, scene_at_level
+from renderer.core.builtin import builtin_scenes
+from renderer.core.primitives import icosphere
+from renderer.core.scene import Scene, SceneObject
+from renderer.core.scene_file import MAX_SEGMENTS, load_scene, scene_from_dict
+from renderer.study.tessellation import FINEST, LEVELS, retessellate, scene_at_level
 
 
 def mesh_of(primitive: dict):

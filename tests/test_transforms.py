@@ -1,4 +1,4 @@
-"""renderer/transforms.py against the notes' matrices, hand-checked points, and pyrr.
+"""renderer/core/transforms.py against the notes' matrices, hand-checked points, and pyrr.
 
 Column vectors throughout: a point is transformed as p' = M p (docs/conventions.md), and
 pyrr's row-vector matrices equal our M.T.
@@ -10,7 +10,7 @@ import numpy as np
 import pyrr
 import pytest
 
-from renderer import transforms as tf
+from renderer.core import transforms as tf
 
 C30, S30 = math.cos(math.radians(30)), math.sin(math.radians(30))
 

@@ -1,4 +1,4 @@
-"""The window viewer (`renderer view`, renderer/viewer.py) in a real window on a virtual X
+"""The window viewer (`renderer view`, renderer/viewer/viewer.py) in a real window on a virtual X
 display (Xvfb): what the window shows is the headless render of the same camera and size;
 the controls act on it; the scripted mode, the reference view and double/triple buffering
 work end to end; without a display it says so in one line and exits with status 2."""
@@ -12,14 +12,14 @@ import glfw
 import numpy as np
 import pytest
 
-from renderer.builtin import resolve_scene
-from renderer.compare import compare_frames
-from renderer.extremes import RAW_MISMATCH_LIMIT
+from renderer.core.builtin import resolve_scene
+from renderer.checks.compare import compare_frames
+from renderer.study.extremes import RAW_MISMATCH_LIMIT
 from renderer.gpu import GpuRenderer
-from renderer.imageio import read_png
-from renderer.orbit import OrbitCamera
-from renderer.scene_file import load_scene
-from renderer.viewer import SCREEN_CLEAR, Viewer
+from renderer.core.imageio import read_png
+from renderer.viewer.orbit import OrbitCamera
+from renderer.core.scene_file import load_scene
+from renderer.viewer.viewer import SCREEN_CLEAR, Viewer
 
 SIZE = (160, 120)
 
@@ -253,7 +253,7 @@ def test_escape_quits(viewer):
 def test_keys_and_mouse_end_to_end_with_xdotool(x_display, tmp_path):
     """The interactive viewer in its own process: xdotool focuses its window, types W
     (wireframe), drags with the left button (orbit), types S (screenshot) and Esc."""
-    from renderer.controls import Controls, ViewState
+    from renderer.viewer.controls import Controls, ViewState
     shot = tmp_path / "shot.png"
     env = {**os.environ, "DISPLAY": x_display}
     viewer = subprocess.Popen([sys.executable, "-m", "renderer", "view", "coloured_lights", "--size",

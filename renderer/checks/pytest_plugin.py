@@ -1,0 +1,228 @@
+"""pytest plugin for golden-image tests, registered through the `pytest11` entry point.
+
+    def test_my_scene(golden):
+        golden.check_scene("my_scene.toml")      # GPU, 256x256, against goldens/test_my_scene.png
+
+    pytest                       # compare; failures go to golden-results/index.html
+    pytest --update-goldens      # create missing goldens, rewrite changed ones (the only writer)
+
+Goldens live in a `goldens/` folder beside the test file, as NAME.png with a NAME.json
+sidecar (renderer/checks/goldens.py); NAME defaults to the test's name. Policies: renderer/checks/policies.py;
+the default is "threshold", or the ini option `goldens_policy`. docs/goldens.md has the rest.
+
+The plugin is inert until a test asks for the `golden` fixture: it imports no GL at start-up
+and touches no folder.
+"""
+
+from __future__ import annotations
+
+import re
+import warnings
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+RESULTS_DEFAULT = "golden-results"
+
+
+class GoldenWarning(UserWarning):
+    """A golden passed, but was made on another GL implementation than the frame."""
+
+
+def pytest_addoption(parser):
+    group = parser.getgroup("goldens", "golden images (checked-renderer)")
+    group.addoption("--update-goldens", action="store_true", default=False,
+                    help="write missing goldens and rewrite those whose pixels changed "
+                         "(the only way a golden is ever written)")
+    group.addoption("--goldens-results", metavar="DIR", default=None,
+                    help=f"folder for the images and index.html of failing comparisons "
+                         f"(default: {RESULTS_DEFAULT} in the rootdir)")
+    parser.addini("goldens_policy", default=None,
+                  help="tolerance policy of golden checks that name none: exact, threshold (the "
+                       "default) or flip")
+
+
+class GoldenSession:
+    """What one pytest run knows about its golden checks."""
+
+    def __init__(self, config):
+        self.update = bool(config.getoption("--update-goldens"))
+        option = config.getoption("--goldens-results")
+        self.results_root = Path(option).resolve() if option else config.rootpath / RESULTS_DEFAULT
+        self.default_policy = config.getini("goldens_policy") or None
+        self.counts: Counter = Counter()
+        self.claimed: dict[Path, str] = {}       # golden PNG -> the first test that checked it under
+                                                 # --update-goldens in this run (written or not)
+        self.changed: list[Path] = []            # goldens created or updated in this run
+        self._results = None
+
+    @property
+    def results(self):
+        if self._results is None:
+            from renderer.checks.golden_report import ResultsFolder
+            self._results = ResultsFolder(self.results_root)
+        return self._results
+
+
+_SESSION = pytest.StashKey[GoldenSession]()
+
+
+def pytest_configure(config):
+    config.stash[_SESSION] = GoldenSession(config)
+
+
+@pytest.fixture
+def golden(request) -> "GoldenChecker":
+    """Hold rendered frames against golden PNGs: golden.check(frame) or golden.check_scene(scene)."""
+    return GoldenChecker(request, request.config.stash[_SESSION])
+
+
+def default_name(test_name: str) -> str:
+    """A golden name from a test's name: test_x[a-b] -> test_x-a-b."""
+    name = test_name.replace("[", "-").replace("]", "")
+    return re.sub(r"[^A-Za-z0-9._-]", "_", name)[:150]
+
+
+def _fail_plainly(error) -> None:
+    """Fail the test with a UserError's one line. Raised `from None`: called in an `except`
+    block, pytest.fail would show the UserError again as the exception it happened during."""
+    raise pytest.fail.Exception(error.line(), pytrace=False) from None
+
+
+def _shown(path: Path) -> str:
+    try:
+        return str(path.relative_to(Path.cwd()))
+    except ValueError:
+        return str(path)
+
+
+class GoldenChecker:
+    """The `golden` fixture: one per test."""
+
+    def __init__(self, request, session: GoldenSession):
+        self._request = request
+        self._session = session
+        self.directory = Path(request.path).parent / "goldens"
+        self._names: set[str] = set()
+
+    def check(self, frame, name: str | None = None, *, policy=None, scene: str | None = None,
+              gl_info: dict | None = None):
+        """Hold `frame` (a Frame, or an (H, W, 4) uint8 array) against golden `name`.
+
+        `policy`: "exact", "threshold", "flip", a dict or a renderer.checks.policies instance.
+        `scene` is recorded in the sidecar; `gl_info` defaults to the frame's own.
+        Fails the test with the figures and the results page's path; returns the Outcome.
+        """
+        from renderer.errors import UserError
+        from renderer.checks.goldens import check_golden, golden_paths
+
+        session, nodeid = self._session, self._request.node.nodeid
+        name = name or default_name(self._request.node.name)
+        if name in self._names:
+            pytest.fail(f"this test already checked a golden named {name!r}; give each check its "
+                        "own name=", pytrace=False)
+        self._names.add(name)
+        try:
+            session.results.prepare()      # first check of the run: clear the last run's results
+        except UserError as error:
+            _fail_plainly(error)
+        rgba8 = getattr(frame, "rgba8", frame)
+        gl_info = gl_info or getattr(frame, "gl_info", None)
+        try:
+            png = golden_paths(self.directory, name)[0]
+            # A golden an earlier test of this run updated (two tests sharing a name) is
+            # compared, not written again: if they disagree, that is the failure to see.
+            update = session.update and png not in session.claimed
+            outcome = check_golden(self.directory, name, rgba8, policy=policy or session.default_policy,
+                                   scene=scene, gl_info=gl_info, update=update)
+        except UserError as error:
+            _fail_plainly(error)
+        session.counts[outcome.status] += 1
+        if update:               # "unchanged" too: a later test of the same name must not rewrite it
+            session.claimed[png] = nodeid
+        if outcome.status in ("created", "updated"):
+            session.changed.append(png)
+            session.results.add(nodeid, outcome)           # for review before committing
+        elif outcome.status == "passed":
+            for note in outcome.notes:
+                warnings.warn(GoldenWarning(f"golden {name!r}: {note}"), stacklevel=2)
+        elif outcome.status in ("failed", "missing"):
+            self._fail(outcome)
+        return outcome
+
+    def _fail(self, outcome):
+        session, nodeid = self._session, self._request.node.nodeid
+        try:
+            entry = session.results.add(nodeid, outcome)
+        except Exception as error:             # the report must not hide the failure itself
+            entry = None
+            report = f"(the results folder could not be written: {error})"
+        else:
+            report = (f"images: {_shown(session.results.root / entry.folder)}/; "
+                      f"all failures: {_shown(session.results.index)}")
+        if outcome.status == "missing":
+            lines = [f"golden {outcome.name!r} does not exist ({_shown(outcome.png)}); run pytest "
+                     "--update-goldens to make it from this frame, look at it, and commit the .png "
+                     "and .json"]
+        else:
+            lines = [f"golden {outcome.name!r} ({_shown(outcome.png)}) does not match under "
+                     f"{outcome.policy.describe()}: {outcome.verdict.summary}"]
+            if entry is not None and entry.figures:
+                f = entry.figures
+                lines.append(f"{f['pixels_differing']} pixels differ at all, {f['pixels_failing']} "
+                             f"fail ({f['failing_rule']}), largest channel difference "
+                             f"{f['max_channel_difference']}/255, mean ꟻLIP {f['mean_flip']:.5f}")
+        lines += outcome.notes
+        lines.append(report)
+        if outcome.status == "failed":
+            lines.append("if the change is intended: pytest --update-goldens, then review and commit")
+        pytest.fail("\n".join(lines), pytrace=False)
+
+    def check_scene(self, scene, name: str | None = None, *, size=(256, 256), context="auto",
+                    shading: str | None = None, policy=None):
+        """Render `scene` on the GPU and check it; returns the Frame.
+
+        `scene`: a renderer.core.scene.Scene, a built-in scene's name, or a scene file (relative
+        paths are taken from the test file's folder). `context`: "auto", "egl", "osmesa" or
+        a moderngl context to reuse. `shading`: render every material flat, gouraud or phong.
+        """
+        from renderer.errors import UserError
+        from renderer.gpu.pipeline import GpuRenderer
+        from renderer.core.scene import Scene
+
+        try:
+            if not isinstance(scene, Scene):
+                scene = self._load(scene)
+            if shading is not None:
+                scene = scene.with_shading(shading)
+            where = {"context_kind": context} if isinstance(context, str) else {"context": context}
+            with GpuRenderer(scene, *size, **where) as gpu:
+                frame = gpu.render(depth=False)
+        except UserError as error:
+            _fail_plainly(error)
+        self.check(frame, name, policy=policy, scene=scene.name)
+        return frame
+
+    def _load(self, scene):
+        from renderer.core.builtin import builtin_scenes, resolve_scene
+        from renderer.core.scene_file import load_scene
+
+        scene = str(scene)
+        local = Path(self._request.path).parent / scene
+        if scene not in builtin_scenes() and local.is_file():
+            return load_scene(local)
+        return load_scene(resolve_scene(scene))
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    session = config.stash.get(_SESSION, None)
+    if session is None or not session.counts:
+        return
+    counts = ", ".join(f"{n} {status}" for status, n in sorted(session.counts.items()))
+    terminalreporter.write_sep("-", "golden images")
+    terminalreporter.write_line(f"goldens: {counts}")
+    for png in session.changed:
+        terminalreporter.write_line(f"written: {_shown(png)}")
+    if session._results is not None and session._results.entries:
+        terminalreporter.write_line(f"results: {_shown(session._results.index)}")

@@ -1,0 +1,78 @@
+"""The built-in scenes (assets/scenes/*.toml) and how a scene argument becomes a file.
+
+    builtin_scenes()        {"sphere": Path(".../assets/scenes/sphere.toml"), ...}
+    resolve_scene(None)     the default scene, "sphere"
+    resolve_scene("hierarchy") or resolve_scene("my/scene.toml")  -> Path
+    describe("sphere")      its one-line description (for `renderer scenes`)
+    scene_descriptions()    {"sphere": "The default: ...", ...}
+"""
+
+from __future__ import annotations
+
+import difflib
+import tomllib
+from pathlib import Path
+
+from renderer.core import resources
+from renderer.errors import SceneError
+
+DEFAULT_SCENE = "sphere"
+
+
+def assets_dir() -> Path:
+    """The assets folder (renderer.core.resources finds it in a checkout or a wheel); a
+    SceneError when it is missing."""
+    try:
+        return resources.assets_dir()
+    except FileNotFoundError as exc:
+        raise SceneError(str(exc)) from None
+
+
+def builtin_scenes() -> dict[str, Path]:
+    """Name (the file's stem) to path of every built-in scene, sorted by name."""
+    folder = assets_dir() / "scenes"
+    return {path.stem: path for path in sorted(folder.glob("*.toml"))}
+
+
+def resolve_scene(arg: str | None) -> Path:
+    """The scene file a command-line argument names.
+
+    None means the default scene. A bare name (no folder, no .toml suffix) is looked up among
+    the built-in scenes first; anything else must be an existing file.
+    """
+    scenes = builtin_scenes()
+    if arg is None:
+        return scenes[DEFAULT_SCENE]
+    path = Path(arg)
+    looks_like_a_name = path.name == arg and path.suffix.lower() != ".toml"
+    if looks_like_a_name and arg in scenes:
+        return scenes[arg]
+    if path.is_file():
+        return path
+    if path.is_dir():
+        raise SceneError("is a directory, not a scene file", file=arg)
+    close = difflib.get_close_matches(arg, list(scenes), n=1, cutoff=0.6)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    raise SceneError(f"no such scene file or built-in scene; {hint}"
+                     f"built-in scenes: {', '.join(scenes)}", file=arg)
+
+
+def scene_description(path: Path) -> str:
+    """The scene's one-line `description` key ("" if it has none or cannot be read)."""
+    try:
+        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return ""
+    description = data.get("description", "")
+    return " ".join(description.split()) if isinstance(description, str) else ""
+
+
+def describe(scene: str) -> str:
+    """One-line description of a built-in scene (by name) or of a scene file (by path)."""
+    scenes = builtin_scenes()
+    return scene_description(scenes[scene] if scene in scenes else Path(scene))
+
+
+def scene_descriptions() -> dict[str, str]:
+    """Name to one-line description of every built-in scene."""
+    return {name: scene_description(path) for name, path in builtin_scenes().items()}

@@ -1,0 +1,38 @@
+"""What a render hands back, from either pipeline."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass
+class Frame:
+    """One rendered image. Row 0 is the top row in every array (docs/conventions.md).
+
+    rgba8:  (H, W, 4) uint8, GL's unorm8 conversion of the clamped colour; alpha is 1 (255)
+            where something was drawn and 0 for the background.
+    linear: (H, W, 4) float32 linear colour before clamping, or None if not asked for.
+    depth:  (H, W) float32 camera-space distance along the viewing axis in scene units,
+            +inf where nothing was drawn, or None if not asked for.
+    milliseconds: wall time of the render call that produced it.
+    rgba8_tie: from the reference only, where some pixels' two nearest surfaces are closer in
+            window depth than GL's float32 arithmetic can order (reference/depth_buffer.py,
+            DEPTH_TIE_TOLERANCE): rgba8 with those pixels showing the other surface. GL may
+            draw either, so comparisons accept either. None when there is no such pixel.
+    gl_info: for a GPU frame, the GL implementation that drew it (GpuRenderer.gl_info:
+            GL_VENDOR, GL_RENDERER, GL_VERSION, context, depth_format); None from the
+            reference. Golden tests record it beside each golden.
+    """
+    rgba8: np.ndarray
+    linear: np.ndarray | None = None
+    depth: np.ndarray | None = None
+    milliseconds: float = 0.0
+    rgba8_tie: np.ndarray | None = None
+    gl_info: dict | None = None
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(width, height) in pixels."""
+        return self.rgba8.shape[1], self.rgba8.shape[0]

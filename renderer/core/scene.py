@@ -1,0 +1,205 @@
+"""The scene model shared by the GPU path and the reference.
+
+A scene is plain data: camera, objects (mesh + transform + material), lights, background.
+Both pipelines read it, and both take their matrices from `Scene.matrices()` so that the
+only thing they do differently is the pipeline itself. Units and conventions:
+docs/conventions.md; the file format: docs/scene-format.md.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Literal
+
+import numpy as np
+
+from renderer.core import transforms
+
+Projection = Literal["perspective", "parallel"]
+ShadingMode = Literal["flat", "gouraud", "phong"]
+Cull = Literal["none", "back", "front"]
+SHADING_MODES = ("flat", "gouraud", "phong")
+
+
+@dataclass
+class Camera:
+    """Eye, look point and up vector as in the notes; projection and clip planes."""
+    eye: tuple = (0.0, 0.0, 5.0)
+    look: tuple = (0.0, 0.0, 0.0)
+    up: tuple = (0.0, 1.0, 0.0)
+    projection: Projection = "perspective"
+    fov_y: float = 45.0          # degrees, full vertical field of view (perspective)
+    height: float = 2.0          # scene units, height of the view volume (parallel)
+    near: float = 0.1            # scene units along the viewing axis
+    far: float = 100.0
+    reversed_z: bool = False     # depth 1 at near, 0 at far (glClipControl ZERO_TO_ONE, GL_GREATER)
+
+    def view(self) -> np.ndarray:
+        return transforms.look_at(self.eye, self.look, self.up)
+
+    def projection_matrix(self, aspect: float) -> np.ndarray:
+        if self.projection == "perspective":
+            return transforms.perspective(math.radians(self.fov_y), aspect, self.near, self.far,
+                                          self.reversed_z)
+        return transforms.orthographic(self.height, aspect, self.near, self.far, self.reversed_z)
+
+
+@dataclass
+class Material:
+    """The notes' reflection coefficients (RGB, linear) and Phong exponent n."""
+    ka: tuple = (0.8, 0.8, 0.8)
+    kd: tuple = (0.8, 0.8, 0.8)
+    ks: tuple = (0.0, 0.0, 0.0)
+    n: float = 32.0
+    two_sided: bool = False
+    shading: ShadingMode = "phong"
+
+    @property
+    def has_specular(self) -> bool:
+        """Whether the lighting has a specular term at all (some k_s not 0). Both pipelines
+        leave the term out otherwise (renderer/gpu/shaders.py, reference/lighting.py)."""
+        return any(float(k) != 0.0 for k in self.ks)
+
+
+@dataclass
+class Mesh:
+    """A triangle mesh: positions (V, 3) float64, unit normals (V, 3) float64, faces (F, 3) int64.
+
+    Faces are counter-clockwise seen from the side their normals point to.
+    """
+    positions: np.ndarray
+    normals: np.ndarray
+    faces: np.ndarray
+    source: str = ""             # where it came from, for messages
+    # How a primitive was made: (name in renderer.core.primitives.PRIMITIVES, its arguments), so
+    # that it can be rebuilt at another tessellation (renderer/study/tessellation.py); None for
+    # mesh files.
+    recipe: tuple[str, dict] | None = None
+
+    @property
+    def triangle_count(self) -> int:
+        return int(len(self.faces))
+
+
+@dataclass
+class Transform:
+    """Model transform in the notes' order: scale, shear, rotate (x, y, z), translate."""
+    scale: tuple = (1.0, 1.0, 1.0)
+    shear: dict = field(default_factory=dict)      # factors named as transforms.SHEAR_FACTORS
+    rotate: tuple = (0.0, 0.0, 0.0)                # degrees about x, y, z
+    translate: tuple = (0.0, 0.0, 0.0)
+
+    def matrix(self) -> np.ndarray:
+        return transforms.model_matrix(self.scale, self.shear,
+                                       tuple(math.radians(a) for a in self.rotate),
+                                       self.translate)
+
+
+@dataclass
+class SceneObject:
+    name: str
+    mesh: Mesh
+    material: Material = field(default_factory=Material)
+    transform: Transform = field(default_factory=Transform)
+    parent: str | None = None    # name of another object; its world matrix applies after ours
+    cull: Cull = "none"          # which faces GL culls (window-space winding; CCW is front)
+
+
+@dataclass
+class DirectionalLight:
+    """An infinitely distant light; `direction` is the way its light travels."""
+    direction: tuple = (0.0, 0.0, -1.0)
+    intensity: tuple = (1.0, 1.0, 1.0)
+
+
+@dataclass
+class PointLight:
+    """A local light at `position`, attenuated by 1 / (c + l d + q d^2)."""
+    position: tuple = (0.0, 0.0, 5.0)
+    intensity: tuple = (1.0, 1.0, 1.0)
+    attenuation: tuple = (1.0, 0.0, 0.0)
+
+
+@dataclass
+class ObjectMatrices:
+    model: np.ndarray            # (4, 4) world matrix, camera-relative: T(-origin) M_world
+    normal: np.ndarray           # (3, 3) normal matrix of M_world (transforms.normal_matrix)
+
+
+@dataclass
+class FrameMatrices:
+    """Everything both pipelines need from the scene's geometry for one image size.
+
+    Camera-relative coordinates (docs/conventions.md): world positions are handed to the
+    pipelines relative to `origin` (the eye), so that float32 keeps its precision near the
+    camera however far the scene lies from the world origin. `view` is then a rotation only;
+    the eye and point lights go through `relative()`.
+    """
+    view: np.ndarray
+    projection: np.ndarray
+    objects: list[ObjectMatrices]
+    origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+
+    def relative(self, points) -> np.ndarray:
+        """World points (..., 3) relative to the origin, in float64."""
+        return np.asarray(points, dtype=np.float64) - self.origin
+
+
+@dataclass
+class Scene:
+    camera: Camera = field(default_factory=Camera)
+    objects: list[SceneObject] = field(default_factory=list)
+    directional_lights: list[DirectionalLight] = field(default_factory=list)
+    point_lights: list[PointLight] = field(default_factory=list)
+    ambient: tuple = (0.1, 0.1, 0.1)
+    background: tuple = (0.0, 0.0, 0.0)
+    name: str = "scene"
+    source: str = ""             # file it was read from, if any
+
+    def world_matrices(self) -> list[np.ndarray]:
+        """World matrix of each object, parents applied (M_world = M_parent_world · M_local)."""
+        by_name = {obj.name: obj for obj in self.objects}
+        cache: dict[str, np.ndarray] = {}
+
+        def world(obj: SceneObject, chain: tuple = ()) -> np.ndarray:
+            if obj.name in cache:
+                return cache[obj.name]
+            if obj.name in chain:
+                raise ValueError(f"parent cycle through object {obj.name!r}")
+            local = obj.transform.matrix()
+            m = local if obj.parent is None else world(by_name[obj.parent], chain + (obj.name,)) @ local
+            cache[obj.name] = m
+            return m
+
+        return [world(obj) for obj in self.objects]
+
+    def matrices(self, width: int, height: int, sample_offset=(0.0, 0.0)) -> FrameMatrices:
+        """View, projection and per-object matrices, camera-relative (FrameMatrices), in float64.
+        `sample_offset` (dx, dy): where in each pixel to sample, in pixels from its centre
+        (GL window coordinates); the projection becomes transforms.jitter(dx, dy, W, H) @ P."""
+        origin = np.asarray(self.camera.eye, dtype=np.float64)
+        to_origin = transforms.translate(*(-origin))
+        cam = self.camera
+        projection = cam.projection_matrix(width / height)
+        if tuple(sample_offset) != (0.0, 0.0):
+            projection = transforms.jitter(*sample_offset, width, height) @ projection
+        return FrameMatrices(
+            view=transforms.look_at_rotation(cam.eye, cam.look, cam.up),
+            projection=projection,
+            objects=[ObjectMatrices(to_origin @ m, transforms.normal_matrix(m))
+                     for m in self.world_matrices()],
+            origin=origin,
+        )
+
+    def shading_modes(self) -> list[str]:
+        """The shading modes the scene uses, in a fixed order."""
+        used = {obj.material.shading for obj in self.objects}
+        return [mode for mode in SHADING_MODES if mode in used]
+
+    def with_shading(self, mode: ShadingMode) -> "Scene":
+        """A copy in which every material uses shading `mode`; meshes are shared, not copied."""
+        if mode not in SHADING_MODES:
+            raise ValueError(f"shading must be one of {', '.join(SHADING_MODES)}, got {mode!r}")
+        objects = [replace(obj, material=replace(obj.material, shading=mode)) for obj in self.objects]
+        return replace(self, objects=objects)

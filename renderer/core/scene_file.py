@@ -1,0 +1,532 @@
+"""Scene files: TOML in, a checked `Scene` out, every mistake one `SceneError` line.
+
+    load_scene("assets/scenes/sphere.toml") -> Scene
+    scene_from_dict({"camera": {...}, "objects": [...]}, source="<dict>", base_dir=".")
+
+docs/scene-format.md documents every key with its unit and default. The reader is strict:
+an unknown key is an error (with the closest known key suggested), numbers must be finite,
+and the camera, transforms and meshes are checked before anything is rendered, so that a
+bad file fails here with "FILE: KEY.PATH: reason" instead of drawing nothing. Key paths
+count list entries from 0: `objects[2].material.kd` is the third [[objects]] table.
+"""
+
+from __future__ import annotations
+
+import difflib
+import inspect
+import math
+import numbers
+import re
+import tomllib
+from pathlib import Path
+from typing import Any, NoReturn
+
+import numpy as np
+
+from renderer.core import transforms
+from renderer.core.builtin import assets_dir
+from renderer.errors import SceneError, show_number
+from renderer.core.meshio import load_mesh
+from renderer.core.primitives import PRIMITIVES
+from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
+                            Scene, SceneObject, Transform)
+
+PROJECTIONS = ("perspective", "parallel")
+CULL_MODES = ("none", "back", "front")
+LIGHT_TYPES = ("directional", "point")
+
+TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials", "lights",
+            "objects")
+CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z")
+MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading")
+LIGHT_KEYS = {
+    "directional": ("type", "direction", "intensity"),
+    "point": ("type", "position", "intensity", "attenuation"),
+}
+OBJECT_KEYS = ("name", "mesh", "material", "scale", "shear", "rotate", "translate", "parent",
+               "cull")
+
+# Limits on primitive arguments: (integer?, smallest, largest). Lengths must be > 0; counts
+# are capped so that a typo cannot ask for a hundred million triangles.
+MAX_SEGMENTS = 1024
+_LENGTH = (False, 0.0, None)          # a float > 0
+PRIMITIVE_LIMITS = {
+    "uv_sphere": {"radius": _LENGTH, "segments": (True, 3, MAX_SEGMENTS),
+                  "rings": (True, 2, MAX_SEGMENTS)},
+    "icosphere": {"radius": _LENGTH, "subdivisions": (True, 0, 6)},
+    "plane": {"size": _LENGTH, "segments": (True, 1, MAX_SEGMENTS)},
+    "cube": {"size": _LENGTH},
+    "cylinder": {"radius": _LENGTH, "height": _LENGTH, "segments": (True, 3, MAX_SEGMENTS)},
+    "torus": {"major_radius": _LENGTH, "minor_radius": _LENGTH,
+              "major_segments": (True, 3, MAX_SEGMENTS), "minor_segments": (True, 3, MAX_SEGMENTS)},
+}
+
+# A model matrix whose linear part has a determinant at or below this is refused.
+MIN_DETERMINANT = 1e-9
+
+
+# --------------------------------------------------------------------------- entry points
+
+def load_scene(path) -> Scene:
+    """Read a TOML scene file. Mesh files it names are found relative to its folder."""
+    path = Path(path)
+    source = str(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except FileNotFoundError:
+        raise SceneError("scene file not found", file=source) from None
+    except IsADirectoryError:
+        raise SceneError("is a directory, not a scene file", file=source) from None
+    except UnicodeDecodeError as exc:
+        raise SceneError(f"not UTF-8 text (byte {exc.start}); a scene file is TOML",
+                         file=source) from None
+    except OSError as exc:
+        raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(_toml_syntax_reason(exc), file=source) from None
+    scene = scene_from_dict(data, source=source, base_dir=path.parent)
+    if "name" not in data:
+        scene.name = path.stem
+    return scene
+
+
+def scene_from_dict(data: dict, source: str = "<dict>", base_dir=None) -> Scene:
+    """Build a Scene from the same structure a TOML file parses to (lists may be tuples).
+
+    source names the data in error messages; base_dir is where relative mesh paths start
+    (default: the current directory).
+    """
+    reader = _Reader(source, Path.cwd() if base_dir is None else Path(base_dir))
+    return reader.scene(data)
+
+
+def _toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
+    """tomllib says "Invalid value (at line 3, column 7)"; we say where first."""
+    message = str(exc)
+    match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)
+    if match:
+        what = message[:match.start()]
+        return f"TOML syntax error at line {match[1]}, column {match[2]}: {what}"
+    match = re.search(r"\s*\(at end of document\)$", message)
+    if match:
+        return f"TOML syntax error at end of file: {message[:match.start()]}"
+    return f"TOML syntax error: {message}"
+
+
+# --------------------------------------------------------------------------- value checks
+
+def describe_value(value: Any) -> str:
+    """What a value is, for "expected X, got Y" messages."""
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, numbers.Integral):
+        return f"an integer ({value})"
+    if isinstance(value, numbers.Real):
+        return f"a number ({show_number(float(value))})"
+    if isinstance(value, str):
+        shown = value if len(value) <= 30 else value[:27] + "..."
+        return f"a string ({shown!r})"
+    if isinstance(value, (list, tuple)):
+        return f"a list of {len(value)} item{'' if len(value) == 1 else 's'}"
+    if isinstance(value, dict):
+        return "a table"
+    return f"a {type(value).__name__} ({value})"
+
+
+
+
+def _show_vec(v) -> str:
+    return "[" + ", ".join(show_number(float(x)) for x in v) + "]"
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, numbers.Real) and not isinstance(value, bool)
+
+
+def _unknown_choice(what: str, value: str, known) -> str:
+    """'unknown shading 'smooth'; expected one of: flat, gouraud, phong' (+ a suggestion)."""
+    known = list(known)
+    close = difflib.get_close_matches(value, known, n=1, cutoff=0.6)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"unknown {what} {value!r}; {hint}expected one of: {', '.join(known)}"
+
+
+def _unknown_key(key: str, known) -> str:
+    known = list(known)
+    close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
+    if close:
+        return f"unknown key; did you mean {close[0]!r}?"
+    return f"unknown key; known keys here: {', '.join(known)}"
+
+
+def _no_such(what: str, value: str, known, listing: str) -> str:
+    """'no material named 'rd'; did you mean 'red'? [materials] defines: red, blue'."""
+    known = list(known)
+    close = difflib.get_close_matches(value, known, n=1, cutoff=0.6)
+    hint = f"did you mean {close[0]!r}? " if close else ""
+    return f"no {what} named {value!r}; {hint}{listing}: {', '.join(known)}"
+
+
+def _join(path: str, key: str) -> str:
+    return f"{path}.{key}" if path else key
+
+
+# --------------------------------------------------------------------------- the reader
+
+class _Reader:
+    """Turns parsed TOML into scene dataclasses; every check raises through `fail`."""
+
+    def __init__(self, source: str, base_dir: Path):
+        self.source = source
+        self.base_dir = base_dir
+
+    def fail(self, key: str | None, reason: str) -> NoReturn:
+        raise SceneError(reason, file=self.source, key=key or None)
+
+    # ---- tables and scalars
+
+    def table(self, value: Any, path: str, known) -> dict:
+        """A table whose keys must all be in `known`."""
+        if not isinstance(value, dict):
+            self.fail(path, f"expected a table, got {describe_value(value)}")
+        for key in value:
+            if key not in known:
+                self.fail(_join(path, str(key)), _unknown_key(str(key), known))
+        return value
+
+    def list_of_tables(self, value: Any, path: str, toml_name: str) -> list:
+        if not isinstance(value, (list, tuple)) or not all(isinstance(v, dict) for v in value):
+            self.fail(path, f"expected a list of tables ([[{toml_name}]]), "
+                            f"got {describe_value(value)}")
+        return list(value)
+
+    def to_float(self, value, path: str) -> float:
+        try:
+            return float(value)
+        except OverflowError:          # TOML integers are unbounded
+            self.fail(path, f"number too large: {str(value)[:20]}...")
+
+    def number(self, value: Any, path: str, *, minimum: float | None = None,
+               above: float | None = None) -> float:
+        if not _is_number(value):
+            self.fail(path, f"expected a number, got {describe_value(value)}")
+        x = self.to_float(value, path)
+        if not math.isfinite(x):
+            self.fail(path, f"expected a finite number, got {show_number(x)}")
+        if minimum is not None and x < minimum:
+            self.fail(path, f"must be >= {minimum:g}, got {x:g}")
+        if above is not None and x <= above:
+            self.fail(path, f"must be > {above:g}, got {x:g}")
+        return x
+
+    def integer(self, value: Any, path: str, minimum: int, maximum: int | None) -> int:
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+            self.fail(path, f"expected an integer, got {describe_value(value)}")
+        if value < minimum:
+            self.fail(path, f"must be >= {minimum}, got {value}")
+        if maximum is not None and value > maximum:
+            self.fail(path, f"must be <= {maximum}, got {value}")
+        return int(value)
+
+    def vec3(self, value: Any, path: str, *, minimum: float | None = None,
+             scalar_ok: bool = False) -> tuple[float, float, float]:
+        """A list of 3 finite numbers (or, where scalar_ok, one number meaning all three)."""
+        expected = "a number or a list of 3 numbers" if scalar_ok else "a list of 3 numbers"
+        if scalar_ok and _is_number(value):
+            value = [value] * 3
+        if not isinstance(value, (list, tuple)) or len(value) != 3:
+            self.fail(path, f"expected {expected}, got {describe_value(value)}")
+        components = []
+        for i, item in enumerate(value):
+            if not _is_number(item):
+                self.fail(path, f"expected {expected}, item {i} is {describe_value(item)}")
+            x = self.to_float(item, path)
+            if not math.isfinite(x):
+                self.fail(path, f"expected finite numbers, item {i} is {show_number(x)}")
+            if minimum is not None and x < minimum:
+                self.fail(path, f"must be >= {minimum:g} in every component, "
+                                f"item {i} is {show_number(x)}")
+            components.append(x)
+        return tuple(components)
+
+    def colour(self, value: Any, path: str) -> tuple[float, float, float]:
+        """Linear RGB, each component >= 0; one number means a grey."""
+        return self.vec3(value, path, minimum=0.0, scalar_ok=True)
+
+    def string(self, value: Any, path: str) -> str:
+        if not isinstance(value, str):
+            self.fail(path, f"expected a string, got {describe_value(value)}")
+        return value
+
+    def choice(self, value: Any, path: str, what: str, known) -> str:
+        text = self.string(value, path)
+        if text not in known:
+            self.fail(path, _unknown_choice(what, text, known))
+        return text
+
+    def boolean(self, value: Any, path: str) -> bool:
+        if not isinstance(value, bool):
+            self.fail(path, f"expected true or false, got {describe_value(value)}")
+        return value
+
+    # ---- the scene
+
+    def scene(self, data: Any) -> Scene:
+        data = self.table(data, "", TOP_KEYS)
+        scene = Scene()
+        if "name" in data:
+            scene.name = self.string(data["name"], "name")
+        if "description" in data:
+            self.string(data["description"], "description")
+        if "background" in data:
+            scene.background = self.colour(data["background"], "background")
+        if "ambient" in data:
+            scene.ambient = self.colour(data["ambient"], "ambient")
+        scene.camera = self.camera(data.get("camera", {}), "camera")
+        materials = self.materials(data.get("materials", {}), "materials")
+        for i, raw in enumerate(self.list_of_tables(data.get("lights", []), "lights", "lights")):
+            light = self.light(raw, f"lights[{i}]")
+            if isinstance(light, DirectionalLight):
+                scene.directional_lights.append(light)
+            else:
+                scene.point_lights.append(light)
+        raw_objects = self.list_of_tables(data.get("objects", []), "objects", "objects")
+        scene.objects = [self.scene_object(raw, f"objects[{i}]", i, materials)
+                         for i, raw in enumerate(raw_objects)]
+        self.check_names_and_parents(scene.objects, raw_objects)
+        scene.source = self.source
+        return scene
+
+    def camera(self, raw: Any, path: str) -> Camera:
+        raw = self.table(raw, path, CAMERA_KEYS)
+        cam = Camera()
+        key = lambda k: _join(path, k)   # noqa: E731 - one-line path helper
+        if "eye" in raw:
+            cam.eye = self.vec3(raw["eye"], key("eye"))
+        if "look" in raw:
+            cam.look = self.vec3(raw["look"], key("look"))
+        if "up" in raw:
+            cam.up = self.vec3(raw["up"], key("up"))
+        if "projection" in raw:
+            cam.projection = self.choice(raw["projection"], key("projection"), "projection",
+                                         PROJECTIONS)
+        if "fov_y" in raw:
+            cam.fov_y = self.number(raw["fov_y"], key("fov_y"))
+            if not 0.0 < cam.fov_y < 180.0:
+                self.fail(key("fov_y"), f"must be between 0 and 180 degrees (both excluded), "
+                                        f"got {cam.fov_y:g}")
+        if "height" in raw:
+            cam.height = self.number(raw["height"], key("height"), above=0.0)
+        if "near" in raw:
+            cam.near = self.number(raw["near"], key("near"))
+        if "far" in raw:
+            cam.far = self.number(raw["far"], key("far"))
+        if "reversed_z" in raw:
+            cam.reversed_z = self.boolean(raw["reversed_z"], key("reversed_z"))
+
+        view = np.subtract(cam.eye, cam.look)
+        if not np.any(view):
+            self.fail(key("look"), f"is the same point as {key('eye')}; the camera needs "
+                                   f"eye - look to be a direction")
+        # Up parallel to the view is allowed: transforms.look_at falls back to another axis.
+        if not np.any(cam.up):
+            self.fail(key("up"), "must not be zero length; up says which way is up in the image")
+        if cam.projection == "perspective" and cam.near <= 0:
+            self.fail(key("near"), f"must be > 0 for a perspective camera, got {cam.near:g}")
+        if cam.far <= cam.near:
+            self.fail(key("far"), f"must be greater than near ({cam.near:g}), got {cam.far:g}")
+        return cam
+
+    def materials(self, raw: Any, path: str) -> dict[str, Material]:
+        if not isinstance(raw, dict):
+            self.fail(path, f"expected a table of named materials ([materials.NAME]), "
+                            f"got {describe_value(raw)}")
+        return {name: self.material(value, _join(path, name)) for name, value in raw.items()}
+
+    def material(self, raw: Any, path: str) -> Material:
+        raw = self.table(raw, path, MATERIAL_KEYS)
+        mat = Material()
+        for coefficient in ("ka", "kd", "ks"):
+            if coefficient in raw:
+                setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
+        if "n" in raw:
+            mat.n = self.number(raw["n"], _join(path, "n"), minimum=0.0)
+        if "two_sided" in raw:
+            mat.two_sided = self.boolean(raw["two_sided"], _join(path, "two_sided"))
+        if "shading" in raw:
+            mat.shading = self.choice(raw["shading"], _join(path, "shading"), "shading",
+                                      SHADING_MODES)
+        return mat
+
+    def light(self, raw: dict, path: str) -> DirectionalLight | PointLight:
+        if "type" not in raw:
+            self.fail(_join(path, "type"), f"missing; expected one of: {', '.join(LIGHT_TYPES)}")
+        kind = self.choice(raw["type"], _join(path, "type"), "light type", LIGHT_TYPES)
+        for k in raw:
+            owners = [t for t in LIGHT_TYPES if t != kind and k in LIGHT_KEYS[t]]
+            if k not in LIGHT_KEYS[kind] and owners:
+                self.fail(_join(path, k), f"belongs to {owners[0]} lights, not {kind} ones; "
+                                          f"keys here: {', '.join(LIGHT_KEYS[kind])}")
+        raw = self.table(raw, path, LIGHT_KEYS[kind])
+        key = lambda k: _join(path, k)   # noqa: E731
+        if kind == "directional":
+            light = DirectionalLight()
+            if "direction" in raw:
+                light.direction = self.vec3(raw["direction"], key("direction"))
+                if not any(light.direction):
+                    self.fail(key("direction"), "must not be zero length")
+        else:
+            light = PointLight()
+            if "position" in raw:
+                light.position = self.vec3(raw["position"], key("position"))
+            if "attenuation" in raw:
+                light.attenuation = self.vec3(raw["attenuation"], key("attenuation"), minimum=0.0)
+                if not any(light.attenuation):
+                    self.fail(key("attenuation"), "must not be all zero: the light is divided "
+                                                  "by c + l d + q d^2")
+        if "intensity" in raw:
+            light.intensity = self.colour(raw["intensity"], key("intensity"))
+        return light
+
+    def scene_object(self, raw: dict, path: str, index: int,
+                     materials: dict[str, Material]) -> SceneObject:
+        raw = self.table(raw, path, OBJECT_KEYS)
+        key = lambda k: _join(path, k)   # noqa: E731
+        name = self.string(raw["name"], key("name")) if "name" in raw else f"object{index}"
+        if "mesh" not in raw:
+            self.fail(key("mesh"), "missing; give mesh = {primitive = \"...\"} or "
+                                   "mesh = {file = \"...\"}")
+        mesh = self.mesh(raw["mesh"], key("mesh"))
+        material = Material()
+        if "material" in raw:
+            material = self.object_material(raw["material"], key("material"), materials)
+        obj = SceneObject(name=name, mesh=mesh, material=material,
+                          transform=self.transform(raw, path))
+        if "parent" in raw:
+            obj.parent = self.string(raw["parent"], key("parent"))
+        if "cull" in raw:
+            obj.cull = self.choice(raw["cull"], key("cull"), "cull mode", CULL_MODES)
+        return obj
+
+    def object_material(self, raw: Any, path: str, materials: dict[str, Material]) -> Material:
+        if isinstance(raw, str):
+            if raw not in materials:
+                if not materials:
+                    self.fail(path, f"no material named {raw!r}: the file defines no "
+                                    f"[materials.NAME] tables")
+                self.fail(path, _no_such("material", raw, materials, "[materials] defines"))
+            return materials[raw]
+        if isinstance(raw, dict):
+            return self.material(raw, path)
+        self.fail(path, f"expected a material name (string) or an inline table, "
+                        f"got {describe_value(raw)}")
+
+    def transform(self, raw: dict, path: str) -> Transform:
+        key = lambda k: _join(path, k)   # noqa: E731
+        t = Transform()
+        if "scale" in raw:
+            t.scale = self.vec3(raw["scale"], key("scale"), scalar_ok=True)
+            if min(t.scale) < 0:
+                self.fail(key("scale"), f"must be >= 0 in every component, got "
+                                        f"{_show_vec(t.scale)}: a negative scale turns the "
+                                        f"object inside out")
+        if "shear" in raw:
+            shear = self.table(raw["shear"], key("shear"), transforms.SHEAR_FACTORS)
+            t.shear = {name: self.number(v, _join(key("shear"), name)) for name, v in shear.items()}
+            det = float(np.linalg.det(transforms.shear(**t.shear)[:3, :3]))
+            if det <= MIN_DETERMINANT:
+                effect = "singular" if abs(det) <= MIN_DETERMINANT else "a mirror (inside out)"
+                self.fail(key("shear"), f"makes the model matrix {effect}: its determinant is "
+                                        f"{det:.3g}; it must stay > 0")
+        if "rotate" in raw:
+            t.rotate = self.vec3(raw["rotate"], key("rotate"))
+        if "translate" in raw:
+            t.translate = self.vec3(raw["translate"], key("translate"))
+        return t
+
+    # ---- meshes
+
+    def mesh(self, raw: Any, path: str) -> Mesh:
+        if not isinstance(raw, dict):
+            self.fail(path, f"expected a table such as {{primitive = \"uv_sphere\"}} or "
+                            f"{{file = \"meshes/knot.obj\"}}, got {describe_value(raw)}")
+        if "primitive" in raw and "file" in raw:
+            self.fail(path, "give either primitive or file, not both")
+        if "file" in raw:
+            self.table(raw, path, ("file",))
+            return self.mesh_file(raw["file"], _join(path, "file"))
+        if "primitive" in raw:
+            return self.primitive(raw, path)
+        self.fail(path, "needs a primitive or a file key")
+
+    def primitive(self, raw: dict, path: str) -> Mesh:
+        name = self.choice(raw["primitive"], _join(path, "primitive"), "primitive", PRIMITIVES)
+        build = PRIMITIVES[name]
+        parameters = list(inspect.signature(build).parameters)
+        args = self.table(raw, path, ["primitive", *parameters])
+        limits = PRIMITIVE_LIMITS.get(name, {})
+        kwargs = {}
+        for arg, value in args.items():
+            if arg == "primitive":
+                continue
+            arg_path = _join(path, arg)
+            is_int, low, high = limits.get(arg, (False, None, None))
+            if is_int:
+                kwargs[arg] = self.integer(value, arg_path, low, high)
+            elif low is not None:
+                kwargs[arg] = self.number(value, arg_path, above=low)
+            else:
+                kwargs[arg] = self.number(value, arg_path)
+        mesh = build(**kwargs)
+        if mesh.triangle_count == 0:
+            self.fail(path, "the primitive has no triangles with these arguments")
+        mesh.recipe = (name, kwargs)
+        return mesh
+
+    def mesh_file(self, value: Any, path: str) -> Mesh:
+        """Relative paths start at the scene file's folder, then at the built-in assets folder
+        (so any scene can use the built-in meshes as "meshes/NAME")."""
+        text = self.string(value, path)
+        if not text:
+            self.fail(path, "is empty; expected a mesh file path")
+        candidates = [Path(text)] if Path(text).is_absolute() else [self.base_dir / text]
+        assets = _builtin_assets_dir()
+        if assets is not None and not Path(text).is_absolute():
+            candidates.append(assets / text)
+        for candidate in candidates:
+            if candidate.exists():
+                return load_mesh(candidate, source=self.source, key=path)
+        looked = " and ".join(str(c.parent.resolve()) for c in candidates)
+        self.fail(path, f"mesh file not found: {text!r} (looked in {looked})")
+
+    # ---- names and parents
+
+    def check_names_and_parents(self, objects: list[SceneObject], raw_objects: list[dict]) -> None:
+        first_index: dict[str, int] = {}
+        for i, obj in enumerate(objects):
+            if obj.name in first_index:
+                where = f"objects[{i}].name" if "name" in raw_objects[i] else f"objects[{i}]"
+                self.fail(where, f"duplicate object name {obj.name!r} "
+                                 f"(objects[{first_index[obj.name]}] has it too)")
+            first_index[obj.name] = i
+        for i, obj in enumerate(objects):
+            if obj.parent is not None and obj.parent not in first_index:
+                self.fail(f"objects[{i}].parent",
+                          _no_such("object", obj.parent, first_index, "objects in this scene"))
+        for i, obj in enumerate(objects):
+            chain = [obj.name]
+            parent = obj.parent
+            while parent is not None:
+                chain.append(parent)
+                if parent == obj.name:
+                    self.fail(f"objects[{i}].parent", f"parent cycle: {' -> '.join(chain)}")
+                parent = objects[first_index[parent]].parent
+                if len(chain) > len(objects) + 1:   # a cycle further up; reported at its own index
+                    break
+
+
+def _builtin_assets_dir() -> Path | None:
+    try:
+        return assets_dir()
+    except SceneError:
+        return None

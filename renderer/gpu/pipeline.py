@@ -1,0 +1,645 @@
+"""The GPU path: the scene drawn with the GLSL programs of glsl/ into an off-screen framebuffer.
+
+    with GpuRenderer(scene, 640, 480) as gpu:        # EGL, else OSMesa
+        frame = gpu.render()                         # Frame: rgba8, depth (and linear if asked)
+        fbo = gpu.draw()                             # the same drawing, nothing read back
+        gpu.resize(800, 600)                         # another size, same programs and meshes
+
+`render()` is `draw()` plus the read-back; the window viewer (renderer/viewer/viewer.py) calls
+`draw()` on a window's context (`context=`) and copies the framebuffer to the screen, so that
+it shows exactly what the headless path renders. `wireframe = True` draws triangle edges only
+(the viewer's W key).
+
+Everything GL is made once per renderer: one program per shader variant the scene's materials
+use, one vertex buffer (positions and normals, float32, interleaved), index buffer and vertex
+array per object, and a single-sample framebuffer with an RGBA8 colour buffer and a 32-bit
+float depth buffer (DEPTH_COMPONENT32F, so the stored depth is the rasteriser's float z_w with
+no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-specified through
+glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
+variants that write it, are made the first time `render(linear=True)` asks for them; so are
+the multisample targets of `render(samples=N)` (RGBA8 colour and DEPTH_COMPONENT32F depth
+through glRenderbufferStorageMultisample, one pair per sample count, resolved into the
+single-sample framebuffer by a blit).
+
+Each frame is planned from its scene: a program per material is specialised to what that
+material and the scene use (renderer/gpu/shaders.py: light counts as constants, the specular term
+only where k_s > 0, back-face code only when two-sided), and an object wholly outside the
+view volume is left out of the plan (renderer/core/visibility.py). `specialise=False` draws with
+the all-features build instead, for benchmarks/bench_specialisation.py; the images are the same.
+
+A camera with `reversed_z` draws with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), depth
+cleared to 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
+frame puts GL's default back, so renderers sharing a context never see each other's.
+
+Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the
+scene's lights and materials, and `render()` only hands them to GL; a pass at a sample offset
+(`render(sample_offset=(dx, dy))`, docs/conventions.md) uploads u_projection alone again.
+After changing the scene (camera, lights,
+materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
+list of objects needs a new renderer.
+Conventions (matrices, window, depth, colour, lighting): docs/conventions.md.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import struct
+import time
+from dataclasses import dataclass
+
+import moderngl
+import numpy as np
+
+from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
+from renderer.errors import ContextError
+from renderer.core.frame import Frame
+from renderer.core.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
+from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
+from renderer.core.transforms import jitter, to_glsl
+from renderer.core.visibility import visible_objects
+
+GL_DITHER = 0x0BD0
+GL_LOWER_LEFT = 0x8CA1                   # glClipControl origin (GL's default)
+GL_NEGATIVE_ONE_TO_ONE = 0x935E          # glClipControl depth: GL's default, -w <= z <= w
+GL_ZERO_TO_ONE = 0x935F                  # reversed-Z: 0 <= z <= w and z_w = z_ndc
+GL_RENDERBUFFER = 0x8D41
+GL_RENDERBUFFER_INTERNAL_FORMAT = 0x8D44
+GL_DEPTH_COMPONENT24 = 0x81A6
+GL_DEPTH_COMPONENT32F = 0x8CAC
+GL_RGBA8 = 0x8058
+GL_SAMPLES = 0x80A9
+GL_NUM_SAMPLE_COUNTS = 0x9380
+DEPTH_FORMAT_NAMES = {GL_DEPTH_COMPONENT24: "DEPTH_COMPONENT24",
+                      GL_DEPTH_COMPONENT32F: "DEPTH_COMPONENT32F"}
+
+CULL_FLAGS = {"none": None, "back": "back", "front": "front"}   # SceneObject.cull -> GL face
+
+
+def _vec3s(values) -> bytes:
+    """Bytes of a GLSL vec3 (or vec3[]) uniform."""
+    return np.asarray(values, dtype=np.float32).tobytes()
+
+
+def _float(value: float) -> bytes:
+    return struct.pack("f", value)
+
+
+def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
+                         light_slots: int | None = None) -> dict[str, bytes]:
+    """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
+    A light array is absent when the scene has no light of that kind (nor does the shader).
+    Positions (eye, point lights) are camera-relative, as the model matrices are.
+    `light_slots` is for the all-features build: arrays of that size (the slots past the
+    scene's lights are zeros, never read) and the counts as uniforms."""
+    directional, point = scene.directional_lights, scene.point_lights
+    values = {
+        "u_view": to_glsl(matrices.view),
+        "u_projection": to_glsl(matrices.projection),
+        "u_eye": _vec3s(matrices.relative(scene.camera.eye)),
+        "u_ambient": _vec3s(scene.ambient),
+    }
+    if light_slots is not None:
+        if max(len(directional), len(point)) > light_slots:
+            raise ValueError(f"the all-features build has room for {light_slots} lights of each "
+                             f"kind; the scene has {len(directional)} directional and "
+                             f"{len(point)} point lights")
+        values["u_num_directional_lights"] = struct.pack("i", len(directional))
+        values["u_num_point_lights"] = struct.pack("i", len(point))
+    slots = {"directional": light_slots or len(directional), "point": light_slots or len(point)}
+
+    def array(kind: str, values_per_light) -> bytes:
+        rows = np.zeros((slots[kind], 3), dtype=np.float32)
+        if values_per_light:
+            rows[:len(values_per_light)] = values_per_light
+        return rows.tobytes()
+
+    if slots["directional"]:
+        values["u_directional_direction"] = array("directional", [l.direction for l in directional])
+        values["u_directional_intensity"] = array("directional", [l.intensity for l in directional])
+    if slots["point"]:
+        values["u_point_position"] = array("point", [matrices.relative(l.position) for l in point])
+        values["u_point_intensity"] = array("point", [l.intensity for l in point])
+        values["u_point_attenuation"] = array("point", [l.attenuation for l in point])
+    return values
+
+
+def object_uniform_values(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, bytes]:
+    """One object's uniforms: its model and normal matrices and its material (u_two_sided
+    is read only by the all-features build)."""
+    material = obj.material
+    return {
+        "u_model": to_glsl(matrices.model),
+        "u_normal_matrix": to_glsl(matrices.normal),
+        "u_ka": _vec3s(material.ka),
+        "u_kd": _vec3s(material.kd),
+        "u_ks": _vec3s(material.ks),
+        "u_n": _float(material.n),
+        "u_two_sided": struct.pack("i", int(bool(material.two_sided))),
+    }
+
+
+def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
+                   index: int) -> dict[str, bytes]:
+    """Every uniform (name -> bytes) for drawing `obj`, object number `index` of `scene`.
+    A program may lack some (the compiler drops unused ones): skip names it does not have."""
+    return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])
+
+
+def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int,
+                     samples: int = 0) -> str:
+    """Re-specify moderngl's 24-bit depth renderbuffer as DEPTH_COMPONENT32F where GL lets
+    us (multisampled when `samples` > 0); returns the format in use."""
+    c_uint, c_int = ctypes.c_uint, ctypes.c_int
+    bind = gl_function(ctx, "glBindRenderbuffer", None, c_uint, c_uint)
+    if samples:
+        multisample = gl_function(ctx, "glRenderbufferStorageMultisample", None,
+                                  c_uint, c_int, c_uint, c_int, c_int)
+        storage = None if multisample is None else (
+            lambda target, fmt, w, h: multisample(target, samples, fmt, w, h))
+    else:
+        storage = gl_function(ctx, "glRenderbufferStorage", None, c_uint, c_uint, c_int, c_int)
+    query = gl_function(ctx, "glGetRenderbufferParameteriv", None, c_uint, c_uint,
+                        ctypes.POINTER(c_int))
+    if bind is None or storage is None or query is None:
+        return "DEPTH_COMPONENT24"
+    value = c_int(0)
+    bind(GL_RENDERBUFFER, renderbuffer.glo)
+    storage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, width, height)
+    ctx.error                                               # clear any error it raised
+    query(GL_RENDERBUFFER, GL_RENDERBUFFER_INTERNAL_FORMAT, ctypes.byref(value))
+    bind(GL_RENDERBUFFER, 0)
+    return DEPTH_FORMAT_NAMES.get(value.value, hex(value.value))
+
+
+def multisample_counts(ctx: moderngl.Context) -> list[int]:
+    """The MSAA sample counts GL offers for an RGBA8 colour buffer, ascending, 1 included
+    (glGetInternalformativ GL_SAMPLES; llvmpipe offers only 4: a request for 2 gets 4)."""
+    c_uint, c_int = ctypes.c_uint, ctypes.c_int
+    query = gl_function(ctx, "glGetInternalformativ", None, c_uint, c_uint, c_uint, c_int,
+                        ctypes.POINTER(c_int))
+    if query is None:
+        return [1]
+    count = c_int(0)
+    activate(ctx)
+    query(GL_RENDERBUFFER, GL_RGBA8, GL_NUM_SAMPLE_COUNTS, 1, ctypes.byref(count))
+    values = (c_int * max(count.value, 1))()
+    query(GL_RENDERBUFFER, GL_RGBA8, GL_SAMPLES, len(values), values)
+    limit = int(ctx.info["GL_MAX_SAMPLES"])
+    return sorted({1, *(v for v in values[:count.value] if 1 < v <= limit)})
+
+
+@dataclass
+class _ObjectBuffers:
+    """GL objects of one scene object: its mesh on the GPU and its vertex arrays per variant."""
+    obj: SceneObject
+    mesh: Mesh                             # the mesh uploaded (update() re-uploads a new one)
+    vbo: moderngl.Buffer | None            # in_position, in_normal: float32, interleaved
+    ibo: moderngl.Buffer | None            # faces, uint32
+    vertex_arrays: dict                    # ShaderVariant -> moderngl.VertexArray
+    uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
+
+
+@dataclass
+class _Draw:
+    """One draw call of a frame, with everything resolved ahead of time."""
+    vertex_array: moderngl.VertexArray
+    enable: int                            # moderngl flags for enable_only
+    cull_face: str | None
+    uploads: list                          # [(moderngl Uniform, bytes)]
+
+
+class GpuRenderer:
+    """Renders one scene at one size through GLSL; see the module docstring."""
+
+    def __init__(self, scene: Scene, width: int, height: int,
+                 context: moderngl.Context | None = None, context_kind: str = "auto",
+                 specialise: bool = True):
+        if int(width) < 1 or int(height) < 1:
+            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        self.scene = scene
+        self.width, self.height = int(width), int(height)
+        self.specialise = bool(specialise)
+        self.wireframe = False           # draw() draws edges only (a viewer's toggle)
+        self._owns_context = context is None
+        self.ctx = make_context(context_kind) if context is None else context
+        self._released = False
+        self._programs = ProgramCache(self.ctx)
+        self._objects: list[_ObjectBuffers] = []
+        self._renderbuffers: list = []
+        self._framebuffers: dict[bool, moderngl.Framebuffer] = {}
+        self._plans: dict[bool, list[_Draw]] = {}
+        self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
+        self._multisample: dict[int, moderngl.Framebuffer] = {}   # samples -> MSAA target
+        self._jittered: dict[bool, tuple] = {}           # plan -> sample offset its programs hold
+        try:
+            activate(self.ctx)
+            self._check_size()
+            self._glDisable = gl_function(self.ctx, "glDisable", None, ctypes.c_uint)
+            self._glClipControl = gl_function(self.ctx, "glClipControl", None, ctypes.c_uint,
+                                              ctypes.c_uint)
+            self._build_targets()
+            self._gl_info = self._query_gl_info()
+            self._build_objects()
+            self.update()
+        except BaseException:
+            self.release()
+            raise
+
+    # -- building ----------------------------------------------------------------------------
+    def _check_size(self) -> None:
+        limit = int(self.ctx.info["GL_MAX_RENDERBUFFER_SIZE"])
+        if max(self.width, self.height) > limit:
+            raise ValueError(f"image size {self.width}x{self.height} exceeds this GL's "
+                             f"renderbuffer limit of {limit} pixels")
+
+    def _build_targets(self) -> None:
+        size = (self.width, self.height)
+        self._color = self.ctx.renderbuffer(size, 4)                       # RGBA8
+        self._depth = self.ctx.depth_renderbuffer(size)
+        self.depth_format = make_float_depth(self.ctx, self._depth, self.width, self.height)
+        self._renderbuffers += [self._color, self._depth]
+        self._framebuffers[False] = self.ctx.framebuffer([self._color], self._depth)
+
+    def _linear_framebuffer(self) -> moderngl.Framebuffer:
+        fbo = self._framebuffers.get(True)
+        if fbo is None:
+            linear = self.ctx.renderbuffer((self.width, self.height), 4, dtype="f4")  # RGBA32F
+            self._renderbuffers.append(linear)
+            fbo = self._framebuffers[True] = self.ctx.framebuffer([self._color, linear], self._depth)
+        return fbo
+
+    def _multisample_framebuffer(self, samples: int) -> moderngl.Framebuffer:
+        """An RGBA8 colour and float depth target with `samples` samples per pixel, made the
+        first time it is asked for; render() resolves it into the single-sample one."""
+        fbo = self._multisample.get(samples)
+        if fbo is None:
+            offered = self.sample_counts
+            if samples not in offered:
+                raise ValueError(f"this GL offers MSAA with {', '.join(map(str, offered))} "
+                                 f"samples per pixel, not {samples}")
+            size = (self.width, self.height)
+            color = self.ctx.renderbuffer(size, 4, samples=samples)
+            depth = self.ctx.depth_renderbuffer(size, samples=samples)
+            make_float_depth(self.ctx, depth, self.width, self.height, samples=samples)
+            self._renderbuffers += [color, depth]
+            fbo = self._multisample[samples] = self.ctx.framebuffer([color], depth)
+        return fbo
+
+    def _build_objects(self) -> None:
+        for obj in self.scene.objects:
+            if obj.cull not in CULL_FLAGS:
+                raise ValueError(f"object {obj.name!r}: cull must be one of "
+                                 f"{', '.join(CULL_FLAGS)}, got {obj.cull!r}")
+            item = _ObjectBuffers(obj, obj.mesh, None, None, {}, {})
+            self._objects.append(item)
+            self._upload(item)
+
+    def _upload(self, item: _ObjectBuffers) -> None:
+        mesh = item.mesh = item.obj.mesh
+        if mesh.triangle_count:
+            vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
+            item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
+            item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
+
+    @staticmethod
+    def _release_buffers(item: _ObjectBuffers) -> None:
+        for vao in item.vertex_arrays.values():
+            vao.release()
+        for buffer in (item.vbo, item.ibo):
+            if buffer is not None:
+                buffer.release()
+        item.vertex_arrays, item.vbo, item.ibo = {}, None, None
+
+    def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
+        return ShaderVariant.for_material(self.scene, obj.material, linear,
+                                          all_features=not self.specialise)
+
+    def _vertex_array(self, item: _ObjectBuffers, variant: ShaderVariant) -> moderngl.VertexArray:
+        vao = item.vertex_arrays.get(variant)
+        if vao is None:
+            program = self._programs.get(variant)
+            if program.get("in_normal", None) is not None:
+                content = (item.vbo, "3f 3f", "in_position", "in_normal")
+            else:                                    # flat: the normal is the face's, not read
+                content = (item.vbo, "3f 3x4", "in_position")
+            vao = self.ctx.vertex_array(program, [content], index_buffer=item.ibo,
+                                        index_element_size=4)
+            item.vertex_arrays[variant] = vao
+        return vao
+
+    # -- uniforms ----------------------------------------------------------------------------
+    def update(self) -> None:
+        """Recompute every uniform from the scene (camera, lights, materials, transforms)."""
+        scene = self.scene
+        if len(scene.objects) != len(self._objects) or any(
+                a is not b.obj for a, b in zip(scene.objects, self._objects)):
+            raise ValueError("the scene's objects changed since this GpuRenderer was made; "
+                             "make a new one")
+        for item in self._objects:
+            if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
+                self._release_buffers(item)
+                self._upload(item)
+        matrices = scene.matrices(self.width, self.height)
+        self._frame_uniforms = frame_uniform_values(
+            scene, matrices, light_slots=None if self.specialise else ALL_FEATURES_LIGHTS)
+        # Objects wholly outside the view volume are left out of the frame's plan.
+        self._visible = (visible_objects(scene, matrices) if self.specialise
+                         else [True] * len(self._objects))
+        for item, object_matrices in zip(self._objects, matrices.objects):
+            item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
+        self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width),
+                                                    scene.camera.reversed_z)
+        self._projection = matrices.projection
+        self._plans.clear()
+        self._jittered.clear()
+
+    def resize(self, width: int, height: int) -> None:
+        """Render at another size from now on (a viewer's window was resized): the framebuffers
+        are made again at that size and update() recomputes the projection for the new aspect.
+        Programs, meshes and vertex arrays are kept."""
+        width, height = int(width), int(height)
+        if width < 1 or height < 1:
+            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        if (width, height) == (self.width, self.height):
+            return
+        activate(self.ctx)
+        self._release_targets()
+        self._staging.clear()
+        self.width, self.height = width, height
+        self._check_size()
+        self._build_targets()
+        self.update()
+
+    def _release_targets(self) -> None:
+        """Free the framebuffers and their renderbuffers (single-sample, linear, MSAA)."""
+        for fbo in [*self._multisample.values(), *self._framebuffers.values()]:
+            fbo.release()
+        for renderbuffer in self._renderbuffers:
+            renderbuffer.release()
+        self._multisample, self._framebuffers, self._renderbuffers = {}, {}, []
+
+    def _plan(self, linear: bool) -> list[_Draw]:
+        """The frame's draw calls; made once per update() for each kind of output."""
+        plan = self._plans.get(linear)
+        if plan is not None:
+            return plan
+        plan, programs = [], {}
+        for item, visible in zip(self._objects, self._visible):
+            if item.vbo is None or not visible:
+                continue
+            variant = self._variant(item.obj, linear)
+            vao = self._vertex_array(item, variant)
+            program = programs[variant] = self._programs.get(variant)
+            uploads = [(program[name], data) for name, data in item.uniform_bytes.items()
+                       if program.get(name, None) is not None]
+            cull = CULL_FLAGS[item.obj.cull]
+            enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
+            plan.append(_Draw(vao, enable, cull, uploads))
+        for program in programs.values():          # the same for every object: set once here
+            for name, data in self._frame_uniforms.items():
+                uniform = program.get(name, None)
+                if uniform is not None:
+                    uniform.write(data)
+        self._plans[linear] = plan
+        return plan
+
+    # -- rendering ---------------------------------------------------------------------------
+    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None,
+               sample_offset: tuple = (0.0, 0.0), samples: int = 1) -> Frame:
+        """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked.
+
+        `sample_offset` (dx, dy) samples each pixel that far from its centre (pixels, GL window
+        coordinates; docs/conventions.md): only u_projection is uploaded again, as
+        transforms.jitter(dx, dy, W, H) @ P. `samples` > 1 draws with MSAA into a multisample
+        target (made once per sample count) resolved into rgba8; linear colour is then not
+        available, and depth is the resolved sample GL picks.
+
+        Each frame's arrays are new unless `out` names an earlier frame of this renderer:
+        then they are written into that frame's arrays, which a loop over many frames (a
+        viewer, a batch, a benchmark) can reuse to skip allocating (and page-faulting in)
+        a few megabytes per frame.
+        """
+        start = time.perf_counter()
+        fbo = self.draw(linear=linear, sample_offset=sample_offset, samples=samples)
+        # GL returns rows bottom-up: read into staging arrays made once, then write each
+        # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
+        reuse = (out.rgba8, out.linear, out.depth) if out is not None else (None, None, None)
+        rgba8 = _flip_into(self._read(fbo, 0, np.uint8), reuse[0])
+        linear_color = depth_map = None
+        if linear:
+            linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
+        if depth:
+            depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
+        return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
+                     gl_info=self._gl_info)
+
+    def draw(self, *, linear: bool = False, sample_offset: tuple = (0.0, 0.0),
+             samples: int = 1) -> moderngl.Framebuffer:
+        """Draw the scene into this renderer's single-sample framebuffer (returned) and read
+        nothing back: render() is draw() plus the read-back; a window viewer blits the
+        framebuffer to the screen instead (renderer/viewer/presenter.py). Arguments as render()'s.
+        With `wireframe` set, triangles are drawn as their edges (glPolygonMode GL_LINE)."""
+        if self._released:
+            raise RuntimeError("this GpuRenderer was released")
+        ctx = self.ctx
+        activate(ctx)
+        if self._glDisable is not None:
+            self._glDisable(GL_DITHER)              # unorm8 output must be the plain rounding
+        if samples > 1 and linear:
+            raise ValueError("linear colour is not available with MSAA (samples > 1)")
+        fbo = self._linear_framebuffer() if linear else self._framebuffers[False]
+        plan = self._plan(linear)
+        self._set_sample_offset(linear, tuple(sample_offset))
+        target = self._multisample_framebuffer(samples) if samples > 1 else fbo
+        target.use()
+        red, green, blue = self.scene.background
+        reversed_z = self.scene.camera.reversed_z
+        # The context may be shared: set the clip control for this frame either way, and
+        # leave GL's default behind for whoever draws next.
+        self._clip_control(reversed_z)
+        try:
+            target.clear(red, green, blue, 0.0, depth=0.0 if reversed_z else 1.0)
+            ctx.depth_func = ">" if reversed_z else "<"
+            ctx.front_face = "ccw"
+            ctx.wireframe = self.wireframe
+            for draw in plan:
+                ctx.enable_only(draw.enable)
+                if draw.cull_face:
+                    ctx.cull_face = draw.cull_face
+                for uniform, data in draw.uploads:
+                    uniform.write(data)
+                draw.vertex_array.render(moderngl.TRIANGLES)
+            if target is not fbo:
+                ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
+        finally:
+            ctx.wireframe = False
+            if reversed_z:
+                self._clip_control(False)
+        return fbo
+
+    def _clip_control(self, reversed_z: bool) -> None:
+        """glClipControl: ZERO_TO_ONE depth for reversed-Z, GL's NEGATIVE_ONE_TO_ONE otherwise."""
+        if self._glClipControl is None:
+            if reversed_z:
+                raise ContextError("reversed_z needs glClipControl (OpenGL 4.5 or "
+                                   "ARB_clip_control), which this GL does not have")
+            return
+        self._glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE if reversed_z else GL_NEGATIVE_ONE_TO_ONE)
+
+    def _set_sample_offset(self, linear: bool, offset: tuple) -> None:
+        """Upload u_projection jittered for `offset` to the plan's programs, if they hold
+        another one (after _plan() they hold the unjittered projection)."""
+        if self._jittered.get(linear, (0.0, 0.0)) == offset:
+            return
+        data = to_glsl(jitter(*offset, self.width, self.height) @ self._projection)
+        for program in {id(d.vertex_array.program): d.vertex_array.program
+                        for d in self._plans[linear]}.values():
+            uniform = program.get("u_projection", None)
+            if uniform is not None:
+                uniform.write(data)
+        self._jittered[linear] = offset
+
+    def _read(self, fbo, attachment: int, dtype) -> np.ndarray:
+        """The attachment's pixels, bottom row first, in a staging array reused every frame."""
+        out = self._staging.get(attachment)
+        if out is None:
+            shape = (self.height, self.width) + ((4,) if attachment >= 0 else ())
+            out = self._staging[attachment] = np.empty(shape, dtype)
+        fbo.read_into(out, components=4 if attachment >= 0 else 1, attachment=attachment,
+                      alignment=1, dtype="f1" if dtype is np.uint8 else "f4")
+        return out
+
+    # -- information -------------------------------------------------------------------------
+    def _query_gl_info(self) -> dict:
+        info = self.ctx.info
+        return {key: info[key] for key in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")} | {
+            "context": context_kind(self.ctx), "depth_format": self.depth_format}
+
+    @property
+    def gl_info(self) -> dict:
+        """GL_VENDOR, GL_RENDERER, GL_VERSION, the context kind ("egl", "osmesa", or
+        "external" for a context passed in) and the depth buffer's format. Asked once, when
+        the renderer is made; every frame it renders carries the same dict."""
+        return dict(self._gl_info)
+
+    @property
+    def subpixel_bits(self) -> int:
+        """GL_SUBPIXEL_BITS: vertices snap to 1 / 2^bits of a pixel (8 on llvmpipe)."""
+        return int(self.ctx.info["GL_SUBPIXEL_BITS"])
+
+    @property
+    def max_samples(self) -> int:
+        """GL_MAX_SAMPLES: the most MSAA samples per pixel this context offers (4 on llvmpipe)."""
+        return int(self.ctx.info["GL_MAX_SAMPLES"])
+
+    @property
+    def sample_counts(self) -> list[int]:
+        """The MSAA sample counts render(samples=...) can use: multisample_counts(ctx)."""
+        return multisample_counts(self.ctx)
+
+    @property
+    def framebuffer(self) -> moderngl.Framebuffer:
+        return self._framebuffers[False]
+
+    @property
+    def programs(self) -> dict:
+        """ShaderVariant -> moderngl.Program, for the variants made so far."""
+        return dict(self._programs.items())
+
+    @property
+    def drawn_objects(self) -> list[str]:
+        """Names of the objects the current frame plan draws, in order: those with triangles
+        and, when specialising, not wholly outside the view volume."""
+        return [item.obj.name for item, visible in zip(self._objects, self._visible)
+                if item.vbo is not None and visible]
+
+    @property
+    def vertex_arrays(self) -> list:
+        """Every vertex array made so far, objects in scene order."""
+        return [vao for item in self._objects for vao in item.vertex_arrays.values()]
+
+    # -- lifetime ----------------------------------------------------------------------------
+    def release(self) -> None:
+        """Free every GL object; the context too if this renderer made it. Idempotent."""
+        if self._released:
+            return
+        self._released = True
+        self._plans.clear()
+        try:
+            activate(self.ctx)
+            for item in self._objects:
+                self._release_buffers(item)
+            self._release_targets()
+            self._programs.release()
+        finally:
+            self._objects, self._framebuffers, self._renderbuffers = [], {}, []
+            self._multisample = {}
+            if self._owns_context:
+                release_context(self.ctx)
+
+    def __enter__(self) -> "GpuRenderer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()
+
+    def __repr__(self) -> str:
+        state = "released" if self._released else context_kind(self.ctx)
+        return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
+
+
+def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:
+    """`out` if it can take a result shaped and typed like `like`, else None (a new array)."""
+    if out is not None and out.shape == like.shape and out.dtype == like.dtype and out.flags.c_contiguous:
+        return out
+    return None
+
+
+def _flip_into(bottom_up: np.ndarray, out: np.ndarray | None) -> np.ndarray:
+    """Rows reversed (row 0 at the top), written into `out` when usable, else a new array."""
+    target = _usable(out, bottom_up)
+    if target is None:
+        return bottom_up[::-1].copy()
+    np.copyto(target, bottom_up[::-1])
+    return target
+
+
+def _depth_conversion(projection: np.ndarray, shape: tuple[int, int], reversed_z: bool = False):
+    """A function from window depth z_w (float32, any strides) to a C-contiguous array of
+    -z_eye (+inf where z_w is the cleared value: 1, or 0 with reversed-Z), for the projection
+    matrix P of the frame; the array is new unless a usable `out` is passed.
+
+    z_ndc = s z_w + t: (s, t) = (2, -1) for GL's default depth mapping, (1, 0) for reversed-Z
+    (glClipControl ZERO_TO_ONE). Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye,
+    so -z_eye = P23 / (P22 + z_ndc) = a / (z_w + b) with a = P23 / s, b = (P22 + t) / s.
+    Parallel (P[3] = (0, 0, 0, 1)): z_ndc = P22 z_eye + P23, so -z_eye = (s z_w + t - P23) / -P22.
+    b is split into a float32 head and tail so that z_w + b loses nothing where z_w is near -b
+    (the head's sum with z_w is exact there, Sterbenz), giving float64-like accuracy in float32.
+    """
+    p22, p23 = float(projection[2, 2]), float(projection[2, 3])
+    s_ndc, t_ndc = (1.0, 0.0) if reversed_z else (2.0, -1.0)
+    cleared = 0.0 if reversed_z else 1.0
+    mask = np.empty(shape, dtype=bool)                     # reused: no allocation per frame
+    perspective = projection[3, 2] == -1.0 and projection[3, 3] == 0.0
+    if perspective:
+        a = np.float32(p23 / s_ndc)
+        b = (p22 + t_ndc) / s_ndc
+        b_head = np.float32(b)
+        b_tail = np.float32(b - float(b_head))
+
+        def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+            out = np.add(window_depth, b_head, out=_usable(out, window_depth))
+            out += b_tail
+            np.divide(a, out, out=out)
+            np.copyto(out, np.inf, where=np.equal(window_depth, cleared, out=mask))
+            return out
+    else:
+        s = np.float32(-s_ndc / p22)
+        t = np.float32((p23 - t_ndc) / p22)
+
+        def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+            out = np.multiply(window_depth, s, out=_usable(out, window_depth))
+            out += t
+            np.copyto(out, np.inf, where=np.equal(window_depth, cleared, out=mask))
+            return out
+    return convert

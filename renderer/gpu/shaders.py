@@ -1,0 +1,247 @@
+"""GLSL sources from glsl/: `#include` expansion, `#define` injection, programs per variant.
+
+Shaders exist only as files in glsl/. A source is prepared in two steps:
+1. every line `#include "name.glsl"` is replaced by that file from the same folder
+   (recursively; each file at most once per shader, a cycle or a missing file is an error);
+2. the variant's `#define`s go right after the `#version` line (GLSL allows nothing but
+   comments before it).
+`#line` directives keep compiler messages pointing at the right file and line: source-string
+0 is the main file, 1, 2, ... the included files in order (`ShaderSource.files`).
+
+A `ShaderVariant` names one combination of compile-time constants; `ProgramCache` compiles
+each variant once per context (the geometry shader only in the flat variant).
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Mapping
+
+import moderngl
+
+from renderer.core.resources import glsl_dir
+
+_INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
+_INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
+_VERSION = re.compile(r'^\s*#\s*version\b')
+_DEFINE_NAME = re.compile(r'^[A-Za-z_][A-Za-z0-9_]*$')
+
+
+class ShaderSourceError(Exception):
+    """A GLSL file that cannot be assembled (missing include, include cycle, no #version),
+    or a program that does not compile; the message names the file and line."""
+
+
+@dataclass(frozen=True)
+class ShaderSource:
+    text: str
+    files: tuple[str, ...]           # files[i] is GLSL source-string number i in messages
+
+
+def _display(path: Path) -> str:
+    try:
+        return str(path.relative_to(glsl_dir().parent))
+    except ValueError:
+        return str(path)
+
+
+def _expand(path: Path, files: list[Path], stack: tuple[Path, ...]) -> list[str]:
+    """The lines of `path` with includes replaced; `files` collects source-string numbers."""
+    number = files.index(path)
+    out = []
+    lines = path.read_text(encoding="utf-8").splitlines()
+    for line_number, line in enumerate(lines, start=1):
+        match = _INCLUDE.match(line)
+        if not match:
+            out.append(line)
+            continue
+        where = f"{_display(path)}:{line_number}"
+        name_match = _INCLUDE_NAME.match(match.group(1))
+        if not name_match:
+            raise ShaderSourceError(f'{where}: malformed include {line.strip()!r}; '
+                                    'write #include "name.glsl"')
+        target = (path.parent / name_match.group(1)).resolve()
+        if target in stack:
+            chain = " -> ".join(_display(p) for p in stack + (target,))
+            raise ShaderSourceError(f"{where}: include cycle {chain}")
+        if not target.is_file():
+            raise ShaderSourceError(f'{where}: #include "{name_match.group(1)}": no such file '
+                                    f"in {path.parent}")
+        if target in files:             # already included once: include guard by default
+            out.append(f"// {line.strip()} (already included)")
+            continue
+        files.append(target)
+        out.append(f"#line 1 {len(files) - 1}")
+        out.extend(_expand(target, files, stack + (target,)))
+        out.append(f"#line {line_number + 1} {number}")
+    return out
+
+
+def _define_lines(defines: Mapping[str, object]) -> list[str]:
+    lines = []
+    for name, value in defines.items():
+        if not _DEFINE_NAME.match(name):
+            raise ShaderSourceError(f"invalid #define name {name!r}")
+        if value is None or value is False:
+            continue
+        lines.append(f"#define {name}" if value is True else f"#define {name} {int(value)}")
+    return lines
+
+
+def shader_source(filename: str, defines: Mapping[str, object] | None = None,
+                  directory: Path | None = None) -> ShaderSource:
+    """The text of glsl/`filename`, includes expanded and `defines` placed after `#version`.
+
+    A define whose value is True is written as a bare `#define NAME`, an int as
+    `#define NAME value`; False or None leaves it out.
+    """
+    items = tuple(sorted((defines or {}).items()))
+    return _shader_source(filename, items, str(directory or glsl_dir()))
+
+
+@functools.lru_cache(maxsize=256)
+def _shader_source(filename: str, defines: tuple, directory: str) -> ShaderSource:
+    path = (Path(directory) / filename).resolve()
+    if not path.is_file():
+        raise ShaderSourceError(f"shader file {filename!r} not found in {directory}")
+    files = [path]
+    lines = _expand(path, files, (path,))
+    version_at = next((i for i, line in enumerate(lines) if _VERSION.match(line)), None)
+    if version_at is None:
+        raise ShaderSourceError(f"{_display(path)}: no #version line")
+    injected = _define_lines(dict(defines))
+    # The original line after #version keeps its number in compiler messages.
+    injected.append(f"#line {version_at + 2} 0")
+    lines[version_at + 1:version_at + 1] = injected
+    return ShaderSource("\n".join(lines) + "\n", tuple(_display(p) for p in files))
+
+
+# The all-features build sizes its light arrays for this many lights of each kind.
+ALL_FEATURES_LIGHTS = 8
+
+
+@dataclass(frozen=True)
+class ShaderVariant:
+    """One combination of the shaders' compile-time constants.
+
+    A specialised variant has only what its material and scene use: the shading mode's
+    stages, the lights of each kind as constant-sized arrays, the specular term only when
+    some k_s > 0, the back-face code only for a two-sided material. `all_features` is the
+    same GLSL with everything compiled in (specular, both sides, arrays of
+    ALL_FEATURES_LIGHTS lights of each kind) and the rest decided by uniforms at run time
+    (how many lights, whether the material is two-sided): what a renderer that does not
+    specialise runs. benchmarks/bench_specialisation.py compares the two.
+    """
+    shading: str                     # "flat", "gouraud" or "phong"
+    two_sided: bool = False
+    num_directional_lights: int = 0
+    num_point_lights: int = 0
+    linear_output: bool = False      # second fragment output: the unclamped float colour
+    specular: bool = False           # the k_s term of the lighting equation
+    all_features: bool = False
+
+    def __post_init__(self):
+        if self.shading not in ("flat", "gouraud", "phong"):
+            raise ValueError(f"unknown shading mode {self.shading!r}")
+
+    def defines(self) -> dict[str, object]:
+        if self.all_features:
+            return {
+                f"SHADING_{self.shading.upper()}": True,
+                "ALL_FEATURES": True,
+                "TWO_SIDED": True,
+                "SPECULAR": True,
+                "NUM_DIRECTIONAL_LIGHTS": ALL_FEATURES_LIGHTS,
+                "NUM_POINT_LIGHTS": ALL_FEATURES_LIGHTS,
+                "LINEAR_OUTPUT": self.linear_output,
+            }
+        return {
+            f"SHADING_{self.shading.upper()}": True,
+            "TWO_SIDED": self.two_sided,
+            "SPECULAR": self.specular,
+            "NUM_DIRECTIONAL_LIGHTS": self.num_directional_lights,
+            "NUM_POINT_LIGHTS": self.num_point_lights,
+            "LINEAR_OUTPUT": self.linear_output,
+        }
+
+    @property
+    def name(self) -> str:
+        """A file-name-safe label, e.g. "phong-two-sided-specular-1dir-2point"."""
+        linear = "-linear" if self.linear_output else ""
+        if self.all_features:
+            return f"{self.shading}-all-features{linear}"
+        sides = "-two-sided" if self.two_sided else ""
+        specular = "-specular" if self.specular else ""
+        return (f"{self.shading}{sides}{specular}-{self.num_directional_lights}dir-"
+                f"{self.num_point_lights}point{linear}")
+
+    @property
+    def uses_geometry_shader(self) -> bool:
+        return self.shading == "flat"
+
+    @classmethod
+    def for_material(cls, scene, material, linear_output: bool = False,
+                     all_features: bool = False) -> "ShaderVariant":
+        """The variant that draws `material` (a renderer.core.scene.Material) in `scene`:
+        specialised to what they use, or the all-features build."""
+        if all_features:
+            return cls(material.shading, linear_output=bool(linear_output), all_features=True)
+        return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
+                   len(scene.point_lights), bool(linear_output), material.has_specular)
+
+
+STAGES = (("vertex_shader", "vertex.glsl"),
+          ("geometry_shader", "geometry.glsl"),
+          ("fragment_shader", "fragment.glsl"))
+
+
+def program_sources(variant: ShaderVariant) -> dict[str, ShaderSource]:
+    """Sources of the stages `variant` links, keyed by moderngl's program() argument names."""
+    defines = variant.defines()
+    return {stage: shader_source(filename, defines) for stage, filename in STAGES
+            if stage != "geometry_shader" or variant.uses_geometry_shader}
+
+
+def program_source(scene, material, linear_output: bool = False) -> tuple[str, str | None, str]:
+    """(vertex, geometry or None, fragment) source texts for `material` in `scene`."""
+    sources = program_sources(ShaderVariant.for_material(scene, material, linear_output))
+    geometry = sources.get("geometry_shader")
+    return (sources["vertex_shader"].text, geometry.text if geometry else None,
+            sources["fragment_shader"].text)
+
+
+class ProgramCache:
+    """Compiled programs of one context, one per variant, made on first use."""
+
+    def __init__(self, ctx: moderngl.Context):
+        self.ctx = ctx
+        self._programs: dict[ShaderVariant, moderngl.Program] = {}
+
+    def get(self, variant: ShaderVariant) -> moderngl.Program:
+        program = self._programs.get(variant)
+        if program is None:
+            program = self._programs[variant] = self._compile(variant)
+        return program
+
+    def _compile(self, variant: ShaderVariant) -> moderngl.Program:
+        sources = program_sources(variant)
+        try:
+            return self.ctx.program(**{stage: s.text for stage, s in sources.items()})
+        except moderngl.Error as exc:
+            legend = "; ".join(f"{stage.split('_')[0]}: " + ", ".join(
+                f"{i}={name}" for i, name in enumerate(s.files)) for stage, s in sources.items())
+            raise ShaderSourceError(f"{variant} does not compile (source strings {legend}):\n{exc}")
+
+    def items(self):
+        return self._programs.items()
+
+    def __len__(self) -> int:
+        return len(self._programs)
+
+    def release(self) -> None:
+        for program in self._programs.values():
+            program.release()
+        self._programs.clear()

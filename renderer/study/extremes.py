@@ -1,0 +1,212 @@
+"""`renderer extremes`: the stiff and extreme scenes of assets/extreme/, each rendered by the
+GPU (EGL and OSMesa) and by the reference, with the figures that show it is stable.
+
+    cases = measure_extremes(extreme_scenes(), (160, 120), {"egl": ctx, "osmesa": ctx})
+    write_report(Path("out"), cases, (160, 120))   # out/extremes.json and out/extremes.md
+
+Ground truth is the reference pipeline in float64 at the same size: the question here is
+numerical stability, not aliasing. Each case passes when no pixel is NaN or Inf anywhere
+(the linear colour, and the depth where something was drawn) and every GPU frame meets the
+pipeline tolerance against it (tests/test_gpu_vs_reference.py's rule). A scene authored with
+reversed-Z is measured a second time with it off, to show the depth error it removes. A
+scene whose file is refused (a NaN vertex) is listed with the one-line error a user sees.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import replace
+from pathlib import Path
+
+import numpy as np
+
+import reference
+from renderer.core.builtin import assets_dir, scene_description
+from renderer.checks.compare import compare_frames, depth_tie_pixels
+from renderer.errors import SceneError
+from renderer.gpu.pipeline import GpuRenderer
+from renderer.core.imageio import write_text
+from renderer.core.scene_file import load_scene
+
+RAW_MISMATCH_LIMIT = 0.001       # the pipeline tolerance: 0 mismatched pixels after ±1 px,
+DEPTH_REL_LIMIT = 1e-3           # at most 0.1 % off in place, depth within 1e-3 relative
+
+# What makes each case stable, keyed by the scene file's name (docs/conventions.md has the rules).
+STABILITY = {
+    "bad_normals": "the loader renormalises file normals and replaces zero-length ones by the "
+                   "computed vertex normal, so both pipelines get unit normals",
+    "camera_along_up": "look_at falls back to the world axis least aligned with the view "
+                       "direction when up is parallel to it",
+    "crossing_w_zero": "clipping in homogeneous coordinates before the divide by w "
+                       "(GL's clipper; the reference divides only after clipping)",
+    "degenerate_triangles": "zero-area triangles are never rasterised; a face normal of zero "
+                            "length stays zero (normalize_or_zero), never NaN",
+    "depth_ratio_1e5": "reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
+                       "depth buffer cleared to 0 and GL_GREATER",
+    "depth_ratio_1e8": "reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
+                       "depth buffer cleared to 0 and GL_GREATER",
+    "duplicate_vertices": "coincident vertices of a file without normals are merged; the "
+                          "repeated faces tie exactly and the first drawn wins in both",
+    "extreme_scale": "the normal matrix is the cofactor matrix (det(M) M^-T), scaled in float64 "
+                     "before the float32 upload",
+    "far_from_origin": "camera-relative transforms: T(-eye) M in float64, the view a rotation, "
+                       "eye and lights relative to the eye",
+    "grazing_light": "max(N.L, 0) and no highlight unless N.L > 0 and R.V > 0",
+    "light_behind": "max(N.L, 0) and no highlight unless N.L > 0 and R.V > 0: ambient only",
+    "nan_mesh": "refused when loaded: one line naming file, key and reason, exit status 2",
+    "phong_exponents": "pow(R.V, n) only for R.V > 0 (GLSL's pow is undefined for a base <= 0); "
+                       "n = 0 gives 1 there, n = 10000 underflows to 0",
+    "point_light_on_surface": "at distance 0 the light is fully incident: L = N, "
+                              "att = 1 / c",
+    "singular_model": "the cofactor normal matrix is defined for det(M) = 0; a normal it "
+                      "zeroes lights as ambient (normalize_or_zero)",
+    "subpixel_triangles": "vertices snapped to 1/256 px and the fill rule decide coverage "
+                          "identically in both pipelines",
+}
+
+
+def extreme_scenes(extra=()) -> dict[str, Path]:
+    """Name to path of every scene in assets/extreme/, then of the `extra` scene files."""
+    scenes = {path.stem: path for path in sorted((assets_dir() / "extreme").glob("*.toml"))}
+    scenes.update((Path(path).stem, Path(path)) for path in extra)
+    return scenes
+
+
+def is_finite_frame(frame) -> bool:
+    """No NaN or Inf in the linear colour, nor in the depth where something was drawn
+    (+inf is the depth of the background by convention)."""
+    drawn = frame.rgba8[..., 3] == 255
+    return bool(np.isfinite(frame.linear).all() and np.isfinite(frame.depth[drawn]).all()
+                and not np.isnan(frame.depth).any())
+
+
+def passes(comparison: dict) -> bool:
+    """The pipeline tolerance (tests/test_gpu_vs_reference.py)."""
+    return (comparison["mismatched_pixels"] == 0
+            and comparison["raw_mismatched_fraction"] <= RAW_MISMATCH_LIMIT
+            and comparison["depth_max_rel"] <= DEPTH_REL_LIMIT)
+
+
+def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
+    """Figures of one scene: finiteness per backend and each GPU frame against the float64
+    reference (the worst context's figures are the case's). `contexts` are the pipeline
+    tolerance's figures, which accept either surface where the reference finds two closer
+    in depth than GL can order (depth ties: `tie_pixels`); `truth` holds the same frame
+    against the reference's own image alone, where z-fighting shows."""
+    width, height = size
+    gpu_frames = {}
+    for kind, ctx in contexts.items():
+        with GpuRenderer(scene, width, height, context=ctx) as gpu:
+            gpu_frames[kind] = gpu.render(linear=True, depth=True)
+            subpixel_bits = gpu.subpixel_bits
+    truth = reference.render(scene, width, height, dtype=np.float64, linear=True,
+                             subpixel_bits=subpixel_bits)
+    finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
+    finite["reference"] = is_finite_frame(truth)
+    per_context = {kind: compare_frames(frame.rgba8, truth.rgba8, frame.depth, truth.depth,
+                                        reference_tie=truth.rgba8_tie).as_dict()
+                   for kind, frame in gpu_frames.items()}
+    against_truth = {kind: compare_frames(frame.rgba8, truth.rgba8).as_dict()
+                     for kind, frame in gpu_frames.items()}
+    return {"finite": finite, "tie_pixels": depth_tie_pixels(truth),
+            "contexts": per_context, "worst": _worst(per_context),
+            "truth": against_truth, "worst_truth": _worst(against_truth),
+            "passes": all(finite.values()) and all(passes(c) for c in per_context.values())}
+
+
+def _worst(comparisons: dict) -> dict:
+    return max(comparisons.values(), key=lambda c: (c["mismatched_pixels"],
+                                                    c["raw_mismatched_fraction"], c["rmse"]))
+
+
+def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: dict) -> list[dict]:
+    """One case per scene (two for a reversed-Z scene: as authored, and with it off)."""
+    cases = []
+    for name, path in scenes.items():
+        base = {"case": name, "file": str(path), "stability": STABILITY.get(name, "")}
+        try:
+            scene = load_scene(path)
+        except SceneError as error:
+            cases.append(base | {"refused": error.line(), "passes": True})
+            continue
+        description = scene_description(path)
+        cases.append(base | {"tests": description, "reversed_z": scene.camera.reversed_z}
+                     | measure_scene(scene, size, contexts))
+        if scene.camera.reversed_z:
+            standard = replace(scene, camera=replace(scene.camera, reversed_z=False))
+            cases.append(base | {"case": f"{name} (reversed_z off)", "tests": description,
+                                 "reversed_z": False, "stability": "none: the 'before' of the "
+                                 "row above", "before": True}
+                         | measure_scene(standard, size, contexts))
+    return cases
+
+
+# -------------------------------------------------------------------------- the report
+
+def _json_safe(value):
+    """Non-finite floats as strings ("inf", "nan"), so that extremes.json is strict JSON."""
+    if isinstance(value, float) and not math.isfinite(value):
+        return str(value)
+    if isinstance(value, dict):
+        return {k: _json_safe(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_json_safe(v) for v in value]
+    return value
+
+
+def _yes_no(flag: bool) -> str:
+    return "yes" if flag else "**NO**"
+
+
+def markdown_table(cases: list[dict], size: tuple[int, int]) -> str:
+    lines = [f"# Extreme cases ({size[0]}x{size[1]})", "",
+             "GPU against the float64 reference (the ground truth here: the same pipeline in "
+             "float64 at the same size). Mismatched: pixels failing the threshold-2 compare "
+             "with ±1 px allowed, both ways; raw: fraction off by more than 2 in place; both "
+             "accept either surface at the reference's depth ties (tie px: pixels where two "
+             "surfaces are closer than GL's float32 depth can order, that is z-fighting). "
+             "Against truth: rmse / max_abs on the 0-255 scale against the reference image "
+             "alone, ties not forgiven. Depth: largest relative error of the camera-space "
+             "depth. Figures are the worst of the GPU contexts. Pass: the pipeline tolerance "
+             f"(0 mismatched, raw <= {RAW_MISMATCH_LIMIT}, depth <= {DEPTH_REL_LIMIT:g}).", "",
+             "| case | what it tests | finite (" + " / ".join(_backends(cases)) + ") | mismatched px "
+             "| raw mismatch | tie px | against truth: rmse / max_abs | depth max rel | pass "
+             "| what makes it stable |",
+             "| --- | --- | --- | ---: | ---: | ---: | --- | ---: | --- | --- |"]
+    for case in cases:
+        if "refused" in case:
+            lines.append(f"| {case['case']} | refused: `{case['refused']}` | - | - | - | - | - "
+                         f"| - | yes (refused) | {case['stability']} |")
+            continue
+        worst, truth = case["worst"], case["worst_truth"]
+        finite = " / ".join(_yes_no(v) for v in case["finite"].values())
+        verdict = _yes_no(case["passes"]) if not case.get("before") else \
+            ("yes" if case["passes"] else "no (expected)")
+        lines.append(
+            f"| {case['case']} | {case['tests']} | {finite} | {worst['mismatched_pixels']} "
+            f"| {worst['raw_mismatched_fraction']:.4f} | {case['tie_pixels']} "
+            f"| {truth['rmse']:.3f} / {truth['max_abs']} "
+            f"| {worst['depth_max_rel']:.2e} | {verdict} | {case['stability']} |")
+    return "\n".join(lines) + "\n"
+
+
+def _backends(cases: list[dict]) -> list[str]:
+    for case in cases:
+        if "finite" in case:
+            return list(case["finite"])
+    return ["reference"]
+
+
+def write_report(out: Path, cases: list[dict], size: tuple[int, int]) -> tuple[Path, Path]:
+    """extremes.json (every figure of every case) and extremes.md (the table), atomically."""
+    json_path, md_path = Path(out) / "extremes.json", Path(out) / "extremes.md"
+    document = {"size": list(size), "cases": cases}
+    write_text(json_path, json.dumps(_json_safe(document), indent=1, allow_nan=False) + "\n")
+    write_text(md_path, markdown_table(cases, size))
+    return json_path, md_path
+
+
+def all_pass(cases: list[dict]) -> bool:
+    """Every case as authored passes (the reversed_z-off rows are the 'before' and may not)."""
+    return all(case["passes"] for case in cases if not case.get("before"))

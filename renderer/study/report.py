@@ -1,0 +1,245 @@
+"""`renderer report`: error against run time over quality settings (issue 4, part 1).
+
+Each scene is rendered at a series of settings of four knobs, each setting on each backend
+(the GPU path and the NumPy reference) `runs` times; the median time and the error of the
+image against the ground truth (renderer/study/ground_truth.py) make one row of results.csv.
+
+    knob            settings                                          scene drawn
+    antialiasing    regular / random / jittered / poisson at N        the truth's (Phong,
+                    samples, adaptive FIRST->TOTAL at a threshold,    finest tessellation):
+                    msaa N (GPU only: the counts the context          the error is the
+                    offers, gpu.multisample_counts)                   sampling error alone
+    tessellation    levels x0.25 .. x4 of the authored segments       Phong, 4-sample grid
+    shading         flat, gouraud, phong                              authored tessellation,
+                                                                      4-sample grid
+    precision       float32, float64 (reference only)                 the truth's, 4-sample grid
+
+Errors are on the float image in [0, 1] (renderer/study/supersample.py) against the float truth:
+rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 8 bits) and
+mismatched_fraction (pixels whose 8-bit value differs from the truth's by more than 2/255 in
+some channel). report.md, results.csv and plots/SCENE-KNOB.png are written when the sweep
+has finished, each atomically.
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from reference.output import to_unorm8
+from renderer.core import sampling
+from renderer.study.report_output import csv_text, plot_png, report_markdown
+from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
+from renderer.core.imageio import write_bytes, write_text
+from renderer.checks.perceptual import flip_error
+from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
+                                  supersample)
+from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS,
+                                            QUICK_SCENES, QUICK_SIZE, TARGETS_RMSE)
+from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
+
+@dataclass(frozen=True)
+class Sweep:
+    """Which settings a report renders."""
+    sample_counts: tuple = (1, 4, 16, 64)          # per pattern; regular keeps the squares
+    adaptive: tuple = ((4, 16, 0.05), (4, 64, 0.05))   # (first, total, threshold)
+    levels: tuple = LEVELS
+    runs: int = 5
+
+
+FULL = Sweep()
+QUICK = Sweep(adaptive=((4, 16, 0.05),), levels=(0.25, 1.0, FINEST))
+
+
+@dataclass(frozen=True)
+class Setting:
+    """One row's recipe: what to draw (`variant`) and how to sample it, on which backend."""
+    knob: str
+    setting: str
+    backend: str                     # "gpu" or "reference"
+    pattern: str                     # a sampling pattern, "adaptive", "msaa", or "regular"
+    variant: tuple                   # ("truth",) | ("level", L) | ("shading", mode)
+    sampling: tuple                  # ("pattern", name, N) | ("adaptive", first, total, t) | ("msaa", N)
+    dtype: str = "float64"
+
+
+def settings(sweep: Sweep, msaa_counts: list[int]) -> list[Setting]:
+    """Every setting of every knob, each backend it runs on."""
+    both = ("gpu", "reference")
+    out = []
+    for name in sampling.PATTERNS:
+        for n in sweep.sample_counts:
+            if name == "regular" and math.isqrt(n) ** 2 != n:
+                continue
+            out += [Setting("antialiasing", f"{name} {n}", b, name, ("truth",), ("pattern", name, n))
+                    for b in both]
+    for first, total, threshold in sweep.adaptive:
+        out += [Setting("antialiasing", f"adaptive {first}->{total} @{threshold:g}", b, "adaptive",
+                        ("truth",), ("adaptive", first, total, threshold)) for b in both]
+    out += [Setting("antialiasing", f"msaa {n}", "gpu", "msaa", ("truth",), ("msaa", n))
+            for n in msaa_counts]
+    base = ("pattern", "regular", BASE_SAMPLES)
+    for level in sweep.levels:
+        out += [Setting("tessellation", f"x{level:g}", b, "regular", ("level", level), base)
+                for b in both]
+    for mode in ("flat", "gouraud", "phong"):
+        out += [Setting("shading", mode, b, "regular", ("shading", mode), base) for b in both]
+    out += [Setting("precision", dtype, "reference", "regular", ("truth",), base, dtype)
+            for dtype in ("float32", "float64")]
+    return out
+
+
+def metrics(image: np.ndarray, truth: np.ndarray) -> dict:
+    """Errors of an (H, W, 3) float image in [0, 1] against the truth (module docstring)."""
+    difference = image - truth
+    mse = float(np.mean(difference ** 2))
+    image8, truth8 = to_unorm8(image), to_unorm8(truth)
+    off = np.abs(image8.astype(np.int16) - truth8.astype(np.int16)) > MISMATCH_LEVELS
+    return {"rmse": math.sqrt(mse), "max_abs": float(np.max(np.abs(difference))),
+            "psnr": 10.0 * math.log10(1.0 / mse) if mse > 0 else math.inf,
+            "flip_mean": flip_error(truth8, image8)[0],
+            "mismatched_fraction": float(off.any(axis=-1).mean())}
+
+
+class SceneRun:
+    """Renders one scene's settings; GL renderers are made once per drawn variant and reused
+    by every run of every setting that draws it."""
+
+    def __init__(self, scene, width: int, height: int, ctx):
+        self.scene, self.width, self.height, self.ctx = scene, width, height, ctx
+        self.subpixel_bits = int(ctx.info["GL_SUBPIXEL_BITS"])      # the reference snaps as GL does
+        self._scenes: dict[tuple, object] = {}
+        self._gpus: dict[tuple, object] = {}
+
+    def drawn(self, variant: tuple):
+        if variant not in self._scenes:
+            kind = variant[0]
+            self._scenes[variant] = (
+                truth_scene(self.scene) if kind == "truth" else
+                scene_at_level(self.scene.with_shading("phong"), variant[1]) if kind == "level" else
+                self.scene.with_shading(variant[1]))
+        return self._scenes[variant]
+
+    def gpu(self, variant: tuple):
+        if variant not in self._gpus:
+            from renderer.gpu.pipeline import GpuRenderer
+            self._gpus[variant] = GpuRenderer(self.drawn(variant), self.width, self.height,
+                                              context=self.ctx)
+        return self._gpus[variant]
+
+    def render(self, setting: Setting) -> tuple[np.ndarray, float]:
+        """(image (H, W, 3) float64 in [0, 1], samples per pixel spent)."""
+        kind, *args = setting.sampling
+        if kind == "msaa":
+            return msaa_image(self.gpu(setting.variant), args[0]), float(args[0])
+        if setting.backend == "gpu":
+            pass_ = gpu_pass(self.gpu(setting.variant))
+        else:
+            pass_ = reference_pass(self.drawn(setting.variant), self.width, self.height,
+                                   dtype=np.dtype(setting.dtype), subpixel_bits=self.subpixel_bits)
+        if kind == "adaptive":
+            return adaptive_supersample(pass_, *args)
+        name, n = args
+        return supersample(pass_, sampling.pattern(name, n)), float(n)
+
+    def timed(self, setting: Setting, runs: int) -> tuple[np.ndarray, float, float]:
+        """(image, samples per pixel, median ms of `runs` runs of the whole setting). The GPU
+        gets one untimed run first (shader compilation, first use of a target)."""
+        if setting.backend == "gpu":
+            self.render(setting)
+        times = []
+        for _ in range(runs):
+            start = time.perf_counter()
+            image, samples = self.render(setting)
+            times.append((time.perf_counter() - start) * 1000.0)
+        return image, samples, statistics.median(times)
+
+    def release(self) -> None:
+        for gpu in self._gpus.values():
+            gpu.release()
+        self._gpus.clear()
+
+
+@dataclass
+class ReportResult:
+    rows: list = field(default_factory=list)
+    seconds: float = 0.0
+    truth_hits: int = 0
+    triangles: dict = field(default_factory=dict)     # scene -> (authored, at the finest level)
+    gl_renderer: str = ""
+    files: list = field(default_factory=list)
+
+
+def check_size(width: int, height: int) -> None:
+    from renderer.errors import UserError
+    if width * height * TRUTH_GRID ** 2 > MAX_TRUTH_PIXELS:
+        raise UserError(f"{width}x{height} is too large for the ground truth ({TRUTH_GRID}x"
+                        f"{TRUTH_GRID} samples per pixel, at most 320x240 pixels)", key="--size")
+
+
+def run_report(scenes: list, out: Path, *, quick: bool = False, size=None, cache_dir=None,
+               context_kind: str = "auto", sweep: Sweep | None = None) -> ReportResult:
+    """Sweep `scenes` (Scene objects), write results.csv, plots/ and report.md under `out`."""
+    from tqdm import tqdm
+
+    from renderer.gpu.context import make_context, release_context
+    from renderer.gpu.pipeline import multisample_counts
+    width, height = size or (QUICK_SIZE if quick else DEFAULT_SIZE)
+    check_size(width, height)
+    sweep = sweep or (QUICK if quick else FULL)
+    cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
+    result = ReportResult()
+    start = time.perf_counter()
+    ctx = make_context(context_kind)
+    try:
+        result.gl_renderer = ctx.info["GL_RENDERER"]
+        plan = settings(sweep, multisample_counts(ctx))
+        with tqdm(total=len(scenes) * (len(plan) + 1), unit="setting", file=sys.stderr,
+                  mininterval=0.5, dynamic_ncols=True) as bar:
+            for scene in scenes:
+                bar.set_description(f"{scene.name}: ground truth")
+                truth, hit = ground_truth(scene, width, height, cache_dir)
+                result.truth_hits += hit
+                result.triangles[scene.name] = tuple(
+                    sum(obj.mesh.triangle_count for obj in drawn.objects)
+                    for drawn in (scene, truth_scene(scene)))
+                bar.update()
+                run = SceneRun(scene, width, height, ctx)
+                try:
+                    for setting in plan:
+                        bar.set_description(f"{scene.name}: {setting.knob} {setting.setting} "
+                                            f"({setting.backend})")
+                        image, samples, ms = run.timed(setting, sweep.runs)
+                        result.rows.append({
+                            "scene": scene.name, "knob": setting.knob, "setting": setting.setting,
+                            "backend": setting.backend, "pattern": setting.pattern,
+                            "samples": samples, "runs": sweep.runs, "median_ms": ms,
+                            **metrics(image, truth)})
+                        bar.update()
+                finally:
+                    run.release()
+    finally:
+        release_context(ctx)
+    result.seconds = time.perf_counter() - start
+    write_outputs(result, Path(out), (width, height), sweep, quick)
+    return result
+
+
+# ------------------------------------------------------------------------------- outputs
+
+def write_outputs(result: ReportResult, out: Path, size, sweep: Sweep, quick: bool) -> None:
+    plots = {}
+    for scene in dict.fromkeys(row["scene"] for row in result.rows):
+        for knob in dict.fromkeys(row["knob"] for row in result.rows if row["scene"] == scene):
+            rows = [row for row in result.rows if row["scene"] == scene and row["knob"] == knob]
+            plots[(scene, knob)] = f"plots/{scene}-{knob}.png"
+            write_bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}"))
+    write_text(out / "results.csv", csv_text(result.rows))
+    write_text(out / "report.md", report_markdown(result, plots, size, sweep, quick))
+    result.files = ["report.md", "results.csv", *plots.values()]

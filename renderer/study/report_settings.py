@@ -1,0 +1,20 @@
+"""The fixed settings of `renderer report`: sizes, targets, the CSV's columns and the textbook
+convergence rates, read by the sweep (report.py) and by its output (report_output.py)."""
+
+DEFAULT_SIZE = (160, 120)
+QUICK_SIZE = (64, 48)
+QUICK_SCENES = ("flat_shading", "gouraud_vs_phong")
+# The errors the "cheapest setting" must reach: about 2.6/255, where one sample often does,
+# and about 0.8/255, where the patterns part ways.
+TARGETS_RMSE = (0.01, 0.003)
+MISMATCH_LEVELS = 2                  # of 255: a pixel further off than this is mismatched
+BASE_SAMPLES = 4                     # regular grid for the knobs other than antialiasing
+CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "runs", "median_ms",
+               "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction")
+TEXTBOOK_SLOPES = {                  # RMSE against N (Mitchell 1996; docs/report)
+    "regular": ("N^-0.5 at worst", "coverage steps of 1/k on a k x k grid: the worst case, "
+                "edges along the grid; other edges do better, but the grid aliases"),
+    "random": ("N^-0.5", "independent samples: the Monte Carlo rate"),
+    "jittered": ("N^-0.75 at edges", "one sample per stratum"),
+    "poisson": ("about N^-0.75", "between random and jittered, close to jittered"),
+}

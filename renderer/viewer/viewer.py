@@ -1,0 +1,315 @@
+"""`renderer view`: a scene in a window, drawn by the same GpuRenderer as the headless path.
+
+Each frame: handle the window's events (renderer/viewer/controls.py turns them into a camera and a
+ViewState), bring the renderer up to date when something changed (GpuRenderer.update, or
+resize when the window's size changed: the image always has the window's aspect ratio),
+draw offscreen (GpuRenderer.draw), and let the presenter (renderer/viewer/presenter.py) put the
+frame on the back buffer by double or triple buffering, with the reference view and the
+overlay beside or over it; then swap. The reference view is the NumPy reference of the same
+view, made in a background process (renderer/viewer/reference_view.py), side by side with the GPU
+image or as a heat map of their difference with its figures.
+
+`Viewer.run(frames=N, orbit=DEG, screenshot=PATH)` is the scripted mode of the command line:
+N frames, the camera orbiting DEG degrees per frame, then what the window shows saved to PNG
+and the frame-time statistics returned.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
+from renderer.gpu.pipeline import GpuRenderer
+from renderer.core.imageio import write_png
+from renderer.viewer.orbit import OrbitCamera
+from renderer.viewer.overlay import text_panel
+from renderer.viewer.presenter import CpuImage, Presenter, fit
+from renderer.viewer.reference_view import BackgroundReference, difference_view, figures_line
+from renderer.core.scene import Scene
+from renderer.viewer.window import Window
+
+SCREEN_CLEAR = (0.12, 0.12, 0.14)          # the window around a letterboxed image
+TITLE_EVERY_S = 0.25                       # how often the title's figures are refreshed
+
+
+@dataclass
+class FrameStats:
+    """Frame-time figures of a run: `frame_ms` from swap to swap (what a user sees),
+    `draw_ms` the part spent issuing the scene's draw calls, `latency_ms` from drawing a
+    frame to the swap that showed it."""
+    frame_ms: list[float] = field(default_factory=list)
+    draw_ms: list[float] = field(default_factory=list)
+    latency_ms: float | None = None
+
+    def summary(self) -> dict:
+        frames = sorted(self.frame_ms)
+        if not frames:
+            return {"frames": 0}
+        median = statistics.median(frames)
+        return {"frames": len(frames) + 1, "frame_ms_median": median,
+                "frame_ms_p5": frames[int(0.05 * (len(frames) - 1))],
+                "frame_ms_p95": frames[int(0.95 * (len(frames) - 1))],
+                "frame_ms_max": frames[-1], "fps": 1000.0 / median if median > 0 else float("inf"),
+                "draw_ms_median": statistics.median(self.draw_ms),
+                "latency_ms_median": self.latency_ms}
+
+    def line(self) -> str:
+        s = self.summary()
+        if s["frames"] < 2:
+            return f"{s['frames']} frame(s): no frame times"
+        latency = "" if s["latency_ms_median"] is None else \
+            f", latency {s['latency_ms_median']:.2f} ms"
+        return (f"{s['frames']} frames: frame time median {s['frame_ms_median']:.2f} ms "
+                f"(p5 {s['frame_ms_p5']:.2f}, p95 {s['frame_ms_p95']:.2f}, max {s['frame_ms_max']:.2f}), "
+                f"{s['fps']:.1f} fps; drawing median {s['draw_ms_median']:.2f} ms{latency}")
+
+
+class Viewer:
+    """A window on one scene; see the module docstring."""
+
+    def __init__(self, scene: Scene, width: int, height: int, *, vsync: bool = True,
+                 buffering: int = 2, reference: str = "off", screenshot: Path | None = None,
+                 on_message=print):
+        self.authored = scene
+        self.shown = working_copy(scene)
+        self.say = on_message
+        self.screenshot_path = screenshot
+        self._screenshots = 0
+        self.state = ViewState(vsync=vsync, buffering=buffering, reference=reference)
+        self.orbit = OrbitCamera(scene.camera)
+        self.controls = Controls(self.state, self.orbit, light_names_of(scene), on_message=on_message,
+                                 scene=scene)
+        self.window = Window(width, height, f"renderer view: {scene.name}", vsync=vsync)
+        try:
+            self.ctx = self.window.ctx
+            size = self.window.framebuffer_size
+            self.controls.resize(*size)
+            apply_view(self.state, self.authored, self.shown, self.orbit.camera)
+            self.gpu = GpuRenderer(self.shown, *size, context=self.ctx)
+            self.gpu.wireframe = self.state.wireframe
+            self.presenter = Presenter(self.ctx, buffering)
+            self.background = BackgroundReference()
+            self._reference_image = CpuImage(self.ctx)   # the reference, for side by side
+            self._difference_image = CpuImage(self.ctx)  # the heat map
+            self._overlay = CpuImage(self.ctx)
+            self._overlay_lines: tuple = ()
+            self._version = 0                 # bumped whenever the shaded image would change
+            self._view: tuple | None = None   # what the version stands for
+            self._requested = -1              # the version the reference was asked for
+            self._reference_version = -1      # the version the reference images show
+            self._figures: dict | None = None
+            self.window.connect(self.controls)
+            self.stats = FrameStats()
+            self._last_swap: float | None = None
+            self._last_title = 0.0
+            self._vsync_set = vsync
+        except BaseException:
+            self.close()
+            raise
+
+    # -- one frame ---------------------------------------------------------------------------
+    def _follow_changes(self) -> None:
+        """Bring the renderer up to date with the window's size and the controls' changes."""
+        state = self.state
+        size = self.window.framebuffer_size
+        if size != (self.gpu.width, self.gpu.height) and min(size) > 0:   # 0 when minimised
+            self.gpu.resize(*size)             # (the controls hear of it from the window)
+        if state.camera_changed or state.scene_changed:
+            apply_view(state, self.authored, self.shown, self.orbit.camera)
+            self.gpu.update()
+            state.camera_changed = state.scene_changed = False
+        # The version names what the shaded image depends on (not wireframe, help or the
+        # reference mode), so that only a new image asks the reference again.
+        view = (self.gpu.width, self.gpu.height, repr(self.orbit.camera), state.shading,
+                state.two_sided, tuple(state.lights_on))
+        if view != self._view:
+            self._view = view
+            self._version += 1
+        self.gpu.wireframe = state.wireframe
+        if state.vsync != self._vsync_set:
+            self.window.set_vsync(state.vsync)
+            self._vsync_set = state.vsync
+        if state.buffering != self.presenter.buffering:
+            self.presenter.set_buffering(state.buffering)
+
+    def _follow_reference(self, wait: bool = False) -> None:
+        """Ask for the reference of the current view when it is wanted and not asked for yet,
+        and take a finished one (`wait`: wait for it): its heat map against a GPU image of
+        the same view."""
+        if self.state.reference == "off":
+            return
+        if self._requested != self._version:
+            self.background.request(working_copy(self.shown), self.gpu.width, self.gpu.height,
+                                    self._version)
+            self._requested = self._version
+        result = self.background.wait() if wait else self.background.poll()
+        if result is not None and result.version == self._version:
+            self._take_reference(result)
+
+    def _take_reference(self, result) -> None:
+        wireframe, self.gpu.wireframe = self.gpu.wireframe, False   # compare shaded images
+        try:
+            gpu_rgba8 = self.gpu.render(depth=False).rgba8
+        finally:
+            self.gpu.wireframe = wireframe
+        difference, self._figures = difference_view(gpu_rgba8, result)
+        self._reference_image.upload(result.rgba8)
+        self._difference_image.upload(difference)
+        self._reference_version = result.version
+
+    def _compose(self, shown) -> None:
+        """The back buffer: the frame (and the reference view) letterboxed, then the overlay."""
+        screen = self.ctx.screen
+        width, height = self.window.framebuffer_size
+        screen.use()
+        blit = self.presenter.blitter.copy
+        mode = self.state.reference
+        have_reference = self._reference_version >= 0
+        whole = (0, 0, width, height)
+        if mode != "off" or fit(shown.size, whole) != whole:
+            screen.clear(*SCREEN_CLEAR, 1.0)           # letterbox bars; else all is covered
+        if mode == "side-by-side":
+            blit(shown, screen, fit(shown.size, (0, 0, width // 2, height)))
+            if have_reference:
+                reference = self._reference_image.framebuffer
+                blit(reference, screen, fit(reference.size, (width // 2, 0, width, height)))
+        elif mode == "difference" and have_reference:
+            difference = self._difference_image.framebuffer
+            blit(difference, screen, fit(difference.size, whole))
+        else:
+            blit(shown, screen, fit(shown.size, whole))
+        lines = self._overlay_text()
+        if lines != self._overlay_lines:
+            panel = text_panel(list(lines), width, height)
+            if panel is not None:
+                self._overlay.upload(panel)
+            else:
+                self._overlay.release()
+            self._overlay_lines = lines
+        panel = self._overlay.framebuffer
+        if lines and panel is not None:
+            pw, ph = panel.size
+            blit(panel, screen, (0, height - ph, pw, height))     # top left
+
+    def _overlay_text(self) -> tuple:
+        lines = []
+        if self.state.reference == "side-by-side":
+            lines.append("left: GPU (GLSL)    right: NumPy reference")
+        if self.state.reference != "off":
+            current = self._reference_version == self._version
+            if self._figures is not None and self._reference_version >= 0:
+                lines.append(figures_line(self._figures) + ("" if current else " (updating)"))
+            elif self.background.busy:
+                lines.append("reference view: computing...")
+        if self.state.help:
+            lines += help_lines(self.state, light_names_of(self.authored))
+        return tuple(lines)
+
+    def frame(self) -> None:
+        """One frame: events, changes, draw, present, swap."""
+        self.window.poll()
+        self._follow_changes()
+        self._follow_reference()
+        started = time.perf_counter()
+        drawn = self.gpu.draw()
+        self.ctx.finish()                     # so that draw_ms is the drawing, not queued work
+        self.stats.draw_ms.append((time.perf_counter() - started) * 1000.0)
+        self.presenter.submit(drawn, started)
+        self._compose(self.presenter.shown)
+        if self.state.screenshot:
+            self.state.screenshot = False
+            self.save_screenshot()
+        self.window.swap()
+        now = time.perf_counter()
+        self.presenter.swapped(now)
+        if self._last_swap is not None:
+            self.stats.frame_ms.append((now - self._last_swap) * 1000.0)
+        self._last_swap = now
+        if now - self._last_title >= TITLE_EVERY_S:
+            self.window.set_title(self.title())
+            self._last_title = now
+
+    @property
+    def figures(self) -> dict | None:
+        """The reference view's figures (renderer/viewer/reference_view.py) for the view on the
+        screen, or None when there are none for it (not asked for, or not ready)."""
+        return self._figures if self._reference_version == self._version else None
+
+    def title(self) -> str:
+        recent = self.stats.frame_ms[-30:]
+        timing = ""
+        if recent:
+            ms = statistics.median(recent)
+            timing = f" | {1000.0 / ms if ms > 0 else 0:.0f} fps, {ms:.1f} ms/frame"
+        latency = self.presenter.latency_ms
+        latency_text = "" if latency is None else f", latency {latency:.1f} ms"
+        return (f"renderer view: {self.authored.name}{timing} | {self.presenter.name} buffering"
+                f"{latency_text} | v-sync {'on' if self.state.vsync else 'off'} | H for help")
+
+    # -- screenshots -------------------------------------------------------------------------
+    def window_image(self) -> np.ndarray:
+        """What the back buffer holds now, (H, W, 3) uint8, row 0 at the top."""
+        width, height = self.window.framebuffer_size
+        data = self.ctx.screen.read(viewport=(0, 0, width, height), components=3, alignment=1)
+        return np.frombuffer(data, np.uint8).reshape(height, width, 3)[::-1].copy()
+
+    def save_screenshot(self, path: Path | None = None) -> Path:
+        if path is None:
+            path = self.screenshot_path
+        if path is None:
+            while True:
+                self._screenshots += 1
+                path = Path(f"view-{self.authored.name}-{self._screenshots:03d}.png")
+                if not path.exists():
+                    break
+        write_png(path, self.window_image())
+        self.say(f"screenshot: {path}")
+        return path
+
+    # -- loops -------------------------------------------------------------------------------
+    def run(self, frames: int | None = None, orbit: float = 0.0,
+            screenshot: Path | None = None) -> FrameStats:
+        """Frames until Esc or the window is closed, or `frames` of them (scripted); then
+        the screenshot, if asked, of what the window shows after the last frame. In the
+        scripted mode a wanted reference view is waited for before the last frame."""
+        count = 0
+        while not (self.state.quit or self.window.should_close):
+            if frames is not None and count >= frames:
+                break
+            last = frames is not None and count == frames - 1
+            if orbit:
+                self.orbit.orbit(orbit, 0.0)
+                self.state.camera_changed = True
+            if last and self.state.reference != "off":
+                self._follow_changes()        # the last frame's view, orbit step included
+                self._follow_reference(wait=True)
+                self._last_swap = None        # the wait is not a frame time
+            self.frame()
+            if last and screenshot is not None:
+                # The image just swapped in is the front buffer now; draw it again (the
+                # same frame, no orbit step) to read it from the back buffer.
+                self._compose(self.presenter.shown)
+                write_png(screenshot, self.window_image())
+            count += 1
+        self.stats.latency_ms = self.presenter.latency_ms
+        return self.stats
+
+    def close(self) -> None:
+        for name in ("background", "_reference_image", "_difference_image", "_overlay",
+                     "presenter", "gpu"):
+            item = getattr(self, name, None)
+            if item is not None:
+                (item.close if hasattr(item, "close") else item.release)()
+        if getattr(self, "window", None) is not None:
+            self.window.close()
+
+    def __enter__(self) -> "Viewer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()

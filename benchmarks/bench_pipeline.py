@@ -15,10 +15,11 @@ import time
 import numpy as np
 
 import reference
-from renderer.core import transforms
 from renderer.core.builtin import builtin_scenes
 from renderer.gpu.context import activate, make_context
-from renderer.gpu.pipeline import GpuRenderer, make_float_depth, uniform_values
+from renderer.gpu import GpuRenderer
+from renderer.gpu.pipeline import make_float_depth
+from renderer.gpu.uniforms import uniform_values
 from renderer.core.primitives import icosphere
 from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject
 from renderer.core.scene_file import load_scene

@@ -44,7 +44,7 @@ void main() {
         N = -N;                      // the back face is seen: light its side
     }
 #endif
-    vec3 color = shade(v_world_position, N);
+    vec3 color = lighting(v_world_position, N);
 #elif defined(SHADING_FLAT)
 #ifdef TWO_SIDED
     vec3 color = BACK_FACE_LIT ? f_color_back : f_color_front;

@@ -24,9 +24,9 @@ void main() {
     vec3 p2 = v_world_position[2];
     vec3 face_normal = normalize_or_zero(cross(p1 - p0, p2 - p0));
     vec3 face_centroid = (p0 + p1 + p2) / 3.0;
-    vec3 front_color = shade(face_centroid, face_normal);
+    vec3 front_color = lighting(face_centroid, face_normal);
 #ifdef TWO_SIDED
-    vec3 back_color = shade(face_centroid, -face_normal);
+    vec3 back_color = lighting(face_centroid, -face_normal);
 #endif
     for (int i = 0; i < 3; ++i) {
         gl_Position = gl_in[i].gl_Position;

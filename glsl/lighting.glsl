@@ -53,7 +53,7 @@ vec3 normalize_or_zero(vec3 v) {
 
 #ifdef SPECULAR
 // spec = max(R.V, 0)^n where N.L > 0 and R.V > 0, else 0: pow never sees a base <= 0.
-float specular_factor(float n_dot_l, float r_dot_v, float n) {
+float specular_term(float n_dot_l, float r_dot_v, float n) {
     if (n_dot_l > 0.0 && r_dot_v > 0.0) {
         return pow(r_dot_v, n);
     }
@@ -63,18 +63,18 @@ float specular_factor(float n_dot_l, float r_dot_v, float n) {
 
 // One light's diffuse and specular terms: att I_l k_d max(N.L, 0) + att I_l k_s spec.
 // N, L, V are unit vectors (V is unused without SPECULAR); att_intensity is att * I_l.
-vec3 light_terms(vec3 N, vec3 L, vec3 V, vec3 att_intensity) {
+vec3 light_contribution(vec3 N, vec3 L, vec3 V, vec3 att_intensity) {
     float n_dot_l = dot(N, L);
     vec3 I = att_intensity * u_kd * max(n_dot_l, 0.0);
 #ifdef SPECULAR
     vec3 R = 2.0 * n_dot_l * N - L;                  // perfect reflection of L about N
-    I += att_intensity * u_ks * specular_factor(n_dot_l, dot(R, V), u_n);
+    I += att_intensity * u_ks * specular_term(n_dot_l, dot(R, V), u_n);
 #endif
     return I;
 }
 
 // The colour I at world point P with unit normal N (already flipped for a two-sided back face).
-vec3 shade(vec3 P, vec3 N) {
+vec3 lighting(vec3 P, vec3 N) {
 #ifdef SPECULAR
     vec3 V = normalize_or_zero(u_eye - P);
 #else
@@ -84,7 +84,7 @@ vec3 shade(vec3 P, vec3 N) {
 #if NUM_DIRECTIONAL_LIGHTS > 0
     for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
         vec3 L = normalize(-u_directional_direction[i]);
-        I += light_terms(N, L, V, u_directional_intensity[i]);       // att = 1
+        I += light_contribution(N, L, V, u_directional_intensity[i]);       // att = 1
     }
 #endif
 #if NUM_POINT_LIGHTS > 0
@@ -94,7 +94,7 @@ vec3 shade(vec3 P, vec3 N) {
         vec3 L = d > 0.0 ? to_light / d : N;         // a light on the surface: fully incident
         vec3 c_l_q = u_point_attenuation[i];
         float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
-        I += light_terms(N, L, V, att * u_point_intensity[i]);
+        I += light_contribution(N, L, V, att * u_point_intensity[i]);
     }
 #endif
     return I;

@@ -1,7 +1,7 @@
 // Twin: reference/vertex.py
 #version 330 core
 // Vertex processing: object space to world space (M) and on to clip space (P V), normals by
-// the normal matrix (inverse-transpose of M's linear part), renormalised.
+// the normal matrix (the cofactor matrix of M's linear part, renderer/core/transforms.py), renormalised.
 // SHADING_FLAT:    hands the world position on to geometry.glsl, which lights the face.
 // SHADING_GOURAUD: lights the vertex here (front colour; back colour too if TWO_SIDED).
 // SHADING_PHONG:   hands world position and normal on to fragment.glsl.
@@ -9,7 +9,7 @@
 #include "lighting.glsl"
 
 uniform mat4 u_model;                // M_world
-uniform mat3 u_normal_matrix;        // (M_world[:3, :3])^-T
+uniform mat3 u_normal_matrix;        // sign(det A) cof(A), A = M_world[:3, :3], scaled
 uniform mat4 u_view;                 // V
 uniform mat4 u_projection;           // P
 
@@ -38,9 +38,9 @@ void main() {
 #else
     vec3 world_normal = normalize_or_zero(u_normal_matrix * in_normal);
 #if defined(SHADING_GOURAUD)
-    v_color_front = shade(world_position.xyz, world_normal);
+    v_color_front = lighting(world_position.xyz, world_normal);
 #ifdef TWO_SIDED
-    v_color_back = shade(world_position.xyz, -world_normal);
+    v_color_back = lighting(world_position.xyz, -world_normal);
 #endif
 #else
     v_world_position = world_position.xyz;

@@ -28,12 +28,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
-# The six planes as (axis, sign, w_factor): inside when w_factor * w + sign * coordinate[axis]
-# >= 0, that is -w <= x, x <= w, -w <= y, y <= w, -w <= z (near), z <= w (far).
-CLIP_PLANES = ((0, 1.0, 1.0), (0, -1.0, 1.0), (1, 1.0, 1.0), (1, -1.0, 1.0),
-               (2, 1.0, 1.0), (2, -1.0, 1.0))
-# Reversed-Z (glClipControl ZERO_TO_ONE): the depth planes are 0 <= z (far) and z <= w (near).
-CLIP_PLANES_REVERSED_Z = CLIP_PLANES[:4] + ((2, 1.0, 0.0), (2, -1.0, 1.0))
+from renderer.core.gl_rules import STANDARD_DEPTH, DepthMapping, depth_mapping
+
+
+
+def clip_planes(mapping: DepthMapping) -> tuple:
+    """The six planes as (axis, sign, w_factor): inside when w_factor * w + sign *
+    coordinate[axis] >= 0, that is -w <= x, x <= w, -w <= y, y <= w, then the depth range of
+    the mapping (core/gl_rules.py): -w <= z (near) or, reversed-Z, 0 <= z (far), and z <= w."""
+    return ((0, 1.0, 1.0), (0, -1.0, 1.0), (1, 1.0, 1.0), (1, -1.0, 1.0),
+            (2, 1.0, mapping.clip_z_min_w), (2, -1.0, 1.0))
+
+
+CLIP_PLANES = clip_planes(STANDARD_DEPTH)
 
 # A triangle clipped by six planes gains at most one vertex per plane.
 MAX_POLYGON_VERTICES = 3 + len(CLIP_PLANES)
@@ -135,7 +142,7 @@ def clip_triangles(gl_Position: np.ndarray, reversed_z: bool = False) -> Clipped
     gl_Position = np.asarray(gl_Position)
     dtype = gl_Position.dtype
     T = len(gl_Position)
-    planes = CLIP_PLANES_REVERSED_Z if reversed_z else CLIP_PLANES
+    planes = clip_planes(depth_mapping(reversed_z))
     identity = np.broadcast_to(np.eye(3, dtype=dtype), (T, 3, 3))
     trivially_inside, trivially_outside = classify_triangles(gl_Position, planes)
     needs_clipping = ~trivially_inside & ~trivially_outside

@@ -1,9 +1,10 @@
 """# Twin: fixed-function GL (OpenGL 4.5 core spec §17.3.6 Depth Buffer Test, GL_LESS)
 
-A depth buffer that keeps, per pixel, the fragment GL would keep: the depth test is GL_LESS
-on window depth z_w against a buffer cleared to 1.0 (reversed-Z: GL_GREATER against a buffer
-cleared to 0.0, run as GL_LESS on the key -z_w, see `depth_key`); fragments are tested in
-draw order, so among exact ties the fragment drawn first stays. Batches of fragments are
+A depth buffer that keeps, per pixel, the fragment GL would keep: the depth test and the
+clear value are the depth mapping's (renderer/core/gl_rules.py): GL_LESS on window depth z_w
+against a buffer cleared to 1.0, or under reversed-Z GL_GREATER against a buffer cleared to
+0.0, run here as GL_LESS on the mapping's key -z_w (`DepthMapping.depth_key`); fragments
+are tested in draw order, so among exact ties the fragment drawn first stays. Batches of fragments are
 resolved with a sort (pixel, z_w, draw order) instead of a loop: within a batch the first
 fragment per pixel is the one that would survive sequential testing, and it then faces the
 stored one with the same rule. Draw order is an explicit key, so batches may even arrive out of order.
@@ -19,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
-DEPTH_CLEAR_VALUE = 1.0
-DEPTH_CLEAR_VALUE_REVERSED_Z = 0.0
+from renderer.core.gl_rules import depth_mapping
+
 NOTHING_DRAWN = -1
 # Window depths closer than this may be ordered either way by GL. Its float32 vertex and
 # interpolation arithmetic is exact to a few units in the last place of z_w, and a float32
@@ -29,22 +30,6 @@ NOTHING_DRAWN = -1
 # Under reversed-Z, z_w is small far away and float32 keeps its relative precision there, so
 # the tolerance is relative: 4 units in the last place of the winner's z_w.
 DEPTH_TIE_TOLERANCE = 4 * 2.0 ** -23
-
-
-def depth_key(z_w: np.ndarray, reversed_z: bool) -> np.ndarray:
-    """What the buffer compares: z_w for GL_LESS; -z_w for reversed-Z's GL_GREATER, so that
-    GL_GREATER on z_w is GL_LESS on the key and every rule below holds for both."""
-    return -z_w if reversed_z else z_w
-
-
-def depth_less(z_fragment: np.ndarray, z_stored: np.ndarray) -> np.ndarray:
-    """GL_LESS: the fragment passes when strictly nearer than what is stored."""
-    return z_fragment < z_stored
-
-
-def drawn_earlier(order_fragment: np.ndarray, order_stored: np.ndarray) -> np.ndarray:
-    """On an exact depth tie the earlier draw wins (the later one fails GL_LESS)."""
-    return (order_stored != NOTHING_DRAWN) & (order_fragment < order_stored)
 
 
 _LAST = np.iinfo(np.int64).max       # the order of a missing candidate: it sorts after all
@@ -81,8 +66,8 @@ class DepthBuffer:
     def __init__(self, width: int, height: int, dtype=np.float64, reversed_z: bool = False):
         self.width, self.height = width, height
         self.reversed_z = reversed_z
-        clear = DEPTH_CLEAR_VALUE_REVERSED_Z if reversed_z else DEPTH_CLEAR_VALUE
-        self.z = np.full(width * height, depth_key(clear, reversed_z), dtype=dtype)
+        self.mapping = depth_mapping(reversed_z)
+        self.z = np.full(width * height, self.mapping.depth_key(self.mapping.clear_depth), dtype=dtype)
         self.order = np.full(width * height, NOTHING_DRAWN, dtype=np.int64)
         self.payload: dict[str, np.ndarray] = {}
         self.z_second = np.full(width * height, np.inf, dtype=dtype)
@@ -94,7 +79,7 @@ class DepthBuffer:
         """Depth-test one batch of fragments and write the survivors (and the runners-up)."""
         if len(pixel) == 0:
             return
-        z_w = depth_key(z_w, self.reversed_z)
+        z_w = self.mapping.depth_key(z_w)
         first, second = nearest_two_per_pixel(pixel, z_w, order)
         target = pixel[first]
         has_second = second >= 0

@@ -7,7 +7,7 @@ world space, vectorised over any number of surface points:
 
 Inputs:  P (..., 3) surface points and N (..., 3) unit normals in world space, E (3,) the
          eye, a `renderer.core.scene.Material` and the scene's lights packed as `Lights`
-         (the NumPy twin of the GLSL light uniforms). Everything in one float dtype.
+         (the GLSL light uniforms, from renderer/core/uniforms.py). Everything in one float dtype.
 Output:  I (..., 3) linear RGB in that dtype, unclamped.
 
 The sides rule (one-sided / two-sided) is not applied here: callers pass the normal that
@@ -20,10 +20,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.core.uniforms import light_uniforms, material_uniforms
+
 
 @dataclass
 class Lights:
-    """The scene's lights as uniform arrays, named as the GLSL uniforms would be.
+    """The scene's lights as uniform arrays, named as the GLSL uniforms are, in the pipeline's
+    dtype: the layout of renderer/core/uniforms.py (LIGHT_UNIFORMS), which the GPU path
+    uploads too.
 
     u_ambient (3,); directional: u_directional_direction (Ld, 3) (the way the light
     travels) and u_directional_intensity (Ld, 3); point: u_point_position (Lp, 3),
@@ -40,22 +44,13 @@ class Lights:
     def from_scene(cls, scene, dtype=np.float64, origin=(0.0, 0.0, 0.0)) -> "Lights":
         """Point-light positions relative to `origin` (the frame's camera-relative origin),
         subtracted in float64 before the cast to `dtype`."""
-        def rows(values, minus=(0.0, 0.0, 0.0)) -> np.ndarray:
-            return (np.asarray(values, dtype=np.float64).reshape(-1, 3) - minus).astype(dtype)
-
-        return cls(
-            u_ambient=np.asarray(scene.ambient, dtype=dtype),
-            u_directional_direction=rows([d.direction for d in scene.directional_lights]),
-            u_directional_intensity=rows([d.intensity for d in scene.directional_lights]),
-            u_point_position=rows([p.position for p in scene.point_lights], origin),
-            u_point_intensity=rows([p.intensity for p in scene.point_lights]),
-            u_point_attenuation=rows([p.attenuation for p in scene.point_lights]),
-        )
+        return cls(**{name: value.astype(dtype) for name, value in light_uniforms(scene, origin).items()})
 
 
 @dataclass
 class MaterialUniforms:
-    """A material's coefficients as arrays of the pipeline's dtype: k_a, k_d, k_s (3,), n."""
+    """A material's coefficients as arrays of the pipeline's dtype: k_a, k_d, k_s (3,), n
+    (renderer/core/uniforms.py, MATERIAL_UNIFORMS)."""
     u_ka: np.ndarray
     u_kd: np.ndarray
     u_ks: np.ndarray
@@ -64,9 +59,8 @@ class MaterialUniforms:
 
     @classmethod
     def from_material(cls, material, dtype=np.float64) -> "MaterialUniforms":
-        return cls(np.asarray(material.ka, dtype=dtype), np.asarray(material.kd, dtype=dtype),
-                   np.asarray(material.ks, dtype=dtype), np.asarray(material.n, dtype=dtype),
-                   material.has_specular)
+        return cls(**{name: value.astype(dtype) for name, value in material_uniforms(material).items()},
+                   specular=material.has_specular)
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:

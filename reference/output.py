@@ -1,7 +1,7 @@
 """# Twin: fixed-function GL (OpenGL 4.5 core spec §2.3.5.1 conversion of floating-point to normalized fixed-point; §18.2 ReadPixels)
 
-The framebuffer as the caller sees it: colour clamped and converted to unorm8 as GL does,
-u = floor(clamp(c, 0, 1) * 255 + 0.5); the background is the scene's background colour with
+The framebuffer as the caller sees it: colour clamped and converted to unorm8 as GL does
+(renderer/core/gl_rules.py, to_unorm8); the background is the scene's background colour with
 alpha 0; rows flipped once so that row 0 is the top (GL's row 0 is the bottom).
 
 Inputs:  color (H*W, 4) linear colour of the surviving fragment per pixel (GL row order,
@@ -15,11 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from renderer.core.frame import Frame
-
-
-def to_unorm8(c: np.ndarray) -> np.ndarray:
-    """GL's float -> unorm8: floor(clamp(c, 0, 1) * 255 + 0.5)."""
-    return np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+from renderer.core.gl_rules import to_unorm8
 
 
 def flip_rows(image: np.ndarray) -> np.ndarray:

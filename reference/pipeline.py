@@ -25,9 +25,10 @@ from reference.fragment import ObjectVaryings, shade_fragments
 from reference.geometry import shade_triangles
 from reference.lighting import Lights
 from reference.output import compose_frame
-from reference.rasterizer import SUBPIXEL_BITS, is_drawn, rasterize, setup_triangles
+from reference.rasterizer import is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
+from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.core.visibility import visible_objects
 
 

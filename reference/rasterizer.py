@@ -40,7 +40,9 @@ from typing import Iterator
 
 import numpy as np
 
-SUBPIXEL_BITS = 8                  # GL_SUBPIXEL_BITS on llvmpipe (FIXED_ORDER in lp_rast.h)
+from renderer.core.gl_rules import (SUBPIXEL_BITS, depth_mapping, is_inside_edge, is_left_or_bottom_edge,
+                                    pixel_centre, snap_to_subpixel_grid)
+
 MAX_CANDIDATES_PER_BATCH = 1 << 19  # (triangle, pixel) pairs tested at once
 
 
@@ -85,29 +87,19 @@ class Fragments:
         return len(self.x)
 
 
-# --- the rules, one small helper each ---------------------------------------------------
+# --- the rules, one small helper each (the fill rule and snapping: renderer/core/gl_rules.py) --
 
 def viewport_transform(gl_Position: np.ndarray, width: int, height: int,
                        reversed_z: bool = False):
-    """Perspective divide and GL's viewport transform. Returns (x_w, y_w, z_w, 1 / w_clip).
-    Reversed-Z (clip control ZERO_TO_ONE) takes z_w = z_ndc, keeping its float precision."""
+    """Perspective divide and GL's viewport transform. Returns (x_w, y_w, z_w, 1 / w_clip);
+    z_w by the depth mapping (core/gl_rules.py; reversed-Z takes z_w = z_ndc, keeping its
+    float precision)."""
     inv_w = 1.0 / gl_Position[..., 3]
     x_ndc, y_ndc, z_ndc = (gl_Position[..., i] * inv_w for i in range(3))
     x_w = (x_ndc + 1.0) * (width / 2.0)
     y_w = (y_ndc + 1.0) * (height / 2.0)
-    z_w = z_ndc if reversed_z else (z_ndc + 1.0) / 2.0
+    z_w = depth_mapping(reversed_z).window_depth(z_ndc)
     return x_w, y_w, z_w, inv_w
-
-
-def snap_to_subpixel_grid(coordinate: np.ndarray, subpixel_bits: int) -> np.ndarray:
-    """Window coordinate -> int64 fixed point with `subpixel_bits` fraction bits, rounded to
-    nearest with ties to even (llvmpipe's subpixel_snap: lrint of x * 2^bits)."""
-    return np.rint(coordinate * float(1 << subpixel_bits)).astype(np.int64)
-
-
-def pixel_centre(index: np.ndarray, subpixel_bits: int) -> np.ndarray:
-    """Fixed-point coordinate of the centre of pixel column/row `index`: index + 1/2."""
-    return (index << subpixel_bits) + (1 << (subpixel_bits - 1))
 
 
 def edge_function(xa, ya, xb, yb, px, py):
@@ -135,19 +127,6 @@ def is_drawn(area2: np.ndarray, cull: str) -> np.ndarray:
         return area2 != 0
     raise ValueError(f"unknown cull mode {cull!r}")
 
-
-def is_left_or_bottom_edge(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
-    """For an edge (dx, dy) of a counter-clockwise triangle (interior on its left):
-    a left edge runs downwards (dy < 0); a bottom edge is horizontal running right."""
-    return (dy < 0) | ((dy == 0) & (dx > 0))
-
-
-def is_inside_edge(edge_value: np.ndarray, inclusive: np.ndarray) -> np.ndarray:
-    """The fill rule: a centre on the edge (value 0) counts only for inclusive edges."""
-    return np.where(inclusive, edge_value >= 0, edge_value > 0)
-
-
-# --- setup ----------------------------------------------------------------------------
 
 def setup_triangles(gl_Position: np.ndarray, width: int, height: int,
                     subpixel_bits: int = SUBPIXEL_BITS, reversed_z: bool = False) -> WindowTriangles:

@@ -235,7 +235,8 @@ def cmd_shaders(args) -> int:
 
 def cmd_report(args) -> int:
     from renderer.core.builtin import builtin_scenes
-    from renderer.study.report import QUICK_SCENES, run_report
+    from renderer.study.report import run_report
+    from renderer.study.report_settings import QUICK_SCENES
     names = args.scenes or (list(QUICK_SCENES) if args.quick else list(builtin_scenes()))
     scenes = [_load(name) for name in names]
     result = run_report(scenes, args.out, quick=args.quick, size=args.size, cache_dir=args.cache,

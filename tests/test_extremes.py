@@ -20,8 +20,10 @@ from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_
 from renderer.core import transforms as tf
 from renderer.checks.compare import compare_frames, depth_tie_pixels
 from renderer.gpu.context import activate, gl_function
-from renderer.study.extremes import STABILITY, extreme_scenes, is_finite_frame, passes
-from renderer.gpu.pipeline import GL_NEGATIVE_ONE_TO_ONE, GpuRenderer
+from renderer.checks.tolerance import PIPELINE_TOLERANCE
+from renderer.study.extremes import STABILITY, extreme_scenes, is_finite_frame
+from renderer.core.gl_rules import GL_NEGATIVE_ONE_TO_ONE
+from renderer.gpu import GpuRenderer
 from renderer.core.primitives import plane
 from renderer.core.scene import Camera, Material, PointLight, Scene, SceneObject, Transform
 from renderer.core.scene_file import load_scene
@@ -178,7 +180,7 @@ def test_look_at_is_unchanged_away_from_the_fallback():
 
 # -- lighting -----------------------------------------------------------------------------------
 
-def test_specular_factor_for_exponents_0_1_and_10000():
+def test_specular_term_for_exponents_0_1_and_10000():
     n_dot_l = np.array([[1.0], [1.0], [1.0], [1.0], [0.0], [1.0]])
     r_dot_v = np.array([[0.5], [1.0], [1e-30], [0.0], [0.7], [-0.2]])
     expected = {0.0: [1, 1, 1, 0, 0, 0], 1.0: [0.5, 1, 1e-30, 0, 0, 0],
@@ -227,16 +229,18 @@ def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, g
     assert is_finite_frame(frame) and is_finite_frame(expected)
     figures = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
                              reference_tie=expected.rgba8_tie).as_dict()
-    assert passes(figures), figures          # the pipeline tolerance (renderer/study/extremes.py)
+    assert PIPELINE_TOLERANCE.passes(figures), PIPELINE_TOLERANCE.failures(figures)
     assert (frame.rgba8[..., 3] == 255).mean() > 0.005        # something was drawn
 
 
-def test_the_pass_rule_is_the_pipeline_tolerance():
+def test_the_pipeline_tolerance_at_its_limits():
     exact = {"mismatched_pixels": 0, "raw_mismatched_fraction": 0.001, "depth_max_rel": 1e-3}
-    assert passes(exact)
+    assert PIPELINE_TOLERANCE.passes(exact)
     for key, over in (("mismatched_pixels", 1), ("raw_mismatched_fraction", 0.0011),
-                      ("depth_max_rel", 1.1e-3)):
-        assert not passes(exact | {key: over})
+                      ("depth_max_rel", 1.1e-3), ("depth_max_rel", float("nan"))):
+        assert not PIPELINE_TOLERANCE.passes(exact | {key: over})
+        assert len(PIPELINE_TOLERANCE.failures(exact | {key: over})) == 1
+    assert PIPELINE_TOLERANCE.passes(exact | {"depth_max_rel": None})     # no depth compared
 
 
 def test_is_finite_frame_sees_nan_and_inf():

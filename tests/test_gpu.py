@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.gpu import GpuRenderer
 from renderer.core.primitives import icosphere, plane
 from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
@@ -217,7 +218,7 @@ def test_gl_info_and_subpixel_bits(egl):
         info = gpu.gl_info
         assert info["context"] == "egl" and "llvmpipe" in info["GL_RENDERER"]
         assert info["GL_VERSION"] and info["depth_format"] == "DEPTH_COMPONENT32F"
-        assert gpu.subpixel_bits == 8
+        assert gpu.subpixel_bits == SUBPIXEL_BITS == 8        # the rule both pipelines read
 
 
 def test_release_is_idempotent_and_final(egl):

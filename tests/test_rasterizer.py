@@ -19,13 +19,14 @@ import numpy as np
 import pytest
 
 from reference.rasterizer import is_drawn, rasterize, setup_triangles
+from renderer.core.gl_rules import SUBPIXEL_BITS
 
 GLSL = Path(__file__).parent / "glsl"
 
 
 # --- the reference side ---------------------------------------------------------------
 
-def reference_coverage(triangles, width: int, height: int, subpixel_bits: int = 8):
+def reference_coverage(triangles, width: int, height: int, subpixel_bits: int = SUBPIXEL_BITS):
     """Per-pixel cover count and facing (GL rows, bottom first) of triangles given in
     window coordinates (T, 3, 2)."""
     xy = np.asarray(triangles, dtype=np.float64).reshape(-1, 3, 2)

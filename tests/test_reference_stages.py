@@ -17,7 +17,7 @@ from reference import render
 from reference.clipping import clip_triangles
 from reference.depth_buffer import DEPTH_TIE_TOLERANCE, DepthBuffer
 from reference.fragment import interpolate
-from reference.output import to_unorm8
+from renderer.core.gl_rules import to_unorm8
 from reference.rasterizer import is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
 from renderer.core import primitives

@@ -12,7 +12,8 @@ import pytest
 
 from renderer.core.builtin import builtin_scenes
 from renderer.study.ground_truth import ground_truth
-from renderer.study.report import CSV_COLUMNS, QUICK, metrics, settings
+from renderer.study.report import QUICK, metrics, settings
+from renderer.study.report_settings import CSV_COLUMNS
 from renderer.study.report_output import convergence_slopes, pareto_front
 from renderer.core.scene_file import load_scene
 

@@ -103,7 +103,7 @@ def test_real_sources_expand_the_lighting_include():
     sources = program_sources(variant)
     assert set(sources) == {"vertex_shader", "fragment_shader"}    # no geometry stage
     fragment = sources["fragment_shader"].text
-    assert "vec3 shade(vec3 P, vec3 N)" in fragment and "#include" not in fragment
+    assert "vec3 lighting(vec3 P, vec3 N)" in fragment and "#include" not in fragment
     assert "#define NUM_DIRECTIONAL_LIGHTS 2" in fragment and "#define TWO_SIDED" in fragment
 
 

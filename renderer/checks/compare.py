@@ -14,8 +14,11 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-DEFAULT_THRESHOLD = 2          # of 255, per channel
-DEFAULT_DEVIATION = 1          # pixels
+from renderer.checks.tolerance import PIPELINE_TOLERANCE
+
+# The defaults of every function here: the pipeline tolerance's (renderer/checks/tolerance.py).
+DEFAULT_THRESHOLD = PIPELINE_TOLERANCE.threshold          # of 255, per channel
+DEFAULT_DEVIATION = PIPELINE_TOLERANCE.deviation          # pixels
 
 
 def _offsets(deviation: int):

@@ -11,6 +11,8 @@ import math
 
 import numpy as np
 
+from renderer.core import gl_rules
+
 
 def identity() -> np.ndarray:
     return np.eye(4)
@@ -136,22 +138,19 @@ def look_at(eye, look, up) -> np.ndarray:
 
 
 def depth_row(near: float, far: float, *, perspective: bool, reversed_z: bool) -> np.ndarray:
-    """Row 2 of a projection matrix (z_clip from the eye-space point), with its depth mapping.
-
-    Standard (GL's): z_ndc = -1 at the near plane and +1 at the far plane, for the default
-    clip control (-w <= z <= w, z_w = (z_ndc + 1) / 2). Reversed-Z: z_ndc = 1 at near and
-    0 at far, for glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE) (0 <= z <= w, z_w = z_ndc):
-    a float32 depth buffer then keeps about 1e-7 relative precision at every distance.
-    With perspective, w_clip = -z_eye; with a parallel projection, w_clip = 1.
+    """Row 2 of a projection matrix (z_clip from the eye-space point): the near plane to
+    z_ndc = a_n and the far plane to a_f, the depth mapping's (core/gl_rules.py: -1 and 1 for
+    GL's default, 1 and 0 for reversed-Z, where a float32 depth buffer keeps about 1e-7
+    relative precision at every distance). With perspective, w_clip = -z_eye and
+    z_ndc = -A - B / z_eye; with a parallel projection, w_clip = 1 and z_ndc = A z_eye + B.
+    Solving for z_eye = -near and -far gives (A, B) below.
     """
+    mapping = gl_rules.depth_mapping(reversed_z)
     n, f = float(near), float(far)
+    a_n, a_f = mapping.ndc_near, mapping.ndc_far
     if perspective:
-        if reversed_z:                    # z_ndc = -(n z_eye + n f) / ((f - n) z_eye)
-            return np.array([0.0, 0.0, n / (f - n), f * n / (f - n)])
-        return np.array([0.0, 0.0, (f + n) / (n - f), 2 * f * n / (n - f)])
-    if reversed_z:
-        return np.array([0.0, 0.0, 1.0 / (f - n), f / (f - n)])
-    return np.array([0.0, 0.0, -2 / (f - n), -(f + n) / (f - n)])
+        return np.array([0.0, 0.0, (a_n * n - a_f * f) / (f - n), (a_n - a_f) * n * f / (f - n)])
+    return np.array([0.0, 0.0, (a_n - a_f) / (f - n), (a_n * f - a_f * n) / (f - n)])
 
 
 def perspective(fov_y: float, aspect: float, near: float, far: float,

@@ -27,8 +27,9 @@ only where k_s > 0, back-face code only when two-sided), and an object wholly ou
 view volume is left out of the plan (renderer/core/visibility.py). `specialise=False` draws with
 the all-features build instead, for benchmarks/bench_specialisation.py; the images are the same.
 
-A camera with `reversed_z` draws with glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE), depth
-cleared to 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
+The depth mapping (clip control, clear value, compare function) is the camera's, from
+renderer/core/gl_rules.py: reversed-Z draws with glClipControl ZERO_TO_ONE, depth cleared to
+0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
 frame puts GL's default back, so renderers sharing a context never see each other's.
 
 Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the
@@ -43,7 +44,6 @@ Conventions (matrices, window, depth, colour, lighting): docs/conventions.md.
 from __future__ import annotations
 
 import ctypes
-import struct
 import time
 from dataclasses import dataclass
 
@@ -53,15 +53,14 @@ import numpy as np
 from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
 from renderer.errors import ContextError
 from renderer.core.frame import Frame
-from renderer.core.scene import FrameMatrices, Mesh, ObjectMatrices, Scene, SceneObject
+from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping
+from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.core.transforms import jitter, to_glsl
+from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
 from renderer.core.visibility import visible_objects
 
 GL_DITHER = 0x0BD0
-GL_LOWER_LEFT = 0x8CA1                   # glClipControl origin (GL's default)
-GL_NEGATIVE_ONE_TO_ONE = 0x935E          # glClipControl depth: GL's default, -w <= z <= w
-GL_ZERO_TO_ONE = 0x935F                  # reversed-Z: 0 <= z <= w and z_w = z_ndc
 GL_RENDERBUFFER = 0x8D41
 GL_RENDERBUFFER_INTERNAL_FORMAT = 0x8D44
 GL_DEPTH_COMPONENT24 = 0x81A6
@@ -73,76 +72,6 @@ DEPTH_FORMAT_NAMES = {GL_DEPTH_COMPONENT24: "DEPTH_COMPONENT24",
                       GL_DEPTH_COMPONENT32F: "DEPTH_COMPONENT32F"}
 
 CULL_FLAGS = {"none": None, "back": "back", "front": "front"}   # SceneObject.cull -> GL face
-
-
-def _vec3s(values) -> bytes:
-    """Bytes of a GLSL vec3 (or vec3[]) uniform."""
-    return np.asarray(values, dtype=np.float32).tobytes()
-
-
-def _float(value: float) -> bytes:
-    return struct.pack("f", value)
-
-
-def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
-                         light_slots: int | None = None) -> dict[str, bytes]:
-    """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
-    A light array is absent when the scene has no light of that kind (nor does the shader).
-    Positions (eye, point lights) are camera-relative, as the model matrices are.
-    `light_slots` is for the all-features build: arrays of that size (the slots past the
-    scene's lights are zeros, never read) and the counts as uniforms."""
-    directional, point = scene.directional_lights, scene.point_lights
-    values = {
-        "u_view": to_glsl(matrices.view),
-        "u_projection": to_glsl(matrices.projection),
-        "u_eye": _vec3s(matrices.relative(scene.camera.eye)),
-        "u_ambient": _vec3s(scene.ambient),
-    }
-    if light_slots is not None:
-        if max(len(directional), len(point)) > light_slots:
-            raise ValueError(f"the all-features build has room for {light_slots} lights of each "
-                             f"kind; the scene has {len(directional)} directional and "
-                             f"{len(point)} point lights")
-        values["u_num_directional_lights"] = struct.pack("i", len(directional))
-        values["u_num_point_lights"] = struct.pack("i", len(point))
-    slots = {"directional": light_slots or len(directional), "point": light_slots or len(point)}
-
-    def array(kind: str, values_per_light) -> bytes:
-        rows = np.zeros((slots[kind], 3), dtype=np.float32)
-        if values_per_light:
-            rows[:len(values_per_light)] = values_per_light
-        return rows.tobytes()
-
-    if slots["directional"]:
-        values["u_directional_direction"] = array("directional", [l.direction for l in directional])
-        values["u_directional_intensity"] = array("directional", [l.intensity for l in directional])
-    if slots["point"]:
-        values["u_point_position"] = array("point", [matrices.relative(l.position) for l in point])
-        values["u_point_intensity"] = array("point", [l.intensity for l in point])
-        values["u_point_attenuation"] = array("point", [l.attenuation for l in point])
-    return values
-
-
-def object_uniform_values(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, bytes]:
-    """One object's uniforms: its model and normal matrices and its material (u_two_sided
-    is read only by the all-features build)."""
-    material = obj.material
-    return {
-        "u_model": to_glsl(matrices.model),
-        "u_normal_matrix": to_glsl(matrices.normal),
-        "u_ka": _vec3s(material.ka),
-        "u_kd": _vec3s(material.kd),
-        "u_ks": _vec3s(material.ks),
-        "u_n": _float(material.n),
-        "u_two_sided": struct.pack("i", int(bool(material.two_sided))),
-    }
-
-
-def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
-                   index: int) -> dict[str, bytes]:
-    """Every uniform (name -> bytes) for drawing `obj`, object number `index` of `scene`.
-    A program may lack some (the compiler drops unused ones): skip names it does not have."""
-    return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])
 
 
 def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int,
@@ -453,13 +382,13 @@ class GpuRenderer:
         target = self._multisample_framebuffer(samples) if samples > 1 else fbo
         target.use()
         red, green, blue = self.scene.background
-        reversed_z = self.scene.camera.reversed_z
+        mapping = depth_mapping(self.scene.camera.reversed_z)
         # The context may be shared: set the clip control for this frame either way, and
         # leave GL's default behind for whoever draws next.
-        self._clip_control(reversed_z)
+        self._clip_control(mapping)
         try:
-            target.clear(red, green, blue, 0.0, depth=0.0 if reversed_z else 1.0)
-            ctx.depth_func = ">" if reversed_z else "<"
+            target.clear(red, green, blue, 0.0, depth=mapping.clear_depth)
+            ctx.depth_func = mapping.depth_func
             ctx.front_face = "ccw"
             ctx.wireframe = self.wireframe
             for draw in plan:
@@ -473,18 +402,18 @@ class GpuRenderer:
                 ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
         finally:
             ctx.wireframe = False
-            if reversed_z:
-                self._clip_control(False)
+            if mapping is not STANDARD_DEPTH:
+                self._clip_control(STANDARD_DEPTH)
         return fbo
 
-    def _clip_control(self, reversed_z: bool) -> None:
-        """glClipControl: ZERO_TO_ONE depth for reversed-Z, GL's NEGATIVE_ONE_TO_ONE otherwise."""
+    def _clip_control(self, mapping: DepthMapping) -> None:
+        """glClipControl with the depth mapping's depth mode (core/gl_rules.py)."""
         if self._glClipControl is None:
-            if reversed_z:
+            if mapping is not STANDARD_DEPTH:
                 raise ContextError("reversed_z needs glClipControl (OpenGL 4.5 or "
                                    "ARB_clip_control), which this GL does not have")
             return
-        self._glClipControl(GL_LOWER_LEFT, GL_ZERO_TO_ONE if reversed_z else GL_NEGATIVE_ONE_TO_ONE)
+        self._glClipControl(GL_LOWER_LEFT, mapping.clip_control)
 
     def _set_sample_offset(self, linear: bool, offset: tuple) -> None:
         """Upload u_projection jittered for `offset` to the plan's programs, if they hold
@@ -526,11 +455,6 @@ class GpuRenderer:
     def subpixel_bits(self) -> int:
         """GL_SUBPIXEL_BITS: vertices snap to 1 / 2^bits of a pixel (8 on llvmpipe)."""
         return int(self.ctx.info["GL_SUBPIXEL_BITS"])
-
-    @property
-    def max_samples(self) -> int:
-        """GL_MAX_SAMPLES: the most MSAA samples per pixel this context offers (4 on llvmpipe)."""
-        return int(self.ctx.info["GL_MAX_SAMPLES"])
 
     @property
     def sample_counts(self) -> list[int]:
@@ -606,19 +530,20 @@ def _flip_into(bottom_up: np.ndarray, out: np.ndarray | None) -> np.ndarray:
 
 def _depth_conversion(projection: np.ndarray, shape: tuple[int, int], reversed_z: bool = False):
     """A function from window depth z_w (float32, any strides) to a C-contiguous array of
-    -z_eye (+inf where z_w is the cleared value: 1, or 0 with reversed-Z), for the projection
+    -z_eye (+inf where z_w is the depth buffer's clear value: 1, or 0 with reversed-Z), for the projection
     matrix P of the frame; the array is new unless a usable `out` is passed.
 
-    z_ndc = s z_w + t: (s, t) = (2, -1) for GL's default depth mapping, (1, 0) for reversed-Z
-    (glClipControl ZERO_TO_ONE). Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye,
+    z_ndc = s z_w + t, the depth mapping's inverse (core/gl_rules.py: (s, t) = (2, -1) for GL's
+    default, (1, 0) for reversed-Z). Perspective (P[3] = (0, 0, -1, 0)): z_ndc = -P22 - P23 / z_eye,
     so -z_eye = P23 / (P22 + z_ndc) = a / (z_w + b) with a = P23 / s, b = (P22 + t) / s.
     Parallel (P[3] = (0, 0, 0, 1)): z_ndc = P22 z_eye + P23, so -z_eye = (s z_w + t - P23) / -P22.
     b is split into a float32 head and tail so that z_w + b loses nothing where z_w is near -b
     (the head's sum with z_w is exact there, Sterbenz), giving float64-like accuracy in float32.
     """
     p22, p23 = float(projection[2, 2]), float(projection[2, 3])
-    s_ndc, t_ndc = (1.0, 0.0) if reversed_z else (2.0, -1.0)
-    cleared = 0.0 if reversed_z else 1.0
+    mapping = depth_mapping(reversed_z)
+    s_ndc, t_ndc = mapping.ndc_from_window
+    cleared = mapping.clear_depth
     mask = np.empty(shape, dtype=bool)                     # reused: no allocation per frame
     perspective = projection[3, 2] == -1.0 and projection[3, 3] == 0.0
     if perspective:

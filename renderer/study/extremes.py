@@ -7,7 +7,7 @@ GPU (EGL and OSMesa) and by the reference, with the figures that show it is stab
 Ground truth is the reference pipeline in float64 at the same size: the question here is
 numerical stability, not aliasing. Each case passes when no pixel is NaN or Inf anywhere
 (the linear colour, and the depth where something was drawn) and every GPU frame meets the
-pipeline tolerance against it (tests/test_gpu_vs_reference.py's rule). A scene authored with
+pipeline tolerance against it (renderer/checks/tolerance.py). A scene authored with
 reversed-Z is measured a second time with it off, to show the depth error it removes. A
 scene whose file is refused (a NaN vertex) is listed with the one-line error a user sees.
 """
@@ -24,13 +24,11 @@ import numpy as np
 import reference
 from renderer.core.builtin import assets_dir, scene_description
 from renderer.checks.compare import compare_frames, depth_tie_pixels
+from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.core.imageio import write_text
 from renderer.core.scene_file import load_scene
-
-RAW_MISMATCH_LIMIT = 0.001       # the pipeline tolerance: 0 mismatched pixels after ±1 px,
-DEPTH_REL_LIMIT = 1e-3           # at most 0.1 % off in place, depth within 1e-3 relative
 
 # What makes each case stable, keyed by the scene file's name (docs/conventions.md has the rules).
 STABILITY = {
@@ -81,13 +79,6 @@ def is_finite_frame(frame) -> bool:
                 and not np.isnan(frame.depth).any())
 
 
-def passes(comparison: dict) -> bool:
-    """The pipeline tolerance (tests/test_gpu_vs_reference.py)."""
-    return (comparison["mismatched_pixels"] == 0
-            and comparison["raw_mismatched_fraction"] <= RAW_MISMATCH_LIMIT
-            and comparison["depth_max_rel"] <= DEPTH_REL_LIMIT)
-
-
 def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
     """Figures of one scene: finiteness per backend and each GPU frame against the float64
     reference (the worst context's figures are the case's). `contexts` are the pipeline
@@ -112,7 +103,7 @@ def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
     return {"finite": finite, "tie_pixels": depth_tie_pixels(truth),
             "contexts": per_context, "worst": _worst(per_context),
             "truth": against_truth, "worst_truth": _worst(against_truth),
-            "passes": all(finite.values()) and all(passes(c) for c in per_context.values())}
+            "passes": all(finite.values()) and all(TOLERANCE.passes(c) for c in per_context.values())}
 
 
 def _worst(comparisons: dict) -> dict:
@@ -169,7 +160,8 @@ def markdown_table(cases: list[dict], size: tuple[int, int]) -> str:
              "Against truth: rmse / max_abs on the 0-255 scale against the reference image "
              "alone, ties not forgiven. Depth: largest relative error of the camera-space "
              "depth. Figures are the worst of the GPU contexts. Pass: the pipeline tolerance "
-             f"(0 mismatched, raw <= {RAW_MISMATCH_LIMIT}, depth <= {DEPTH_REL_LIMIT:g}).", "",
+             f"({TOLERANCE.max_mismatched_pixels} mismatched, raw <= {TOLERANCE.raw_mismatch_limit}, "
+             f"depth <= {TOLERANCE.depth_rel_limit:g}).", "",
              "| case | what it tests | finite (" + " / ".join(_backends(cases)) + ") | mismatched px "
              "| raw mismatch | tie px | against truth: rmse / max_abs | depth max rel | pass "
              "| what makes it stable |",

@@ -32,16 +32,15 @@ from pathlib import Path
 
 import numpy as np
 
-from reference.output import to_unorm8
 from renderer.core import sampling
+from renderer.core.gl_rules import to_unorm8
 from renderer.study.report_output import csv_text, plot_png, report_markdown
 from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
 from renderer.core.imageio import write_bytes, write_text
 from renderer.checks.perceptual import flip_error
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
-from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS,
-                                            QUICK_SCENES, QUICK_SIZE, TARGETS_RMSE)
+from renderer.study.report_settings import BASE_SAMPLES, DEFAULT_SIZE, MISMATCH_LEVELS, QUICK_SIZE
 from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
 
 @dataclass(frozen=True)

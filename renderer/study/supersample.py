@@ -19,7 +19,7 @@ from typing import Callable
 import numpy as np
 
 import reference
-from reference.rasterizer import SUBPIXEL_BITS
+from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.core.sampling import DEFAULT_SEED, jittered
 
 Pass = Callable[[tuple], np.ndarray]          # (dx, dy) -> (H, W, 3) linear colour

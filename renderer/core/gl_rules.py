@@ -1,0 +1,128 @@
+"""GL's fixed-function rules, each written once: what both pipelines read and the tests hold
+llvmpipe to (the conformance suite's rrRenderState is the model). The GPU path sets GL's state
+from these values; the NumPy reference (reference/) computes with them; nothing else writes
+them down.
+
+- the depth mapping (`DepthMapping`, one for GL's default and one for reversed-Z): the clip
+  volume's depth range, window depth from z_ndc and back, the depth buffer's clear value and
+  compare function, and the glClipControl depth mode that selects it;
+- the sub-pixel grid: vertices snap to 1 / 2^SUBPIXEL_BITS of a pixel, to nearest;
+- the fill rule: pixel centres at (i + 1/2, j + 1/2), a centre on an edge belongs to the
+  triangle only for a left or bottom edge;
+- unorm conversion: a colour channel c in the framebuffer is floor(clamp(c, 0, 1) * 255 + 0.5).
+
+Window coordinates are GL's (origin bottom-left, y up); docs/conventions.md states the rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+# --- depth ---------------------------------------------------------------------------------
+
+GL_LOWER_LEFT = 0x8CA1                   # glClipControl origin: GL's default, kept always
+GL_NEGATIVE_ONE_TO_ONE = 0x935E          # glClipControl depth mode: GL's default
+GL_ZERO_TO_ONE = 0x935F                  # glClipControl depth mode for reversed-Z
+
+
+@dataclass(frozen=True)
+class DepthMapping:
+    """How clip-space z becomes window depth z_w, and how the depth test reads z_w.
+
+    The clip volume keeps ndc_min w <= z_clip <= w; after the divide, z_w maps that range
+    [ndc_min, 1] linearly onto [0, 1] (glDepthRange's default). The projection puts the near
+    plane at z_ndc = ndc_near and the far plane at ndc_far (core/transforms.depth_row); the
+    buffer is cleared to the far plane's z_w, and a fragment passes when it is strictly
+    nearer than what is stored (GL_LESS, or GL_GREATER when near has the larger z_w).
+    """
+    name: str
+    ndc_min: float            # lower end of z_ndc: -1 (GL's default) or 0 (ZERO_TO_ONE)
+    ndc_near: float           # z_ndc of the near plane
+    ndc_far: float            # z_ndc of the far plane
+    clip_control: int         # glClipControl depth mode that gives ndc_min
+
+    def window_depth(self, z_ndc):
+        """z_w = (z_ndc - ndc_min) / (1 - ndc_min): (z_ndc + 1) / 2, or z_ndc itself."""
+        return (z_ndc - self.ndc_min) / (1.0 - self.ndc_min)
+
+    @property
+    def ndc_from_window(self) -> tuple[float, float]:
+        """(s, t) with z_ndc = s z_w + t, the inverse of window_depth: (2, -1) or (1, 0)."""
+        return 1.0 - self.ndc_min, self.ndc_min
+
+    @property
+    def clip_z_min_w(self) -> float:
+        """The lower depth clip plane keeps clip_z_min_w * w + z_clip >= 0: 1 (-w <= z) or 0
+        (0 <= z). Written 0 - ndc_min so that it is +0.0, never -0.0."""
+        return 0.0 - self.ndc_min
+
+    @property
+    def clear_depth(self) -> float:
+        """The depth buffer's clear value: the far plane's window depth (1, or 0 reversed)."""
+        return float(self.window_depth(self.ndc_far))
+
+    @property
+    def greater(self) -> bool:
+        """True when nearer means larger z_w (reversed-Z): the test is GL_GREATER."""
+        return self.ndc_near > self.ndc_far
+
+    @property
+    def depth_func(self) -> str:
+        """The compare function as moderngl spells it: "<" (GL_LESS) or ">" (GL_GREATER)."""
+        return ">" if self.greater else "<"
+
+    def depth_key(self, z_w):
+        """What a GL_LESS comparison sees: z_w, or -z_w under GL_GREATER, so that one rule
+        ("smaller key is nearer") serves both mappings."""
+        return -z_w if self.greater else z_w
+
+
+STANDARD_DEPTH = DepthMapping("standard", ndc_min=-1.0, ndc_near=-1.0, ndc_far=1.0,
+                              clip_control=GL_NEGATIVE_ONE_TO_ONE)
+# Reversed-Z: near -> 1, far -> 0 in a [0, 1] z_ndc range, so that z_w = z_ndc keeps float32's
+# relative precision where distant depths crowd together (docs/conventions.md, "Depth").
+REVERSED_Z_DEPTH = DepthMapping("reversed-Z", ndc_min=0.0, ndc_near=1.0, ndc_far=0.0,
+                                clip_control=GL_ZERO_TO_ONE)
+
+
+def depth_mapping(reversed_z: bool) -> DepthMapping:
+    """The mapping a camera uses (Camera.reversed_z)."""
+    return REVERSED_Z_DEPTH if reversed_z else STANDARD_DEPTH
+
+
+# --- the sub-pixel grid and the fill rule ----------------------------------------------------
+
+SUBPIXEL_BITS = 8          # GL_SUBPIXEL_BITS on llvmpipe (FIXED_ORDER in lp_rast.h)
+
+
+def snap_to_subpixel_grid(coordinate: np.ndarray, subpixel_bits: int) -> np.ndarray:
+    """Window coordinate -> int64 fixed point with `subpixel_bits` fraction bits, rounded to
+    nearest with ties to even (llvmpipe's subpixel_snap: lrint of x * 2^bits)."""
+    return np.rint(coordinate * float(1 << subpixel_bits)).astype(np.int64)
+
+
+def pixel_centre(index: np.ndarray, subpixel_bits: int) -> np.ndarray:
+    """Fixed-point coordinate of the centre of pixel column/row `index`: index + 1/2."""
+    return (index << subpixel_bits) + (1 << (subpixel_bits - 1))
+
+
+def is_left_or_bottom_edge(dx: np.ndarray, dy: np.ndarray) -> np.ndarray:
+    """For an edge (dx, dy) of a counter-clockwise triangle (interior on its left):
+    a left edge runs downwards (dy < 0); a bottom edge is horizontal running right.
+    These are the inclusive edges of the fill rule."""
+    return (dy < 0) | ((dy == 0) & (dx > 0))
+
+
+def is_inside_edge(edge_value: np.ndarray, inclusive: np.ndarray) -> np.ndarray:
+    """The fill rule: a centre on the edge (value 0) counts only for inclusive edges."""
+    return np.where(inclusive, edge_value >= 0, edge_value > 0)
+
+
+# --- output ----------------------------------------------------------------------------------
+
+def to_unorm8(c: np.ndarray) -> np.ndarray:
+    """GL's float -> unorm8 (OpenGL 4.5 §2.3.5.1, without dithering, which the GPU path
+    disables): floor(clamp(c, 0, 1) * 255 + 0.5)."""
+    return np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)

@@ -1,0 +1,87 @@
+"""The uniform layout, written once: every uniform the GLSL programs read, its GLSL type, and its
+value for a frame or an object as float64 arrays (int for flags and counts).
+
+Both pipelines take their uniforms from here: the GPU path casts these arrays to bytes
+(renderer/gpu/uniforms.py: float32, matrices column-major), and the reference reads the same
+arrays in its own dtype (reference/lighting.py: Lights, MaterialUniforms). The names are the
+GLSL names (glsl/lighting.glsl, glsl/vertex.glsl). Positions are camera-relative
+(FrameMatrices.relative, docs/conventions.md); a light array of a kind the scene lacks has
+no rows (the GPU path then leaves it out: GLSL has no empty arrays).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from renderer.core.scene import FrameMatrices, Material, ObjectMatrices, Scene, SceneObject
+
+# name -> GLSL type; "vec3[]" is an array with one row per light of that kind.
+LIGHT_UNIFORMS = {
+    "u_ambient": "vec3",                    # I_a
+    "u_directional_direction": "vec3[]",    # D, the way the light travels
+    "u_directional_intensity": "vec3[]",    # I_l
+    "u_point_position": "vec3[]",           # Q
+    "u_point_intensity": "vec3[]",          # I_l
+    "u_point_attenuation": "vec3[]",        # (c, l, q)
+}
+FRAME_UNIFORMS = {
+    "u_view": "mat4",                       # V, a rotation (camera-relative coordinates)
+    "u_projection": "mat4",                 # P
+    "u_eye": "vec3",                        # E, the eye
+    **LIGHT_UNIFORMS,
+}
+MATERIAL_UNIFORMS = {
+    "u_ka": "vec3",                         # k_a, k_d, k_s: linear RGB reflection coefficients
+    "u_kd": "vec3",
+    "u_ks": "vec3",
+    "u_n": "float",                         # the Phong exponent
+}
+OBJECT_UNIFORMS = {
+    "u_model": "mat4",                      # T(-origin) M_world
+    "u_normal_matrix": "mat3",              # transforms.normal_matrix(M_world)
+    **MATERIAL_UNIFORMS,
+    "u_two_sided": "bool",                  # read by the all-features build only
+}
+# The all-features build (renderer/gpu/shaders.py) reads the light counts at run time.
+LIGHT_COUNT_UNIFORMS = {"u_num_directional_lights": "int", "u_num_point_lights": "int"}
+UNIFORM_TYPES = FRAME_UNIFORMS | OBJECT_UNIFORMS | LIGHT_COUNT_UNIFORMS
+
+
+def _rows(values) -> np.ndarray:
+    return np.asarray(values, dtype=np.float64).reshape(-1, 3)
+
+
+def light_uniforms(scene: Scene, origin=(0.0, 0.0, 0.0)) -> dict[str, np.ndarray]:
+    """The ambient light and the light arrays (LIGHT_UNIFORMS), float64; point-light positions
+    relative to `origin` (the frame's camera-relative origin)."""
+    directional, point = scene.directional_lights, scene.point_lights
+    return {
+        "u_ambient": np.asarray(scene.ambient, dtype=np.float64),
+        "u_directional_direction": _rows([light.direction for light in directional]),
+        "u_directional_intensity": _rows([light.intensity for light in directional]),
+        "u_point_position": _rows([light.position for light in point]) - np.asarray(origin, dtype=np.float64),
+        "u_point_intensity": _rows([light.intensity for light in point]),
+        "u_point_attenuation": _rows([light.attenuation for light in point]),
+    }
+
+
+def frame_uniforms(scene: Scene, matrices: FrameMatrices) -> dict[str, np.ndarray]:
+    """The uniforms shared by every object of a frame (FRAME_UNIFORMS), float64."""
+    return {"u_view": matrices.view, "u_projection": matrices.projection,
+            "u_eye": matrices.relative(scene.camera.eye),
+            **light_uniforms(scene, matrices.origin)}
+
+
+def material_uniforms(material: Material) -> dict[str, np.ndarray]:
+    """A material's coefficients (MATERIAL_UNIFORMS), float64."""
+    return {"u_ka": np.asarray(material.ka, dtype=np.float64),
+            "u_kd": np.asarray(material.kd, dtype=np.float64),
+            "u_ks": np.asarray(material.ks, dtype=np.float64),
+            "u_n": np.asarray(material.n, dtype=np.float64)}
+
+
+def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.ndarray]:
+    """One object's uniforms (OBJECT_UNIFORMS): its matrices and its material."""
+    return {"u_model": matrices.model, "u_normal_matrix": matrices.normal,
+            **material_uniforms(obj.material),
+            "u_two_sided": np.asarray(int(bool(obj.material.two_sided)))}

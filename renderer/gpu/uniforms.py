@@ -1,0 +1,60 @@
+"""Uniform values as GL takes them: the layout of renderer/core/uniforms.py (the one source,
+shared with the reference) cast to bytes. Floats and vectors become float32, matrices
+column-major float32 (transforms.to_glsl, so that GLSL `M * v` is `M @ v`), flags and counts
+int32. A light array of a kind the scene lacks is left out (neither does the shader declare
+it), except in the all-features build, whose arrays have `light_slots` rows, zeros past the
+scene's lights, with the counts as uniforms.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from renderer.core.scene import FrameMatrices, Scene, SceneObject
+from renderer.core.transforms import to_glsl
+from renderer.core.uniforms import UNIFORM_TYPES, frame_uniforms, object_uniforms
+
+
+def as_bytes(name: str, value) -> bytes:
+    """The bytes GL takes for uniform `name` (its type from the layout)."""
+    kind = UNIFORM_TYPES[name]
+    if kind in ("mat3", "mat4"):
+        return to_glsl(value)
+    if kind in ("int", "bool"):
+        return np.asarray(value, dtype=np.int32).tobytes()
+    return np.asarray(value, dtype=np.float32).tobytes()
+
+
+def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
+                         light_slots: int | None = None) -> dict[str, bytes]:
+    """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
+    `light_slots` is for the all-features build: arrays of that size and the counts."""
+    values = frame_uniforms(scene, matrices)
+    if light_slots is not None:
+        directional, point = len(scene.directional_lights), len(scene.point_lights)
+        if max(directional, point) > light_slots:
+            raise ValueError(f"the all-features build has room for {light_slots} lights of each "
+                             f"kind; the scene has {directional} directional and {point} point lights")
+        values["u_num_directional_lights"] = np.asarray(directional)
+        values["u_num_point_lights"] = np.asarray(point)
+    out = {}
+    for name, value in values.items():
+        if UNIFORM_TYPES[name] == "vec3[]":
+            rows = light_slots or len(value)
+            if rows == 0:
+                continue
+            value = np.concatenate([value, np.zeros((rows - len(value), 3))])
+        out[name] = as_bytes(name, value)
+    return out
+
+
+def object_uniform_values(obj: SceneObject, matrices) -> dict[str, bytes]:
+    """One object's uniforms: its model and normal matrices and its material."""
+    return {name: as_bytes(name, value) for name, value in object_uniforms(obj, matrices).items()}
+
+
+def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,
+                   index: int) -> dict[str, bytes]:
+    """Every uniform (name -> bytes) for drawing `obj`, object number `index` of `scene`.
+    A program may lack some (the compiler drops unused ones): skip names it does not have."""
+    return frame_uniform_values(scene, matrices) | object_uniform_values(obj, matrices.objects[index])

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from renderer.core.gl_rules import to_unorm8
+
 
 def flip_error(expected_rgba8: np.ndarray, actual_rgba8: np.ndarray) -> tuple[float, np.ndarray]:
     """(mean ꟻLIP error, (H, W, 3) uint8 error map in the magma colour map).
@@ -23,5 +25,4 @@ def flip_error(expected_rgba8: np.ndarray, actual_rgba8: np.ndarray) -> tuple[fl
     expected = np.ascontiguousarray(expected_rgba8[..., :3], dtype=np.float32) / 255.0
     actual = np.ascontiguousarray(actual_rgba8[..., :3], dtype=np.float32) / 255.0
     error_map, mean, _ = flip_evaluator.evaluate(expected, actual, "LDR")
-    image = np.clip(np.asarray(error_map) * 255.0 + 0.5, 0, 255).astype(np.uint8)
-    return float(mean), image
+    return float(mean), to_unorm8(np.asarray(error_map))

@@ -32,12 +32,13 @@ renderer/core/gl_rules.py: reversed-Z draws with glClipControl ZERO_TO_ONE, dept
 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
 frame puts GL's default back, so renderers sharing a context never see each other's.
 
-Uniform values are computed once, as bytes, from `Scene.matrices()` (camera-relative) and the
-scene's lights and materials, and `render()` only hands them to GL; a pass at a sample offset
-(`render(sample_offset=(dx, dy))`, docs/conventions.md) uploads u_projection alone again.
-After changing the scene (camera, lights,
-materials, transforms, or an object's mesh for another Mesh), call `update()`; a different
-list of objects needs a new renderer.
+Uniform values are computed once per update(), as bytes (renderer/gpu/uniforms.py, from the
+layout the reference reads too: renderer/core/uniforms.py), from `Scene.matrices()`
+(camera-relative) and the scene's lights and materials, and `render()` only hands them to GL;
+a pass at a sample offset (`render(sample_offset=(dx, dy))`, docs/conventions.md) uploads
+u_projection alone again. After changing the scene (camera, lights, materials, transforms, or
+an object's mesh for another Mesh), call `update()`; a different list of objects needs a new
+renderer.
 Conventions (matrices, window, depth, colour, lighting): docs/conventions.md.
 """
 

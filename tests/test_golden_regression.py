@@ -9,9 +9,12 @@ import xml.etree.ElementTree as ElementTree
 from pathlib import Path
 
 import numpy as np
+import pytest
 from PIL import Image
 
 from renderer.checks.goldens import read_golden
+
+pytestmark = pytest.mark.slow          # four pytest runs in subprocesses
 
 REPO = Path(__file__).resolve().parents[1]
 GOLDEN = "sphere-phong"

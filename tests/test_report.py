@@ -73,6 +73,7 @@ def test_every_knob_runs_on_its_backends():
         {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
 
 
+@pytest.mark.slow                       # the quick sweep, through the command line
 def test_report_command_writes_csv_plots_and_markdown(tmp_path):
     out = tmp_path / "report"
     result = run("report", "point_light_plane", "--quick", "--size", "16x12", "--out", str(out),

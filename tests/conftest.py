@@ -10,8 +10,12 @@ Why an option rather than `-m "not slow and not window"` in addopts: undoing an 
 and a user's own `-m` would silently replace ours; `--all` says what it does.
 
 Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
-`on_x_display` (Xvfb).
+`on_x_display` (Xvfb), `cli` (the command line in a new process).
 """
+
+import os
+import subprocess
+import sys
 
 import pytest
 
@@ -19,6 +23,7 @@ from renderer.gpu.context import make_context
 
 CONTEXT_KINDS = ("egl", "osmesa")
 DEFAULT_LEFT_OUT = ("slow", "window")
+CLI_TIMEOUT_S = 120
 _LEFT_OUT = pytest.StashKey[int]()
 
 
@@ -97,3 +102,25 @@ def on_x_display(x_display, monkeypatch):
     monkeypatch.setenv("DISPLAY", x_display)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     return x_display
+
+
+# -- the command line ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def cli():
+    """cli(*args, cwd=None, display=None, timeout=CLI_TIMEOUT_S): `python -m renderer ARGS`
+    in a new process, as a user types it; returns the CompletedProcess (text stdout, stderr).
+
+    cwd      the folder it runs in (default: this process's);
+    display  None: no display (DISPLAY and WAYLAND_DISPLAY removed: every command but `view`
+             works without one, and `view` says so); ":N": that X display;
+    timeout  seconds until it is killed and the test fails.
+    Arguments may be paths."""
+    def run(*args, cwd=None, display=None, timeout=CLI_TIMEOUT_S) -> subprocess.CompletedProcess:
+        env = {key: value for key, value in os.environ.items()
+               if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
+        if display is not None:
+            env["DISPLAY"] = display
+        return subprocess.run([sys.executable, "-m", "renderer", *map(str, args)],
+                              capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout)
+    return run

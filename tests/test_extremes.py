@@ -6,8 +6,6 @@ import ctypes
 import functools
 import json
 import math
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -252,21 +250,17 @@ def test_is_finite_frame_sees_nan_and_inf():
 
 # -- the command line -----------------------------------------------------------------------------
 
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "renderer", *args], capture_output=True, text=True)
-
-
-def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path):
+def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli):
     out = tmp_path / "x.png"
-    result = run("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
+    result = cli("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
     assert result.returncode == 2 and not out.exists()
     [line] = result.stderr.strip().splitlines()
     assert "nan_mesh.toml: objects[0].mesh.file:" in line
     assert "vertex 2 is not finite (nan, 1, 0)" in line and "Traceback" not in result.stderr
 
 
-def test_renderer_extremes_writes_the_json_and_the_table(tmp_path):
-    result = run("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa")
+def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
+    result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa")
     assert result.returncode == 0, result.stdout + result.stderr
     document = json.loads((tmp_path / "extremes.json").read_text())
     table = (tmp_path / "extremes.md").read_text()

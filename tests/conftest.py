@@ -10,13 +10,17 @@ Why an option rather than `-m "not slow and not window"` in addopts: undoing an 
 and a user's own `-m` would silently replace ours; `--all` says what it does.
 
 Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
-`on_x_display` (Xvfb), `cli` (the command line in a new process).
+`on_x_display` (Xvfb), `cli` (the command line in a new process) and `reference_frames`
+(NumPy reference frames, each rendered once per test run).
 """
 
 import os
 import subprocess
 import sys
+from dataclasses import fields
+from pathlib import Path
 
+import numpy as np
 import pytest
 
 from renderer.gpu.context import make_context
@@ -124,3 +128,37 @@ def cli():
         return subprocess.run([sys.executable, "-m", "renderer", *map(str, args)],
                               capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout)
     return run
+
+
+# -- reference frames ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def reference_frames():
+    """reference_frames(scene, width, height, *, shading=None, **options): the Frame of
+    `reference.render(scene, width, height, **options)`, rendered once per test run.
+
+    `scene` is a built-in scene's name or a scene file; `shading` renders every material
+    flat, gouraud or phong (Scene.with_shading). Frames are cached by scene, shading, size
+    and options, and their arrays are read-only: a test that changes one copies it first."""
+    import reference
+    from renderer.core.builtin import resolve_scene
+    from renderer.core.scene_file import load_scene
+
+    frames = {}
+
+    def frame(scene, width: int, height: int, *, shading: str | None = None, **options):
+        path = Path(resolve_scene(str(scene))).resolve()
+        key = (path, shading, width, height, tuple(sorted(options.items())))
+        if key not in frames:
+            loaded = load_scene(path)
+            if shading is not None:
+                loaded = loaded.with_shading(shading)
+            rendered = reference.render(loaded, width, height, **options)
+            for field in fields(rendered):
+                value = getattr(rendered, field.name)
+                if isinstance(value, np.ndarray):
+                    value.flags.writeable = False
+            frames[key] = rendered
+        return frames[key]
+
+    return frame

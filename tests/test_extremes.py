@@ -206,11 +206,6 @@ def extreme_scene(name):
     return load_scene(extreme_scenes()[name])
 
 
-@functools.lru_cache(maxsize=None)
-def reference_frame(name):
-    return reference.render(extreme_scene(name), *SIZE, linear=True)
-
-
 def test_every_case_is_documented_and_there_are_at_least_14():
     assert len(RENDERED) >= 14
     assert set(extreme_scenes()) == set(STABILITY)
@@ -218,10 +213,11 @@ def test_every_case_is_documented_and_there_are_at_least_14():
 
 @pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
 @pytest.mark.parametrize("name", RENDERED)
-def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts):
+def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts,
+                                                          reference_frames):
     with GpuRenderer(extreme_scene(name), *SIZE, context=gl_contexts[context_kind]) as gpu:
         frame = gpu.render(linear=True, depth=True)
-    expected = reference_frame(name)
+    expected = reference_frames(extreme_scenes()[name], *SIZE, linear=True)
     assert is_finite_frame(frame) and is_finite_frame(expected)
     figures = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
                              reference_tie=expected.rgba8_tie).as_dict()
@@ -237,8 +233,8 @@ def test_the_pass_rule_is_the_pipeline_tolerance():
         assert not passes(exact | {key: over})
 
 
-def test_is_finite_frame_sees_nan_and_inf():
-    frame = reference_frame("singular_model")
+def test_is_finite_frame_sees_nan_and_inf(reference_frames):
+    frame = reference_frames(extreme_scenes()["singular_model"], *SIZE, linear=True)
     broken = replace(frame, linear=frame.linear.copy())
     broken.linear[0, 0, 0] = np.nan
     assert not is_finite_frame(broken)

@@ -1,12 +1,86 @@
-"""Shared fixtures: one headless GL context of each kind for the whole test session, and a
-virtual X display for the window viewer."""
+"""Shared fixtures and the default selection.
 
+The default run (`python -m pytest`) leaves out the tests marked `slow` (several seconds
+each: a wheel build, the golden suite run in a copy of the repository, a `renderer report`)
+and `window` (a real window on a virtual X display). `pytest --all` runs every test; CI
+does (.ci/run). A `-m` expression on the command line chooses by itself instead.
+
+Why an option rather than `-m "not slow and not window"` in addopts: undoing an addopts
+`-m` takes another `-m` with an expression that selects everything, which nobody guesses,
+and a user's own `-m` would silently replace ours; `--all` says what it does.
+
+Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
+`on_x_display` (Xvfb), `cli` (the command line in a new process) and `reference_frames`
+(NumPy reference frames, each rendered once per test run).
+"""
+
+import os
+import subprocess
+import sys
+from dataclasses import fields
+from pathlib import Path
+
+import numpy as np
 import pytest
 
 from renderer.gpu.context import make_context
 
 CONTEXT_KINDS = ("egl", "osmesa")
+DEFAULT_LEFT_OUT = ("slow", "window")
+CLI_TIMEOUT_S = 120
+_LEFT_OUT = pytest.StashKey[int]()
 
+
+# -- the default selection --------------------------------------------------------------------
+
+def pytest_addoption(parser):
+    parser.addoption("--all", action="store_true", dest="run_all",
+                     help="run every test, also those marked slow or window (the default run "
+                          "leaves them out; CI runs with --all)")
+
+
+def pytest_itemcollected(item):
+    # Every test on the virtual X display opens a window: marked here, so none is missed
+    # (and before `-m` chooses, so that `-m window` finds them).
+    if "x_display" in item.fixturenames:
+        item.add_marker(pytest.mark.window)
+
+
+@pytest.hookimpl(trylast=True)          # after -k: only what it kept counts as left out here
+def pytest_collection_modifyitems(config, items):
+    if config.option.run_all or config.option.markexpr:
+        return
+    kept, left_out = [], []
+    for item in items:
+        marked = any(item.get_closest_marker(name) for name in DEFAULT_LEFT_OUT)
+        (left_out if marked else kept).append(item)
+    if left_out:
+        config.hook.pytest_deselected(items=left_out)
+        items[:] = kept
+    config.stash[_LEFT_OUT] = len(left_out)
+
+
+def pytest_report_header(config):
+    if not (config.option.run_all or config.option.markexpr):
+        return "default run: tests marked slow or window are left out (pytest --all runs them)"
+
+
+def pytest_sessionfinish(session, exitstatus):
+    # Naming only slow or window tests without --all runs nothing, as asked: not an error
+    # (a -k or a path that matches no test at all still is).
+    if exitstatus == pytest.ExitCode.NO_TESTS_COLLECTED and session.config.stash.get(_LEFT_OUT, 0):
+        session.exitstatus = pytest.ExitCode.OK
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    left_out = config.stash.get(_LEFT_OUT, 0)
+    if left_out:
+        tests = "test" if left_out == 1 else "tests"
+        terminalreporter.write_line(f"left out {left_out} {tests} marked slow or window; "
+                                    f"pytest --all runs every test")
+
+
+# -- GL contexts and the virtual display --------------------------------------------------------
 
 @pytest.fixture(scope="session")
 def gl_contexts():
@@ -20,7 +94,7 @@ def gl_contexts():
 @pytest.fixture(scope="session")
 def x_display():
     """A virtual X display (Xvfb) for the window viewer's tests, ":N". It must start: CI
-    installs xvfb (install.sh)."""
+    installs xvfb (install.sh). A test using it is marked `window`."""
     from renderer.viewer.virtual_display import virtual_display
     with virtual_display() as display:
         yield display
@@ -32,3 +106,59 @@ def on_x_display(x_display, monkeypatch):
     monkeypatch.setenv("DISPLAY", x_display)
     monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
     return x_display
+
+
+# -- the command line ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def cli():
+    """cli(*args, cwd=None, display=None, timeout=CLI_TIMEOUT_S): `python -m renderer ARGS`
+    in a new process, as a user types it; returns the CompletedProcess (text stdout, stderr).
+
+    cwd      the folder it runs in (default: this process's);
+    display  None: no display (DISPLAY and WAYLAND_DISPLAY removed: every command but `view`
+             works without one, and `view` says so); ":N": that X display;
+    timeout  seconds until it is killed and the test fails.
+    Arguments may be paths."""
+    def run(*args, cwd=None, display=None, timeout=CLI_TIMEOUT_S) -> subprocess.CompletedProcess:
+        env = {key: value for key, value in os.environ.items()
+               if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
+        if display is not None:
+            env["DISPLAY"] = display
+        return subprocess.run([sys.executable, "-m", "renderer", *map(str, args)],
+                              capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout)
+    return run
+
+
+# -- reference frames ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def reference_frames():
+    """reference_frames(scene, width, height, *, shading=None, **options): the Frame of
+    `reference.render(scene, width, height, **options)`, rendered once per test run.
+
+    `scene` is a built-in scene's name or a scene file; `shading` renders every material
+    flat, gouraud or phong (Scene.with_shading). Frames are cached by scene, shading, size
+    and options, and their arrays are read-only: a test that changes one copies it first."""
+    import reference
+    from renderer.core.builtin import resolve_scene
+    from renderer.core.scene_file import load_scene
+
+    frames = {}
+
+    def frame(scene, width: int, height: int, *, shading: str | None = None, **options):
+        path = Path(resolve_scene(str(scene))).resolve()
+        key = (path, shading, width, height, tuple(sorted(options.items())))
+        if key not in frames:
+            loaded = load_scene(path)
+            if shading is not None:
+                loaded = loaded.with_shading(shading)
+            rendered = reference.render(loaded, width, height, **options)
+            for field in fields(rendered):
+                value = getattr(rendered, field.name)
+                if isinstance(value, np.ndarray):
+                    value.flags.writeable = False
+            frames[key] = rendered
+        return frames[key]
+
+    return frame

@@ -1,21 +1,15 @@
 """The command line as a user types it."""
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 
 from renderer.core.imageio import read_png
 
 
-def run(*args, cwd=None):
-    return subprocess.run([sys.executable, "-m", "renderer", *args], capture_output=True, text=True, cwd=cwd)
-
-
-def test_render_default_scene_writes_png_and_depth(tmp_path):
+def test_render_default_scene_writes_png_and_depth(tmp_path, cli):
     out, depth = tmp_path / "a.png", tmp_path / "d.npy"
-    result = run("render", "-o", str(out), "--size", "64x48", "--depth", str(depth))
+    result = cli("render", "-o", str(out), "--size", "64x48", "--depth", str(depth))
     assert result.returncode == 0, result.stderr
     image = read_png(out)
     assert image.shape == (48, 64, 4)
@@ -24,14 +18,14 @@ def test_render_default_scene_writes_png_and_depth(tmp_path):
     assert np.isinf(d).any() and np.isfinite(d).any()
 
 
-def test_render_without_output_names_the_file_after_the_scene(tmp_path):
-    result = run("render", "--size", "32x24", "--backend", "reference", cwd=tmp_path)
+def test_render_without_output_names_the_file_after_the_scene(tmp_path, cli):
+    result = cli("render", "--size", "32x24", "--backend", "reference", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "sphere.png").exists()
 
 
-def test_compare_prints_the_figures_and_writes_three_images(tmp_path):
-    result = run("compare", "sphere", "--size", "80x60", "--context", "osmesa", "--out", str(tmp_path))
+def test_compare_prints_the_figures_and_writes_three_images(tmp_path, cli):
+    result = cli("compare", "sphere", "--size", "80x60", "--context", "osmesa", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
     figures = json.loads(result.stdout)
     for key in ("max_abs", "mean_abs", "rmse", "psnr", "raw_mismatched_pixels", "mismatched_pixels",
@@ -43,37 +37,37 @@ def test_compare_prints_the_figures_and_writes_three_images(tmp_path):
         assert read_png(tmp_path / name).shape[:2] == (60, 80)
 
 
-def test_scenes_lists_one_name_first_on_each_line():
-    result = run("scenes")
+def test_scenes_lists_one_name_first_on_each_line(cli):
+    result = cli("scenes")
     assert result.returncode == 0
     names = [line.split()[0] for line in result.stdout.splitlines()]
     assert "sphere" in names and len(names) >= 8
 
 
-def test_bad_size_is_one_line_and_status_2(tmp_path):
-    result = run("render", "--size", "wide", "-o", str(tmp_path / "x.png"))
+def test_bad_size_is_one_line_and_status_2(tmp_path, cli):
+    result = cli("render", "--size", "wide", "-o", str(tmp_path / "x.png"))
     assert result.returncode == 2
     assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
     assert not (tmp_path / "x.png").exists()
 
 
-def test_unknown_scene_names_the_built_in_ones(tmp_path):
-    result = run("render", "no_such_scene", "-o", str(tmp_path / "x.png"))
+def test_unknown_scene_names_the_built_in_ones(tmp_path, cli):
+    result = cli("render", "no_such_scene", "-o", str(tmp_path / "x.png"))
     assert result.returncode == 2
     assert "sphere" in result.stderr and "Traceback" not in result.stderr
 
 
-def test_written_files_get_the_usual_permissions(tmp_path):
+def test_written_files_get_the_usual_permissions(tmp_path, cli):
     import os
     out = tmp_path / "p.png"
-    assert run("render", "--size", "16x12", "--backend", "reference", "-o", str(out)).returncode == 0
+    assert cli("render", "--size", "16x12", "--backend", "reference", "-o", str(out)).returncode == 0
     mask = os.umask(0)
     os.umask(mask)
     assert out.stat().st_mode & 0o777 == 0o666 & ~mask
     assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]     # no temporary left
 
 
-def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path, gl_contexts):
+def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path, gl_contexts, cli):
     """hierarchy draws with three variants (phong, gouraud, flat with its geometry stage);
     each file is the text the renderer compiles, and it compiles as it is."""
     from renderer.core.builtin import builtin_scenes
@@ -82,7 +76,7 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
     from renderer.core.scene_file import load_scene
     from renderer.gpu.shaders import ShaderVariant, program_sources
 
-    result = run("shaders", "hierarchy", "--out", str(tmp_path))
+    result = cli("shaders", "hierarchy", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[0] == \
         ("phong-specular-1dir-1point: phong-specular-1dir-1point.vert, "

@@ -6,8 +6,6 @@ import ctypes
 import functools
 import json
 import math
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -210,11 +208,6 @@ def extreme_scene(name):
     return load_scene(extreme_scenes()[name])
 
 
-@functools.lru_cache(maxsize=None)
-def reference_frame(name):
-    return reference.render(extreme_scene(name), *SIZE, linear=True)
-
-
 def test_every_case_is_documented_and_there_are_at_least_14():
     assert len(RENDERED) >= 14
     assert set(extreme_scenes()) == set(STABILITY)
@@ -222,10 +215,11 @@ def test_every_case_is_documented_and_there_are_at_least_14():
 
 @pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
 @pytest.mark.parametrize("name", RENDERED)
-def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts):
+def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts,
+                                                          reference_frames):
     with GpuRenderer(extreme_scene(name), *SIZE, context=gl_contexts[context_kind]) as gpu:
         frame = gpu.render(linear=True, depth=True)
-    expected = reference_frame(name)
+    expected = reference_frames(extreme_scenes()[name], *SIZE, linear=True)
     assert is_finite_frame(frame) and is_finite_frame(expected)
     figures = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
                              reference_tie=expected.rgba8_tie).as_dict()
@@ -243,8 +237,8 @@ def test_the_pipeline_tolerance_at_its_limits():
     assert PIPELINE_TOLERANCE.passes(exact | {"depth_max_rel": None})     # no depth compared
 
 
-def test_is_finite_frame_sees_nan_and_inf():
-    frame = reference_frame("singular_model")
+def test_is_finite_frame_sees_nan_and_inf(reference_frames):
+    frame = reference_frames(extreme_scenes()["singular_model"], *SIZE, linear=True)
     broken = replace(frame, linear=frame.linear.copy())
     broken.linear[0, 0, 0] = np.nan
     assert not is_finite_frame(broken)
@@ -256,21 +250,17 @@ def test_is_finite_frame_sees_nan_and_inf():
 
 # -- the command line -----------------------------------------------------------------------------
 
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "renderer", *args], capture_output=True, text=True)
-
-
-def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path):
+def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli):
     out = tmp_path / "x.png"
-    result = run("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
+    result = cli("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
     assert result.returncode == 2 and not out.exists()
     [line] = result.stderr.strip().splitlines()
     assert "nan_mesh.toml: objects[0].mesh.file:" in line
     assert "vertex 2 is not finite (nan, 1, 0)" in line and "Traceback" not in result.stderr
 
 
-def test_renderer_extremes_writes_the_json_and_the_table(tmp_path):
-    result = run("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa")
+def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
+    result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa")
     assert result.returncode == 0, result.stdout + result.stderr
     document = json.loads((tmp_path / "extremes.json").read_text())
     table = (tmp_path / "extremes.md").read_text()

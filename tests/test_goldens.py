@@ -16,7 +16,6 @@ from pathlib import Path
 
 import pytest
 
-import reference
 from renderer.core.builtin import builtin_scenes
 from renderer.checks.compare import compare_frames
 from renderer.checks.goldens import read_golden
@@ -62,11 +61,12 @@ def test_gpu_matches_golden(name, mode, context_kind, gl_contexts, golden):
 
 
 @pytest.mark.parametrize("name, mode", VARIANTS, ids=IDS)
-def test_golden_matches_reference(name, mode):
+def test_golden_matches_reference(name, mode, reference_frames):
     png = GOLDENS / f"{name}-{mode}.png"
     if not png.exists():
         pytest.fail(f"{png} is missing; make it with pytest --update-goldens", pytrace=False)
-    expected = reference.render(scene_variant(name, mode), *SIZE, depth=False)
+    expected = reference_frames(name, *SIZE, shading=None if mode == AS_AUTHORED else mode,
+                                depth=False)
     result = compare_frames(read_golden(png), expected.rgba8, reference_tie=expected.rgba8_tie)
     failures = PIPELINE_TOLERANCE.failures(result)
     if failures:

@@ -9,7 +9,6 @@ import functools
 
 import pytest
 
-import reference
 from renderer.core.builtin import builtin_scenes
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
@@ -24,18 +23,13 @@ def scene_named(name):
     return load_scene(builtin_scenes()[name])
 
 
-@functools.lru_cache(maxsize=None)
-def reference_frame(name, size, subpixel_bits):
-    return reference.render(scene_named(name), *size, subpixel_bits=subpixel_bits)
-
-
 @pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
 @pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 @pytest.mark.parametrize("name", sorted(builtin_scenes()))
-def test_gpu_matches_reference(name, size, context_kind, gl_contexts):
+def test_gpu_matches_reference(name, size, context_kind, gl_contexts, reference_frames):
     with GpuRenderer(scene_named(name), *size, context=gl_contexts[context_kind]) as gpu:
         frame = gpu.render(depth=True)
-        expected = reference_frame(name, size, gpu.subpixel_bits)
+        expected = reference_frames(name, *size, subpixel_bits=gpu.subpixel_bits)
     result = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
                             reference_tie=expected.rgba8_tie)
     assert result.depth_max_rel is not None

@@ -3,8 +3,6 @@
 
 import csv
 import math
-import subprocess
-import sys
 from dataclasses import replace
 
 import numpy as np
@@ -16,10 +14,6 @@ from renderer.study.report import QUICK, metrics, settings
 from renderer.study.report_settings import CSV_COLUMNS
 from renderer.study.report_output import convergence_slopes, pareto_front
 from renderer.core.scene_file import load_scene
-
-
-def run(*args):
-    return subprocess.run([sys.executable, "-m", "renderer", *args], capture_output=True, text=True)
 
 
 def test_ground_truth_is_cached_by_scene_content(tmp_path):
@@ -74,9 +68,10 @@ def test_every_knob_runs_on_its_backends():
         {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
 
 
-def test_report_command_writes_csv_plots_and_markdown(tmp_path):
+@pytest.mark.slow                       # the quick sweep, through the command line
+def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     out = tmp_path / "report"
-    result = run("report", "point_light_plane", "--quick", "--size", "16x12", "--out", str(out),
+    result = cli("report", "point_light_plane", "--quick", "--size", "16x12", "--out", str(out),
                  "--cache", str(tmp_path / "cache"), "--context", "osmesa")
     assert result.returncode == 0, result.stderr
     with open(out / "results.csv", newline="") as handle:
@@ -111,9 +106,9 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path):
     (("no_such_scene",), "no_such_scene: no such scene file or built-in scene"),
     (("sphere", "--size", "400x300"), "--size: 400x300 is too large for the ground truth"),
 ])
-def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason):
+def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli):
     out = tmp_path / "report"
-    result = run("report", *args, "--out", str(out), "--cache", str(tmp_path / "cache"))
+    result = cli("report", *args, "--out", str(out), "--cache", str(tmp_path / "cache"))
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [result.stderr.strip()]
     assert reason in result.stderr and "Traceback" not in result.stderr

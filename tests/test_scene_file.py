@@ -6,8 +6,6 @@ line must turn it into that one line on stderr, exit status 2 and no output file
 
 import dataclasses
 import re
-import subprocess
-import sys
 import tomllib
 from pathlib import Path
 
@@ -619,20 +617,16 @@ CLI_CASES = [
 ]
 
 
-def run_cli(scene_arg: str, out_png: Path) -> subprocess.CompletedProcess:
-    return subprocess.run(
-        [sys.executable, "-m", "renderer", "render", scene_arg, "-o", str(out_png),
-         "--backend", "reference", "--size", "32x24"],
-        cwd=REPO, capture_output=True, text=True, timeout=120)
+RENDER_SMALL = ("--backend", "reference", "--size", "32x24")      # `renderer render` options
 
 
 @pytest.mark.parametrize("text, expected", [case[1:] for case in CLI_CASES],
                          ids=[case[0] for case in CLI_CASES])
-def test_cli_bad_scene_exits_2_with_one_line(tmp_path, text, expected):
+def test_cli_bad_scene_exits_2_with_one_line(tmp_path, text, expected, cli):
     nan_mesh = write(tmp_path, "nan.obj", OBJ_TRIANGLE.replace("v 0 0 0", "v nan 0 0"))
     bad_scene = write(tmp_path, "bad.toml", text)
     out_png = tmp_path / "out.png"
-    result = run_cli(str(bad_scene), out_png)
+    result = cli("render", bad_scene, "-o", out_png, *RENDER_SMALL, cwd=REPO)
     assert result.returncode == 2, result.stderr
     assert "Traceback" not in result.stderr
     lines = result.stderr.strip().splitlines()
@@ -642,9 +636,9 @@ def test_cli_bad_scene_exits_2_with_one_line(tmp_path, text, expected):
     assert not out_png.exists()
 
 
-def test_cli_unknown_scene_name_exits_2_and_lists_builtins(tmp_path):
+def test_cli_unknown_scene_name_exits_2_and_lists_builtins(tmp_path, cli):
     out_png = tmp_path / "out.png"
-    result = run_cli("no_such_scene", out_png)
+    result = cli("render", "no_such_scene", "-o", out_png, *RENDER_SMALL, cwd=REPO)
     assert result.returncode == 2, result.stderr
     assert "Traceback" not in result.stderr
     lines = result.stderr.strip().splitlines()
@@ -653,12 +647,12 @@ def test_cli_unknown_scene_name_exits_2_and_lists_builtins(tmp_path):
     assert not out_png.exists()
 
 
-def test_cli_nan_is_not_rendered_even_when_unused(tmp_path):
+def test_cli_nan_is_not_rendered_even_when_unused(tmp_path, cli):
     """A NaN in a light's intensity must stop the render, not produce a black picture."""
     bad_scene = write(tmp_path, "bad.toml", '[[lights]]\ntype = "point"\nintensity = [1, nan, 1]\n'
                       + OBJECT)
     out_png = tmp_path / "out.png"
-    result = run_cli(str(bad_scene), out_png)
+    result = cli("render", bad_scene, "-o", out_png, *RENDER_SMALL, cwd=REPO)
     assert result.returncode == 2 and "Traceback" not in result.stderr
     assert "lights[0].intensity: expected finite numbers, item 1 is nan" in result.stderr
     assert not out_png.exists()

@@ -44,34 +44,26 @@ def assert_matches(window_rgb, headless_rgba8):
     assert PIPELINE_TOLERANCE.passes(result), (PIPELINE_TOLERANCE.failures(result), result)
 
 
-def run_cli(*args, display=None, cwd=None, timeout=120):
-    env = {key: value for key, value in os.environ.items() if key not in ("DISPLAY", "WAYLAND_DISPLAY")}
-    if display is not None:
-        env["DISPLAY"] = display
-    return subprocess.run([sys.executable, "-m", "renderer", "view", *args], capture_output=True,
-                          text=True, env=env, cwd=cwd, timeout=timeout)
-
-
 # -- no display ---------------------------------------------------------------------------------
-def test_without_a_display_one_line_suggests_xvfb_run_and_exits_2(tmp_path):
+def test_without_a_display_one_line_suggests_xvfb_run_and_exits_2(tmp_path, cli):
     shot = tmp_path / "shot.png"
-    result = run_cli("sphere", "--frames", "2", "--screenshot", str(shot))
+    result = cli("view", "sphere", "--frames", "2", "--screenshot", str(shot), display=None)
     assert result.returncode == 2
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "xvfb-run" in lines[0] and "DISPLAY" in lines[0], result.stderr
     assert "Traceback" not in result.stderr and not shot.exists()
 
 
-def test_a_bad_option_is_one_line_and_status_2():
-    result = run_cli("sphere", "--frames", "0")
+def test_a_bad_option_is_one_line_and_status_2(cli):
+    result = cli("view", "sphere", "--frames", "0")
     assert result.returncode == 2 and "at least 1" in result.stderr
 
 
 # -- the scripted mode, through the command line --------------------------------------------------
-def test_scripted_screenshot_is_the_headless_render(x_display, tmp_path):
+def test_scripted_screenshot_is_the_headless_render(x_display, tmp_path, cli):
     shot = tmp_path / "shot.png"
-    result = run_cli("sphere", "--size", "160x120", "--frames", "3", "--screenshot", str(shot),
-                     display=x_display)
+    result = cli("view", "sphere", "--size", "160x120", "--frames", "3", "--screenshot", str(shot),
+                 display=x_display)
     assert result.returncode == 0, result.stderr
     assert "frame time median" in result.stdout and "fps" in result.stdout
     assert_matches(read_png(shot)[..., :3], headless(scene()))
@@ -79,14 +71,14 @@ def test_scripted_screenshot_is_the_headless_render(x_display, tmp_path):
 
 @pytest.mark.parametrize("buffering, frames_late", [("double", 0), ("triple", 1)])
 def test_orbiting_shows_the_camera_of_the_frame_on_the_screen(x_display, tmp_path, buffering,
-                                                              frames_late):
+                                                              frames_late, cli):
     """--orbit turns the camera before each frame is drawn; with triple buffering the window
     shows the frame before the last one drawn."""
     shot = tmp_path / "shot.png"
     args = ["hierarchy", "--size", "160x120", "--frames", "4", "--orbit", "10",
             "--screenshot", str(shot)]
-    result = run_cli(*args, *(["--triple-buffering"] if buffering == "triple" else []),
-                     display=x_display)
+    result = cli("view", *args, *(["--triple-buffering"] if buffering == "triple" else []),
+                 display=x_display)
     assert result.returncode == 0, result.stderr
     authored = scene("hierarchy")
     orbit = OrbitCamera(authored.camera)
@@ -97,10 +89,10 @@ def test_orbiting_shows_the_camera_of_the_frame_on_the_screen(x_display, tmp_pat
         assert "latency" in result.stdout
 
 
-def test_reference_side_by_side_shows_both_pipelines_alike(x_display, tmp_path):
+def test_reference_side_by_side_shows_both_pipelines_alike(x_display, tmp_path, cli):
     shot = tmp_path / "shot.png"
-    result = run_cli("gouraud_vs_phong", "--size", "240x120", "--frames", "2", "--reference",
-                     "side-by-side", "--screenshot", str(shot), display=x_display)
+    result = cli("view", "gouraud_vs_phong", "--size", "240x120", "--frames", "2", "--reference",
+                 "side-by-side", "--screenshot", str(shot), display=x_display)
     assert result.returncode == 0, result.stderr
     assert "GPU vs reference" in result.stdout and "0 mismatched px" in result.stdout
     image = read_png(shot)[..., :3].astype(int)
@@ -112,17 +104,17 @@ def test_reference_side_by_side_shows_both_pipelines_alike(x_display, tmp_path):
     assert (image[100:, :] == clear).all()         # the letterbox below the images
 
 
-def test_scripted_reference_is_of_the_last_frames_view_when_orbiting(x_display):
-    result = run_cli("sphere", "--size", "80x60", "--frames", "3", "--orbit", "15",
-                     "--reference", "difference", display=x_display)
+def test_scripted_reference_is_of_the_last_frames_view_when_orbiting(x_display, cli):
+    result = cli("view", "sphere", "--size", "80x60", "--frames", "3", "--orbit", "15",
+                 "--reference", "difference", display=x_display)
     assert result.returncode == 0, result.stderr
     assert "GPU vs reference" in result.stdout and "0 mismatched px" in result.stdout
 
 
-def test_reference_difference_is_a_dark_heat_map(x_display, tmp_path):
+def test_reference_difference_is_a_dark_heat_map(x_display, tmp_path, cli):
     shot = tmp_path / "shot.png"
-    result = run_cli("sphere", "--size", "160x120", "--frames", "2", "--reference", "difference",
-                     "--screenshot", str(shot), display=x_display)
+    result = cli("view", "sphere", "--size", "160x120", "--frames", "2", "--reference",
+                 "difference", "--screenshot", str(shot), display=x_display)
     assert result.returncode == 0, result.stderr
     image = read_png(shot)[..., :3]
     below_overlay = image[40:]                      # the figures' panel is at the top left

@@ -5,7 +5,11 @@ import sys
 import zipfile
 from pathlib import Path
 
+import pytest
+
 REPO = Path(__file__).resolve().parents[1]
+
+pytestmark = pytest.mark.slow          # builds a wheel
 
 
 def test_wheel_carries_shaders_and_assets_and_renders_from_another_folder(tmp_path):

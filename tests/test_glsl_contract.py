@@ -39,6 +39,7 @@ from renderer.core.builtin import builtin_scenes
 from renderer.core.resources import glsl_dir
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import load_scene
+from renderer.core.uniforms import UNIFORM_TYPES
 from renderer.gpu import GpuRenderer
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS
 
@@ -61,7 +62,7 @@ GPU_ONLY_UNIFORMS = {
 def uploaded_uniform_names() -> set[str]:
     """Every uniform name the GPU path uploads for a scene with every feature, in the
     specialised and in the all-features build."""
-    from renderer.gpu.pipeline import frame_uniform_values, object_uniform_values
+    from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
     scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
     matrices = scene.matrices(64, 48)
     names = set(frame_uniform_values(scene, matrices))
@@ -439,6 +440,33 @@ def test_every_declared_uniform_is_uploaded(parsed):
 def test_every_uploaded_uniform_is_declared(parsed):
     problems = uploads_not_declared(parsed, uploaded_uniform_names())
     assert not problems, report(problems)
+
+
+def uniform_types_unlike_the_layout(parsed, layout=UNIFORM_TYPES) -> list[str]:
+    """Each declared uniform has the GLSL type the one layout (renderer/core/uniforms.py) gives
+    it, "vec3[]" for an array of vec3; and the layout names nothing the shaders lack."""
+    problems = []
+    declared = all_uniforms(parsed)
+    for name, d in sorted(declared.items()):
+        glsl_type = d.type + ("[]" if d.array is not None else "")
+        if layout.get(name) != glsl_type:
+            problems.append(f"{d.where}: uniform {name} is {glsl_type}; the layout "
+                            f"(renderer/core/uniforms.py) says {layout.get(name, 'nothing')}")
+    problems += [f"renderer/core/uniforms.py: {name} is in the layout but no shader declares it"
+                 for name in sorted(set(layout) - set(declared))]
+    return problems
+
+
+def test_the_uniform_types_are_the_layouts(parsed):
+    problems = uniform_types_unlike_the_layout(parsed)
+    assert not problems, report(problems)
+
+
+def test_a_uniform_of_another_type_is_caught(parsed):
+    layout = UNIFORM_TYPES | {"u_n": "vec3", "u_gone": "float"}
+    problems = uniform_types_unlike_the_layout(parsed, layout)
+    assert len(problems) == 2 and "uniform u_n is float; the layout (renderer/core/uniforms.py) says vec3" in problems[0]
+    assert problems[1] == "renderer/core/uniforms.py: u_gone is in the layout but no shader declares it"
 
 
 def test_the_gpu_only_uniforms_are_declared(parsed):

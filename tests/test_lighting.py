@@ -9,6 +9,7 @@ fragment stages decide which normal it sees (one-sided, two-sided, flat, Gouraud
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -148,6 +149,42 @@ def test_two_sided_flips_the_normal_seen_from_behind(shading):
         return render(scene, 16, 16, linear=True).linear[8, 8]
     assert centre_colour(False) == pytest.approx([0.1, 0.1, 0.1, 1.0], abs=1e-6)
     assert centre_colour(True) == pytest.approx([0.7, 0.7, 0.7, 1.0], abs=1e-6)
+
+
+ONE_SIDED_RULE = ("seen from behind, a surface shows the light falling on its front, and a light "
+                  "on the viewer's side adds nothing but the ambient term")
+
+
+@pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
+def test_one_sided_seen_from_behind_shows_the_light_on_its_front(shading, gl_contexts):
+    """The sentence of docs/scene-format.md (two_sided) and docs/conventions.md, held against
+    both pipelines: a one-sided plane facing +y seen from below (its back), with k_a 0.5 under
+    I_a 0.2 and k_d 0.6. Lit from above (on its front): 0.1 + 0.6. Lit from below (the
+    viewer's side): 0.1, the ambient term. Two-sided is the other way round."""
+    from renderer.gpu import GpuRenderer
+
+    def centre(light_travels_y, two_sided):
+        scene = Scene(camera=Camera(eye=(0, -3, 0), look=(0, 0, 0), up=(0, 0, 1)),
+                      objects=[SceneObject("plane", primitives.plane(2.0),
+                                           Material(ka=(0.5, 0.5, 0.5), kd=(0.6, 0.6, 0.6),
+                                                    ks=(0, 0, 0), shading=shading,
+                                                    two_sided=two_sided))],
+                      directional_lights=[DirectionalLight((0, light_travels_y, 0))],
+                      ambient=(0.2, 0.2, 0.2))
+        with GpuRenderer(scene, 16, 16, context=gl_contexts["egl"]) as gpu:
+            on_gpu = gpu.render(linear=True).linear[8, 8, :3]
+        on_reference = render(scene, 16, 16, linear=True).linear[8, 8, :3]
+        np.testing.assert_allclose(on_gpu, on_reference, atol=1e-6)
+        return on_reference
+
+    for document in ("docs/scene-format.md", "docs/conventions.md"):
+        text = " ".join((Path(__file__).parents[1] / document).read_text().split())
+        assert ONE_SIDED_RULE in text, document
+    from_above, from_below = -1.0, 1.0            # the way the light travels along y
+    assert centre(from_above, two_sided=False) == pytest.approx([0.7] * 3, abs=1e-6)
+    assert centre(from_below, two_sided=False) == pytest.approx([0.1] * 3, abs=1e-6)
+    assert centre(from_above, two_sided=True) == pytest.approx([0.1] * 3, abs=1e-6)
+    assert centre(from_below, two_sided=True) == pytest.approx([0.7] * 3, abs=1e-6)
 
 
 def test_phong_specular_follows_the_fragment():

@@ -1,9 +1,21 @@
 #!/usr/bin/env bash
 # Sets up everything from nothing: the system GL libraries (Mesa's EGL and OSMesa, which run
 # on the CPU when there is no GPU), a virtual environment in .venv, and this package in it
-# with its test dependencies. Safe to run again.
+# with its test dependencies. Safe to run again: a step already done is skipped (the pip step
+# when .venv was installed from this very pyproject.toml; delete .venv/.install-stamp to
+# force it). Quiet unless something goes wrong, when the step's whole output is shown.
 set -euo pipefail
 cd "$(dirname "$0")"
+
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+quietly() {          # run a step with its output kept aside; show it only if the step fails
+    if ! "$@" >"$log" 2>&1; then
+        cat "$log" >&2
+        echo "install.sh: failed: $*" >&2
+        exit 1
+    fi
+}
 
 packages=(libegl1 libegl-mesa0 libgl1-mesa-dri libosmesa6 libgl1 libglx-mesa0 libx11-6 xvfb xdotool)
 missing=()
@@ -12,10 +24,21 @@ for p in "${packages[@]}"; do
 done
 if [ ${#missing[@]} -gt 0 ]; then
     sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
-    $sudo apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${missing[@]}"
+    echo "install.sh: installing ${missing[*]} (apt-get)"
+    quietly $sudo apt-get update -qq
+    quietly $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq "${missing[@]}"
 fi
 
-python3 -m venv .venv
-.venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e '.[test]'
+# What the environment was installed from: pyproject.toml and the Python that runs it.
+stamp=".venv/.install-stamp"
+want=$( { cat pyproject.toml; python3 --version; } | sha256sum | cut -d' ' -f1)
+if [ -x .venv/bin/python ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ] \
+        && .venv/bin/python -c "import renderer, reference" 2>/dev/null; then
+    exit 0                                   # up to date: nothing to do
+fi
+echo "install.sh: installing the package and its dependencies into .venv (pip)"
+[ -x .venv/bin/python ] || quietly python3 -m venv .venv
+rm -f "$stamp"
+quietly .venv/bin/python -m pip install -q --upgrade pip
+quietly .venv/bin/python -m pip install -q -e '.[test]'
+echo "$want" > "$stamp"

@@ -15,7 +15,8 @@ import sys
 import time
 from pathlib import Path
 
-from renderer.errors import UserError
+from renderer import __version__
+from renderer.errors import UsageError, UserError
 
 DEFAULT_SIZE = (640, 480)
 
@@ -41,12 +42,30 @@ def positive_int(text: str) -> int:
 
 
 class _Parser(argparse.ArgumentParser):
-    def error(self, message):          # argparse's own two-line usage + message, but exit 2 anyway
-        raise UserError(f"{self.prog}: {message}")
+    """argparse, but a refused command line is a UsageError: main() prints the reason after
+    the (sub)command's name on one line, then its usage on one line (never wrapped), and
+    returns 2."""
+
+    def error(self, message):
+        raise UsageError(message, prog=self.prog, usage=self.usage_line())
+
+    def parse_args(self, args=None, namespace=None):
+        # argparse hands a subcommand's unknown options up to the top: refuse them with the
+        # subcommand's usage, which is the one that lists what it takes.
+        args, extras = self.parse_known_args(args, namespace)
+        if extras:
+            getattr(args, "parser", self).error(f"unrecognized arguments: {' '.join(extras)}")
+        return args
+
+    def usage_line(self) -> str:
+        formatter = argparse.HelpFormatter(self.prog, width=1_000_000)
+        formatter.add_usage(self.usage, self._actions, self._mutually_exclusive_groups)
+        return formatter.format_help().strip()
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="renderer", description="A GLSL renderer checked against a NumPy reference.")
+    parser.add_argument("--version", action="version", version=f"renderer {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     def common(p):
@@ -121,6 +140,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
+    for subparser in sub.choices.values():       # for the commands' own checks of their options
+        subparser.set_defaults(parser=subparser)
     return parser
 
 
@@ -164,7 +185,7 @@ def cmd_view(args) -> int:
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     if args.frames is None and args.stats is not None:
-        raise UserError("renderer view: --stats needs --frames (the scripted mode)")
+        args.parser.error("--stats needs --frames (the scripted mode)")
     scripted = args.frames is not None
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,
@@ -287,8 +308,15 @@ COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "sha
 
 def main(argv=None) -> int:
     try:
-        args = build_parser().parse_args(argv)
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as done:       # --help, --version: printed; their status
+            return done.code
         return COMMANDS[args.command](args)
+    except UsageError as error:
+        print(f"{error.prog}: {error.reason}", file=sys.stderr)
+        print(error.usage, file=sys.stderr)
+        return 2
     except UserError as error:
         print(f"renderer: {error.line()}", file=sys.stderr)
         return 2

@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 from renderer.core.imageio import read_png
 
@@ -44,11 +45,52 @@ def test_scenes_lists_one_name_first_on_each_line(cli):
     assert "sphere" in names and len(names) >= 8
 
 
-def test_bad_size_is_one_line_and_status_2(tmp_path, cli):
+def test_bad_size_is_the_reason_then_the_usage_and_status_2(tmp_path, cli):
+    """An argument error: one line with the reason (the program named once), then the
+    subcommand's usage on one line."""
     result = cli("render", "--size", "wide", "-o", str(tmp_path / "x.png"))
     assert result.returncode == 2
-    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.stderr
+    assert result.stderr.splitlines() == [
+        "renderer render: argument --size: expected WIDTHxHEIGHT such as 640x480, got 'wide'",
+        build_parser_usage("render")]
     assert not (tmp_path / "x.png").exists()
+
+
+def build_parser_usage(command: str) -> str:
+    """The usage line `renderer COMMAND` prints after an argument error."""
+    from renderer.cli import build_parser
+    parser = build_parser()
+    subparser = parser.parse_args([command]).parser if command else parser
+    return subparser.usage_line()
+
+
+def test_version_prints_the_version(capsys):
+    import renderer
+    from renderer.cli import main
+    assert main(["--version"]) == 0
+    assert capsys.readouterr().out == f"renderer {renderer.__version__}\n"
+
+
+@pytest.mark.parametrize("argv, reason", [
+    (["render", "--size", "0x10"], "renderer render: argument --size: width and height must be 1 to "
+                                   "16384 pixels, got '0x10'"),
+    (["render", "--bogus"], "renderer render: unrecognized arguments: --bogus"),
+    (["render", "--backend", "cuda"], "renderer render: argument --backend: invalid choice: 'cuda' "
+                                      "(choose from 'gpu', 'reference')"),
+    (["view", "--stats", "s.json"], "renderer view: --stats needs --frames (the scripted mode)"),
+    (["scenes", "extra"], "renderer scenes: unrecognized arguments: extra"),
+    ([], "renderer: the following arguments are required: command"),
+])
+def test_an_argument_error_names_the_program_once_then_gives_the_usage(argv, reason, capsys, tmp_path,
+                                                                        monkeypatch):
+    from renderer.cli import main
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    usage = build_parser_usage(argv[0] if argv else "")
+    assert err.splitlines() == [reason, usage] and out == ""
+    assert usage.startswith(f"usage: renderer {argv[0] if argv else '[-h] [--version]'}")
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_unknown_scene_names_the_built_in_ones(tmp_path, cli):

@@ -8,7 +8,6 @@ with nothing written; a bug keeps its traceback.
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
 import sys
@@ -180,7 +179,7 @@ def cmd_render(args) -> int:
 
 def cmd_view(args) -> int:
     """The window viewer (renderer/viewer/viewer.py); without a display, one line and status 2."""
-    from renderer.core.imageio import write_text
+    from renderer.core.jsonio import write_json
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
@@ -199,7 +198,7 @@ def cmd_view(args) -> int:
         figures = viewer.figures
     if scripted:
         if args.stats is not None:
-            write_text(args.stats, json.dumps(stats.summary() | {"reference": figures}, indent=1))
+            write_json(args.stats, stats.summary() | {"reference": figures})
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
@@ -212,6 +211,7 @@ def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
     from renderer.core.imageio import write_png
+    from renderer.core.jsonio import finite_or_none, to_json
     scene = _load(args.scene)
     # Median of a few frames: the first one pays for shader compilation.
     gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
@@ -226,9 +226,10 @@ def cmd_compare(args) -> int:
     write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold,
                                          reference_tie=ref_frame.rgba8_tie))
     figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
+               "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
-    print(json.dumps(figures, allow_nan=True))
+    print(to_json(figures))
     return 0
 
 

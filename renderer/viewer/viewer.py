@@ -54,7 +54,7 @@ class FrameStats:
         return {"frames": len(frames) + 1, "frame_ms_median": median,
                 "frame_ms_p5": frames[int(0.05 * (len(frames) - 1))],
                 "frame_ms_p95": frames[int(0.95 * (len(frames) - 1))],
-                "frame_ms_max": frames[-1], "fps": 1000.0 / median if median > 0 else float("inf"),
+                "frame_ms_max": frames[-1], "fps": 1000.0 / median if median > 0 else None,
                 "draw_ms_median": statistics.median(self.draw_ms),
                 "latency_ms_median": self.latency_ms}
 
@@ -62,11 +62,12 @@ class FrameStats:
         s = self.summary()
         if s["frames"] < 2:
             return f"{s['frames']} frame(s): no frame times"
+        fps = "no" if s["fps"] is None else f"{s['fps']:.1f}"     # None: frames took no time
         latency = "" if s["latency_ms_median"] is None else \
             f", latency {s['latency_ms_median']:.2f} ms"
         return (f"{s['frames']} frames: frame time median {s['frame_ms_median']:.2f} ms "
                 f"(p5 {s['frame_ms_p5']:.2f}, p95 {s['frame_ms_p95']:.2f}, max {s['frame_ms_max']:.2f}), "
-                f"{s['fps']:.1f} fps; drawing median {s['draw_ms_median']:.2f} ms{latency}")
+                f"{fps} fps; drawing median {s['draw_ms_median']:.2f} ms{latency}")
 
 
 class Viewer:

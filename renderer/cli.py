@@ -12,9 +12,11 @@ import os
 import statistics
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from renderer import __version__
+from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.errors import UsageError, UserError
 
 DEFAULT_SIZE = (640, 480)
@@ -37,6 +39,16 @@ def positive_int(text: str) -> int:
         value = 0
     if value < 1:
         raise argparse.ArgumentTypeError(f"expected a whole number of at least 1, got {text!r}")
+    return value
+
+
+def channel_threshold(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 255:
+        raise argparse.ArgumentTypeError(f"expected a whole number of levels from 0 to 255, got {text!r}")
     return value
 
 
@@ -102,11 +114,21 @@ def build_parser() -> argparse.ArgumentParser:
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
 
-    compare = sub.add_parser("compare", help="render through the GPU and the reference and compare")
+    compare = sub.add_parser(
+        "compare", help="render through the GPU and the reference and compare",
+        description="Render a scene through the GPU and the NumPy reference, write gpu.png, "
+                    "reference.png and diff.png, and print the figures as one JSON object. "
+                    "Exit status: 0 when the two agree within the pipeline tolerance "
+                    f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
+                    "(what fails is said on stderr), 2 for bad input.")
     common(compare)
     compare.add_argument("--out", type=Path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
-    compare.add_argument("--threshold", type=int, default=2, help="per-channel threshold of 255 (default 2)")
+    compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
+                         metavar="LEVELS",
+                         help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
+                              f"tolerance with this threshold decides the exit status (default "
+                              f"{PIPELINE_TOLERANCE.threshold}, the tolerance's own)")
 
     shaders = sub.add_parser("shaders", help="write the exact GLSL a scene's draws use")
     shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
@@ -218,18 +240,26 @@ def cmd_compare(args) -> int:
     start = time.perf_counter()
     ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
     reference_ms = (time.perf_counter() - start) * 1000.0
+    tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
-                            threshold=args.threshold, reference_tie=ref_frame.rgba8_tie)
+                            threshold=tolerance.threshold, deviation=tolerance.deviation,
+                            reference_tie=ref_frame.rgba8_tie)
     out = args.out or Path(f"compare-{scene.name}")
     write_png(out / "gpu.png", gpu_frame.rgba8)
     write_png(out / "reference.png", ref_frame.rgba8)
-    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold,
-                                         reference_tie=ref_frame.rgba8_tie))
+    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
+                                         tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
     figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
+    failures = tolerance.failures(result)
+    figures["passes"] = not failures
     print(to_json(figures))
+    if failures:
+        print(f"renderer compare: {scene.name} fails the pipeline tolerance: {'; '.join(failures)}",
+              file=sys.stderr)
+        return 1
     return 0
 
 

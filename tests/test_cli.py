@@ -143,3 +143,67 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
     assert "#define SPECULAR" in flat["geometry_shader"]
     activate(ctx)
     ctx.program(**flat).release()
+
+
+# -- compare's exit status ------------------------------------------------------------------------
+
+def sphere_with_a_square_off_by_128(reference_frames):
+    """The reference's 32x24 sphere with a 4x4 square in its middle 128 levels off in R, G
+    and B: as a GPU frame, 16 pixels that nothing within ±1 px matches at a threshold under 128."""
+    from dataclasses import replace
+    frame = reference_frames("sphere", 32, 24)
+    rgba8 = frame.rgba8.copy()
+    assert (rgba8[10:14, 14:18, 3] == 255).all()              # on the sphere
+    rgba8[10:14, 14:18, :3] ^= 0x80
+    return replace(frame, rgba8=rgba8)
+
+
+@pytest.mark.parametrize("threshold, status", [(None, 1), ("127", 1), ("128", 0), ("255", 0)])
+def test_compare_exits_1_when_the_pipeline_tolerance_fails(threshold, status, tmp_path, capsys,
+                                                           gpu_stand_in, reference_frames):
+    """The pipeline tolerance at the threshold asked for (default: the tolerance's own, 2)
+    decides: 0 when the images agree, 1 when they do not, with what fails on stderr."""
+    from renderer.cli import main
+    gpu_stand_in(sphere_with_a_square_off_by_128(reference_frames))
+    argv = ["compare", "sphere", "--size", "32x24", "--out", str(tmp_path)]
+    assert main(argv + (["--threshold", threshold] if threshold else [])) == status
+    out, err = capsys.readouterr()
+    figures = json.loads(out)
+    assert figures["passes"] is (status == 0)
+    assert figures["threshold"] == int(threshold or 2)
+    assert figures["mismatched_pixels"] == (16 if status else 0)
+    if status:
+        level = threshold or 2
+        assert err.splitlines() == [
+            f"renderer compare: sphere fails the pipeline tolerance: 16 pixels fail within ±1 px at "
+            f"{level}/255 (at most 0 may); 2.0833% of pixels differ by more than {level}/255 in place "
+            f"(at most 0.1%)"]
+    else:
+        assert err == ""
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["diff.png", "gpu.png", "reference.png"]
+
+
+def test_compare_exits_0_when_the_images_agree(tmp_path, capsys, gpu_stand_in, reference_frames):
+    from renderer.cli import main
+    gpu_stand_in(reference_frames("sphere", 32, 24))
+    assert main(["compare", "sphere", "--size", "32x24", "--out", str(tmp_path)]) == 0
+    assert json.loads(capsys.readouterr().out)["passes"] is True
+
+
+@pytest.mark.parametrize("threshold", ["-1", "256", "2.5", "two"])
+def test_compare_refuses_a_threshold_outside_0_to_255(threshold, tmp_path, capsys):
+    from renderer.cli import main
+    out = tmp_path / "cmp"
+    assert main(["compare", "sphere", "--out", str(out), "--threshold", threshold]) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines() == [f"renderer compare: argument --threshold: expected a whole number of "
+                                f"levels from 0 to 255, got {threshold!r}", build_parser_usage("compare")]
+    assert not out.exists()
+
+
+def test_compare_help_gives_the_exit_status(capsys):
+    from renderer.cli import main
+    assert main(["compare", "--help"]) == 0
+    text = " ".join(capsys.readouterr().out.split())
+    assert ("Exit status: 0 when the two agree within the pipeline tolerance" in text
+            and "1 when they do not" in text and "2 for bad input" in text)

@@ -62,31 +62,23 @@ def test_no_module_writes_json_but_the_helper():
 
 # -- each output ------------------------------------------------------------------------------
 
-def fake_gpu(frame):
-    """A stand-in for cli._render_gpu that hands back `frame` as the GPU's."""
-    from renderer.core.gl_rules import SUBPIXEL_BITS
-
-    def render(scene, size, context_kind, frames=1):
-        return frame, 1.0, {"GL_RENDERER": "llvmpipe (fake)", "context": "fake"}, SUBPIXEL_BITS
-    return render
-
-
-def test_compare_prints_null_psnr_for_identical_images(tmp_path, capsys, monkeypatch, reference_frames):
+def test_compare_prints_null_psnr_for_identical_images(tmp_path, capsys, gpu_stand_in, reference_frames):
     """The GPU's frame replaced by the reference's own: identical, so PSNR is infinite."""
     from renderer import cli
-    monkeypatch.setattr(cli, "_render_gpu", fake_gpu(reference_frames("sphere", *SIZE)))
+    gpu_stand_in(reference_frames("sphere", *SIZE))
     status = cli.main(["compare", "sphere", "--size", "32x24", "--out", str(tmp_path)])
     figures = strict_loads(capsys.readouterr().out)
     assert status == 0
     assert figures["psnr"] is None and figures["rmse"] == 0.0 and figures["max_abs"] == 0
 
 
-def test_compare_prints_psnr_as_a_number_otherwise(tmp_path, capsys, monkeypatch, reference_frames):
+def test_compare_prints_psnr_as_a_number_otherwise(tmp_path, capsys, gpu_stand_in, reference_frames):
+    from dataclasses import replace
     from renderer import cli
     frame = reference_frames("sphere", *SIZE)
-    gpu = type(frame)(**{**frame.__dict__, "rgba8": frame.rgba8.copy()})
+    gpu = replace(frame, rgba8=frame.rgba8.copy())
     gpu.rgba8[0, 0, :3] ^= 0xFF
-    monkeypatch.setattr(cli, "_render_gpu", fake_gpu(gpu))
+    gpu_stand_in(gpu)
     cli.main(["compare", "sphere", "--size", "32x24", "--out", str(tmp_path)])
     figures = strict_loads(capsys.readouterr().out)
     assert figures["psnr"] == pytest.approx(20 * math.log10(255 / figures["rmse"]))

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
+from renderer.core.frame import BACKGROUNDS
 from renderer.errors import UsageError, UserError
 
 DEFAULT_SIZE = (640, 480)
@@ -92,6 +93,10 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
     render.add_argument("--depth", type=Path, metavar="OUT.npy",
                         help="also write camera-space depth (float32, +inf where empty)")
+    render.add_argument("--background", choices=BACKGROUNDS, default="opaque",
+                        help="opaque (default): the picture as an image viewer shows it, the "
+                             "scene's background colour where nothing is drawn (RGB); transparent: "
+                             "RGBA, alpha 0 where nothing is drawn and 255 elsewhere")
 
     view = sub.add_parser("view", help="open a scene in a window (glfw): orbit, pan, zoom, "
                                        "switch shading, compare with the reference; H for help")
@@ -192,7 +197,7 @@ def cmd_render(args) -> int:
     else:
         import reference
         frame = reference.render(scene, *args.size)
-    write_png(output, frame.rgba8)
+    write_png(output, frame.image(args.background))
     if args.depth:
         write_npy(args.depth, frame.depth)
     print(f"wrote {output} ({args.size[0]}x{args.size[1]}, {args.backend}, {frame.milliseconds:.1f} ms)")

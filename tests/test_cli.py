@@ -207,3 +207,48 @@ def test_compare_help_gives_the_exit_status(capsys):
     text = " ".join(capsys.readouterr().out.split())
     assert ("Exit status: 0 when the two agree within the pipeline tolerance" in text
             and "1 when they do not" in text and "2 for bad input" in text)
+
+
+# -- the background of the files `render` writes ------------------------------------------------
+
+def render_in_process(tmp_path, *args) -> int:
+    from renderer.cli import main
+    return main(["render", "--backend", "reference", "--size", "32x24", *map(str, args)])
+
+
+def test_render_writes_the_picture_opaque_by_default(tmp_path, reference_frames):
+    """orthographic's background is [0.9, 0.92, 0.95]: the file shows it, opaque (RGB), as
+    an image viewer shows the picture; the pixels are the frame's colour everywhere."""
+    from PIL import Image
+    out = tmp_path / "o.png"
+    assert render_in_process(tmp_path, "orthographic", "-o", out) == 0
+    with Image.open(out) as image:
+        assert image.mode == "RGB"
+        pixels = np.asarray(image)
+    frame = reference_frames("orthographic", 32, 24)
+    assert np.array_equal(pixels, frame.rgba8[..., :3])
+    nothing_drawn = frame.rgba8[..., 3] == 0
+    assert nothing_drawn.any() and (pixels[nothing_drawn] == [230, 235, 242]).all()
+    assert read_png(out)[..., 3].min() == 255
+
+
+def test_render_background_transparent_writes_the_coverage_alpha(tmp_path, reference_frames):
+    """--background transparent: RGBA, alpha 255 where something was drawn and 0 elsewhere,
+    the frame's rgba8 as it is (what goldens and compare's images hold)."""
+    from PIL import Image
+    out = tmp_path / "t.png"
+    assert render_in_process(tmp_path, "orthographic", "-o", out, "--background", "transparent") == 0
+    with Image.open(out) as image:
+        assert image.mode == "RGBA"
+        pixels = np.asarray(image)
+    frame = reference_frames("orthographic", 32, 24)
+    assert np.array_equal(pixels, frame.rgba8)
+    assert set(np.unique(pixels[..., 3])) == {0, 255}
+
+
+def test_frame_image_by_background(reference_frames):
+    frame = reference_frames("sphere", 32, 24)
+    assert np.array_equal(frame.image(), frame.rgba8[..., :3])
+    assert frame.image("transparent") is frame.rgba8
+    with pytest.raises(ValueError, match="background must be one of"):
+        frame.image("white")

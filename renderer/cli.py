@@ -89,7 +89,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
-    render.add_argument("-o", "--output", type=Path, help="PNG to write (default: SCENE_NAME.png)")
+    render.add_argument("-o", "--output", type=Path, metavar="OUT.png",
+                        help="image to write, in the format its suffix names (.png, .jpg, .webp, "
+                             ".tif, ...; default: SCENE_NAME.png)")
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
     render.add_argument("--depth", type=Path, metavar="OUT.npy",
                         help="also write camera-space depth (float32, +inf where empty)")
@@ -108,7 +110,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "statistics and exit")
     view.add_argument("--screenshot", type=Path, metavar="OUT.png",
                       help="with --frames: what the window shows after the last frame; "
-                           "otherwise the file the S key writes (default view-SCENE-NNN.png)")
+                           "otherwise the file the S key writes (default view-SCENE-NNN.png); "
+                           "in the format its suffix names (.png, .jpg, ...)")
     view.add_argument("--stats", type=Path, metavar="OUT.json",
                       help="with --frames: also write the frame-time statistics as JSON")
     view.add_argument("--orbit", type=float, default=0.0, metavar="DEGREES_PER_FRAME",
@@ -189,7 +192,12 @@ def _render_gpu(scene, size, context_kind, frames=1):
 
 
 def cmd_render(args) -> int:
-    from renderer.core.imageio import write_npy, write_png
+    from renderer.core.imageio import image_format, write_image, write_npy
+    if args.output is not None:              # a name Pillow cannot write: said before any work
+        image_format(args.output, alpha=args.background == "transparent")
+    if args.depth is not None and args.depth.suffix.lower() != ".npy":
+        raise UserError("--depth writes a NumPy array; name the file with .npy, e.g. depth.npy",
+                        file=str(args.depth))
     scene = _load(args.scene)
     output = args.output or Path(f"{scene.name}.png")
     if args.backend == "gpu":
@@ -197,7 +205,7 @@ def cmd_render(args) -> int:
     else:
         import reference
         frame = reference.render(scene, *args.size)
-    write_png(output, frame.image(args.background))
+    write_image(output, frame.image(args.background))
     if args.depth:
         write_npy(args.depth, frame.depth)
     print(f"wrote {output} ({args.size[0]}x{args.size[1]}, {args.backend}, {frame.milliseconds:.1f} ms)")
@@ -206,12 +214,15 @@ def cmd_render(args) -> int:
 
 def cmd_view(args) -> int:
     """The window viewer (renderer/viewer/viewer.py); without a display, one line and status 2."""
+    from renderer.core.imageio import image_format
     from renderer.core.jsonio import write_json
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
+    if args.screenshot is not None:          # before the window opens: a screenshot is RGB
+        image_format(args.screenshot)
     scripted = args.frames is not None
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,

@@ -252,3 +252,74 @@ def test_frame_image_by_background(reference_frames):
     assert frame.image("transparent") is frame.rgba8
     with pytest.raises(ValueError, match="background must be one of"):
         frame.image("white")
+
+
+# -- the format of the files the command line writes ------------------------------------------------
+
+@pytest.mark.parametrize("name, image_format, mode", [
+    ("o.jpg", "JPEG", "RGB"), ("o.JPEG", "JPEG", "RGB"), ("o.webp", "WEBP", "RGB"),
+    ("o.tif", "TIFF", "RGB"), ("o.bmp", "BMP", "RGB"), ("o.png", "PNG", "RGB")])
+def test_render_writes_the_format_its_suffix_names(name, image_format, mode, tmp_path, reference_frames):
+    from PIL import Image
+    out = tmp_path / name
+    assert render_in_process(tmp_path, "sphere", "-o", out) == 0
+    with Image.open(out) as image:
+        assert (image.format, image.mode, image.size) == (image_format, mode, (32, 24))
+        pixels = np.asarray(image).astype(int)
+    expected = reference_frames("sphere", 32, 24).rgba8[..., :3].astype(int)
+    difference = np.abs(pixels - expected)
+    if image_format == "JPEG":                         # lossy, at quality 95
+        assert difference.mean() < 2.0
+    else:
+        assert difference.max() == 0
+    assert [p.name for p in tmp_path.iterdir()] == [name]
+
+
+def test_render_transparent_keeps_alpha_in_a_format_that_has_it(tmp_path, reference_frames):
+    from PIL import Image
+    out = tmp_path / "t.webp"
+    assert render_in_process(tmp_path, "sphere", "-o", out, "--background", "transparent") == 0
+    with Image.open(out) as image:
+        assert (image.format, image.mode) == ("WEBP", "RGBA")
+        alpha = np.asarray(image)[..., 3]
+    assert np.array_equal(alpha, reference_frames("sphere", 32, 24).rgba8[..., 3])
+
+
+@pytest.mark.parametrize("name, args, reason", [
+    ("o.xyz", (), "cannot write .xyz images; use .png, .jpg, .webp, .tif, .bmp or another suffix "
+                  "Pillow writes"),
+    ("o.h5", (), "cannot write .h5 images; use .png, .jpg, .webp, .tif, .bmp or another suffix "
+                 "Pillow writes"),
+    ("out", (), "no suffix to say the image format; name the file e.g. out.png or out.jpg"),
+    ("o.jpg", ("--background", "transparent"),
+     "JPEG (.jpg) keeps no alpha channel, which a transparent background needs; use .png, .webp "
+     "or .tif"),
+    ("o.bmp", ("--background", "transparent"),
+     "BMP (.bmp) keeps no alpha channel, which a transparent background needs; use .png, .webp "
+     "or .tif"),
+])
+def test_render_refuses_a_file_name_it_cannot_write(name, args, reason, tmp_path, capsys):
+    out = tmp_path / name
+    assert render_in_process(tmp_path, "sphere", "-o", out, *args) == 2
+    assert capsys.readouterr().err.splitlines() == [f"renderer: {out}: {reason}"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_render_refuses_depth_that_is_not_npy(tmp_path, capsys):
+    depth = tmp_path / "d.png"
+    assert render_in_process(tmp_path, "sphere", "-o", tmp_path / "o.png", "--depth", depth) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"renderer: {depth}: --depth writes a NumPy array; name the file with .npy, e.g. depth.npy"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_view_refuses_a_screenshot_name_before_opening_a_window(tmp_path, capsys, monkeypatch):
+    from renderer.cli import main
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    shot = tmp_path / "s.xyz"
+    assert main(["view", "sphere", "--frames", "1", "--screenshot", str(shot)]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        f"renderer: {shot}: cannot write .xyz images; use .png, .jpg, .webp, .tif, .bmp or another "
+        f"suffix Pillow writes"]
+    assert list(tmp_path.iterdir()) == []

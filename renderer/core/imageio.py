@@ -19,8 +19,9 @@ from PIL import Image
 
 from renderer.errors import UserError
 
-# Formats Pillow would write at a quality meant for something else (JPEG: 75).
-SAVE_OPTIONS = {"JPEG": {"quality": 95}}
+# Pillow's defaults are for photographs (JPEG at quality 75 with halved chroma, lossy WebP);
+# a render has sharp edges and flat colours: JPEG at 95 with full chroma, WebP lossless.
+SAVE_OPTIONS = {"JPEG": {"quality": 95, "subsampling": 0}, "WEBP": {"lossless": True}}
 SUGGESTED_SUFFIXES = ".png, .jpg, .webp, .tif, .bmp"
 ALPHA_SUFFIXES = ".png, .webp or .tif"
 

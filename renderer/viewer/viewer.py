@@ -25,7 +25,7 @@ import numpy as np
 
 from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
 from renderer.gpu.pipeline import GpuRenderer
-from renderer.core.imageio import write_png
+from renderer.core.imageio import write_image
 from renderer.viewer.orbit import OrbitCamera
 from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
@@ -268,7 +268,7 @@ class Viewer:
                 path = Path(f"view-{self.authored.name}-{self._screenshots:03d}.png")
                 if not path.exists():
                     break
-        write_png(path, self.window_image())
+        write_image(path, self.window_image())
         self.say(f"screenshot: {path}")
         return path
 
@@ -295,7 +295,7 @@ class Viewer:
                 # The image just swapped in is the front buffer now; draw it again (the
                 # same frame, no orbit step) to read it from the back buffer.
                 self._compose(self.presenter.shown)
-                write_png(screenshot, self.window_image())
+                write_image(screenshot, self.window_image())
             count += 1
         self.stats.latency_ms = self.presenter.latency_ms
         return self.stats

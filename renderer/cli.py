@@ -95,6 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
     render.add_argument("--depth", type=Path, metavar="OUT.npy",
                         help="also write camera-space depth (float32, +inf where empty)")
+    render.add_argument("-q", "--quiet", action="store_true",
+                        help="do not say where the image was written (one line on stderr)")
     render.add_argument("--background", choices=BACKGROUNDS, default="opaque",
                         help="opaque (default): the picture as an image viewer shows it, the "
                              "scene's background colour where nothing is drawn (RGB); transparent: "
@@ -208,7 +210,10 @@ def cmd_render(args) -> int:
     write_image(output, frame.image(args.background))
     if args.depth:
         write_npy(args.depth, frame.depth)
-    print(f"wrote {output} ({args.size[0]}x{args.size[1]}, {args.backend}, {frame.milliseconds:.1f} ms)")
+    if not args.quiet:
+        written = f"{output} and {args.depth}" if args.depth else f"{output}"
+        print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {args.backend}, "
+              f"{frame.milliseconds:.1f} ms)", file=sys.stderr)
     return 0
 
 

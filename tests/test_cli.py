@@ -1,6 +1,7 @@
 """The command line as a user types it."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -23,6 +24,22 @@ def test_render_without_output_names_the_file_after_the_scene(tmp_path, cli):
     result = cli("render", "--size", "32x24", "--backend", "reference", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
     assert (tmp_path / "sphere.png").exists()
+    assert result.stdout == ""
+    assert re.fullmatch(r"wrote sphere\.png \(32x24, reference, \d+\.\d ms\)\n", result.stderr)
+
+
+def test_render_says_where_it_wrote_on_stderr_unless_quiet(tmp_path, capsys, monkeypatch):
+    from renderer.cli import main
+    monkeypatch.chdir(tmp_path)
+    assert main(["render", "--size", "16x12", "--backend", "reference", "--depth", "d.npy"]) == 0
+    out, err = capsys.readouterr()
+    assert out == ""
+    assert re.fullmatch(r"wrote sphere\.png and d\.npy \(16x12, reference, \d+\.\d ms\)\n", err)
+    for quiet in ("--quiet", "-q"):
+        (tmp_path / "sphere.png").unlink()
+        assert main(["render", "--size", "16x12", "--backend", "reference", quiet]) == 0
+        assert capsys.readouterr() == ("", "")
+        assert (tmp_path / "sphere.png").exists()
 
 
 def test_compare_prints_the_figures_and_writes_three_images(tmp_path, cli):

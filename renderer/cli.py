@@ -193,6 +193,15 @@ def _render_gpu(scene, size, context_kind, frames=1):
         return frame, statistics.median(timings), gpu.gl_info, gpu.subpixel_bits
 
 
+def warn_if_nothing_drawn(scene, frame) -> None:
+    """One line on stderr when no pixel of the frame was drawn, saying why if the objects'
+    bounding boxes tell (renderer/core/visibility.py). The exit status stays as it is."""
+    if not frame.rgba8[..., 3].any():
+        from renderer.core.visibility import nothing_in_view
+        reason = nothing_in_view(scene, scene.matrices(*frame.size))
+        print(f"renderer: warning: nothing was drawn: {reason}", file=sys.stderr)
+
+
 def cmd_render(args) -> int:
     from renderer.core.imageio import image_format, write_image, write_npy
     if args.output is not None:              # a name Pillow cannot write: said before any work
@@ -207,6 +216,7 @@ def cmd_render(args) -> int:
     else:
         import reference
         frame = reference.render(scene, *args.size)
+    warn_if_nothing_drawn(scene, frame)
     write_image(output, frame.image(args.background))
     if args.depth:
         write_npy(args.depth, frame.depth)
@@ -261,6 +271,7 @@ def cmd_compare(args) -> int:
     start = time.perf_counter()
     ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
     reference_ms = (time.perf_counter() - start) * 1000.0
+    warn_if_nothing_drawn(scene, gpu_frame)
     tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
                             threshold=tolerance.threshold, deviation=tolerance.deviation,

@@ -1,8 +1,10 @@
 """The command line: `renderer render | view | compare | shaders | report | scenes | extremes`
 (also `python -m renderer`).
 
-A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
-with nothing written; a bug keeps its traceback.
+A user's mistake (bad scene, bad output name, no GL) is one line on stderr and exit status
+2, with nothing written; an option argparse refuses is its reason on one line and the
+command's usage on the next, also status 2; a bug keeps its traceback. `compare` exits 1 when
+the images fail the pipeline tolerance.
 """
 
 from __future__ import annotations

@@ -1,21 +1,26 @@
 """The command line: `renderer render | view | compare | shaders | report | scenes | extremes`
 (also `python -m renderer`).
 
-A user's mistake (bad scene, bad option, no GL) is one line on stderr and exit status 2,
-with nothing written; a bug keeps its traceback.
+A user's mistake (bad scene, bad output name, no GL) is one line on stderr and exit status
+2, with nothing written; an option argparse refuses is its reason on one line and the
+command's usage on the next, also status 2; a bug keeps its traceback. `compare` exits 1 when
+the images fail the pipeline tolerance.
 """
 
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import statistics
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
-from renderer.errors import UserError
+from renderer import __version__
+from renderer.checks.tolerance import PIPELINE_TOLERANCE
+from renderer.core.frame import BACKGROUNDS
+from renderer.errors import UsageError, UserError
 
 DEFAULT_SIZE = (640, 480)
 
@@ -40,13 +45,41 @@ def positive_int(text: str) -> int:
     return value
 
 
+def channel_threshold(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        value = -1
+    if not 0 <= value <= 255:
+        raise argparse.ArgumentTypeError(f"expected a whole number of levels from 0 to 255, got {text!r}")
+    return value
+
+
 class _Parser(argparse.ArgumentParser):
-    def error(self, message):          # argparse's own two-line usage + message, but exit 2 anyway
-        raise UserError(f"{self.prog}: {message}")
+    """argparse, but a refused command line is a UsageError: main() prints the reason after
+    the (sub)command's name on one line, then its usage on one line (never wrapped), and
+    returns 2."""
+
+    def error(self, message):
+        raise UsageError(message, prog=self.prog, usage=self.usage_line())
+
+    def parse_args(self, args=None, namespace=None):
+        # argparse hands a subcommand's unknown options up to the top: refuse them with the
+        # subcommand's usage, which is the one that lists what it takes.
+        args, extras = self.parse_known_args(args, namespace)
+        if extras:
+            getattr(args, "parser", self).error(f"unrecognized arguments: {' '.join(extras)}")
+        return args
+
+    def usage_line(self) -> str:
+        formatter = argparse.HelpFormatter(self.prog, width=1_000_000)
+        formatter.add_usage(self.usage, self._actions, self._mutually_exclusive_groups)
+        return formatter.format_help().strip()
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="renderer", description="A GLSL renderer checked against a NumPy reference.")
+    parser.add_argument("--version", action="version", version=f"renderer {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     def common(p):
@@ -58,10 +91,18 @@ def build_parser() -> argparse.ArgumentParser:
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
-    render.add_argument("-o", "--output", type=Path, help="PNG to write (default: SCENE_NAME.png)")
+    render.add_argument("-o", "--output", type=Path, metavar="OUT.png",
+                        help="image to write, in the format its suffix names (.png, .jpg, .webp, "
+                             ".tif, ...; default: SCENE_NAME.png)")
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
     render.add_argument("--depth", type=Path, metavar="OUT.npy",
                         help="also write camera-space depth (float32, +inf where empty)")
+    render.add_argument("-q", "--quiet", action="store_true",
+                        help="do not say where the image was written (one line on stderr)")
+    render.add_argument("--background", choices=BACKGROUNDS, default="opaque",
+                        help="opaque (default): the picture as an image viewer shows it, the "
+                             "scene's background colour where nothing is drawn (RGB); transparent: "
+                             "RGBA, alpha 0 where nothing is drawn and 255 elsewhere")
 
     view = sub.add_parser("view", help="open a scene in a window (glfw): orbit, pan, zoom, "
                                        "switch shading, compare with the reference; H for help")
@@ -73,7 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "statistics and exit")
     view.add_argument("--screenshot", type=Path, metavar="OUT.png",
                       help="with --frames: what the window shows after the last frame; "
-                           "otherwise the file the S key writes (default view-SCENE-NNN.png)")
+                           "otherwise the file the S key writes (default view-SCENE-NNN.png); "
+                           "in the format its suffix names (.png, .jpg, ...)")
     view.add_argument("--stats", type=Path, metavar="OUT.json",
                       help="with --frames: also write the frame-time statistics as JSON")
     view.add_argument("--orbit", type=float, default=0.0, metavar="DEGREES_PER_FRAME",
@@ -84,11 +126,21 @@ def build_parser() -> argparse.ArgumentParser:
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
 
-    compare = sub.add_parser("compare", help="render through the GPU and the reference and compare")
+    compare = sub.add_parser(
+        "compare", help="render through the GPU and the reference and compare",
+        description="Render a scene through the GPU and the NumPy reference, write gpu.png, "
+                    "reference.png and diff.png, and print the figures as one JSON object. "
+                    "Exit status: 0 when the two agree within the pipeline tolerance "
+                    f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
+                    "(what fails is said on stderr), 2 for bad input.")
     common(compare)
     compare.add_argument("--out", type=Path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
-    compare.add_argument("--threshold", type=int, default=2, help="per-channel threshold of 255 (default 2)")
+    compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
+                         metavar="LEVELS",
+                         help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
+                              f"tolerance with this threshold decides the exit status (default "
+                              f"{PIPELINE_TOLERANCE.threshold}, the tolerance's own)")
 
     shaders = sub.add_parser("shaders", help="write the exact GLSL a scene's draws use")
     shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
@@ -121,6 +173,8 @@ def build_parser() -> argparse.ArgumentParser:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
+    for subparser in sub.choices.values():       # for the commands' own checks of their options
+        subparser.set_defaults(parser=subparser)
     return parser
 
 
@@ -141,8 +195,22 @@ def _render_gpu(scene, size, context_kind, frames=1):
         return frame, statistics.median(timings), gpu.gl_info, gpu.subpixel_bits
 
 
+def warn_if_nothing_drawn(scene, frame) -> None:
+    """One line on stderr when no pixel of the frame was drawn, saying why if the objects'
+    bounding boxes tell (renderer/core/visibility.py). The exit status stays as it is."""
+    if not frame.rgba8[..., 3].any():
+        from renderer.core.visibility import nothing_in_view
+        reason = nothing_in_view(scene, scene.matrices(*frame.size))
+        print(f"renderer: warning: nothing was drawn: {reason}", file=sys.stderr)
+
+
 def cmd_render(args) -> int:
-    from renderer.core.imageio import write_npy, write_png
+    from renderer.core.imageio import image_format, write_image, write_npy
+    if args.output is not None:              # a name Pillow cannot write: said before any work
+        image_format(args.output, alpha=args.background == "transparent")
+    if args.depth is not None and args.depth.suffix.lower() != ".npy":
+        raise UserError("--depth writes a NumPy array; name the file with .npy, e.g. depth.npy",
+                        file=str(args.depth))
     scene = _load(args.scene)
     output = args.output or Path(f"{scene.name}.png")
     if args.backend == "gpu":
@@ -150,21 +218,28 @@ def cmd_render(args) -> int:
     else:
         import reference
         frame = reference.render(scene, *args.size)
-    write_png(output, frame.rgba8)
+    warn_if_nothing_drawn(scene, frame)
+    write_image(output, frame.image(args.background))
     if args.depth:
         write_npy(args.depth, frame.depth)
-    print(f"wrote {output} ({args.size[0]}x{args.size[1]}, {args.backend}, {frame.milliseconds:.1f} ms)")
+    if not args.quiet:
+        written = f"{output} and {args.depth}" if args.depth else f"{output}"
+        print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {args.backend}, "
+              f"{frame.milliseconds:.1f} ms)", file=sys.stderr)
     return 0
 
 
 def cmd_view(args) -> int:
     """The window viewer (renderer/viewer/viewer.py); without a display, one line and status 2."""
-    from renderer.core.imageio import write_text
+    from renderer.core.imageio import image_format
+    from renderer.core.jsonio import write_json
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     if args.frames is None and args.stats is not None:
-        raise UserError("renderer view: --stats needs --frames (the scripted mode)")
+        args.parser.error("--stats needs --frames (the scripted mode)")
+    if args.screenshot is not None:          # before the window opens: a screenshot is RGB
+        image_format(args.screenshot)
     scripted = args.frames is not None
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,
@@ -178,7 +253,7 @@ def cmd_view(args) -> int:
         figures = viewer.figures
     if scripted:
         if args.stats is not None:
-            write_text(args.stats, json.dumps(stats.summary() | {"reference": figures}, indent=1))
+            write_json(args.stats, stats.summary() | {"reference": figures})
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
@@ -191,23 +266,34 @@ def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
     from renderer.core.imageio import write_png
+    from renderer.core.jsonio import finite_or_none, to_json
     scene = _load(args.scene)
     # Median of a few frames: the first one pays for shader compilation.
     gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
     start = time.perf_counter()
     ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
     reference_ms = (time.perf_counter() - start) * 1000.0
+    warn_if_nothing_drawn(scene, gpu_frame)
+    tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
-                            threshold=args.threshold, reference_tie=ref_frame.rgba8_tie)
+                            threshold=tolerance.threshold, deviation=tolerance.deviation,
+                            reference_tie=ref_frame.rgba8_tie)
     out = args.out or Path(f"compare-{scene.name}")
     write_png(out / "gpu.png", gpu_frame.rgba8)
     write_png(out / "reference.png", ref_frame.rgba8)
-    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, args.threshold,
-                                         reference_tie=ref_frame.rgba8_tie))
+    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
+                                         tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
     figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
+               "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
-    print(json.dumps(figures, allow_nan=True))
+    failures = tolerance.failures(result)
+    figures["passes"] = not failures
+    print(to_json(figures))
+    if failures:
+        print(f"renderer compare: {scene.name} fails the pipeline tolerance: {'; '.join(failures)}",
+              file=sys.stderr)
+        return 1
     return 0
 
 
@@ -287,8 +373,15 @@ COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "sha
 
 def main(argv=None) -> int:
     try:
-        args = build_parser().parse_args(argv)
+        try:
+            args = build_parser().parse_args(argv)
+        except SystemExit as done:       # --help, --version: printed; their status
+            return done.code
         return COMMANDS[args.command](args)
+    except UsageError as error:
+        print(f"{error.prog}: {error.reason}", file=sys.stderr)
+        print(error.usage, file=sys.stderr)
+        return 2
     except UserError as error:
         print(f"renderer: {error.line()}", file=sys.stderr)
         return 2

@@ -21,6 +21,15 @@ class UserError(Exception):
         return f"{where}: {self.reason}" if where else self.reason
 
 
+class UsageError(UserError):
+    """A command line that argparse (or a check of how options go together) refuses. The
+    command line prints `PROG: REASON` and then the usage line of the (sub)command PROG."""
+
+    def __init__(self, reason: str, prog: str, usage: str):
+        self.prog, self.usage = prog, usage
+        super().__init__(reason)
+
+
 class SceneError(UserError):
     """A scene file (or a mesh it names) that cannot be rendered."""
 

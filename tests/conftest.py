@@ -10,8 +10,9 @@ Why an option rather than `-m "not slow and not window"` in addopts: undoing an 
 and a user's own `-m` would silently replace ours; `--all` says what it does.
 
 Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
-`on_x_display` (Xvfb), `cli` (the command line in a new process) and `reference_frames`
-(NumPy reference frames, each rendered once per test run).
+`on_x_display` (Xvfb), `cli` (the command line in a new process), `gpu_stand_in` (the command
+line's GPU frames replaced, in this process) and `reference_frames` (NumPy reference frames,
+each rendered once per test run).
 """
 
 import os
@@ -128,6 +129,23 @@ def cli():
         return subprocess.run([sys.executable, "-m", "renderer", *map(str, args)],
                               capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout)
     return run
+
+
+@pytest.fixture
+def gpu_stand_in(monkeypatch):
+    """gpu_stand_in(frame): from now on, in this test, the command line's GPU render
+    (renderer.cli._render_gpu, which `render --backend gpu` and `compare` call) hands back
+    `frame` instead of drawing, so that `renderer.cli.main([...])` can be run in-process on a
+    frame made to order (e.g. a reference frame with some pixels changed)."""
+    from renderer import cli
+    from renderer.core.gl_rules import SUBPIXEL_BITS
+
+    def stand_in(frame):
+        def render(scene, size, context_kind, frames=1):
+            assert frame.size == tuple(size), "the stand-in frame has another size"
+            return frame, 1.0, {"GL_RENDERER": "llvmpipe (stand-in)", "context": "stand-in"}, SUBPIXEL_BITS
+        monkeypatch.setattr(cli, "_render_gpu", render)
+    return stand_in
 
 
 # -- reference frames ---------------------------------------------------------------------------

@@ -69,6 +69,18 @@ def test_scripted_screenshot_is_the_headless_render(x_display, tmp_path, cli):
     assert_matches(read_png(shot)[..., :3], headless(scene()))
 
 
+def test_scripted_screenshot_in_the_format_its_suffix_names(x_display, tmp_path, cli):
+    from PIL import Image
+    shot = tmp_path / "shot.jpg"
+    result = cli("view", "sphere", "--size", "160x120", "--frames", "1", "--screenshot", str(shot),
+                 display=x_display)
+    assert result.returncode == 0, result.stderr
+    with Image.open(shot) as image:
+        assert (image.format, image.mode, image.size) == ("JPEG", "RGB", (160, 120))
+        pixels = np.asarray(image).astype(int)
+    assert np.abs(pixels - headless(scene())[..., :3].astype(int)).mean() < 2.0     # lossy
+
+
 @pytest.mark.parametrize("buffering, frames_late", [("double", 0), ("triple", 1)])
 def test_orbiting_shows_the_camera_of_the_frame_on_the_screen(x_display, tmp_path, buffering,
                                                               frames_late, cli):

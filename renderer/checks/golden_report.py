@@ -14,7 +14,6 @@ refused rather than emptied.
 from __future__ import annotations
 
 import html
-import json
 import shutil
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +22,7 @@ from renderer.checks.compare import channel_difference, heat_map, position_devia
 from renderer.errors import show_number
 from renderer.checks.goldens import GoldenError, Outcome
 from renderer.core.imageio import write_png, write_text
+from renderer.core.jsonio import write_json
 from renderer.checks.perceptual import flip_error
 
 MARKER = ".golden-results"
@@ -99,7 +99,7 @@ class ResultsFolder:
             write_png(path / "flip.png", flip_map)
             entry.figures = figures_of(outcome, mean_flip)
         entry.figures.update(test=test, golden=str(outcome.png), status=outcome.status, notes=outcome.notes)
-        write_text(path / "figures.json", json.dumps(entry.figures, indent=2) + "\n")
+        write_json(path / "figures.json", entry.figures, indent=2)
         self.entries.append(entry)
         self.write_index()
         return entry

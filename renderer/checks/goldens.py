@@ -24,6 +24,7 @@ import numpy as np
 import renderer
 from renderer.errors import UserError
 from renderer.core.imageio import read_png, write_png, write_text
+from renderer.core.jsonio import to_json
 from renderer.checks.policies import Policy, Verdict, policy_from
 
 SIDECAR_FORMAT = 1
@@ -173,12 +174,12 @@ def _update(png, sidecar_path, name, actual, policy, wanted) -> Outcome:
         if all(sidecar.get(key) == wanted[key] for key in DECLARED_KEYS):
             status = "unchanged"
         else:
-            write_text(sidecar_path, json.dumps(wanted, indent=2) + "\n")
+            write_text(sidecar_path, to_json(wanted, indent=2) + "\n")
             status = "refreshed"
         verdict = None
     else:
         write_png(png, actual)                       # the PNG first: the sidecar names its pixels
-        write_text(sidecar_path, json.dumps(wanted, indent=2) + "\n")
+        write_text(sidecar_path, to_json(wanted, indent=2) + "\n")
         status = "created" if expected is None else "updated"
         verdict = policy.evaluate(expected, actual) if expected is not None and \
             expected.shape == actual.shape else None

@@ -6,6 +6,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+# How an image file shows where nothing was drawn (docs/conventions.md, "Colour"):
+# "opaque": RGB, the scene's background colour, as an image viewer shows the picture;
+# "transparent": RGBA with the coverage alpha of rgba8 (0 where nothing was drawn).
+BACKGROUNDS = ("opaque", "transparent")
+
 
 @dataclass
 class Frame:
@@ -31,6 +36,13 @@ class Frame:
     milliseconds: float = 0.0
     rgba8_tie: np.ndarray | None = None
     gl_info: dict | None = None
+
+    def image(self, background: str = "opaque") -> np.ndarray:
+        """The pixels an image file of this frame holds: (H, W, 3) for an opaque background,
+        rgba8 itself, with alpha as coverage, for a transparent one (BACKGROUNDS)."""
+        if background not in BACKGROUNDS:
+            raise ValueError(f"background must be one of {BACKGROUNDS}, got {background!r}")
+        return self.rgba8[..., :3] if background == "opaque" else self.rgba8
 
     @property
     def size(self) -> tuple[int, int]:

@@ -14,7 +14,6 @@ scene whose file is refused (a NaN vertex) is listed with the one-line error a u
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import replace
 from pathlib import Path
@@ -28,6 +27,7 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.core.imageio import write_text
+from renderer.core.jsonio import write_json
 from renderer.core.scene_file import load_scene
 
 # What makes each case stable, keyed by the scene file's name (docs/conventions.md has the rules).
@@ -194,7 +194,7 @@ def write_report(out: Path, cases: list[dict], size: tuple[int, int]) -> tuple[P
     """extremes.json (every figure of every case) and extremes.md (the table), atomically."""
     json_path, md_path = Path(out) / "extremes.json", Path(out) / "extremes.md"
     document = {"size": list(size), "cases": cases}
-    write_text(json_path, json.dumps(_json_safe(document), indent=1, allow_nan=False) + "\n")
+    write_json(json_path, _json_safe(document))
     write_text(md_path, markdown_table(cases, size))
     return json_path, md_path
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
 from renderer.gpu.pipeline import GpuRenderer
-from renderer.core.imageio import write_png
+from renderer.core.imageio import write_image
 from renderer.viewer.orbit import OrbitCamera
 from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
@@ -54,7 +54,7 @@ class FrameStats:
         return {"frames": len(frames) + 1, "frame_ms_median": median,
                 "frame_ms_p5": frames[int(0.05 * (len(frames) - 1))],
                 "frame_ms_p95": frames[int(0.95 * (len(frames) - 1))],
-                "frame_ms_max": frames[-1], "fps": 1000.0 / median if median > 0 else float("inf"),
+                "frame_ms_max": frames[-1], "fps": 1000.0 / median if median > 0 else None,
                 "draw_ms_median": statistics.median(self.draw_ms),
                 "latency_ms_median": self.latency_ms}
 
@@ -62,11 +62,12 @@ class FrameStats:
         s = self.summary()
         if s["frames"] < 2:
             return f"{s['frames']} frame(s): no frame times"
+        fps = "no" if s["fps"] is None else f"{s['fps']:.1f}"     # None: frames took no time
         latency = "" if s["latency_ms_median"] is None else \
             f", latency {s['latency_ms_median']:.2f} ms"
         return (f"{s['frames']} frames: frame time median {s['frame_ms_median']:.2f} ms "
                 f"(p5 {s['frame_ms_p5']:.2f}, p95 {s['frame_ms_p95']:.2f}, max {s['frame_ms_max']:.2f}), "
-                f"{s['fps']:.1f} fps; drawing median {s['draw_ms_median']:.2f} ms{latency}")
+                f"{fps} fps; drawing median {s['draw_ms_median']:.2f} ms{latency}")
 
 
 class Viewer:
@@ -267,7 +268,7 @@ class Viewer:
                 path = Path(f"view-{self.authored.name}-{self._screenshots:03d}.png")
                 if not path.exists():
                     break
-        write_png(path, self.window_image())
+        write_image(path, self.window_image())
         self.say(f"screenshot: {path}")
         return path
 
@@ -294,7 +295,7 @@ class Viewer:
                 # The image just swapped in is the front buffer now; draw it again (the
                 # same frame, no orbit step) to read it from the back buffer.
                 self._compose(self.presenter.shown)
-                write_png(screenshot, self.window_image())
+                write_image(screenshot, self.window_image())
             count += 1
         self.stats.latency_ms = self.presenter.latency_ms
         return self.stats

@@ -1,0 +1,32 @@
+"""JSON as every output of the project writes it (`renderer compare`'s figures, extremes.json,
+the viewer's --stats, golden sidecars and figures.json): standard JSON (RFC 8259).
+
+Standard JSON has no NaN or infinity, and Python's json module writes them as `NaN` and
+`Infinity` unless told not to, which strict parsers (jq, JavaScript's JSON.parse, serde)
+refuse. `to_json` tells it not to (allow_nan=False): a non-finite float anywhere raises
+ValueError, so a figure that turns NaN fails loudly instead of writing a file nobody can
+read. A figure that is infinite on purpose is mapped before: `finite_or_none` (the PSNR of
+two identical images is null).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+from renderer.core.imageio import write_text
+
+
+def to_json(value, *, indent: int | None = None) -> str:
+    """json.dumps(value, indent=indent), refusing NaN and infinities (ValueError)."""
+    return json.dumps(value, indent=indent, allow_nan=False)
+
+
+def write_json(path, value, *, indent: int = 1) -> None:
+    """`to_json(value)` and a newline, written atomically (imageio.write_text)."""
+    write_text(path, to_json(value, indent=indent) + "\n")
+
+
+def finite_or_none(x: float | None) -> float | None:
+    """x when it is a finite number, else None (JSON's null)."""
+    return x if x is not None and math.isfinite(x) else None

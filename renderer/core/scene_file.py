@@ -26,7 +26,7 @@ import numpy as np
 from renderer.core import transforms
 from renderer.core.builtin import assets_dir
 from renderer.errors import SceneError, show_number
-from renderer.core.meshio import load_mesh
+from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
                             Scene, SceneObject, Transform)
@@ -45,6 +45,7 @@ LIGHT_KEYS = {
 }
 OBJECT_KEYS = ("name", "mesh", "material", "scale", "shear", "rotate", "translate", "parent",
                "cull")
+MESH_FILE_KEYS = ("file", "crease_angle")
 
 # Limits on primitive arguments: (integer?, smallest, largest). Lengths must be > 0; counts
 # are capped so that a typo cannot ask for a hundred million triangles.
@@ -453,9 +454,16 @@ class _Reader:
         if "primitive" in raw and "file" in raw:
             self.fail(path, "give either primitive or file, not both")
         if "file" in raw:
-            self.table(raw, path, ("file",))
-            return self.mesh_file(raw["file"], _join(path, "file"))
+            self.table(raw, path, MESH_FILE_KEYS)
+            crease_angle = DEFAULT_CREASE_ANGLE
+            if "crease_angle" in raw:
+                crease_angle = self.crease_angle(raw["crease_angle"], _join(path, "crease_angle"))
+            return self.mesh_file(raw["file"], _join(path, "file"), crease_angle)
         if "primitive" in raw:
+            if "crease_angle" in raw:
+                self.fail(_join(path, "crease_angle"),
+                          "is for mesh files (mesh = { file = ... }); a primitive has exact "
+                          "normals, its flat faces already separate")
             return self.primitive(raw, path)
         self.fail(path, "needs a primitive or a file key")
 
@@ -483,7 +491,14 @@ class _Reader:
         mesh.recipe = (name, kwargs)
         return mesh
 
-    def mesh_file(self, value: Any, path: str) -> Mesh:
+    def crease_angle(self, value: Any, path: str) -> float:
+        angle = self.number(value, path)
+        if not 0.0 < angle <= 180.0:
+            self.fail(path, f"must be between 0 (excluded) and 180 degrees (180: smooth across "
+                            f"every edge), got {angle:g}")
+        return angle
+
+    def mesh_file(self, value: Any, path: str, crease_angle: float = DEFAULT_CREASE_ANGLE) -> Mesh:
         """Relative paths start at the scene file's folder, then at the built-in assets folder
         (so any scene can use the built-in meshes as "meshes/NAME")."""
         text = self.string(value, path)
@@ -495,7 +510,8 @@ class _Reader:
             candidates.append(assets / text)
         for candidate in candidates:
             if candidate.exists():
-                return load_mesh(candidate, source=self.source, key=path)
+                return load_mesh(candidate, source=self.source, key=path,
+                                 crease_angle=crease_angle)
         looked = " and ".join(str(c.parent.resolve()) for c in candidates)
         self.fail(path, f"mesh file not found: {text!r} (looked in {looked})")
 

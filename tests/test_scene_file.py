@@ -194,6 +194,43 @@ def test_resolve_scene_missing_path(tmp_path):
     assert info.value.line().startswith(f"{missing}: no such scene file or built-in scene; ")
 
 
+def test_load_scene_takes_a_builtin_name_from_any_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    scene = load_scene("hierarchy")
+    assert scene.name == "hierarchy" and scene.source == str(builtin_scenes()["hierarchy"])
+    assert summary(scene) == summary(load_scene(builtin_scenes()["hierarchy"]))
+    assert load_scene(Path("sphere")).source == str(builtin_scenes()["sphere"])
+
+
+def test_load_scene_an_existing_file_wins_over_a_name(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write(tmp_path, "sphere", 'name = "mine"\n')        # a file without .toml named like one
+    assert load_scene("sphere").name == "mine"
+    (tmp_path / "sphere").unlink()
+    (tmp_path / "sphere").mkdir()                        # a folder of that name does not shadow it
+    assert load_scene("sphere").source == str(builtin_scenes()["sphere"])
+
+
+def test_load_scene_unknown_name_is_the_command_lines_line(tmp_path, monkeypatch, capsys):
+    from renderer.cli import main
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError) as info:
+        load_scene("spher")
+    assert info.value.line() == (
+        "spher: no such scene file or built-in scene; did you mean 'sphere'? built-in scenes: "
+        + ", ".join(sorted(BUILTIN_NAMES)))
+    assert main(["render", "spher", "--backend", "reference", "--size", "8x6"]) == 2
+    assert capsys.readouterr().err.splitlines() == [f"renderer: {info.value.line()}"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_load_scene_a_missing_path_is_still_not_found(tmp_path):
+    for missing in (tmp_path / "nothing.toml", tmp_path / "nothing", "nothing.toml"):
+        with pytest.raises(SceneError) as info:
+            load_scene(missing)
+        assert info.value.line() == f"{missing}: scene file not found"
+
+
 # --------------------------------------------------------------------------- the complete example
 
 def documented_example() -> str:

@@ -1,6 +1,6 @@
 """Scene files: TOML in, a checked `Scene` out, every mistake one `SceneError` line.
 
-    load_scene("assets/scenes/sphere.toml") -> Scene
+    load_scene("sphere") or load_scene("my_scene.toml") -> Scene   (a built-in name or a path)
     scene_from_dict({"camera": {...}, "objects": [...]}, source="<dict>", base_dir=".")
 
 docs/scene-format.md documents every key with its unit and default. The reader is strict:
@@ -24,7 +24,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer.core import transforms
-from renderer.core.builtin import assets_dir
+from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
 from renderer.core.primitives import PRIMITIVES
@@ -68,9 +68,19 @@ MIN_DETERMINANT = 1e-9
 
 # --------------------------------------------------------------------------- entry points
 
-def load_scene(path) -> Scene:
-    """Read a TOML scene file. Mesh files it names are found relative to its folder."""
-    path = Path(path)
+def load_scene(scene) -> Scene:
+    """Read a TOML scene file, given by its path or, from any folder, a built-in scene by its
+    name ("sphere", "hierarchy", ...: what `renderer scenes` lists). Mesh files it names are
+    found relative to its folder.
+
+    An existing file wins over a built-in name spelt the same. A bare name (no folder, no
+    `.toml` suffix) that is neither gives the command line's one-line error
+    ("spher: no such scene file or built-in scene; did you mean 'sphere'? ..."); any other
+    path that does not exist gives "FILE: scene file not found".
+    """
+    path = Path(scene)
+    if not path.is_file() and is_scene_name(str(scene)):
+        path = resolve_scene(str(scene))
     source = str(path)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8-sig"))

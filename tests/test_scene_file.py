@@ -18,6 +18,7 @@ from renderer.errors import SceneError
 from renderer.core.primitives import cube, plane, uv_sphere
 from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
                             Transform)
+from renderer.core.meshio import load_mesh
 from renderer.core.scene_file import load_scene, scene_from_dict
 
 REPO = Path(__file__).resolve().parent.parent
@@ -193,6 +194,43 @@ def test_resolve_scene_missing_path(tmp_path):
     assert info.value.line().startswith(f"{missing}: no such scene file or built-in scene; ")
 
 
+def test_load_scene_takes_a_builtin_name_from_any_folder(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    scene = load_scene("hierarchy")
+    assert scene.name == "hierarchy" and scene.source == str(builtin_scenes()["hierarchy"])
+    assert summary(scene) == summary(load_scene(builtin_scenes()["hierarchy"]))
+    assert load_scene(Path("sphere")).source == str(builtin_scenes()["sphere"])
+
+
+def test_load_scene_an_existing_file_wins_over_a_name(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    write(tmp_path, "sphere", 'name = "mine"\n')        # a file without .toml named like one
+    assert load_scene("sphere").name == "mine"
+    (tmp_path / "sphere").unlink()
+    (tmp_path / "sphere").mkdir()                        # a folder of that name does not shadow it
+    assert load_scene("sphere").source == str(builtin_scenes()["sphere"])
+
+
+def test_load_scene_unknown_name_is_the_command_lines_line(tmp_path, monkeypatch, capsys):
+    from renderer.cli import main
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(SceneError) as info:
+        load_scene("spher")
+    assert info.value.line() == (
+        "spher: no such scene file or built-in scene; did you mean 'sphere'? built-in scenes: "
+        + ", ".join(sorted(BUILTIN_NAMES)))
+    assert main(["render", "spher", "--backend", "reference", "--size", "8x6"]) == 2
+    assert capsys.readouterr().err.splitlines() == [f"renderer: {info.value.line()}"]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_load_scene_a_missing_path_is_still_not_found(tmp_path):
+    for missing in (tmp_path / "nothing.toml", tmp_path / "nothing", "nothing.toml"):
+        with pytest.raises(SceneError) as info:
+            load_scene(missing)
+        assert info.value.line() == f"{missing}: scene file not found"
+
+
 # --------------------------------------------------------------------------- the complete example
 
 def documented_example() -> str:
@@ -222,7 +260,7 @@ def test_complete_example_loads_with_every_value(tmp_path):
                                   far=60.0)
     assert scene.directional_lights == [DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8))]
     assert scene.point_lights == [PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01))]
-    floor, ball, box, knot = scene.objects
+    floor, ball, box, knot, gem = scene.objects
     red = Material((0.3, 0.05, 0.05), (0.8, 0.1, 0.1), (0.6, 0.6, 0.6), 50.0, False, "phong")
     grey = Material((0.4, 0.4, 0.4), (0.5, 0.5, 0.5), (0.0, 0.0, 0.0), 1.0, True, "gouraud")
     assert (floor.name, floor.material, floor.cull, floor.parent) == ("floor", grey, "none", None)
@@ -239,6 +277,12 @@ def test_complete_example_loads_with_every_value(tmp_path):
     np.testing.assert_array_equal(box.mesh.positions, cube(0.5).positions)
     assert Path(knot.mesh.source) == assets_dir() / "meshes" / "torus_knot.obj"
     assert knot.material == Material() and knot.cull == "back"
+    # crease_angle 120 is above the 109.5 degrees between the tetrahedron's face normals:
+    # smooth, 4 vertices (the default 30 would give 12, flat)
+    assert Path(gem.mesh.source) == assets_dir() / "meshes" / "tetrahedron.stl"
+    assert gem.mesh.positions.shape == (4, 3) and gem.mesh.faces.shape == (4, 3)
+    np.testing.assert_allclose(gem.mesh.normals, gem.mesh.positions / np.sqrt(3), atol=1e-6)
+    assert gem.transform == Transform((0.5, 0.5, 0.5), translate=(0.0, 0.5, -2.0))
     # the child's world matrix is its parent's times its own
     world = dict(zip([o.name for o in scene.objects], scene.world_matrices()))
     np.testing.assert_allclose(world["box"], world["ball"] @ box.transform.matrix())
@@ -265,6 +309,9 @@ def test_complete_example_round_trip_file_dict_and_dataclasses(tmp_path):
                         Transform((0.8, 0.8, 0.8), {"xy": 0.3, "zx": -0.2}, (30.0, 45.0, 0.0),
                                   (0.0, 1.2, 0.0)), parent="ball"),
             from_file.objects[3],
+            SceneObject("gem", load_mesh(assets_dir() / "meshes" / "tetrahedron.stl",
+                                         crease_angle=120.0),
+                        transform=Transform((0.5, 0.5, 0.5), translate=(0.0, 0.5, -2.0))),
         ],
         directional_lights=[DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8))],
         point_lights=[PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01))],
@@ -487,6 +534,25 @@ BAD_SCENES = [
     ("primitive and file", '[[objects]]\nmesh = { primitive = "cube", file = "a.obj" }\n',
      "objects[0].mesh: give either primitive or file, not both"),
     ("mesh with neither", "[[objects]]\nmesh = {}\n", "objects[0].mesh: needs a primitive or a file key"),
+    # the crease angle of a mesh file
+    ("zero crease angle", '[[objects]]\nmesh = { file = "meshes/tetrahedron.stl", crease_angle = 0 }\n',
+     "objects[0].mesh.crease_angle: must be between 0 (excluded) and 180 degrees (180: smooth "
+     "across every edge), got 0"),
+    ("negative crease angle", '[[objects]]\nmesh = { file = "meshes/tetrahedron.stl", crease_angle = -30 }\n',
+     "objects[0].mesh.crease_angle: must be between 0 (excluded) and 180 degrees (180: smooth "
+     "across every edge), got -30"),
+    ("crease angle above 180", '[[objects]]\nmesh = { file = "meshes/tetrahedron.stl", crease_angle = 180.5 }\n',
+     "objects[0].mesh.crease_angle: must be between 0 (excluded) and 180 degrees (180: smooth "
+     "across every edge), got 180.5"),
+    ("crease angle as a string", '[[objects]]\nmesh = { file = "meshes/tetrahedron.stl", crease_angle = "30" }\n',
+     "objects[0].mesh.crease_angle: expected a number, got a string ('30')"),
+    ("nan crease angle", '[[objects]]\nmesh = { file = "meshes/tetrahedron.stl", crease_angle = nan }\n',
+     "objects[0].mesh.crease_angle: expected a finite number, got nan"),
+    ("misspelt crease angle", '[[objects]]\nmesh = { file = "meshes/tetrahedron.stl", crease = 30 }\n',
+     "objects[0].mesh.crease: unknown key; did you mean 'crease_angle'?"),
+    ("crease angle of a primitive", '[[objects]]\nmesh = { primitive = "cube", crease_angle = 30 }\n',
+     "objects[0].mesh.crease_angle: is for mesh files (mesh = { file = ... }); a primitive has "
+     "exact normals, its flat faces already separate"),
     ("no mesh", '[[objects]]\nname = "ghost"\n',
      'objects[0].mesh: missing; give mesh = {primitive = "..."} or mesh = {file = "..."}'),
     # materials

@@ -3,6 +3,7 @@ display (Xvfb): what the window shows is the headless render of the same camera 
 the controls act on it; the scripted mode, the reference view and double/triple buffering
 work end to end; without a display it says so in one line and exits with status 2."""
 
+import json
 import os
 import subprocess
 import sys
@@ -66,6 +67,7 @@ def test_scripted_screenshot_is_the_headless_render(x_display, tmp_path, cli):
                  display=x_display)
     assert result.returncode == 0, result.stderr
     assert "frame time median" in result.stdout and "fps" in result.stdout
+    assert result.stdout.splitlines()[0].startswith("3 frames: "), result.stdout
     assert_matches(read_png(shot)[..., :3], headless(scene()))
 
 
@@ -121,6 +123,18 @@ def test_scripted_reference_is_of_the_last_frames_view_when_orbiting(x_display, 
                  "--reference", "difference", display=x_display)
     assert result.returncode == 0, result.stderr
     assert "GPU vs reference" in result.stdout and "0 mismatched px" in result.stdout
+
+
+def test_scripted_frame_count_with_the_reference_view(x_display, tmp_path, cli):
+    """--frames N reports N frames with a reference view too (the wait for the reference
+    before the last frame is not a frame time, but the last frame is a frame)."""
+    stats = tmp_path / "stats.json"
+    result = cli("view", "sphere", "--size", "80x60", "--frames", "4", "--reference",
+                 "difference", "--no-vsync", "--stats", stats, display=x_display)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.splitlines()[0].startswith("4 frames: "), result.stdout
+    summary = json.loads(stats.read_text())
+    assert summary["frames"] == 4 and summary["reference"]["mismatched"] == 0
 
 
 def test_reference_difference_is_a_dark_heat_map(x_display, tmp_path, cli):
@@ -316,6 +330,25 @@ def test_closing_the_window_ends_the_run(viewer):
     glfw.set_window_should_close(viewer.window._handle, True)   # what the close button does
     stats = viewer.run()
     assert stats.frame_ms == [] and not viewer.state.quit
+
+
+@pytest.mark.parametrize("reference", ["off", "side-by-side"])
+def test_run_reports_the_frames_it_ran(on_x_display, reference):
+    """run(frames=N) swaps N frames and says N, with or without the reference view; the
+    frame times are the intervals between swaps, less the one across the wait for the
+    reference before the last frame."""
+    with Viewer(scene("point_light_plane"), 80, 60, vsync=False, reference=reference,
+                on_message=lambda line: None) as viewer:
+        for frames in (1, 2, 5):
+            viewer.stats = type(viewer.stats)()
+            viewer._last_swap = None
+            stats = viewer.run(frames=frames, orbit=3.0)
+            assert stats.summary()["frames"] == frames
+            assert stats.line().startswith(f"{frames} frame")
+            assert stats.frames == frames
+            waits = 1 if reference != "off" and frames > 1 else 0
+            assert len(stats.frame_ms) == frames - 1 - waits
+        assert stats.line().startswith("5 frames: frame time median")
 
 
 def test_the_reference_is_asked_again_only_for_a_new_image(on_x_display):

@@ -3,6 +3,7 @@
     builtin_scenes()        {"sphere": Path(".../assets/scenes/sphere.toml"), ...}
     resolve_scene(None)     the default scene, "sphere"
     resolve_scene("hierarchy") or resolve_scene("my/scene.toml")  -> Path
+    is_scene_name("hierarchy")  True: no folder, no .toml suffix (may name a built-in scene)
     describe("sphere")      its one-line description (for `renderer scenes`)
     scene_descriptions()    {"sphere": "The default: ...", ...}
 """
@@ -34,6 +35,13 @@ def builtin_scenes() -> dict[str, Path]:
     return {path.stem: path for path in sorted(folder.glob("*.toml"))}
 
 
+def is_scene_name(arg: str) -> bool:
+    """Whether a scene argument has the form of a built-in scene's name: no folder and no
+    `.toml` suffix. (Whether such a scene exists is resolve_scene's question.)"""
+    path = Path(arg)
+    return path.name == arg and path.suffix.lower() != ".toml"
+
+
 def resolve_scene(arg: str | None) -> Path:
     """The scene file a command-line argument names.
 
@@ -44,8 +52,7 @@ def resolve_scene(arg: str | None) -> Path:
     if arg is None:
         return scenes[DEFAULT_SCENE]
     path = Path(arg)
-    looks_like_a_name = path.name == arg and path.suffix.lower() != ".toml"
-    if looks_like_a_name and arg in scenes:
+    if is_scene_name(arg) and arg in scenes:
         return scenes[arg]
     if path.is_file():
         return path

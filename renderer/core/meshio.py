@@ -9,8 +9,12 @@ the mesh, that scene file and its key). What it checks:
   lies in range (OBJ files are also scanned line by line, because trimesh silently turns an
   OBJ index of 0 into a wrong triangle);
 - normals: those in the file are kept and renormalised; a zero-length or non-finite one is
-  replaced by the computed normal at that vertex. A file without normals (STL never has
-  them) has its coincident vertices merged and gets smooth, angle-weighted vertex normals.
+  replaced by the computed smooth normal at that vertex. A file without normals (STL never
+  has them) has its coincident vertices merged and gets angle-weighted vertex normals with a
+  crease angle (`crease_vertex_normals`, default DEFAULT_CREASE_ANGLE): smooth across an
+  edge where the two faces' normals differ by up to the angle, split into one vertex per side
+  where they differ by more, as modelling tools do. `crease_angle=180` is smooth everywhere
+  (`smooth_vertex_normals`).
 """
 
 from __future__ import annotations
@@ -34,29 +38,38 @@ MIN_NORMAL_LENGTH = 1e-8
 # Given to vertices no triangle uses (or only zero-area ones): any unit vector will do.
 FALLBACK_NORMAL = (0.0, 0.0, 1.0)
 
+# Degrees: where the normals of two faces sharing an edge (in a file without normals) differ
+# by more than this, the edge is hard: each side gets vertices of its own. 180: no creases.
+DEFAULT_CREASE_ANGLE = 30.0
+
 
 class _MeshProblem(Exception):
     """Raised inside this module; `load_mesh` turns it into a SceneError with the right names."""
 
 
-def load_mesh(path, *, source: str | None = None, key: str | None = None) -> Mesh:
+def load_mesh(path, *, source: str | None = None, key: str | None = None,
+              crease_angle: float = DEFAULT_CREASE_ANGLE) -> Mesh:
     """Read and check a triangle mesh file.
 
     path:   the mesh file.
     source: the scene file that names the mesh, if any; with `key` (e.g.
             "objects[2].mesh.file") it makes the error line point at the scene entry:
             "scene.toml: objects[2].mesh.file: /abs/knot.obj: 4 faces index ...".
+    crease_angle: degrees, 0 < angle <= 180, for a file without normals (see
+            `crease_vertex_normals`); a file with normals keeps its own.
     """
+    if not 0.0 < crease_angle <= 180.0:
+        raise ValueError(f"crease_angle must be in (0, 180] degrees, got {crease_angle!r}")
     path = Path(path)
     try:
-        return _load_checked(path)
+        return _load_checked(path, crease_angle)
     except _MeshProblem as problem:
         if source is not None:
             raise SceneError(f"{path}: {problem}", file=source, key=key) from None
         raise SceneError(str(problem), file=str(path), key=key) from None
 
 
-def _load_checked(path: Path) -> Mesh:
+def _load_checked(path: Path, crease_angle: float) -> Mesh:
     if not path.exists():
         raise _MeshProblem("mesh file not found")
     if not path.is_file():
@@ -71,7 +84,7 @@ def _load_checked(path: Path) -> Mesh:
     _check_geometry(positions, faces)
     if file_normals is None:
         positions, faces = merge_coincident_vertices(positions, faces)
-        normals = smooth_vertex_normals(positions, faces)
+        positions, normals, faces = crease_vertex_normals(positions, faces, crease_angle)
     else:
         normals = _repair_normals(file_normals, smooth_vertex_normals(positions, faces))
     return Mesh(positions, normals, faces, str(path))
@@ -191,19 +204,150 @@ def merge_coincident_vertices(positions: np.ndarray, faces: np.ndarray):
     return unique[order], rank[np.asarray(inverse).reshape(-1)][faces]
 
 
-def smooth_vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Unit vertex normals: each face's normal weighted by its corner angle at the vertex
-    (Thürrner and Wüthrich, as trimesh does). Vertices no face with area uses get
-    FALLBACK_NORMAL."""
+def _face_normals_and_angles(positions: np.ndarray, faces: np.ndarray):
+    """Unit face normals (F, 3), zero for a face whose cross product is exactly zero, and the
+    corner angles (F, 3) in radians (trimesh: all three 0 for a degenerate face)."""
     triangles = positions[faces]                                   # (F, 3, 3)
     cross = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
     length = np.linalg.norm(cross, axis=1, keepdims=True)
     face_normals = np.divide(cross, length, out=np.zeros_like(cross), where=length > 0)
-    corner_angles = trimesh.triangles.angles(triangles)   # (F, 3) radians, 0 if degenerate
+    return face_normals, trimesh.triangles.angles(triangles)
+
+
+def smooth_vertex_normals(positions: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Unit vertex normals: each face's normal weighted by its corner angle at the vertex
+    (Thürrner and Wüthrich, as trimesh does). Vertices no face with area uses get
+    FALLBACK_NORMAL."""
+    face_normals, corner_angles = _face_normals_and_angles(positions, faces)
     summed = np.zeros_like(positions)
     for corner in range(3):
         np.add.at(summed, faces[:, corner], face_normals * corner_angles[:, corner:corner + 1])
     return _unit_or_fallback(summed, np.broadcast_to(FALLBACK_NORMAL, positions.shape))
+
+
+def crease_vertex_normals(positions: np.ndarray, faces: np.ndarray,
+                          crease_angle: float = DEFAULT_CREASE_ANGLE):
+    """Angle-weighted vertex normals with a crease angle (degrees), as modelling tools make
+    them (Blender's auto smooth, Houdini's cusp angle); returns (positions, normals, faces),
+    each vertex split into one per fan of faces around it.
+
+    The rule: an edge is *hard* where the unit normals of two faces sharing it differ by more
+    than `crease_angle` (n_f . n_g < cos(crease_angle)), and *soft* otherwise. Around each
+    vertex, faces joined through soft edges form a fan (faces that only touch at the vertex
+    are separate fans). Every corner of a fan gets the fan's normal: the sum of its faces'
+    unit normals, each weighted by its corner angle at the vertex (as
+    `smooth_vertex_normals`), normalised. A face without area (zero cross product) joins no
+    fan: its corners take the smooth normal of all the faces at the vertex. So a pyramid's
+    sides are flat, and a surface that turns by less than the angle from face to face keeps
+    one normal per position.
+
+    Exact and deterministic: a fan's sum adds its faces in the order smooth_vertex_normals
+    adds them, so where all of a vertex's faces are one fan its normal is the smooth one bit
+    for bit; corners of a vertex whose sums are equal share one vertex. Vertex i of the
+    output is vertex i of the input where nothing splits; a split vertex's copies follow it,
+    in the order their corners first appear in `faces`; vertices no face uses are kept
+    (FALLBACK_NORMAL). `crease_angle >= 180` is smooth_vertex_normals, nothing split.
+    """
+    positions = np.asarray(positions, dtype=np.float64)
+    faces = np.asarray(faces, dtype=np.int64)
+    if crease_angle >= 180.0:
+        return positions, smooth_vertex_normals(positions, faces), faces
+    cos_crease = np.cos(np.radians(crease_angle))
+    face_count, vertex_count = len(faces), len(positions)
+    corner_count = 3 * face_count
+    face_normals, corner_angles = _face_normals_and_angles(positions, faces)
+    has_area = face_normals.any(axis=1)
+
+    # Corners in smooth_vertex_normals' order: corner c = k * F + f is corner k of face f.
+    corner = np.arange(corner_count)
+    corner_vertex = faces.T.reshape(-1)
+    corner_face = corner % face_count
+    weighted = face_normals[corner_face] * corner_angles.T.reshape(-1, 1)
+
+    # Soft edges: two faces with area on one undirected edge, within the angle. Each joins
+    # the two faces' corners at either end of the edge. Edge k of a face runs from its
+    # corner k to its corner k + 1.
+    next_corner = (corner + face_count) % corner_count
+    a, b = corner_vertex, corner_vertex[next_corner]
+    keep = (a != b) & has_area[corner_face]
+    low_corner = np.where(a < b, corner, next_corner)[keep]       # the corner at the lower index
+    high_corner = np.where(a < b, next_corner, corner)[keep]
+    edges = np.column_stack([np.minimum(a, b)[keep], np.maximum(a, b)[keep]])
+    order = np.lexsort((low_corner, edges[:, 1], edges[:, 0]))
+    first, second = (order[i] for i in _pairs_of_equal_rows(edges[order]))
+    soft = np.einsum("ij,ij->i", face_normals[corner_face[low_corner[first]]],
+                     face_normals[corner_face[low_corner[second]]]) >= cos_crease
+    first, second = first[soft], second[soft]
+    fan = _components(corner_count, np.concatenate([low_corner[first], high_corner[first]]),
+                      np.concatenate([low_corner[second], high_corner[second]]))
+
+    summed = np.empty((corner_count, 3))
+    for axis in range(3):     # bincount adds in input order: a fan's corners in corner order
+        fan_sum = np.bincount(fan, weights=weighted[:, axis], minlength=corner_count)
+        vertex_sum = np.bincount(corner_vertex, weights=weighted[:, axis], minlength=vertex_count)
+        summed[:, axis] = np.where(has_area[corner_face], fan_sum[fan], vertex_sum[corner_vertex])
+    summed += 0.0                                                   # -0.0 -> 0.0
+
+    # One output vertex per (vertex, distinct sum), then each vertex no face uses.
+    order = np.lexsort((summed[:, 2], summed[:, 1], summed[:, 0], corner_vertex))
+    key = np.column_stack([corner_vertex, summed])[order]
+    starts = np.concatenate([[True], (key[1:] != key[:-1]).any(axis=1)])
+    group = np.empty(corner_count, dtype=np.int64)
+    group[order] = np.cumsum(starts) - 1
+    group_count = int(starts.sum())
+    appearance = corner_face * 3 + corner // face_count            # f * 3 + k: file order
+    group_first = np.full(group_count, corner_count, dtype=np.int64)
+    np.minimum.at(group_first, group, appearance)
+    group_vertex = np.zeros(group_count, dtype=np.int64)
+    group_vertex[group] = corner_vertex
+    group_sum = np.zeros((group_count, 3))
+    group_sum[group] = summed
+    unused = np.flatnonzero(np.bincount(corner_vertex, minlength=vertex_count) == 0)
+    out_vertex = np.concatenate([group_vertex, unused])
+    out_first = np.concatenate([group_first, np.full(len(unused), -1, dtype=np.int64)])
+    out_sum = np.concatenate([group_sum, np.zeros((len(unused), 3))])
+    out_order = np.lexsort((out_first, out_vertex))
+    new_index = np.empty(len(out_order), dtype=np.int64)
+    new_index[out_order] = np.arange(len(out_order))
+    new_faces = new_index[group].reshape(3, face_count).T.copy()
+    fallback = np.broadcast_to(FALLBACK_NORMAL, (len(out_order), 3))
+    normals = _unit_or_fallback(out_sum[out_order], fallback)
+    return positions[out_vertex[out_order]], normals, new_faces
+
+
+def _pairs_of_equal_rows(rows: np.ndarray):
+    """(i, j), i < j, for every two equal rows of `rows` (sorted, so that equal rows are
+    adjacent): the faces that share an edge, two on a closed surface, more where the mesh
+    is not a manifold."""
+    count = len(rows)
+    if count == 0:
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    starts = np.flatnonzero(np.concatenate([[True], (rows[1:] != rows[:-1]).any(axis=1)]))
+    lengths = np.diff(np.append(starts, count))
+    later = np.repeat(starts + lengths, lengths) - np.arange(count) - 1   # rows after it in its run
+    first = np.repeat(np.arange(count), later)
+    step = np.arange(int(later.sum())) - np.repeat(np.cumsum(later) - later, later)
+    return first, first + 1 + step
+
+
+def _components(count: int, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+    """Connected components of the graph on nodes 0..count-1 with edges (u[i], v[i]): each
+    node's label is the least node of its component. The least labels spread along the
+    edges, and by pointer jumping, until nothing changes."""
+    label = np.arange(count)
+    while True:
+        lowest = np.minimum(label[u], label[v])
+        new = label.copy()
+        np.minimum.at(new, u, lowest)
+        np.minimum.at(new, v, lowest)
+        while True:
+            jumped = new[new]
+            if np.array_equal(jumped, new):
+                break
+            new = jumped
+        if np.array_equal(new, label):
+            return label
+        label = new
 
 
 def _repair_normals(file_normals: np.ndarray, computed: np.ndarray) -> np.ndarray:

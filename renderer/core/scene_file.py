@@ -1,6 +1,6 @@
 """Scene files: TOML in, a checked `Scene` out, every mistake one `SceneError` line.
 
-    load_scene("assets/scenes/sphere.toml") -> Scene
+    load_scene("sphere") or load_scene("my_scene.toml") -> Scene   (a built-in name or a path)
     scene_from_dict({"camera": {...}, "objects": [...]}, source="<dict>", base_dir=".")
 
 docs/scene-format.md documents every key with its unit and default. The reader is strict:
@@ -24,9 +24,9 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer.core import transforms
-from renderer.core.builtin import assets_dir
+from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
-from renderer.core.meshio import load_mesh
+from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
                             Scene, SceneObject, Transform)
@@ -45,6 +45,7 @@ LIGHT_KEYS = {
 }
 OBJECT_KEYS = ("name", "mesh", "material", "scale", "shear", "rotate", "translate", "parent",
                "cull")
+MESH_FILE_KEYS = ("file", "crease_angle")
 
 # Limits on primitive arguments: (integer?, smallest, largest). Lengths must be > 0; counts
 # are capped so that a typo cannot ask for a hundred million triangles.
@@ -67,9 +68,19 @@ MIN_DETERMINANT = 1e-9
 
 # --------------------------------------------------------------------------- entry points
 
-def load_scene(path) -> Scene:
-    """Read a TOML scene file. Mesh files it names are found relative to its folder."""
-    path = Path(path)
+def load_scene(scene) -> Scene:
+    """Read a TOML scene file, given by its path or, from any folder, a built-in scene by its
+    name ("sphere", "hierarchy", ...: what `renderer scenes` lists). Mesh files it names are
+    found relative to its folder.
+
+    An existing file wins over a built-in name spelt the same. A bare name (no folder, no
+    `.toml` suffix) that is neither gives the command line's one-line error
+    ("spher: no such scene file or built-in scene; did you mean 'sphere'? ..."); any other
+    path that does not exist gives "FILE: scene file not found".
+    """
+    path = Path(scene)
+    if not path.is_file() and is_scene_name(str(scene)):
+        path = resolve_scene(str(scene))
     source = str(path)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
@@ -453,9 +464,16 @@ class _Reader:
         if "primitive" in raw and "file" in raw:
             self.fail(path, "give either primitive or file, not both")
         if "file" in raw:
-            self.table(raw, path, ("file",))
-            return self.mesh_file(raw["file"], _join(path, "file"))
+            self.table(raw, path, MESH_FILE_KEYS)
+            crease_angle = DEFAULT_CREASE_ANGLE
+            if "crease_angle" in raw:
+                crease_angle = self.crease_angle(raw["crease_angle"], _join(path, "crease_angle"))
+            return self.mesh_file(raw["file"], _join(path, "file"), crease_angle)
         if "primitive" in raw:
+            if "crease_angle" in raw:
+                self.fail(_join(path, "crease_angle"),
+                          "is for mesh files (mesh = { file = ... }); a primitive has exact "
+                          "normals, its flat faces already separate")
             return self.primitive(raw, path)
         self.fail(path, "needs a primitive or a file key")
 
@@ -483,7 +501,14 @@ class _Reader:
         mesh.recipe = (name, kwargs)
         return mesh
 
-    def mesh_file(self, value: Any, path: str) -> Mesh:
+    def crease_angle(self, value: Any, path: str) -> float:
+        angle = self.number(value, path)
+        if not 0.0 < angle <= 180.0:
+            self.fail(path, f"must be between 0 (excluded) and 180 degrees (180: smooth across "
+                            f"every edge), got {angle:g}")
+        return angle
+
+    def mesh_file(self, value: Any, path: str, crease_angle: float = DEFAULT_CREASE_ANGLE) -> Mesh:
         """Relative paths start at the scene file's folder, then at the built-in assets folder
         (so any scene can use the built-in meshes as "meshes/NAME")."""
         text = self.string(value, path)
@@ -495,7 +520,8 @@ class _Reader:
             candidates.append(assets / text)
         for candidate in candidates:
             if candidate.exists():
-                return load_mesh(candidate, source=self.source, key=path)
+                return load_mesh(candidate, source=self.source, key=path,
+                                 crease_angle=crease_angle)
         looked = " and ".join(str(c.parent.resolve()) for c in candidates)
         self.fail(path, f"mesh file not found: {text!r} (looked in {looked})")
 

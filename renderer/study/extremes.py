@@ -44,8 +44,9 @@ STABILITY = {
                        "depth buffer cleared to 0 and GL_GREATER",
     "depth_ratio_1e8": "reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
                        "depth buffer cleared to 0 and GL_GREATER",
-    "duplicate_vertices": "coincident vertices of a file without normals are merged; the "
-                          "repeated faces tie exactly and the first drawn wins in both",
+    "duplicate_vertices": "coincident vertices of a file without normals are merged (and split "
+                          "again at creases); the repeated faces share their vertices, tie "
+                          "exactly and the first drawn wins in both",
     "extreme_scale": "the normal matrix is the cofactor matrix (det(M) M^-T), scaled in float64 "
                      "before the float32 upload",
     "far_from_origin": "camera-relative transforms: T(-eye) M in float64, the view a rotation, "

@@ -39,9 +39,11 @@ TITLE_EVERY_S = 0.25                       # how often the title's figures are r
 
 @dataclass
 class FrameStats:
-    """Frame-time figures of a run: `frame_ms` from swap to swap (what a user sees),
-    `draw_ms` the part spent issuing the scene's draw calls, `latency_ms` from drawing a
-    frame to the swap that showed it."""
+    """Frame-time figures of a run: `frames` the frames drawn and swapped, `frame_ms` from
+    swap to swap (what a user sees; one fewer than the frames, and none across a wait for
+    the reference view), `draw_ms` the part spent issuing the scene's draw calls,
+    `latency_ms` from drawing a frame to the swap that showed it."""
+    frames: int = 0
     frame_ms: list[float] = field(default_factory=list)
     draw_ms: list[float] = field(default_factory=list)
     latency_ms: float | None = None
@@ -49,9 +51,9 @@ class FrameStats:
     def summary(self) -> dict:
         frames = sorted(self.frame_ms)
         if not frames:
-            return {"frames": 0}
+            return {"frames": self.frames}
         median = statistics.median(frames)
-        return {"frames": len(frames) + 1, "frame_ms_median": median,
+        return {"frames": self.frames, "frame_ms_median": median,
                 "frame_ms_p5": frames[int(0.05 * (len(frames) - 1))],
                 "frame_ms_p95": frames[int(0.95 * (len(frames) - 1))],
                 "frame_ms_max": frames[-1], "fps": 1000.0 / median if median > 0 else None,
@@ -60,7 +62,7 @@ class FrameStats:
 
     def line(self) -> str:
         s = self.summary()
-        if s["frames"] < 2:
+        if "frame_ms_median" not in s:
             return f"{s['frames']} frame(s): no frame times"
         fps = "no" if s["fps"] is None else f"{s['fps']:.1f}"     # None: frames took no time
         latency = "" if s["latency_ms_median"] is None else \
@@ -226,6 +228,7 @@ class Viewer:
             self.state.screenshot = False
             self.save_screenshot()
         self.window.swap()
+        self.stats.frames += 1
         now = time.perf_counter()
         self.presenter.swapped(now)
         if self._last_swap is not None:

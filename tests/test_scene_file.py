@@ -206,9 +206,11 @@ def test_load_scene_an_existing_file_wins_over_a_name(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     write(tmp_path, "sphere", 'name = "mine"\n')        # a file without .toml named like one
     assert load_scene("sphere").name == "mine"
+    assert resolve_scene("sphere") == Path("sphere")     # the command line's rule is the same
     (tmp_path / "sphere").unlink()
     (tmp_path / "sphere").mkdir()                        # a folder of that name does not shadow it
     assert load_scene("sphere").source == str(builtin_scenes()["sphere"])
+    assert resolve_scene("sphere") == builtin_scenes()["sphere"]
 
 
 def test_load_scene_unknown_name_is_the_command_lines_line(tmp_path, monkeypatch, capsys):

@@ -43,19 +43,19 @@ def is_scene_name(arg: str) -> bool:
 
 
 def resolve_scene(arg: str | None) -> Path:
-    """The scene file a command-line argument names.
+    """The scene file an argument names, on the command line and in load_scene alike.
 
-    None means the default scene. A bare name (no folder, no .toml suffix) is looked up among
-    the built-in scenes first; anything else must be an existing file.
+    None means the default scene. An existing file wins; then a bare name (no folder, no
+    .toml suffix) is looked up among the built-in scenes; anything else is an error.
     """
     scenes = builtin_scenes()
     if arg is None:
         return scenes[DEFAULT_SCENE]
     path = Path(arg)
-    if is_scene_name(arg) and arg in scenes:
-        return scenes[arg]
     if path.is_file():
         return path
+    if is_scene_name(arg) and arg in scenes:
+        return scenes[arg]
     if path.is_dir():
         raise SceneError("is a directory, not a scene file", file=arg)
     close = difflib.get_close_matches(arg, list(scenes), n=1, cutoff=0.6)

@@ -105,7 +105,7 @@ def test_view_stats_json_is_strict(tmp_path, capsys, monkeypatch):
             return False
 
         def run(self, frames, orbit, screenshot):
-            return FrameStats(frame_ms=[0.0, 0.0], draw_ms=[0.0, 0.0], latency_ms=None)
+            return FrameStats(frames=3, frame_ms=[0.0, 0.0], draw_ms=[0.0, 0.0], latency_ms=None)
 
     monkeypatch.setattr(viewer_module, "Viewer", FakeViewer)
     stats = tmp_path / "stats.json"

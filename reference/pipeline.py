@@ -3,8 +3,9 @@
 The reference draw, stage by stage as dEQP's drawBasicPrimitives reads: for each object in
 scene order, vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping
 -> viewport transform and snapping -> facing and culling -> rasterisation -> depth test;
-then fragment shading for the one surviving fragment per pixel, and output conversion.
-Objects wholly outside the view volume are skipped (renderer/core/visibility.py, as the GPU path).
+then fragment shading for the one surviving fragment per pixel, and output conversion. A
+large frame runs the stages from rasterisation on band by band (TILE_PIXELS), so that its
+memory stays bounded. Objects wholly outside the view volume are skipped (renderer/core/visibility.py, as the GPU path).
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 
@@ -16,6 +17,7 @@ float32 -z_eye with +inf background). Conventions: docs/conventions.md.
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -25,20 +27,33 @@ from reference.fragment import ObjectVaryings, shade_fragments
 from reference.geometry import shade_triangles
 from reference.lighting import Lights
 from reference.output import compose_frame
-from reference.rasterizer import is_drawn, rasterize, setup_triangles
+from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.core.visibility import visible_objects
 
 
-def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, depth: DepthBuffer,
-                first_order: int, width: int, height: int, subpixel_bits: int, dtype) -> ObjectVaryings:
-    """Vertex processing to depth test for one object; returns what the fragment stage needs.
+# A frame of more pixels than this is drawn in tiles of at most this many (bands of rows), so
+# that the depth buffer, its runner-up and the fragment stage's arrays (about 300 bytes a
+# pixel in float64) stay bounded however large the image: only the output arrays grow with it.
+TILE_PIXELS = 1 << 20
 
-    Draw order is first_order + the triangle's index in the mesh, so it is global across
-    objects; the triangles a clipped triangle turns into share its order.
-    """
+
+@dataclass
+class PreparedObject:
+    """One object after vertex processing, clipping, the viewport transform and culling:
+    what rasterisation needs for any tile, and the fragment stage's varyings."""
+    varyings: ObjectVaryings
+    window: WindowTriangles       # the drawn triangles in window coordinates
+    source: np.ndarray            # (T,) the mesh triangle each came from
+    clip_weights: np.ndarray      # (T, 3, 3) its vertices as weights of the source's
+
+
+def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: int, height: int,
+                   subpixel_bits: int, reversed_z: bool, dtype) -> PreparedObject:
+    """Vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping ->
+    viewport transform and snapping -> facing and culling, for one object."""
     mesh, material = obj.mesh, obj.material
     vertices = shade_vertices(mesh.positions, mesh.normals, u_model=matrices.model,
                               u_normal_matrix=matrices.normal, u_view=frame_matrices.view,
@@ -47,57 +62,124 @@ def draw_object(index: int, obj, matrices, frame_matrices, lights: Lights, eye, 
     faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
     triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye)
                  if material.shading == "flat" else None)
-    reversed_z = depth.reversed_z
     clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
-    window, source, clip_weights = window.select(keep), clipped.source[keep], clipped.weights[keep]
+    return PreparedObject(ObjectVaryings(material, faces, vertices, triangles), window.select(keep),
+                          clipped.source[keep], clipped.weights[keep])
 
-    for fragments in rasterize(window, width, height):
+
+def draw_tile(index: int, prepared: PreparedObject, depth: DepthBuffer, first_order: int,
+              width: int, height: int, region) -> None:
+    """Rasterisation -> depth test of one prepared object within `region` (x0, y0, x1, y1),
+    the tile `depth` covers.
+
+    Draw order is first_order + the triangle's index in the mesh, so it is global across
+    objects; the triangles a clipped triangle turns into share its order.
+    """
+    x0, y0, x1, _ = region
+    source, clip_weights = prepared.source, prepared.clip_weights
+    for fragments in rasterize(prepared.window, width, height, region=region):
         t = fragments.triangle
         # weights w.r.t. the source triangle's vertices: sum_k b_k * clip_weights[k, :]
         b, cw = fragments.barycentric, clip_weights[t]
         weights = b[:, 0:1] * cw[:, 0] + b[:, 1:2] * cw[:, 1] + b[:, 2:3] * cw[:, 2]
-        depth.test_and_write(fragments.y * width + fragments.x, fragments.z_w,
+        depth.test_and_write((fragments.y - y0) * (x1 - x0) + (fragments.x - x0), fragments.z_w,
                              first_order + source[t],
                              object=np.full(len(t), index, dtype=np.int32), triangle=source[t],
                              weights=weights, gl_FrontFacing=fragments.gl_FrontFacing)
-    return ObjectVaryings(material, faces, vertices, triangles)
+
+
+def tiles(width: int, height: int, tile_pixels: int = TILE_PIXELS) -> list[tuple[int, int, int, int]]:
+    """The frame as bands of whole rows (x0, y0, x1, y1), GL rows, of at most `tile_pixels`
+    pixels each (at least one row); one band when the frame is that small."""
+    rows = max(1, tile_pixels // width)
+    return [(0, y, width, min(y + rows, height)) for y in range(0, height, rows)]
 
 
 def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: int = SUBPIXEL_BITS,
-           linear: bool = False, depth: bool = True, sample_offset=(0.0, 0.0)) -> Frame:
+           linear: bool = False, depth: bool = True, sample_offset=(0.0, 0.0),
+           tile_pixels: int = TILE_PIXELS) -> Frame:
     """Render `scene` at width x height with the NumPy reference pipeline, each pixel sampled
-    at `sample_offset` (dx, dy) pixels from its centre (Scene.matrices)."""
+    at `sample_offset` (dx, dy) pixels from its centre (Scene.matrices). A frame of more than
+    `tile_pixels` pixels is drawn band by band (the same image: every stage after culling
+    works pixel by pixel), so its memory beyond the output arrays stays bounded."""
     start = time.perf_counter()
     dtype = np.dtype(dtype)
     frame_matrices = scene.matrices(width, height, sample_offset)
     # Camera-relative positions, as the GPU gets them (renderer.core.scene.FrameMatrices).
     lights = Lights.from_scene(scene, dtype, origin=frame_matrices.origin)
     eye = frame_matrices.relative(scene.camera.eye).astype(dtype)
-    depth_buffer = DepthBuffer(width, height, dtype, scene.camera.reversed_z)
+    reversed_z = scene.camera.reversed_z
 
     # Objects wholly outside the view volume are skipped, as the GPU path skips them.
     visible = visible_objects(scene, frame_matrices)
-    objects, first_order = [], 0
-    for index, (obj, matrices) in enumerate(zip(scene.objects, frame_matrices.objects)):
-        objects.append(draw_object(index, obj, matrices, frame_matrices, lights, eye, depth_buffer,
-                                   first_order, width, height, subpixel_bits, dtype)
-                       if visible[index] else None)
+    prepared, first_orders, first_order = [], [], 0
+    for obj, matrices, shown in zip(scene.objects, frame_matrices.objects, visible):
+        prepared.append(prepare_object(obj, matrices, frame_matrices, lights, eye, width, height,
+                                       subpixel_bits, reversed_z, dtype) if shown else None)
+        first_orders.append(first_order)
         first_order += len(obj.mesh.faces)
+    objects = [p.varyings if p is not None else None for p in prepared]
 
+    bands = tiles(width, height, tile_pixels)
+    if len(bands) == 1:
+        frame = _render_tile(bands[0], prepared, objects, first_orders, lights, eye, scene,
+                             width, height, linear, depth, dtype)
+    else:
+        frame = _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene,
+                                 width, height, linear, depth, dtype)
+    frame.milliseconds = (time.perf_counter() - start) * 1000.0
+    return frame
+
+
+def _render_tile(region, prepared, objects, first_orders, lights, eye, scene, width, height,
+                 linear, depth, dtype) -> Frame:
+    """Rasterisation, depth test, fragment shading and output of one tile: a Frame of the
+    tile's size."""
+    x0, y0, x1, y1 = region
+    depth_buffer = DepthBuffer(x1 - x0, y1 - y0, dtype, scene.camera.reversed_z)
+    for index, item in enumerate(prepared):
+        if item is not None:
+            draw_tile(index, item, depth_buffer, first_orders[index], width, height, region)
     drawn = depth_buffer.drawn
     color, view_depth = shade_surviving(objects, depth_buffer.payload, drawn, lights, eye, dtype)
     frame = compose_frame(color, drawn, view_depth if depth else None, scene.background,
-                          width, height, linear=linear)
+                          x1 - x0, y1 - y0, linear=linear)
     # Where two surfaces are closer in depth than GL can order, the other one may show: its
     # colour goes beside the winner's, for comparisons to accept either (renderer/checks/compare.py).
     ties = depth_buffer.depth_ties()
     if ties.any():
         other, _ = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype)
         frame.rgba8_tie = compose_frame(np.where(ties[:, None], other, color), drawn, None,
-                                        scene.background, width, height, linear=False).rgba8
-    frame.milliseconds = (time.perf_counter() - start) * 1000.0
+                                        scene.background, x1 - x0, y1 - y0, linear=False).rgba8
+    return frame
+
+
+def _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene, width, height,
+                     linear, depth, dtype) -> Frame:
+    """Each band drawn as its own tile and pasted into the frame's arrays (image rows are top
+    first: GL rows [y0, y1) are image rows [H - y1, H - y0))."""
+    frame = Frame(np.empty((height, width, 4), np.uint8),
+                  np.empty((height, width, 4), np.float32) if linear else None,
+                  np.empty((height, width), np.float32) if depth else None)
+    ties = []
+    for region in bands:
+        _, y0, _, y1 = region
+        rows = slice(height - y1, height - y0)
+        part = _render_tile(region, prepared, objects, first_orders, lights, eye, scene,
+                            width, height, linear, depth, dtype)
+        frame.rgba8[rows] = part.rgba8
+        if linear:
+            frame.linear[rows] = part.linear
+        if depth:
+            frame.depth[rows] = part.depth
+        if part.rgba8_tie is not None:
+            ties.append((rows, part.rgba8_tie))
+    if ties:
+        frame.rgba8_tie = frame.rgba8.copy()
+        for rows, tie in ties:
+            frame.rgba8_tie[rows] = tie
     return frame
 
 

@@ -137,24 +137,26 @@ def setup_triangles(gl_Position: np.ndarray, width: int, height: int,
     return WindowTriangles(x, y, x_w, y_w, z_w, inv_w, signed_area_twice(x, y), subpixel_bits)
 
 
-def bounding_boxes(tris: WindowTriangles, width: int, height: int):
-    """Pixel ranges [i0, i1] x [j0, j1] whose centres may be covered, clipped to the viewport."""
+def bounding_boxes(tris: WindowTriangles, width: int, height: int, region=None):
+    """Pixel ranges [i0, i1] x [j0, j1] whose centres may be covered, clipped to the viewport,
+    or to `region` (x0, y0, x1, y1), a rectangle of pixels of it (GL rows; ends excluded)."""
     bits = tris.subpixel_bits
     half = 1 << (bits - 1)
     i0 = -((half - tris.x.min(axis=1)) >> bits)           # ceil((x_min - half) / one)
     j0 = -((half - tris.y.min(axis=1)) >> bits)
     i1 = (tris.x.max(axis=1) - half) >> bits               # floor((x_max - half) / one)
     j1 = (tris.y.max(axis=1) - half) >> bits
-    return (np.maximum(i0, 0), np.minimum(i1, width - 1),
-            np.maximum(j0, 0), np.minimum(j1, height - 1))
+    x0, y0, x1, y1 = (0, 0, width, height) if region is None else region
+    return (np.maximum(i0, x0), np.minimum(i1, x1 - 1),
+            np.maximum(j0, y0), np.minimum(j1, y1 - 1))
 
 
-def _work_items(tris: WindowTriangles, width: int, height: int, max_candidates: int):
+def _work_items(tris: WindowTriangles, width: int, height: int, max_candidates: int, region=None):
     """Split each triangle's bounding box into row bands of at most `max_candidates` pixels.
 
     Returns per item: triangle, i0, box width, j0, band height.
     """
-    i0, i1, j0, j1 = bounding_boxes(tris, width, height)
+    i0, i1, j0, j1 = bounding_boxes(tris, width, height, region)
     box_w = np.maximum(i1 - i0 + 1, 0)
     box_h = np.maximum(j1 - j0 + 1, 0)
     rows_per_band = np.maximum(max_candidates // np.maximum(box_w, 1), 1)
@@ -224,11 +226,12 @@ def edge_equations(tris: WindowTriangles) -> EdgeEquations:
 
 
 def rasterize(tris: WindowTriangles, width: int, height: int, *,
-              max_candidates: int = MAX_CANDIDATES_PER_BATCH) -> Iterator[Fragments]:
+              max_candidates: int = MAX_CANDIDATES_PER_BATCH, region=None) -> Iterator[Fragments]:
     """Fragments of the triangles in batches of at most about 2 * max_candidates tested
-    (triangle, pixel) pairs, in triangle order. Triangles must have area2 != 0."""
+    (triangle, pixel) pairs, in triangle order. Triangles must have area2 != 0. `region`
+    (x0, y0, x1, y1): only the pixels of that rectangle of the viewport (a tile)."""
     edges = edge_equations(tris)
-    tri, i0, box_w, j0, box_h = _work_items(tris, width, height, max_candidates)
+    tri, i0, box_w, j0, box_h = _work_items(tris, width, height, max_candidates, region)
     counts = box_w * box_h
     ends = np.cumsum(counts)
     batch_of_item = (ends - counts) // max_candidates

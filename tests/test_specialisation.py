@@ -182,9 +182,9 @@ def test_both_pipelines_skip_the_same_objects_and_draw_the_same_image(gl_context
     np.testing.assert_array_equal(frame.rgba8, everything.rgba8)
 
     drawn = []
-    original = reference.pipeline.draw_object
-    monkeypatch.setattr(reference.pipeline, "draw_object",
-                        lambda index, obj, *rest: drawn.append(obj.name) or original(index, obj, *rest))
+    original = reference.pipeline.prepare_object
+    monkeypatch.setattr(reference.pipeline, "prepare_object",
+                        lambda obj, *rest: drawn.append(obj.name) or original(obj, *rest))
     expected = reference.render(scene, *SIZE, subpixel_bits=subpixel_bits)
     assert drawn == ["box0", "box3"]
     result = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,

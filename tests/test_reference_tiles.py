@@ -1,0 +1,47 @@
+"""The reference draws a large frame band by band (reference/pipeline.py, TILE_PIXELS), so its
+memory beyond the output arrays stays bounded. Every stage after culling works pixel by pixel,
+so the bands must give the very same frame as one pass: colour, linear colour, depth and the
+depth-tie image, bit for bit."""
+
+import numpy as np
+import pytest
+
+import reference
+from reference.pipeline import TILE_PIXELS, tiles
+from renderer.core.builtin import assets_dir
+from renderer.core.scene_file import load_scene
+
+SIZE = (96, 64)
+
+
+def test_bands_cover_the_frame_once_in_whole_rows():
+    assert tiles(640, 480) == [(0, 0, 640, 480)]                     # small: one band
+    bands = tiles(1000, 30, tile_pixels=3000)
+    assert bands == [(0, 0, 1000, 3), (0, 3, 1000, 6), (0, 6, 1000, 9), (0, 9, 1000, 12),
+                     (0, 12, 1000, 15), (0, 15, 1000, 18), (0, 18, 1000, 21), (0, 21, 1000, 24),
+                     (0, 24, 1000, 27), (0, 27, 1000, 30)]
+    assert tiles(5000, 3, tile_pixels=100) == [(0, 0, 5000, 1), (0, 1, 5000, 2), (0, 2, 5000, 3)]
+    assert TILE_PIXELS * 300 < 512 * 2 ** 20                 # a band's working set: well under 512 MiB
+
+
+@pytest.mark.parametrize("tile_pixels", (SIZE[0] * 7, 10), ids=("7-row bands", "1-row bands"))
+@pytest.mark.parametrize("name", ("near_plane", "hierarchy", "orthographic", "x_depth_ratio_1e8"))
+def test_bands_give_the_same_frame_bit_for_bit(name, tile_pixels, reference_frames):
+    scene = assets_dir() / "extreme" / f"{name[2:]}.toml" if name.startswith("x_") else name
+    whole = reference_frames(scene, *SIZE, linear=True)
+    banded = reference.render(load_scene(scene), *SIZE, linear=True, tile_pixels=tile_pixels)
+    for field in ("rgba8", "linear", "depth"):
+        np.testing.assert_array_equal(getattr(banded, field), getattr(whole, field), err_msg=field)
+    assert (banded.rgba8_tie is None) == (whole.rgba8_tie is None)
+    if whole.rgba8_tie is not None:
+        np.testing.assert_array_equal(banded.rgba8_tie, whole.rgba8_tie)
+
+
+def test_depth_ties_are_pasted_band_by_band(reference_frames):
+    """flat_shading at 256x256 has two pixels where the reference accepts another surface
+    (a depth tie); drawn in 1-row bands, the tie image is the same."""
+    whole = reference_frames("flat_shading", 256, 256)
+    assert int((whole.rgba8_tie != whole.rgba8).any(axis=-1).sum()) == 2
+    banded = reference.render(load_scene("flat_shading"), 256, 256, tile_pixels=256)
+    np.testing.assert_array_equal(banded.rgba8, whole.rgba8)
+    np.testing.assert_array_equal(banded.rgba8_tie, whole.rgba8_tie)

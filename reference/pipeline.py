@@ -31,13 +31,15 @@ from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_tri
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import SUBPIXEL_BITS
+from renderer.core.memory import REFERENCE_TILE_PIXELS
 from renderer.core.visibility import visible_objects
 
 
 # A frame of more pixels than this is drawn in tiles of at most this many (bands of rows), so
 # that the depth buffer, its runner-up and the fragment stage's arrays (about 300 bytes a
 # pixel in float64) stay bounded however large the image: only the output arrays grow with it.
-TILE_PIXELS = 1 << 20
+# Defined with the memory estimates that count on it (renderer/core/memory.py).
+TILE_PIXELS = REFERENCE_TILE_PIXELS
 
 
 @dataclass

@@ -173,9 +173,33 @@ def build_parser() -> argparse.ArgumentParser:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
+    for name in ("render", "view", "compare", "shaders", "report", "extremes"):
+        sub.choices[name].add_argument(
+            "--max-memory", type=memory_size, metavar="SIZE",
+            help="refuse, before any work, what would need more memory than this (512M, 4G, ...; "
+                 "default: half of this machine's memory; renderer/core/memory.py)")
     for subparser in sub.choices.values():       # for the commands' own checks of their options
         subparser.set_defaults(parser=subparser)
     return parser
+
+
+def memory_size(text: str) -> int:
+    from renderer.core.memory import parse_size as parse_memory
+    try:
+        return parse_memory(text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
+
+
+def check_memory(scene, size, backends) -> None:
+    """One line, before any rendering, when the estimated memory (renderer/core/memory.py) of
+    drawing `scene` at `size` on each of `backends` is over the limit."""
+    from renderer.core import memory
+    triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
+    estimate = {"gpu": memory.gpu_bytes, "reference": memory.reference_bytes}
+    needed = sum(estimate[backend](*size, triangles) for backend in backends)
+    memory.check(needed, f"rendering {scene.name} at {size[0]}x{size[1]} ({triangles:,} triangles) "
+                         f"on {' and '.join(backends)}")
 
 
 def _load(scene_arg):
@@ -212,6 +236,7 @@ def cmd_render(args) -> int:
         raise UserError("--depth writes a NumPy array; name the file with .npy, e.g. depth.npy",
                         file=str(args.depth))
     scene = _load(args.scene)
+    check_memory(scene, args.size, [args.backend])
     output = args.output or Path(f"{scene.name}.png")
     if args.backend == "gpu":
         frame = _render_gpu(scene, args.size, args.context)[0]
@@ -236,6 +261,7 @@ def cmd_view(args) -> int:
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
+    check_memory(scene, args.size, ["gpu"])
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
@@ -268,6 +294,7 @@ def cmd_compare(args) -> int:
     from renderer.core.imageio import write_png
     from renderer.core.jsonio import finite_or_none, to_json
     scene = _load(args.scene)
+    check_memory(scene, args.size, ["gpu", "reference"])
     # Median of a few frames: the first one pays for shader compilation.
     gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
     start = time.perf_counter()
@@ -377,7 +404,9 @@ def main(argv=None) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as done:       # --help, --version: printed; their status
             return done.code
-        return COMMANDS[args.command](args)
+        from renderer.core.memory import limit_set
+        with limit_set(getattr(args, "max_memory", None)):
+            return COMMANDS[args.command](args)
     except UsageError as error:
         print(f"{error.prog}: {error.reason}", file=sys.stderr)
         print(error.usage, file=sys.stderr)

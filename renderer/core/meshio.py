@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from renderer.core import memory
 from renderer.errors import SceneError, show_number
 from renderer.core.scene import Mesh
 
@@ -78,6 +79,11 @@ def _load_checked(path: Path, crease_angle: float) -> Mesh:
     if suffix not in MESH_SUFFIXES:
         raise _MeshProblem(f"unsupported mesh format {suffix or '(no suffix)'!r}; "
                            f"expected one of {', '.join(MESH_SUFFIXES)}")
+    # Checked before parsing: the parsers take up to MESH_PARSE_FACTOR times the file's size.
+    size = path.stat().st_size
+    too_much = memory.over_limit(size * memory.MESH_PARSE_FACTOR)
+    if too_much:
+        raise _MeshProblem(f"a mesh file of {memory.show(size)} {too_much}")
     if suffix == ".obj":
         _check_obj_face_indices(path)
     positions, faces, file_normals = _read_with_trimesh(path)

@@ -119,6 +119,18 @@ def torus(major_radius: float = 1.0, minor_radius: float = 0.35,
     return Mesh(positions, normals.reshape(-1, 3), faces, f"torus({major_segments}x{minor_segments})")
 
 
+# The most triangles each primitive makes with given arguments, known before it is built (a
+# scene's memory is estimated before any mesh exists: renderer/core/memory.py).
+TRIANGLES = {
+    "uv_sphere": lambda segments=32, rings=16, **_: 2 * segments * rings,
+    "icosphere": lambda subdivisions=2, **_: 20 * 4 ** subdivisions,
+    "plane": lambda segments=1, **_: 2 * segments * segments,
+    "cube": lambda **_: 12,
+    "cylinder": lambda segments=32, **_: 4 * segments,
+    "torus": lambda major_segments=48, minor_segments=24, **_: 2 * major_segments * minor_segments,
+}
+
+
 PRIMITIVES = {
     "uv_sphere": uv_sphere,
     "icosphere": icosphere,

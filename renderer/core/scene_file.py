@@ -27,7 +27,9 @@ from renderer.core import transforms
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
+from renderer.core import memory
 from renderer.core.primitives import PRIMITIVES
+from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
                             Scene, SceneObject, Transform)
 
@@ -190,6 +192,7 @@ class _Reader:
     def __init__(self, source: str, base_dir: Path):
         self.source = source
         self.base_dir = base_dir
+        self.primitive_triangles = 0      # so far, for the memory check before building more
 
     def fail(self, key: str | None, reason: str) -> NoReturn:
         raise SceneError(reason, file=self.source, key=key or None)
@@ -495,6 +498,13 @@ class _Reader:
                 kwargs[arg] = self.number(value, arg_path, above=low)
             else:
                 kwargs[arg] = self.number(value, arg_path)
+        # Refused before it is built: a few segment counts at their maxima make tens of
+        # millions of triangles (renderer/core/memory.py).
+        self.primitive_triangles += PRIMITIVE_TRIANGLES[name](**kwargs)
+        too_much = memory.over_limit(self.primitive_triangles * memory.SCENE_BYTES_PER_TRIANGLE)
+        if too_much:
+            self.fail(path, f"the scene's primitives up to here make up to "
+                            f"{self.primitive_triangles:,} triangles: building them {too_much}")
         mesh = build(**kwargs)
         if mesh.triangle_count == 0:
             self.fail(path, "the primitive has no triangles with these arguments")

@@ -1,0 +1,88 @@
+"""Peak memory of the GPU path and the reference against image size and triangle count, beside
+the estimate renderer/core/memory.py makes before rendering, and the limit refusing before
+anything is allocated.
+
+    .venv/bin/python benchmarks/bench_memory.py            # sizes up to 2048x2048 (a minute or two)
+    .venv/bin/python benchmarks/bench_memory.py --full     # and 4096x4096
+
+Each case runs in a new process; the figure is its peak resident memory (ru_maxrss) above
+what the process held after importing and building the scene, so that the baseline of
+Python, NumPy and the scene is left out; the estimate is the same difference.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import subprocess
+import sys
+import time
+
+CHILD = r"""
+import json, resource, sys, warnings
+warnings.simplefilter("ignore")
+backend, width, height, segments = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+import reference
+from renderer.core import memory
+from renderer.core.scene_file import scene_from_dict
+from renderer.gpu import GpuRenderer
+scene = scene_from_dict({
+    "camera": {"eye": [0, 0, 4], "look": [0, 0, 0]},
+    "lights": [{"type": "directional", "direction": [0, -0.5, -1]}],
+    "objects": [{"name": "ball", "material": {"shading": "phong"},
+                 "mesh": {"primitive": "uv_sphere", "segments": segments, "rings": segments // 2}}]})
+triangles = sum(o.mesh.triangle_count for o in scene.objects)
+before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+if backend == "gpu":
+    with GpuRenderer(scene, width, height, context_kind="egl") as gpu:
+        frame = gpu.render(depth=True)
+    estimate = memory.gpu_bytes(width, height, triangles)
+else:
+    frame = reference.render(scene, width, height)
+    estimate = memory.reference_bytes(width, height, triangles)
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+print(json.dumps({"triangles": triangles, "measured": peak - before, "estimate": estimate}))
+"""
+
+
+def measure(backend: str, width: int, height: int, segments: int) -> dict:
+    start = time.perf_counter()
+    result = subprocess.run([sys.executable, "-c", CHILD, backend, str(width), str(height),
+                             str(segments)], capture_output=True, text=True, check=True)
+    return json.loads(result.stdout.splitlines()[-1]) | {"seconds": time.perf_counter() - start}
+
+
+def refusal(width: int, height: int, limit: str) -> dict:
+    """`renderer render` at a size over the limit: its status, its one line, its peak memory."""
+    code = ("import resource, sys\nfrom renderer.cli import main\nstatus = main(sys.argv[1:])\n"
+            "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)\nsys.exit(status)")
+    start = time.perf_counter()
+    result = subprocess.run([sys.executable, "-c", code, "render", "sphere", "--size",
+                             f"{width}x{height}", "--max-memory", limit, "-o", "/tmp/never.png"],
+                            capture_output=True, text=True)
+    return {"status": result.returncode, "line": result.stderr.strip(),
+            "peak": int(result.stdout.split()[-1]), "seconds": time.perf_counter() - start}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--full", action="store_true", help="also 4096x4096")
+    args = parser.parse_args()
+    mib = 1 << 20
+    sizes = [256, 1024, 2048] + ([4096] if args.full else [])
+    print(f"{'backend':10} {'size':>11} {'triangles':>10} {'measured MiB':>13} {'estimate MiB':>13} "
+          f"{'estimate/measured':>18} {'s':>6}")
+    cases = [(b, s, 8) for b in ("gpu", "reference") for s in sizes]
+    cases += [(b, 256, segments) for b in ("gpu", "reference") for segments in (256, 1024)]
+    for backend, size, segments in cases:
+        r = measure(backend, size, size, segments)
+        print(f"{backend:10} {f'{size}x{size}':>11} {r['triangles']:>10,} {r['measured'] / mib:>13.0f} "
+              f"{r['estimate'] / mib:>13.0f} {r['estimate'] / max(r['measured'], 1):>18.2f} "
+              f"{r['seconds']:>6.1f}")
+    r = refusal(16384, 16384, "1G")
+    print(f"\nrenderer render sphere --size 16384x16384 --max-memory 1G: status {r['status']} in "
+          f"{r['seconds']:.1f} s, peak {r['peak'] / mib:.0f} MiB (the whole process)\n  {r['line']}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,132 @@
+"""Memory a render will need, estimated before anything is allocated, and the limit it must stay
+under, so that a large size, a huge primitive or a big mesh file is refused with one line
+instead of running the machine out of memory.
+
+The figures are per pixel and per triangle, measured with benchmarks/bench_memory.py on
+llvmpipe (peak resident memory over the process's baseline) and rounded up:
+
+    GPU path     renderbuffers, read-back staging and the output arrays: 32 bytes a pixel
+                 (+48 for linear colour, +8 a sample for MSAA), plus the context's own
+                 ~128 MiB; 160 bytes a triangle (the scene's float64 mesh and the float32
+                 vertex and index buffers)
+    reference    the output arrays, 8 bytes a pixel (+16 linear, +4 for a depth-tie image),
+                 and a working set of 320 bytes a pixel of one band of at most TILE_PIXELS
+                 (reference/pipeline.py draws a large frame band by band); 640 bytes a
+                 triangle (vertex outputs, clipping, window triangles, all float64)
+    mesh files   parsing takes up to 16 times the file's size (trimesh's text parsers)
+
+The limit is half of the machine's physical memory unless set (`renderer ... --max-memory`,
+or `limit_set`); `check` raises the one-line UserError when an estimate is over it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+
+from renderer.errors import UserError
+
+MIB = 1 << 20
+GIB = 1 << 30
+
+GPU_FIXED = 128 * MIB
+GPU_BYTES_PER_PIXEL = 32
+GPU_LINEAR_BYTES_PER_PIXEL = 48
+GPU_BYTES_PER_SAMPLE_PIXEL = 8
+GPU_BYTES_PER_TRIANGLE = 160
+
+REFERENCE_FIXED = 64 * MIB
+REFERENCE_OUTPUT_BYTES_PER_PIXEL = 12          # rgba8, depth and a possible tie image
+REFERENCE_LINEAR_BYTES_PER_PIXEL = 16
+REFERENCE_WORKING_BYTES_PER_PIXEL = 320        # of one band
+REFERENCE_BYTES_PER_TRIANGLE = 640
+# A reference frame of more pixels than this is drawn in bands of at most this many
+# (reference/pipeline.py), so that its working set stays bounded.
+REFERENCE_TILE_PIXELS = 1 << 20
+
+MESH_PARSE_FACTOR = 16                          # bytes of memory per byte of mesh file
+SCENE_BYTES_PER_TRIANGLE = 256                  # building a primitive (float64 mesh + temporaries)
+
+DEFAULT_FRACTION = 0.5                          # of physical memory
+_limit: int | None = None
+
+
+def physical_memory() -> int:
+    """The machine's physical memory in bytes."""
+    return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+
+
+def default_limit() -> int:
+    return int(physical_memory() * DEFAULT_FRACTION)
+
+
+def limit() -> int:
+    """The limit in force: the one set, else half of physical memory."""
+    return default_limit() if _limit is None else _limit
+
+
+@contextlib.contextmanager
+def limit_set(value: int | None):
+    """Within the block, estimates are held against `value` bytes (None: the default)."""
+    global _limit
+    before, _limit = _limit, value
+    try:
+        yield
+    finally:
+        _limit = before
+
+
+def parse_size(text: str) -> int:
+    """'512M', '2G', '1.5GiB', '300000000' -> bytes (binary units); ValueError otherwise."""
+    match = re.fullmatch(r"\s*(\d+(?:\.\d+)?)\s*([kmgt]?)(?:i?b)?\s*", text.lower())
+    if not match:
+        raise ValueError(f"expected a size such as 512M or 2G, got {text!r}")
+    number, unit = float(match[1]), match[2]
+    value = int(number * (1 << (10 * " kmgt".index(unit or " "))))
+    if value <= 0:
+        raise ValueError(f"must be more than 0 bytes, got {text!r}")
+    return value
+
+
+def show(n: int) -> str:
+    """Bytes as people read them: 6.4 GiB, 512 MiB, 27 kB."""
+    if n >= GIB:
+        return f"{n / GIB:.1f} GiB"
+    return f"{n / MIB:.0f} MiB" if n >= MIB else f"{n / 1024:.0f} kB"
+
+
+def gpu_bytes(width: int, height: int, triangles: int, *, linear: bool = False,
+              samples: int = 1) -> int:
+    pixels = width * height
+    per_pixel = GPU_BYTES_PER_PIXEL + (GPU_LINEAR_BYTES_PER_PIXEL if linear else 0)
+    per_pixel += GPU_BYTES_PER_SAMPLE_PIXEL * samples if samples > 1 else 0
+    return GPU_FIXED + pixels * per_pixel + triangles * GPU_BYTES_PER_TRIANGLE
+
+
+def reference_bytes(width: int, height: int, triangles: int, *, linear: bool = False,
+                    tile_pixels: int | None = None) -> int:
+    from_band = REFERENCE_TILE_PIXELS if tile_pixels is None else tile_pixels
+    pixels = width * height
+    band = min(pixels, max(from_band, width))       # a band is whole rows, at least one
+    per_pixel = REFERENCE_OUTPUT_BYTES_PER_PIXEL + (REFERENCE_LINEAR_BYTES_PER_PIXEL if linear else 0)
+    return (REFERENCE_FIXED + pixels * per_pixel + band * REFERENCE_WORKING_BYTES_PER_PIXEL
+            + triangles * REFERENCE_BYTES_PER_TRIANGLE)
+
+
+def over_limit(needed: int) -> str | None:
+    """None when `needed` bytes fit under the limit, else the end of a refusal:
+    "needs about 19.1 GiB of memory, over the limit of 12.0 GiB (...)"."""
+    allowed = limit()
+    if needed <= allowed:
+        return None
+    origin = "set by --max-memory" if _limit is not None else \
+        f"half of this machine's {show(physical_memory())}; --max-memory changes it"
+    return f"needs about {show(needed)} of memory, over the limit of {show(allowed)} ({origin})"
+
+
+def check(needed: int, what: str, *, file: str | None = None) -> None:
+    """A one-line UserError when `needed` bytes exceed the limit; `what` says what needs them."""
+    reason = over_limit(needed)
+    if reason:
+        raise UserError(f"{what} {reason}", file=file)

@@ -160,6 +160,28 @@ def check_folder(folder) -> Path:
     return folder
 
 
+class _Plain:
+    """A file as a writer without a file descriptor. NumPy (tofile) and Pillow (encode_to_file)
+    write to a real file's descriptor themselves and report a full disk as 'N requested and M
+    written' or 'encoder error', without the errno; through this, every byte goes through
+    Python's write, which raises OSError(ENOSPC) and the like as they are."""
+
+    def __init__(self, handle):
+        self._handle = handle
+
+    def write(self, data) -> int:
+        return self._handle.write(data)
+
+    def flush(self) -> None:
+        self._handle.flush()
+
+    def seek(self, offset: int, whence: int = 0) -> int:
+        return self._handle.seek(offset, whence)
+
+    def tell(self) -> int:
+        return self._handle.tell()
+
+
 class Outputs:
     """The files of one command, written to temporaries and renamed into place together
     (`outputs()`; module docstring)."""
@@ -196,7 +218,7 @@ class Outputs:
         self._staged.append((tmp, path))
         try:
             with os.fdopen(fd, "wb") as handle:
-                write(handle)
+                write(_Plain(handle))
         except OSError as error:
             raise _fault(path, error) from None
         return path

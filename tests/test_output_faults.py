@@ -273,3 +273,25 @@ def test_a_temporary_of_a_live_process_is_left_alone(tmp_path):
         sleeper.wait()
     imageio.write_png(image, np.zeros((2, 2, 3), np.uint8))
     assert not theirs.exists()
+
+
+@pytest.mark.parametrize("command", [["compare"], ["shaders"], ["extremes"], ["report", "--quick"]])
+def test_an_output_folder_that_is_a_file_is_refused_before_any_work(command, tmp_path, capsys,
+                                                                     monkeypatch):
+    from renderer.cli import main
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "taken").write_text("keep me\n")
+    assert main([*command, "--out", "taken"]) == 2
+    assert one_line(capsys) == "renderer: taken: taken is not a folder, so nothing can be written in it"
+    assert (tmp_path / "taken").read_text() == "keep me\n" and leftovers(tmp_path) == []
+
+
+def test_view_refuses_a_screenshot_that_is_a_folder_before_opening_a_window(tmp_path, capsys,
+                                                                             monkeypatch):
+    from renderer.cli import main
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    shot = tmp_path / "shot.png"
+    shot.mkdir()
+    assert main(["view", "sphere", "--frames", "1", "--screenshot", str(shot)]) == 2
+    assert one_line(capsys) == f"renderer: {shot}: is a folder; name a file in it, e.g. {shot}/out.png"

@@ -51,12 +51,6 @@ SUGGESTED_SUFFIXES = ".png, .jpg, .webp, .tif, .bmp"
 ALPHA_SUFFIXES = ".png, .webp or .tif"
 
 
-def _umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask
-
-
 _TEMP = re.compile(r"\.(?P<name>.+)\.renderer-(?P<pid>\d+)-[0-9a-z_]+\.tmp")
 
 
@@ -212,7 +206,7 @@ class Outputs:
         remove_stale_temporaries(path)
         tmp = temp_name(path)
         try:
-            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666 & ~_umask())
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)   # less the umask
         except OSError as error:
             raise _fault(path, error) from None
         self._staged.append((tmp, path))

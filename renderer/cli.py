@@ -3,8 +3,12 @@
 
 A user's mistake (bad scene, bad output name, no GL) is one line on stderr and exit status
 2, with nothing written; an option argparse refuses is its reason on one line and the
-command's usage on the next, also status 2; a bug keeps its traceback. `compare` exits 1 when
-the images fail the pipeline tolerance.
+command's usage on the next, also status 2; a write the system refuses (read-only, disk full,
+I/O error: errors.SystemFault) is one line and status 1, with nothing written either; a bug
+keeps its traceback. `compare` exits 1 when the images fail the pipeline tolerance.
+
+Every command writes its files through one transaction (renderer/core/imageio.py, `outputs`):
+its output names are checked before any work, and its files are renamed into place together.
 """
 
 from __future__ import annotations
@@ -55,6 +59,14 @@ def channel_threshold(text: str) -> int:
     return value
 
 
+def output_path(text: str) -> Path:
+    """An output file or folder name. An empty one is refused with one line (a UserError,
+    which argparse lets through), before any work: Path('') would be the current folder."""
+    if not text:
+        raise UserError("an empty output name; name the file or folder, e.g. out.png or out/")
+    return Path(text)
+
+
 class _Parser(argparse.ArgumentParser):
     """argparse, but a refused command line is a UsageError: main() prints the reason after
     the (sub)command's name on one line, then its usage on one line (never wrapped), and
@@ -91,11 +103,11 @@ def build_parser() -> argparse.ArgumentParser:
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
-    render.add_argument("-o", "--output", type=Path, metavar="OUT.png",
+    render.add_argument("-o", "--output", type=output_path, metavar="OUT.png",
                         help="image to write, in the format its suffix names (.png, .jpg, .webp, "
                              ".tif, ...; default: SCENE_NAME.png)")
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
-    render.add_argument("--depth", type=Path, metavar="OUT.npy",
+    render.add_argument("--depth", type=output_path, metavar="OUT.npy",
                         help="also write camera-space depth (float32, +inf where empty)")
     render.add_argument("-q", "--quiet", action="store_true",
                         help="do not say where the image was written (one line on stderr)")
@@ -112,11 +124,11 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--frames", type=positive_int, metavar="N",
                       help="scripted: render N frames, save --screenshot, print frame-time "
                            "statistics and exit")
-    view.add_argument("--screenshot", type=Path, metavar="OUT.png",
+    view.add_argument("--screenshot", type=output_path, metavar="OUT.png",
                       help="with --frames: what the window shows after the last frame; "
                            "otherwise the file the S key writes (default view-SCENE-NNN.png); "
                            "in the format its suffix names (.png, .jpg, ...)")
-    view.add_argument("--stats", type=Path, metavar="OUT.json",
+    view.add_argument("--stats", type=output_path, metavar="OUT.json",
                       help="with --frames: also write the frame-time statistics as JSON")
     view.add_argument("--orbit", type=float, default=0.0, metavar="DEGREES_PER_FRAME",
                       help="turn the camera about its look point every frame")
@@ -134,7 +146,7 @@ def build_parser() -> argparse.ArgumentParser:
                     f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
                     "(what fails is said on stderr), 2 for bad input.")
     common(compare)
-    compare.add_argument("--out", type=Path, help="folder for gpu.png, reference.png, diff.png "
+    compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
                          metavar="LEVELS",
@@ -144,7 +156,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     shaders = sub.add_parser("shaders", help="write the exact GLSL a scene's draws use")
     shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
-    shaders.add_argument("--out", type=Path, help="folder for VARIANT.vert/.geom/.frag "
+    shaders.add_argument("--out", type=output_path, help="folder for VARIANT.vert/.geom/.frag "
                                                    "(default: shaders-SCENE_NAME)")
 
     report = sub.add_parser("report", help="error against run time over quality settings "
@@ -152,7 +164,7 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("scenes", nargs="*", metavar="SCENE",
                         help="scene files or built-in names (default: every built-in scene; "
                              "with --quick, two small ones)")
-    report.add_argument("--out", type=Path, required=True, help="folder for the report")
+    report.add_argument("--out", type=output_path, required=True, help="folder for the report")
     report.add_argument("--quick", action="store_true",
                         help="a reduced sweep at 64x48 that takes about a minute (for CI)")
     report.add_argument("--size", type=parse_size, metavar="WxH",
@@ -167,7 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
     extremes = sub.add_parser("extremes", help="render the extreme scenes (assets/extreme/) through "
                                                "both pipelines and report their stability")
     extremes.add_argument("scenes", nargs="*", help="further scene files to measure alike")
-    extremes.add_argument("--out", type=Path, default=Path("extremes"),
+    extremes.add_argument("--out", type=output_path, default=Path("extremes"),
                           help="folder for extremes.json and extremes.md (default: extremes)")
     extremes.add_argument("--size", type=parse_size, default=(320, 240), metavar="WxH",
                           help="image size in pixels (default 320x240)")
@@ -229,24 +241,27 @@ def warn_if_nothing_drawn(scene, frame) -> None:
 
 
 def cmd_render(args) -> int:
-    from renderer.core.imageio import image_format, write_image, write_npy
+    from renderer.core.imageio import check_outputs, image_format, outputs
     if args.output is not None:              # a name Pillow cannot write: said before any work
         image_format(args.output, alpha=args.background == "transparent")
     if args.depth is not None and args.depth.suffix.lower() != ".npy":
         raise UserError("--depth writes a NumPy array; name the file with .npy, e.g. depth.npy",
                         file=str(args.depth))
+    check_outputs(args.output, args.depth)   # a folder, a file as parent, the same file twice
     scene = _load(args.scene)
     check_memory(scene, args.size, [args.backend])
     output = args.output or Path(f"{scene.name}.png")
+    check_outputs(output, args.depth)
     if args.backend == "gpu":
         frame = _render_gpu(scene, args.size, args.context)[0]
     else:
         import reference
         frame = reference.render(scene, *args.size)
     warn_if_nothing_drawn(scene, frame)
-    write_image(output, frame.image(args.background))
-    if args.depth:
-        write_npy(args.depth, frame.depth)
+    with outputs(output, args.depth) as out:     # both or neither
+        out.image(output, frame.image(args.background))
+        if args.depth:
+            out.npy(args.depth, frame.depth)
     if not args.quiet:
         written = f"{output} and {args.depth}" if args.depth else f"{output}"
         print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {args.backend}, "
@@ -256,8 +271,8 @@ def cmd_render(args) -> int:
 
 def cmd_view(args) -> int:
     """The window viewer (renderer/viewer/viewer.py); without a display, one line and status 2."""
-    from renderer.core.imageio import image_format
-    from renderer.core.jsonio import write_json
+    from renderer.core.imageio import check_outputs, image_format, outputs
+    from renderer.core.jsonio import json_text
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
@@ -267,19 +282,24 @@ def cmd_view(args) -> int:
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
         image_format(args.screenshot)
     scripted = args.frames is not None
+    check_outputs(args.screenshot, args.stats if scripted else None)
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,
                 screenshot=None if scripted else args.screenshot) as viewer:
         if not scripted:
             print(f"renderer view: {scene.name}; H for help, Esc to quit")
         try:
-            stats = viewer.run(args.frames, args.orbit, args.screenshot if scripted else None)
+            stats = viewer.run(args.frames, args.orbit, None)     # the screenshot: below, with --stats
         except KeyboardInterrupt:              # Ctrl-C in the terminal: as good as Esc
             return 0
         figures = viewer.figures
+        shown = viewer.shown_image() if scripted and args.screenshot is not None else None
     if scripted:
-        if args.stats is not None:
-            write_json(args.stats, stats.summary() | {"reference": figures})
+        with outputs(args.screenshot, args.stats) as out:    # both or neither
+            if shown is not None:
+                out.image(args.screenshot, shown)
+            if args.stats is not None:
+                out.text(args.stats, json_text(stats.summary() | {"reference": figures}))
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
@@ -291,10 +311,15 @@ def cmd_view(args) -> int:
 def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
-    from renderer.core.imageio import write_png
+    from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.jsonio import finite_or_none, to_json
+    if args.out is not None:
+        check_folder(args.out)
     scene = _load(args.scene)
     check_memory(scene, args.size, ["gpu", "reference"])
+    out = check_folder(args.out or Path(f"compare-{scene.name}"))
+    names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
+    check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
     gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
     start = time.perf_counter()
@@ -305,11 +330,11 @@ def cmd_compare(args) -> int:
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
                             threshold=tolerance.threshold, deviation=tolerance.deviation,
                             reference_tie=ref_frame.rgba8_tie)
-    out = args.out or Path(f"compare-{scene.name}")
-    write_png(out / "gpu.png", gpu_frame.rgba8)
-    write_png(out / "reference.png", ref_frame.rgba8)
-    write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
-                                         tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
+    with outputs(*names) as written:             # all three or none
+        written.png(names[0], gpu_frame.rgba8)
+        written.png(names[1], ref_frame.rgba8)
+        written.png(names[2], heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
+                                       tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
     figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
@@ -327,29 +352,35 @@ def cmd_compare(args) -> int:
 def cmd_shaders(args) -> int:
     """One set of files per shader variant the scene draws with, named after the variant,
     and a line per variant naming the objects that use it."""
-    from renderer.core.imageio import write_text
+    from renderer.core.imageio import check_folder, outputs
     from renderer.gpu.shaders import ShaderVariant, program_sources
+    if args.out is not None:
+        check_folder(args.out)
     scene = _load(args.scene)
-    out = args.out or Path(f"shaders-{scene.name}")
+    out = check_folder(args.out or Path(f"shaders-{scene.name}"))
     users: dict[ShaderVariant, list[str]] = {}
     for obj in scene.objects:
         if obj.mesh.triangle_count:
             users.setdefault(ShaderVariant.for_material(scene, obj.material), []).append(obj.name)
     suffixes = {"vertex_shader": "vert", "geometry_shader": "geom", "fragment_shader": "frag"}
-    for variant, names in users.items():
-        files = []
-        for stage, source in program_sources(variant).items():
-            path = out / f"{variant.name}.{suffixes[stage]}"
-            write_text(path, source.text)
-            files.append(path.name)
-        print(f"{variant.name}: {', '.join(files)} (objects: {', '.join(names)})")
+    lines = []
+    with outputs() as written:                   # every variant's files or none
+        for variant, names in users.items():
+            files = []
+            for stage, source in program_sources(variant).items():
+                files.append(written.text(out / f"{variant.name}.{suffixes[stage]}", source.text).name)
+            lines.append(f"{variant.name}: {', '.join(files)} (objects: {', '.join(names)})")
+    for line in lines:
+        print(line)
     return 0
 
 
 def cmd_report(args) -> int:
     from renderer.core.builtin import builtin_scenes
     from renderer.study.report import run_report
+    from renderer.core.imageio import check_folder, check_outputs
     from renderer.study.report_settings import QUICK_SCENES
+    check_outputs(check_folder(args.out) / "report.md", args.out / "results.csv")
     names = args.scenes or (list(QUICK_SCENES) if args.quick else list(builtin_scenes()))
     scenes = [_load(name) for name in names]
     result = run_report(scenes, args.out, quick=args.quick, size=args.size, cache_dir=args.cache,
@@ -372,6 +403,8 @@ def cmd_extremes(args) -> int:
     from renderer.gpu.context import make_context, release_context
     from renderer.study.extremes import all_pass, extreme_scenes, measure_extremes, write_report
     from renderer.core.scene_file import load_scene
+    from renderer.core.imageio import check_folder, check_outputs
+    check_outputs(check_folder(args.out) / "extremes.json", args.out / "extremes.md")
     extra = [resolve_scene(arg) for arg in args.scenes]
     for path in extra:
         load_scene(path)                     # a bad extra scene: its one line before any work
@@ -411,9 +444,9 @@ def main(argv=None) -> int:
         print(f"{error.prog}: {error.reason}", file=sys.stderr)
         print(error.usage, file=sys.stderr)
         return 2
-    except UserError as error:
+    except UserError as error:           # 2: the user's mistake; 1: a SystemFault (errors.py)
         print(f"renderer: {error.line()}", file=sys.stderr)
-        return 2
+        return error.status
     except BrokenPipeError:              # `renderer scenes | head`: the reader left, not an error
         sys.stdout = open(os.devnull, "w")
         return 0

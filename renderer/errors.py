@@ -1,7 +1,9 @@
 """User-facing errors: one line naming the file, the key and the reason.
 
-The command line turns a `UserError` into that line on stderr and exit status 2; anything
-else is a bug and keeps its traceback.
+The command line turns a `UserError` into that line on stderr and its `status`: 2 for a
+mistake in what the user gave (a bad scene, option or output name), 1 for a `SystemFault`,
+where the system failed us (a read-only folder or file system, a full disk, an I/O error).
+Anything else is a bug and keeps its traceback.
 """
 
 from __future__ import annotations
@@ -11,6 +13,8 @@ import math
 
 class UserError(Exception):
     """A mistake in the user's input (a scene file, a mesh, an option), not a bug."""
+
+    status = 2          # the command line's exit status for it
 
     def __init__(self, reason: str, file: str | None = None, key: str | None = None):
         self.reason, self.file, self.key = reason, file, key
@@ -28,6 +32,13 @@ class UsageError(UserError):
     def __init__(self, reason: str, prog: str, usage: str):
         self.prog, self.usage = prog, usage
         super().__init__(reason)
+
+
+class SystemFault(UserError):
+    """The system refused what a correct command asked (writing to a read-only folder or file
+    system, a full disk, an I/O error): one line like a UserError, but exit status 1."""
+
+    status = 1
 
 
 class SceneError(UserError):

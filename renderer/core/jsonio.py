@@ -22,9 +22,15 @@ def to_json(value, *, indent: int | None = None) -> str:
     return json.dumps(value, indent=indent, allow_nan=False)
 
 
+def json_text(value, *, indent: int = 1) -> str:
+    """A JSON file's text: `to_json(value)` and a newline."""
+    return to_json(value, indent=indent) + "\n"
+
+
 def write_json(path, value, *, indent: int = 1) -> None:
-    """`to_json(value)` and a newline, written atomically (imageio.write_text)."""
-    write_text(path, to_json(value, indent=indent) + "\n")
+    """`json_text(value)` written atomically (imageio.write_text; with other files of the same
+    command: `imageio.outputs()` and `out.text(path, json_text(value))`)."""
+    write_text(path, json_text(value, indent=indent))
 
 
 def finite_or_none(x: float | None) -> float | None:

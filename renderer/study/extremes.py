@@ -26,8 +26,8 @@ from renderer.checks.compare import compare_frames, depth_tie_pixels
 from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import GpuRenderer
-from renderer.core.imageio import write_text
-from renderer.core.jsonio import write_json
+from renderer.core.imageio import outputs
+from renderer.core.jsonio import json_text
 from renderer.core.scene_file import load_scene
 
 # What makes each case stable, keyed by the scene file's name (docs/conventions.md has the rules).
@@ -192,11 +192,13 @@ def _backends(cases: list[dict]) -> list[str]:
 
 
 def write_report(out: Path, cases: list[dict], size: tuple[int, int]) -> tuple[Path, Path]:
-    """extremes.json (every figure of every case) and extremes.md (the table), atomically."""
+    """extremes.json (every figure of every case) and extremes.md (the table): both or neither
+    (imageio.outputs)."""
     json_path, md_path = Path(out) / "extremes.json", Path(out) / "extremes.md"
     document = {"size": list(size), "cases": cases}
-    write_json(json_path, _json_safe(document))
-    write_text(md_path, markdown_table(cases, size))
+    with outputs(json_path, md_path) as written:
+        written.text(json_path, json_text(_json_safe(document)))
+        written.text(md_path, markdown_table(cases, size))
     return json_path, md_path
 
 

@@ -36,7 +36,7 @@ from renderer.core import sampling
 from renderer.core.gl_rules import to_unorm8
 from renderer.study.report_output import csv_text, plot_png, report_markdown
 from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
-from renderer.core.imageio import write_bytes, write_text
+from renderer.core.imageio import outputs
 from renderer.checks.perceptual import flip_error
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
@@ -234,11 +234,17 @@ def run_report(scenes: list, out: Path, *, quick: bool = False, size=None, cache
 
 def write_outputs(result: ReportResult, out: Path, size, sweep: Sweep, quick: bool) -> None:
     plots = {}
+    with outputs() as written:               # the whole report or none of it
+        _write_outputs(written, result, out, size, sweep, quick, plots)
+    result.files = ["report.md", "results.csv", *plots.values()]
+
+
+def _write_outputs(written, result: ReportResult, out: Path, size, sweep: Sweep, quick: bool,
+                   plots: dict) -> None:
     for scene in dict.fromkeys(row["scene"] for row in result.rows):
         for knob in dict.fromkeys(row["knob"] for row in result.rows if row["scene"] == scene):
             rows = [row for row in result.rows if row["scene"] == scene and row["knob"] == knob]
             plots[(scene, knob)] = f"plots/{scene}-{knob}.png"
-            write_bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}"))
-    write_text(out / "results.csv", csv_text(result.rows))
-    write_text(out / "report.md", report_markdown(result, plots, size, sweep, quick))
-    result.files = ["report.md", "results.csv", *plots.values()]
+            written.bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}"))
+    written.text(out / "results.csv", csv_text(result.rows))
+    written.text(out / "report.md", report_markdown(result, plots, size, sweep, quick))

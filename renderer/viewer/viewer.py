@@ -262,6 +262,13 @@ class Viewer:
         data = self.ctx.screen.read(viewport=(0, 0, width, height), components=3, alignment=1)
         return np.frombuffer(data, np.uint8).reshape(height, width, 3)[::-1].copy()
 
+    def shown_image(self) -> np.ndarray:
+        """What the window shows now, (H, W, 3) uint8: the image just swapped in is the front
+        buffer; it is drawn again (the same frame, no orbit step) to read it from the back
+        buffer."""
+        self._compose(self.presenter.shown)
+        return self.window_image()
+
     def save_screenshot(self, path: Path | None = None) -> Path:
         if path is None:
             path = self.screenshot_path
@@ -295,10 +302,7 @@ class Viewer:
                 self._last_swap = None        # the wait is not a frame time
             self.frame()
             if last and screenshot is not None:
-                # The image just swapped in is the front buffer now; draw it again (the
-                # same frame, no orbit step) to read it from the back buffer.
-                self._compose(self.presenter.shown)
-                write_image(screenshot, self.window_image())
+                write_image(screenshot, self.shown_image())
             count += 1
         self.stats.latency_ms = self.presenter.latency_ms
         return self.stats

@@ -24,7 +24,7 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
-from renderer.errors import UsageError, UserError
+from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
 
@@ -441,7 +441,7 @@ def main(argv=None) -> int:
         with limit_set(getattr(args, "max_memory", None)):
             return COMMANDS[args.command](args)
     except UsageError as error:
-        print(f"{error.prog}: {error.reason}", file=sys.stderr)
+        print(f"{error.prog}: {escaped(error.reason)}", file=sys.stderr)
         print(error.usage, file=sys.stderr)
         return 2
     except UserError as error:           # 2: the user's mistake; 1: a SystemFault (errors.py)

@@ -9,6 +9,7 @@ Anything else is a bug and keeps its traceback.
 from __future__ import annotations
 
 import math
+import unicodedata
 
 
 class UserError(Exception):
@@ -21,8 +22,32 @@ class UserError(Exception):
         super().__init__(self.line())
 
     def line(self) -> str:
-        where = ": ".join(part for part in (self.file, self.key) if part)
-        return f"{where}: {self.reason}" if where else self.reason
+        """FILE: KEY: REASON, always one line whatever the input: a file or key holding a line
+        break or another control character is shown quoted (Python's repr), and such
+        characters in the reason are escaped (\\n, \\x1b, \\u2028)."""
+        where = ": ".join(quoted(part) for part in (self.file, self.key) if part)
+        reason = escaped(self.reason)
+        return f"{where}: {reason}" if where else reason
+
+
+def _is_control(char: str) -> bool:
+    # Cc: C0/C1 controls (\n, \r, \x1b, \x85, ...); Zl, Zp: U+2028, U+2029, which
+    # str.splitlines and many terminals also take as line breaks.
+    return unicodedata.category(char) in ("Cc", "Zl", "Zp")
+
+
+def quoted(text: str) -> str:
+    """`text` as it is, or repr-quoted when it holds a control character (a line break...)."""
+    text = str(text)
+    return repr(text) if any(_is_control(c) for c in text) else text
+
+
+def escaped(text: str) -> str:
+    """`text` with each control character written as its escape (newline as \\n)."""
+    text = str(text)
+    if not any(_is_control(c) for c in text):
+        return text
+    return "".join(repr(c)[1:-1] if _is_control(c) else c for c in text)
 
 
 class UsageError(UserError):

@@ -286,6 +286,42 @@ def test_update_rewrites_a_changed_golden_and_the_next_run_passes(spec):
     spec.run(phase="after").assert_outcomes(passed=1)
 
 
+def test_update_keeps_a_golden_the_frame_passes_unless_asked_for_all(spec):
+    """Plain --update-goldens rewrites only goldens that fail their policy: one broken golden
+    does not drag along every golden that differs within tolerance. --update-goldens=all
+    rewrites every golden whose pixels differ at all."""
+    spec.write("""
+        def test_within(golden):
+            golden.check(frame(after=[(np.s_[0, 0], 1), (np.s_[3, 3], 2)]))
+
+        def test_broken(golden):
+            golden.check(frame(after=[(np.s_[20, 5], 10)]))
+    """)
+    spec.run("--update-goldens").assert_outcomes(passed=2)
+    within_before = snapshot(spec.goldens)["test_within.png"]
+
+    result = spec.run("--update-goldens", phase="after")
+    result.assert_outcomes(passed=2)
+    result.stdout.fnmatch_lines(["goldens: 1 passed, 1 updated", "written: goldens/test_broken.png"])
+    result.stdout.no_fnmatch_line("written: goldens/test_within.png")
+    assert snapshot(spec.goldens)["test_within.png"] == within_before
+    assert np.array_equal(read_golden(spec.goldens / "test_within.png"), GREY)
+
+    result = spec.run("--update-goldens=all", phase="after")
+    result.assert_outcomes(passed=2)
+    result.stdout.fnmatch_lines(["goldens: 1 unchanged, 1 updated", "written: goldens/test_within.png"])
+    assert read_golden(spec.goldens / "test_within.png")[3, 3, 0] == 130
+    assert snapshot(spec.goldens)["test_within.png"] != within_before
+
+
+def test_update_all_creates_missing_goldens_too_and_the_path_is_not_its_value(spec):
+    spec.write(ONE_GOLDEN)
+    spec.run("--update-goldens=all").assert_outcomes(passed=1)
+    assert (spec.goldens / "test_sky.png").is_file()
+    # A path after plain --update-goldens is a path, not the option's value.
+    spec.run("--update-goldens", "test_spec.py").assert_outcomes(passed=1)
+
+
 def test_only_the_golden_that_changed_fails(spec):
     spec.write("""
         def test_one(golden):
@@ -758,6 +794,7 @@ def test_plugin_is_inert_when_no_test_uses_golden(spec):
 def test_options_are_listed_in_help(spec):
     result = spec.run("--help")
     result.stdout.fnmatch_lines(["*golden images (checked-renderer)*", "*--update-goldens*",
+                                 "*--update-goldens=all*",
                                  "*--goldens-results=DIR*", "*goldens_policy*"])
 
 

@@ -5,8 +5,11 @@
                     GL_RENDERER, GL_VERSION, context), the policy it is held to, and the
                     SHA-256 of its pixels (so a PNG edited or half-updated since is noticed)
 
-`check_golden(..., update=True)` is the only code that writes a golden; the pytest plugin
-(renderer/checks/pytest_plugin.py) calls it so only under --update-goldens. Writes are atomic
+`check_golden(..., update=...)` is the only code that writes a golden; the pytest plugin
+(renderer/checks/pytest_plugin.py) calls it so only under --update-goldens. `update="failing"`
+(plain --update-goldens) writes missing goldens and rewrites only those the frame fails under
+their policy (or whose PNG and sidecar disagree); `update="all"` (or True;
+--update-goldens=all) rewrites every golden whose pixels differ at all. Writes are atomic
 (renderer/core/imageio.py): an interrupted update leaves the old file or the new one, never a
 truncated one. This module knows nothing of pytest.
 """
@@ -131,13 +134,21 @@ def _size(rgba8: np.ndarray) -> str:
     return f"{rgba8.shape[1]}x{rgba8.shape[0]}"
 
 
+UPDATE_MODES = ("failing", "all")
+
+
 def check_golden(directory, name: str, actual_rgba8: np.ndarray, *, policy=None, scene: str | None = None,
-                 gl_info: dict | None = None, update: bool = False) -> Outcome:
+                 gl_info: dict | None = None, update: bool | str = False) -> Outcome:
     """Hold a frame against golden `name` in `directory` under `policy` (default "threshold").
 
     Without `update` nothing is written: a missing golden is status "missing"; a golden of
-    another size, or an unreadable PNG or sidecar, raises GoldenError. With `update` the
-    golden is created, or rewritten when its pixels or declared sidecar keys differ at all.
+    another size, or an unreadable PNG or sidecar, raises GoldenError.
+    With update="failing" a missing, unreadable or wrong-size golden is created, a golden the
+    frame fails under the policy, or whose sidecar does not describe its PNG, is rewritten
+    ("updated"); a golden the frame passes keeps its pixels (status "passed" when they differ,
+    "unchanged" or "refreshed" (declared sidecar keys only) when they are equal).
+    With update="all" (or True) the golden is rewritten when its pixels or declared sidecar
+    keys differ at all.
     """
     policy = policy_from(policy)
     actual = np.asarray(actual_rgba8)
@@ -145,9 +156,14 @@ def check_golden(directory, name: str, actual_rgba8: np.ndarray, *, policy=None,
         raise GoldenError(f"a golden holds an (H, W, 4) uint8 RGBA image; got {actual.dtype} "
                           f"{actual.shape}", key=name)
     png, sidecar_path = golden_paths(directory, name)
+    if update is True:
+        update = "all"
+    if update and update not in UPDATE_MODES:
+        raise GoldenError(f"unknown update mode {update!r}; expected one of: {', '.join(UPDATE_MODES)}",
+                          key="update")
     if update:
         wanted = make_sidecar(name, actual, policy, scene, gl_info)
-        return _update(png, sidecar_path, name, actual, policy, wanted)
+        return _update(png, sidecar_path, name, actual, policy, wanted, update, gl_info)
     if not png.exists():
         return Outcome(name, "missing", png, actual, None, policy, None, [])
     expected = read_golden(png)
@@ -164,12 +180,26 @@ def check_golden(directory, name: str, actual_rgba8: np.ndarray, *, policy=None,
     return Outcome(name, "passed" if verdict.passed else "failed", png, actual, expected, policy, verdict, notes)
 
 
-def _update(png, sidecar_path, name, actual, policy, wanted) -> Outcome:
+def _update(png, sidecar_path, name, actual, policy, wanted, mode, gl_info) -> Outcome:
     try:
         expected = read_golden(png) if png.exists() else None
         sidecar = read_sidecar(sidecar_path) if expected is not None else {}
     except GoldenError:                              # an unreadable golden is replaced
         expected, sidecar = None, {}
+    if (mode == "failing" and expected is not None and expected.shape == actual.shape
+            and not np.array_equal(expected, actual)
+            and sidecar.get("rgba_sha256") == pixels_sha256(expected)):
+        verdict = policy.evaluate(expected, actual)
+        if verdict.passed:                           # within policy: the golden keeps its pixels
+            kept = dict(wanted, rgba_sha256=sidecar["rgba_sha256"])
+            status = "passed"
+            if not all(sidecar.get(key) == kept[key] for key in DECLARED_KEYS):
+                # The declared keys are the test's; what made the pixels stays as recorded.
+                write_text(sidecar_path, to_json(
+                    dict(sidecar, **{key: kept[key] for key in DECLARED_KEYS}), indent=2) + "\n")
+                status = "refreshed"
+            notes = [note for note in (implementation_note(sidecar, gl_info),) if note]
+            return Outcome(name, status, png, actual, expected, policy, verdict, notes)
     if expected is not None and expected.shape == actual.shape and np.array_equal(expected, actual):
         if all(sidecar.get(key) == wanted[key] for key in DECLARED_KEYS):
             status = "unchanged"

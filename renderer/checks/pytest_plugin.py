@@ -4,7 +4,8 @@
         golden.check_scene("my_scene.toml")      # GPU, 256x256, against goldens/test_my_scene.png
 
     pytest                       # compare; failures go to golden-results/index.html
-    pytest --update-goldens      # create missing goldens, rewrite changed ones (the only writer)
+    pytest --update-goldens      # create missing goldens, rewrite those that fail (the only writer)
+    pytest --update-goldens=all  # ... and rewrite every golden whose pixels differ at all
 
 Goldens live in a `goldens/` folder beside the test file, as NAME.png with a NAME.json
 sidecar (renderer/checks/goldens.py); NAME defaults to the test's name. Policies: renderer/checks/policies.py;
@@ -32,9 +33,18 @@ class GoldenWarning(UserWarning):
 
 def pytest_addoption(parser):
     group = parser.getgroup("goldens", "golden images (checked-renderer)")
-    group.addoption("--update-goldens", action="store_true", default=False,
-                    help="write missing goldens and rewrite those whose pixels changed "
-                         "(the only way a golden is ever written)")
+    # Two option strings rather than an optional value: `--update-goldens tests/` must not
+    # take the path as its value. argparse matches "--update-goldens=all" whole first.
+    group.addoption("--update-goldens", action="store_const", const="failing", default=None,
+                    dest="update_goldens",
+                    help="write missing goldens and rewrite those the frame fails under their "
+                         "policy (the only way a golden is ever written); goldens that pass "
+                         "keep their pixels")
+    group.addoption("--update-goldens=all", action="store_const", const="all",
+                    dest="update_goldens",
+                    help="as --update-goldens, and also rewrite every golden whose pixels "
+                         "differ from the frame at all (after a deliberate change, or to make "
+                         "goldens exact on this machine)")
     group.addoption("--goldens-results", metavar="DIR", default=None,
                     help=f"folder for the images and index.html of failing comparisons "
                          f"(default: {RESULTS_DEFAULT} in the rootdir)")
@@ -47,7 +57,7 @@ class GoldenSession:
     """What one pytest run knows about its golden checks."""
 
     def __init__(self, config):
-        self.update = bool(config.getoption("--update-goldens"))
+        self.update = config.getoption("update_goldens") or False   # False, "failing" or "all"
         option = config.getoption("--goldens-results")
         self.results_root = Path(option).resolve() if option else config.rootpath / RESULTS_DEFAULT
         self.default_policy = config.getini("goldens_policy") or None
@@ -133,13 +143,13 @@ class GoldenChecker:
             png = golden_paths(self.directory, name)[0]
             # A golden an earlier test of this run updated (two tests sharing a name) is
             # compared, not written again: if they disagree, that is the failure to see.
-            update = session.update and png not in session.claimed
+            update = session.update if png not in session.claimed else False
             outcome = check_golden(self.directory, name, rgba8, policy=policy or session.default_policy,
                                    scene=scene, gl_info=gl_info, update=update)
         except UserError as error:
             _fail_plainly(error)
         session.counts[outcome.status] += 1
-        if update:               # "unchanged" too: a later test of the same name must not rewrite it
+        if update:               # "unchanged" and "passed" too: a later test of the same name must not rewrite it
             session.claimed[png] = nodeid
         if outcome.status in ("created", "updated"):
             session.changed.append(png)

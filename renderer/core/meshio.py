@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import logging
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -32,6 +33,10 @@ from renderer.core.scene import Mesh
 
 # Suffixes we hand to trimesh; the first three are the ones the tests cover.
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
+
+# Largest |coordinate| a mesh file may hold: the GPU computes in float32 (largest 3.4e38), and
+# a coordinate is multiplied by scales and matrices (renderer/core/scene_file.py MAX_NUMBER).
+MAX_COORDINATE = 1e18
 
 # A normal shorter than this (before renormalising) counts as missing.
 MIN_NORMAL_LENGTH = 1e-8
@@ -63,7 +68,8 @@ def load_mesh(path, *, source: str | None = None, key: str | None = None,
         raise ValueError(f"crease_angle must be in (0, 180] degrees, got {crease_angle!r}")
     path = Path(path)
     try:
-        return _load_checked(path, crease_angle)
+        with _quiet_libraries():
+            return _load_checked(path, crease_angle)
     except _MeshProblem as problem:
         if source is not None:
             raise SceneError(f"{path}: {problem}", file=source, key=key) from None
@@ -86,6 +92,8 @@ def _load_checked(path: Path, crease_angle: float) -> Mesh:
         raise _MeshProblem(f"a mesh file of {memory.show(size)} {too_much}")
     if suffix == ".obj":
         _check_obj_face_indices(path)
+    if suffix == ".ply":
+        _check_ascii_ply_face_indices(path)
     positions, faces, file_normals = _read_with_trimesh(path)
     _check_geometry(positions, faces)
     if file_normals is None:
@@ -97,14 +105,19 @@ def _load_checked(path: Path, crease_angle: float) -> Mesh:
 
 
 @contextlib.contextmanager
-def _quiet_trimesh():
-    """trimesh logs warnings (materials, sparse fallbacks) to stderr; our contract is one
-    error line or nothing, so its logger is raised to ERROR while we read a file."""
+def _quiet_libraries():
+    """Our contract is one error line or nothing, so while we read a user's file nothing a
+    library says reaches the terminal: trimesh's logger (materials, sparse fallbacks) is
+    raised above CRITICAL, Python warnings (trimesh's and NumPy's RuntimeWarnings on inf or
+    1e300 coordinates) are dropped, and NumPy's floating-point errors are ignored. What is
+    wrong with the file is found by our own checks, which say it in one line."""
     logger = logging.getLogger("trimesh")
     level = logger.level
-    logger.setLevel(logging.ERROR)
+    logger.setLevel(logging.CRITICAL + 1)
     try:
-        yield
+        with warnings.catch_warnings(), np.errstate(all="ignore"):
+            warnings.simplefilter("ignore")
+            yield
     finally:
         logger.setLevel(level)
 
@@ -114,12 +127,18 @@ def _read_with_trimesh(path: Path):
 
     process=False keeps the file's vertices and normals as written (no merging, no repair).
     """
+    kind = path.suffix.lower()[1:].upper()
     try:
-        with _quiet_trimesh():
-            loaded = trimesh.load_scene(str(path), process=False)
+        loaded = trimesh.load_scene(str(path), process=False)
+    except ImportError:
+        # trimesh falls back to guessing a text encoding (charset_normalizer, not installed)
+        # when a file is neither its binary layout nor UTF-8 text.
+        raise _MeshProblem(f"could not be read as {kind}: not a valid {kind} file (neither "
+                           f"binary {kind} nor text)") from None
     except Exception as exc:   # trimesh raises anything from ValueError to IndexError
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        raise _MeshProblem(f"could not be read as {path.suffix.lower()[1:].upper()}: {reason}")
+        raise _MeshProblem(f"could not be read as {kind}: not a valid {kind} file: {reason}") \
+            from None
 
     parts = []
     for node in loaded.graph.nodes_geometry:
@@ -168,6 +187,13 @@ def _check_geometry(positions: np.ndarray, faces: np.ndarray) -> None:
         shown = ", ".join(show_number(x) for x in positions[i])
         raise _MeshProblem(f"vertex {i} is not finite ({shown}); "
                            f"{int(bad.sum())} of {len(positions)} vertices are NaN or Inf")
+    large = (np.abs(positions) > MAX_COORDINATE).any(axis=1)
+    if large.any():
+        i = int(np.argmax(large))
+        shown = ", ".join(show_number(x) for x in positions[i])
+        raise _MeshProblem(f"vertex {i} ({shown}) is too large for the GPU's float32 "
+                           f"arithmetic; coordinates must satisfy |x| <= {MAX_COORDINATE:g} "
+                           f"({int(large.sum())} of {len(positions)} vertices do not)")
     out = (faces < 0) | (faces >= len(positions))
     if out.any():
         f = int(np.argmax(out.any(axis=1)))
@@ -198,6 +224,58 @@ def _check_obj_face_indices(path: Path) -> None:
                     f"line {number}: face index {index} out of range (the file has "
                     f"{vertex_count} vertices; OBJ indices run from 1 to {vertex_count}, "
                     f"or -1 to -{vertex_count} counting back)")
+
+
+def _check_ascii_ply_face_indices(path: Path) -> None:
+    """Check an ASCII PLY's face indices as written, in Python integers: trimesh narrows them
+    to the header's type first (an index of 2**31 + 10 would come out as -2147483648).
+    Binary PLY cannot hold a value its type does not; trimesh reads those as they are."""
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read()
+    except OSError as exc:
+        raise _MeshProblem(f"could not be read: {exc.strerror or exc}")
+    end = data.find(b"end_header")
+    if end < 0:
+        return                                       # trimesh says what is wrong
+    header = data[:end].decode("ascii", errors="replace").splitlines()
+    if not any(line.split()[:2] == ["format", "ascii"] for line in header):
+        return
+    elements = []                                    # [name, count, [(name, is_list)]]
+    for line in header:
+        fields = line.split()
+        if fields[:1] == ["element"] and len(fields) == 3 and fields[2].isdigit():
+            elements.append([fields[1], int(fields[2]), []])
+        elif fields[:1] == ["property"] and elements and len(fields) >= 3:
+            elements[-1][2].append((fields[-1], fields[1] == "list"))
+    vertex_count = next((count for name, count, _ in elements if name == "vertex"), 0)
+    body = data[end:].split(b"\n", 1)[1] if b"\n" in data[end:] else b""
+    lines = iter(body.decode("ascii", errors="replace").splitlines())
+    face = 0
+    for name, count, properties in elements:
+        for _ in range(count):
+            tokens = next(lines, "").split()
+            position = 0
+            for prop, is_list in properties:
+                if position >= len(tokens):
+                    return                           # short line: trimesh says what is wrong
+                try:
+                    length = int(tokens[position]) if is_list else 1
+                    values = [int(t) for t in tokens[position + is_list:
+                                                     position + is_list + length]]
+                except ValueError:
+                    values, length = [], (int(is_list) and 0)
+                    if name == "face" and prop in ("vertex_indices", "vertex_index"):
+                        return                       # not integers: trimesh says what is wrong
+                if name == "face" and prop in ("vertex_indices", "vertex_index"):
+                    for index in values:
+                        if not 0 <= index < vertex_count:
+                            raise _MeshProblem(
+                                f"face {face} has vertex index {index} out of range (the mesh "
+                                f"has {vertex_count} vertices, indices 0 to {vertex_count - 1})")
+                position += (1 + length) if is_list else 1
+            if name == "face":
+                face += 1
 
 
 def merge_coincident_vertices(positions: np.ndarray, faces: np.ndarray):

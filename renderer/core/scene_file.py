@@ -26,8 +26,8 @@ import numpy as np
 from renderer.core import transforms
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
-from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
 from renderer.core import memory
+from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
@@ -66,6 +66,15 @@ PRIMITIVE_LIMITS = {
 
 # A model matrix whose linear part has a determinant at or below this is refused.
 MIN_DETERMINANT = 1e-9
+
+# The GPU computes in float32 (largest value 3.4e38): every number in a scene file, and every
+# mesh coordinate (meshio.MAX_COORDINATE), must have |x| <= MAX_NUMBER, so that products of
+# two such numbers stay finite. The matrices they compose (camera-relative model matrix,
+# normal matrix, projection) and each object's bounding box through them, in clip space,
+# must stay within MAX_COMPOSED, which leaves 8 orders of magnitude for the image's aspect
+# ratio and the GPU's own arithmetic.
+MAX_NUMBER = MAX_COORDINATE
+MAX_COMPOSED = 1e30
 
 
 # --------------------------------------------------------------------------- entry points
@@ -227,6 +236,9 @@ class _Reader:
         x = self.to_float(value, path)
         if not math.isfinite(x):
             self.fail(path, f"expected a finite number, got {show_number(x)}")
+        if abs(x) > MAX_NUMBER:
+            self.fail(path, f"{show_number(x)} is too large for the GPU's float32 arithmetic; "
+                            f"numbers must satisfy |x| <= {MAX_NUMBER:g}")
         if minimum is not None and x < minimum:
             self.fail(path, f"must be >= {minimum:g}, got {x:g}")
         if above is not None and x <= above:
@@ -257,6 +269,9 @@ class _Reader:
             x = self.to_float(item, path)
             if not math.isfinite(x):
                 self.fail(path, f"expected finite numbers, item {i} is {show_number(x)}")
+            if abs(x) > MAX_NUMBER:
+                self.fail(path, f"item {i} is {show_number(x)}, too large for the GPU's float32 "
+                                f"arithmetic; numbers must satisfy |x| <= {MAX_NUMBER:g}")
             if minimum is not None and x < minimum:
                 self.fail(path, f"must be >= {minimum:g} in every component, "
                                 f"item {i} is {show_number(x)}")
@@ -308,8 +323,29 @@ class _Reader:
         scene.objects = [self.scene_object(raw, f"objects[{i}]", i, materials)
                          for i, raw in enumerate(raw_objects)]
         self.check_names_and_parents(scene.objects, raw_objects)
+        self.check_float32_range(scene)
         scene.source = self.source
         return scene
+
+    def check_float32_range(self, scene: Scene) -> None:
+        """Refuse a scene whose composed matrices, or objects through them, leave float32's
+        safe range (MAX_COMPOSED), though every number in it is within MAX_NUMBER."""
+        with np.errstate(all="ignore"):
+            frame = scene.matrices(1, 1)
+            clip_from_eye = frame.projection @ frame.view
+            if not _within(clip_from_eye):
+                self.fail("camera", f"its projection matrix has entries beyond "
+                                    f"{MAX_COMPOSED:g}, more than the GPU's float32 arithmetic "
+                                    f"holds safely; widen fov_y or height, or bring near and far "
+                                    f"closer to 1")
+            for i, (obj, matrices) in enumerate(zip(scene.objects, frame.objects)):
+                corners = _box_corners(obj.mesh.positions)
+                clip = (clip_from_eye @ matrices.model @ corners.T).T
+                if not (_within(matrices.model) and _within(matrices.normal) and _within(clip)):
+                    self.fail(f"objects[{i}]", f"its transform (with its parents') takes it "
+                                               f"beyond {MAX_COMPOSED:g} in the GPU's float32 "
+                                               f"coordinates; scale, translate or the camera "
+                                               f"put it too far away or make it too large")
 
     def camera(self, raw: Any, path: str) -> Camera:
         raw = self.table(raw, path, CAMERA_KEYS)
@@ -559,6 +595,22 @@ class _Reader:
                 parent = objects[first_index[parent]].parent
                 if len(chain) > len(objects) + 1:   # a cycle further up; reported at its own index
                     break
+
+
+def _within(values) -> bool:
+    values = np.asarray(values, dtype=np.float64)
+    return bool(np.isfinite(values).all() and (np.abs(values) <= MAX_COMPOSED).all())
+
+
+def _box_corners(positions) -> np.ndarray:
+    """The 8 corners (8, 4) of the axis-aligned box around `positions`, homogeneous."""
+    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    if len(positions) == 0:
+        return np.zeros((0, 4))
+    low, high = positions.min(axis=0), positions.max(axis=0)
+    corners = np.array([[(low, high)[(k >> axis) & 1][axis] for axis in range(3)]
+                        for k in range(8)])
+    return np.hstack([corners, np.ones((8, 1))])
 
 
 def _builtin_assets_dir() -> Path | None:

@@ -17,6 +17,10 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import os
+import signal
+import subprocess
+import sys
 import weakref
 
 import moderngl
@@ -192,6 +196,94 @@ def _make_osmesa() -> moderngl.Context:
 
 _MAKERS = {"egl": _make_egl, "osmesa": _make_osmesa}
 
+# --------------------------------------------------------------------------- the probe
+#
+# A broken driver does not always fail politely: with GALLIUM_DRIVER naming a driver Mesa
+# lacks, OSMesaCreateContextAttribs dies of SIGSEGV, taking the process with it. So before a
+# kind is trusted in this process, a short child process makes one context of that kind and
+# exits 0; its answer is cached per (kind, the environment Mesa reads) for the process.
+# The child's stderr (Mesa's "libEGL warning: ..." lines) is kept off the terminal.
+
+# Environment variables that choose or configure Mesa's driver or the GL libraries loaded.
+PROBE_ENVIRONMENT = ("GALLIUM_DRIVER", "LIBGL_ALWAYS_SOFTWARE", "MESA_LOADER_DRIVER_OVERRIDE",
+                     "EGL_PLATFORM", "LIBGL_DRIVERS_PATH", "__EGL_VENDOR_LIBRARY_FILENAMES",
+                     "__EGL_VENDOR_LIBRARY_DIRS", "LD_LIBRARY_PATH", "LD_PRELOAD",
+                     "MESA_GL_VERSION_OVERRIDE", "PYOPENGL_OSMESA_LIBRARY", "OSMESA_LIBRARY")
+PROBE_TIMEOUT_S = 30
+
+# The child imports moderngl and, for OSMesa, renderer/gpu/osmesa.py by its path (it imports
+# nothing of ours), not the renderer package: about 0.1 s of start-up, not 1 s.
+_PROBE_SCRIPT = """
+import sys
+kind, osmesa_path, required = sys.argv[1], sys.argv[2], int(sys.argv[3])
+try:
+    import moderngl
+    if kind == "egl":
+        ctx = moderngl.create_standalone_context(require=required, backend="egl")
+    else:
+        import importlib.util
+        spec = importlib.util.spec_from_file_location("_renderer_osmesa_probe", osmesa_path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        ctx = moderngl.create_context(require=required, standalone=True,
+                                      context=module.OSMesaLoader())
+    ctx.release()
+except Exception as exc:
+    print("PROBE-FAILED " + (" ".join(str(exc).split()) or type(exc).__name__), file=sys.stderr)
+    sys.exit(3)
+"""
+
+_probed: dict[tuple, str | None] = {}
+
+
+def _probe_key(kind: str) -> tuple:
+    return (kind,) + tuple(os.environ.get(name) for name in PROBE_ENVIRONMENT)
+
+
+def probe(kind: str) -> str | None:
+    """None if a context of `kind` ("egl", "osmesa") can be made here, else one line saying
+    why (the child's own error, or the signal it died of). Cached for the process."""
+    key = _probe_key(kind)
+    if key not in _probed:
+        _probed[key] = _run_probe(kind)
+    return _probed[key]
+
+
+def _run_probe(kind: str) -> str | None:
+    osmesa_path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "osmesa.py")
+    try:
+        done = subprocess.run([sys.executable, "-c", _PROBE_SCRIPT, kind, osmesa_path,
+                               str(REQUIRED_GL)], stdin=subprocess.DEVNULL,
+                              stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                              timeout=PROBE_TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        return f"{_kind_name(kind)} context did not start in a probe within {PROBE_TIMEOUT_S} s"
+    except OSError as exc:                  # no child process at all: trust the kind untested
+        return None if exc.errno is not None else _one_line(exc)
+    if done.returncode == 0:
+        return None
+    if done.returncode < 0:
+        try:
+            cause = signal.Signals(-done.returncode).name
+        except ValueError:
+            cause = f"signal {-done.returncode}"
+        return f"{_kind_name(kind)} context failed in a probe (the process died of {cause})"
+    lines = done.stderr.decode("utf-8", errors="replace").splitlines()
+    said = [line[len("PROBE-FAILED "):] for line in lines if line.startswith("PROBE-FAILED ")]
+    return _one_line(RuntimeError(said[-1] if said else f"the probe exited {done.returncode}"))
+
+
+def _kind_name(kind: str) -> str:
+    return "EGL" if kind == "egl" else "OSMesa"
+
+
+def _driver_hint() -> str | None:
+    driver = os.environ.get("GALLIUM_DRIVER")
+    if driver is not None:
+        return (f"is GALLIUM_DRIVER={driver} a driver Mesa has? (unset it, or set it to "
+                f"llvmpipe or softpipe)")
+    return None
+
 
 def make_context(kind: str = "auto") -> moderngl.Context:
     """A new headless moderngl context (OpenGL 3.3 core or newer), current on return.
@@ -204,14 +296,20 @@ def make_context(kind: str = "auto") -> moderngl.Context:
     tried = ("egl", "osmesa") if kind == "auto" else (kind,)
     failures = []
     for name in tried:
+        problem = probe(name)             # a child process: a driver's crash is not ours
+        if problem is not None:
+            failures.append(f"{name}: {problem}")
+            continue
         try:
             return _MAKERS[name]()
         except Exception as exc:          # glcontext raises bare Exception
             failures.append(f"{name}: {_one_line(exc)}")
-    hint = " or ".join(f"{PACKAGES[name]} (for {name.upper() if name == 'egl' else 'OSMesa'})"
-                       for name in tried)
+    hint = _driver_hint()
+    if hint is None:
+        packages = " or ".join(f"{PACKAGES[name]} (for {_kind_name(name)})" for name in tried)
+        hint = f"install the Debian packages {packages}"
     raise ContextError(f"no headless OpenGL {REQUIRED_GL // 100}.{REQUIRED_GL % 100 // 10} context "
-                       f"could be made ({'; '.join(failures)}); install the Debian packages {hint}")
+                       f"could be made ({'; '.join(failures)}); {hint}")
 
 
 def adopt_context(ctx: moderngl.Context, make_current, release, get_proc_address) -> None:

@@ -68,7 +68,7 @@ def scene_description(path: Path) -> str:
     """The scene's one-line `description` key ("" if it has none or cannot be read)."""
     try:
         data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+    except (OSError, ValueError, RecursionError):     # TOMLDecodeError, UnicodeDecodeError are ValueErrors
         return ""
     description = data.get("description", "")
     return " ".join(description.split()) if isinstance(description, str) else ""

@@ -62,6 +62,13 @@ PRIMITIVE_LIMITS = {
               "major_segments": (True, 3, MAX_SEGMENTS), "minor_segments": (True, 3, MAX_SEGMENTS)},
 }
 
+# Arrays and tables nest at most this many levels (the top-level table is level 1; a
+# scene's deepest value, objects[i].mesh.file or a shear factor, is at level 4 or 5).
+MAX_NESTING = 32
+
+# A parent cycle longer than this shows its first and last names only.
+MAX_CYCLE_SHOWN = 8
+
 # A model matrix whose linear part has a determinant at or below this is refused.
 MIN_DETERMINANT = 1e-9
 
@@ -95,6 +102,9 @@ def load_scene(scene) -> Scene:
         raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(_toml_syntax_reason(exc), file=source) from None
+    except RecursionError:               # tomllib recurses once per level of nesting
+        raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
+                         f"nests at most {MAX_NESTING} levels", file=source) from None
     scene = scene_from_dict(data, source=source, base_dir=path.parent)
     if "name" not in data:
         scene.name = path.stem
@@ -108,7 +118,27 @@ def scene_from_dict(data: dict, source: str = "<dict>", base_dir=None) -> Scene:
     (default: the current directory).
     """
     reader = _Reader(source, Path.cwd() if base_dir is None else Path(base_dir))
+    _check_nesting(data, reader)
     return reader.scene(data)
+
+
+def _check_nesting(data: Any, reader: "_Reader") -> None:
+    """Refuse arrays and tables nested more than MAX_NESTING levels (the top-level table is
+    level 1), naming the key path where it happens. Walked with a stack, not recursion, so
+    that data nested thousands deep is refused rather than overflowing Python's stack."""
+    stack = [(data, "", 1)]
+    while stack:
+        value, path, depth = stack.pop()
+        if isinstance(value, dict):
+            children = [(v, _join(path, str(k))) for k, v in value.items()]
+        elif isinstance(value, (list, tuple)):
+            children = [(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        else:
+            continue
+        if depth > MAX_NESTING:
+            shown = path if len(path) <= 60 else path[:57] + "..."
+            reader.fail(shown, f"arrays or tables nested more than {MAX_NESTING} levels deep")
+        stack.extend((v, p, depth + 1) for v, p in children)
 
 
 def _toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
@@ -539,16 +569,30 @@ class _Reader:
             if obj.parent is not None and obj.parent not in first_index:
                 self.fail(f"objects[{i}].parent",
                           _no_such("object", obj.parent, first_index, "objects in this scene"))
-        for i, obj in enumerate(objects):
-            chain = [obj.name]
-            parent = obj.parent
-            while parent is not None:
-                chain.append(parent)
-                if parent == obj.name:
-                    self.fail(f"objects[{i}].parent", f"parent cycle: {' -> '.join(chain)}")
-                parent = objects[first_index[parent]].parent
-                if len(chain) > len(objects) + 1:   # a cycle further up; reported at its own index
-                    break
+        # A parent cycle is reported at the first object on it, as the chain from that object
+        # back to itself. Each object is visited once (a chain of any length, no recursion):
+        # walk up from each object not yet visited until a root, an object visited before,
+        # or an object on this walk (a cycle).
+        parent_index = [None if obj.parent is None else first_index[obj.parent] for obj in objects]
+        walk_of = [-1] * len(objects)                    # which walk first visited an object
+        cycles: list[list[int]] = []
+        for start in range(len(objects)):
+            walk, at = [], start
+            while at is not None and walk_of[at] < 0:
+                walk_of[at] = start
+                walk.append(at)
+                at = parent_index[at]
+            if at is not None and walk_of[at] == start:  # came back onto this walk: a cycle
+                cycles.append(walk[walk.index(at):])
+        if cycles:
+            first = min(min(cycle) for cycle in cycles)
+            cycle = next(c for c in cycles if first in c)
+            k = cycle.index(first)
+            names = [objects[j].name for j in cycle[k:] + cycle[:k]] + [objects[first].name]
+            if len(names) > MAX_CYCLE_SHOWN + 1:         # one line of reasonable length
+                names = [*names[:MAX_CYCLE_SHOWN // 2], f"... ({len(names) - 1} objects) ...",
+                         *names[-(MAX_CYCLE_SHOWN // 2):]]
+            self.fail(f"objects[{first}].parent", f"parent cycle: {' -> '.join(names)}")
 
 
 def _builtin_assets_dir() -> Path | None:

@@ -1,0 +1,121 @@
+"""Issue 13, "tracebacks on input": a bad scene file, mesh or path is one line on stderr
+naming the file, the key and the reason, exit status 2, nothing written. Each case here is
+one a fuzzer found raising instead (RecursionError, OSError, ValueError, a shader compiler's
+error log) or writing where it should not; each goes through the command line in-process."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from renderer.cli import main
+from renderer.core.scene_file import MAX_NESTING, load_scene
+
+CUBE = 'mesh = { primitive = "cube" }\n'
+
+
+def refused(capsys, args, cwd: Path) -> str:
+    """Run the command line; assert status 2, one stderr line, no traceback, nothing written
+    in `cwd` (no image, no temporary file). Returns the line."""
+    before = sorted(p.name for p in cwd.iterdir())
+    status = main([str(a) for a in args])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert len(err.splitlines()) == 1, err
+    assert "Traceback" not in err
+    assert sorted(p.name for p in cwd.iterdir()) == before
+    return err.strip()
+
+
+@pytest.fixture
+def work(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def render(*args):
+    return ["render", "--backend", "reference", "--size", "16x12", *args]
+
+
+# -- 1. deep nesting --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("value", ["[" * 1000 + "]" * 1000,
+                                   "{a = " * 1000 + "1" + "}" * 1000],
+                         ids=["arrays", "inline tables"])
+def test_toml_nested_a_thousand_deep_is_one_line(capsys, work, value):
+    (work / "deep.toml").write_text(f"x = {value}\n")
+    line = refused(capsys, render("deep.toml"), work)
+    assert line == (f"renderer: deep.toml: arrays or tables nested too deeply for the TOML "
+                    f"parser; a scene file nests at most {MAX_NESTING} levels")
+
+
+def test_nesting_over_the_limit_is_refused_at_its_key(capsys, work):
+    # 40 levels: the parser copes, the reader refuses, naming where it is too deep.
+    (work / "deep.toml").write_text("[camera]\neye = " + "[" * 40 + "]" * 40 + "\n")
+    line = refused(capsys, render("deep.toml"), work)
+    assert line.startswith("renderer: deep.toml: camera.eye[0][0]")
+    assert line.endswith(f"arrays or tables nested more than {MAX_NESTING} levels deep")
+
+
+def test_nesting_at_the_limit_is_the_usual_type_error(capsys, work):
+    # camera (2) eye (3) and 29 more arrays: level 32, allowed; then eye is simply wrong.
+    (work / "deep.toml").write_text("[camera]\neye = " + "[" * 30 + "]" * 30 + "\n")
+    line = refused(capsys, render("deep.toml"), work)
+    assert line == ("renderer: deep.toml: camera.eye: expected a list of 3 numbers, "
+                    "got a list of 1 item")
+
+
+# -- 2. deep parent chains and long cycles ----------------------------------------------------
+
+def chain_scene(n: int, cycle: bool = False) -> str:
+    """n objects, o{i} the parent of o{i+1}, listed children first; with `cycle`, o0's parent
+    is the last one."""
+    lines = []
+    for i in reversed(range(n)):
+        lines.append(f'[[objects]]\nname = "o{i}"\n{CUBE}translate = [0.001, 0, 0]\n')
+        if i > 0:
+            lines.append(f'parent = "o{i - 1}"\n')
+        elif cycle:
+            lines.append(f'parent = "o{n - 1}"\n')
+    return "".join(lines)
+
+
+def test_a_thousand_deep_parent_chain_renders(capsys, work):
+    (work / "chain.toml").write_text(chain_scene(1000))
+    scene = load_scene(work / "chain.toml")
+    world = scene.world_matrices()
+    # o999 is listed first and has the longest chain: 1000 translations of 0.001 along x.
+    assert world[0][0, 3] == pytest.approx(1.0)
+    assert main(render("chain.toml", "-o", "chain.png", "-q")) == 0
+    assert (work / "chain.png").is_file()
+
+
+def test_world_matrices_multiply_in_the_recursive_order():
+    # M_world = M_parent_world @ M_local, bit for bit, for a chain with rotations and scales.
+    scene = load_scene("hierarchy")
+    by_name = {obj.name: obj for obj in scene.objects}
+
+    def recursive(obj):
+        local = obj.transform.matrix()
+        return local if obj.parent is None else recursive(by_name[obj.parent]) @ local
+
+    for obj, world in zip(scene.objects, scene.world_matrices()):
+        assert np.array_equal(world, recursive(obj))
+    assert any(obj.parent for obj in scene.objects)
+
+
+def test_a_thousand_long_parent_cycle_is_one_short_line(capsys, work):
+    (work / "cycle.toml").write_text(chain_scene(1000, cycle=True))
+    line = refused(capsys, render("cycle.toml"), work)
+    # objects[999] is o0, the first on the cycle in the order of the objects' list
+    assert line == ("renderer: cycle.toml: objects[0].parent: parent cycle: o999 -> o998 -> "
+                    "o997 -> o996 -> ... (1000 objects) ... -> o2 -> o1 -> o0 -> o999")
+
+
+def test_a_chain_into_a_cycle_is_reported_at_the_cycle(capsys, work):
+    (work / "cycle.toml").write_text(
+        f'[[objects]]\nname = "tail"\nparent = "a"\n{CUBE}'
+        f'[[objects]]\nname = "a"\nparent = "b"\n{CUBE}'
+        f'[[objects]]\nname = "b"\nparent = "a"\n{CUBE}')
+    line = refused(capsys, render("cycle.toml"), work)
+    assert line == "renderer: cycle.toml: objects[1].parent: parent cycle: a -> b -> a"

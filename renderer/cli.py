@@ -206,13 +206,14 @@ def warn_if_nothing_drawn(scene, frame) -> None:
 
 def cmd_render(args) -> int:
     from renderer.core.imageio import image_format, write_image, write_npy
+    from renderer.core.paths import output_stem
     if args.output is not None:              # a name Pillow cannot write: said before any work
         image_format(args.output, alpha=args.background == "transparent")
     if args.depth is not None and args.depth.suffix.lower() != ".npy":
         raise UserError("--depth writes a NumPy array; name the file with .npy, e.g. depth.npy",
                         file=str(args.depth))
     scene = _load(args.scene)
-    output = args.output or Path(f"{scene.name}.png")
+    output = args.output or Path(f"{output_stem(scene)}.png")
     if args.backend == "gpu":
         frame = _render_gpu(scene, args.size, args.context)[0]
     else:
@@ -266,6 +267,7 @@ def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
     from renderer.core.imageio import write_png
+    from renderer.core.paths import output_stem
     from renderer.core.jsonio import finite_or_none, to_json
     scene = _load(args.scene)
     # Median of a few frames: the first one pays for shader compilation.
@@ -278,7 +280,7 @@ def cmd_compare(args) -> int:
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
                             threshold=tolerance.threshold, deviation=tolerance.deviation,
                             reference_tie=ref_frame.rgba8_tie)
-    out = args.out or Path(f"compare-{scene.name}")
+    out = args.out or Path(f"compare-{output_stem(scene)}")
     write_png(out / "gpu.png", gpu_frame.rgba8)
     write_png(out / "reference.png", ref_frame.rgba8)
     write_png(out / "diff.png", heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
@@ -301,9 +303,10 @@ def cmd_shaders(args) -> int:
     """One set of files per shader variant the scene draws with, named after the variant,
     and a line per variant naming the objects that use it."""
     from renderer.core.imageio import write_text
+    from renderer.core.paths import output_stem
     from renderer.gpu.shaders import ShaderVariant, program_sources
     scene = _load(args.scene)
-    out = args.out or Path(f"shaders-{scene.name}")
+    out = args.out or Path(f"shaders-{output_stem(scene)}")
     users: dict[ShaderVariant, list[str]] = {}
     for obj in scene.objects:
         if obj.mesh.triangle_count:
@@ -367,6 +370,19 @@ def cmd_extremes(args) -> int:
     return 0 if all_pass(cases) else 1
 
 
+# Options that name a file or folder to write (or, --cache, to read and write): each goes
+# through renderer.core.paths.checked_path before the command starts. Scene arguments and
+# mesh files are checked where they are read (resolve_scene, load_scene, load_mesh).
+PATH_OPTIONS = ("output", "depth", "out", "screenshot", "stats", "cache")
+
+
+def _check_paths(args) -> None:
+    from renderer.core.paths import checked_path
+    for name in PATH_OPTIONS:
+        if getattr(args, name, None) is not None:
+            setattr(args, name, checked_path(getattr(args, name)))
+
+
 COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
             "scenes": cmd_scenes, "extremes": cmd_extremes}
 
@@ -377,6 +393,7 @@ def main(argv=None) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as done:       # --help, --version: printed; their status
             return done.code
+        _check_paths(args)
         return COMMANDS[args.command](args)
     except UsageError as error:
         print(f"{error.prog}: {error.reason}", file=sys.stderr)

@@ -119,3 +119,122 @@ def test_a_chain_into_a_cycle_is_reported_at_the_cycle(capsys, work):
         f'[[objects]]\nname = "b"\nparent = "a"\n{CUBE}')
     line = refused(capsys, render("cycle.toml"), work)
     assert line == "renderer: cycle.toml: objects[1].parent: parent cycle: a -> b -> a"
+
+
+# -- 4. paths the operating system cannot take ------------------------------------------------
+
+LONG_NAME = "n" * 300                       # over NAME_MAX (255 bytes)
+LONG_PATH = "d/" * 2100 + "s.toml"          # over PATH_MAX (4096 bytes), no name too long
+
+
+@pytest.mark.parametrize("arg, reason", [
+    ("a\0b.toml", "the path contains a null byte"),
+    (LONG_NAME + ".toml", "a name in the path is 305 bytes long"),
+    (LONG_PATH, "the path is 4206 bytes long; the longest a path can be is 4095 bytes (PATH_MAX)"),
+], ids=["null byte", "name over NAME_MAX", "path over PATH_MAX"])
+def test_a_scene_argument_the_system_cannot_take_is_one_line(capsys, work, arg, reason):
+    line = refused(capsys, render(arg), work)
+    assert line.startswith("renderer: ")
+    assert reason in line
+
+
+@pytest.mark.parametrize("mesh, reason", [
+    ("m\\u0000.obj", "the path contains a null byte"),
+    (LONG_NAME + ".obj", "a name in the path is 304 bytes long"),
+    (LONG_PATH[:-6] + "m.obj", "the path is 4205 bytes long"),
+], ids=["null byte", "name over NAME_MAX", "path over PATH_MAX"])
+def test_a_mesh_path_the_system_cannot_take_is_one_line(capsys, work, mesh, reason):
+    (work / "s.toml").write_text(f'[[objects]]\nmesh = {{ file = "{mesh}" }}\n')
+    line = refused(capsys, render("s.toml"), work)
+    assert line.startswith("renderer: s.toml: objects[0].mesh.file: ")
+    assert reason in line
+
+
+@pytest.mark.parametrize("option", ["-o", "--depth"])
+@pytest.mark.parametrize("value, reason", [
+    ("o\0.png", "the path contains a null byte"),
+    (LONG_NAME + ".png", "a name in the path is 304 bytes long"),
+    (LONG_PATH[:-6] + "o.png", "the path is 4205 bytes long"),
+], ids=["null byte", "name over NAME_MAX", "path over PATH_MAX"])
+def test_an_output_path_the_system_cannot_take_is_one_line(capsys, work, option, value, reason):
+    if option == "--depth":
+        value = value[:-4] + ".npy"
+    line = refused(capsys, render("sphere", option, value), work)
+    assert reason in line
+
+
+@pytest.mark.parametrize("args", [
+    ["compare", "sphere", "--out", "x\0"],
+    ["shaders", "sphere", "--out", LONG_NAME],
+    ["report", "sphere", "--out", "r", "--cache", "c\0"],
+    ["extremes", "--out", LONG_PATH],
+    ["view", "sphere", "--frames", "1", "--screenshot", "s\0.png"],
+    ["view", "sphere", "--frames", "1", "--stats", LONG_NAME + ".json"],
+], ids=["compare --out", "shaders --out", "report --cache", "extremes --out",
+        "view --screenshot", "view --stats"])
+def test_every_path_option_is_checked(capsys, work, args):
+    line = refused(capsys, args, work)
+    assert "null byte" in line or "bytes long" in line
+
+
+def test_a_folder_that_cannot_be_searched_is_one_line(capsys, work, monkeypatch):
+    # The tests run as root, whom chmod 000 does not stop: the probe says permission denied
+    # as stat() does for anyone else in a folder without search (x) permission.
+    from renderer.core import paths
+    locked = work / "locked"
+    locked.mkdir()
+    (work / "s.toml").write_text(f'[[objects]]\nmesh = {{ file = "locked/m.obj" }}\n')
+    real = paths._stat
+
+    def probe(path):
+        if str(locked) in str(Path(path).absolute()):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path)
+
+    monkeypatch.setattr(paths, "_stat", probe)
+    denied = "permission denied: a folder on the way cannot be searched"
+    line = refused(capsys, render("locked/s.toml"), work)
+    assert line == f"renderer: locked/s.toml: {denied}"
+    line = refused(capsys, render("s.toml"), work)
+    assert line == f"renderer: s.toml: objects[0].mesh.file: locked/m.obj: {denied}"
+    line = refused(capsys, render("sphere", "-o", "locked/out.png"), work)
+    assert line == f"renderer: locked/out.png: {denied}"
+
+
+def test_an_unsearchable_folder_for_real(capsys, work):
+    import os
+    if os.geteuid() == 0:
+        pytest.skip("root may search any folder; the probe's seam is tested above")
+    locked = work / "locked"
+    locked.mkdir()
+    locked.chmod(0)
+    try:
+        line = refused(capsys, render("locked/s.toml"), work)
+        assert "permission denied" in line
+    finally:
+        locked.chmod(0o755)
+
+
+# -- 5. default output names come from the file's name, not the scene's `name` ---------------
+
+@pytest.mark.parametrize("name", ["../../x", "/tmp/abs", "", "n" * 300, "a\\u0000b", ".hidden"])
+def test_the_scene_name_never_decides_where_render_writes(capsys, tmp_path, monkeypatch, name):
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    monkeypatch.chdir(work)
+    (work / "my scene.toml").write_text(f'name = "{name}"\n[[objects]]\n{CUBE}')
+    assert main(render("my scene.toml", "-q")) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["my scene.toml",
+                                                                          "my_scene.png"]
+
+
+def test_default_names_of_compare_and_shaders_come_from_the_file(capsys, work):
+    (work / "s.toml").write_text(f'name = "../evil"\n[[objects]]\n{CUBE}')
+    assert main(["shaders", "s.toml"]) == 0
+    assert (work / "shaders-s").is_dir()
+    assert not (work.parent / "evil").exists() and not list(work.glob("shaders-.*"))
+
+
+def test_a_built_in_scene_writes_under_its_name(capsys, work):
+    assert main(render("-q")) == 0
+    assert [p.name for p in work.iterdir()] == ["sphere.png"]

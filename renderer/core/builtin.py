@@ -15,6 +15,7 @@ import tomllib
 from pathlib import Path
 
 from renderer.core import resources
+from renderer.core.paths import checked_path
 from renderer.errors import SceneError
 
 DEFAULT_SCENE = "sphere"
@@ -51,7 +52,7 @@ def resolve_scene(arg: str | None) -> Path:
     scenes = builtin_scenes()
     if arg is None:
         return scenes[DEFAULT_SCENE]
-    path = Path(arg)
+    path = checked_path(arg, error=SceneError)
     if path.is_file():
         return path
     if is_scene_name(arg) and arg in scenes:

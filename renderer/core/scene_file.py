@@ -27,6 +27,7 @@ from renderer.core import transforms
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
+from renderer.core.paths import checked_path
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
                             Scene, SceneObject, Transform)
@@ -85,7 +86,7 @@ def load_scene(scene) -> Scene:
     ("spher: no such scene file or built-in scene; did you mean 'sphere'? ..."); any other
     path that does not exist gives "FILE: scene file not found".
     """
-    path = Path(scene)
+    path = checked_path(scene, error=SceneError)
     if not path.is_file() and is_scene_name(str(scene)):
         path = resolve_scene(str(scene))
     source = str(path)
@@ -544,11 +545,13 @@ class _Reader:
         text = self.string(value, path)
         if not text:
             self.fail(path, "is empty; expected a mesh file path")
+        checked_path(text, file=self.source, key=path, error=SceneError)
         candidates = [Path(text)] if Path(text).is_absolute() else [self.base_dir / text]
         assets = _builtin_assets_dir()
         if assets is not None and not Path(text).is_absolute():
             candidates.append(assets / text)
         for candidate in candidates:
+            checked_path(candidate, file=self.source, key=path, error=SceneError)
             if candidate.exists():
                 return load_mesh(candidate, source=self.source, key=path,
                                  crease_angle=crease_angle)

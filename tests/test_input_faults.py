@@ -238,3 +238,49 @@ def test_default_names_of_compare_and_shaders_come_from_the_file(capsys, work):
 def test_a_built_in_scene_writes_under_its_name(capsys, work):
     assert main(render("-q")) == 0
     assert [p.name for p in work.iterdir()] == ["sphere.png"]
+
+
+# -- 3. more lights than GL guarantees uniform storage for ------------------------------------
+
+def lights_scene(directional: int, point: int, shading: str = "phong") -> str:
+    lights = ['[[lights]]\ntype = "directional"\ndirection = [0, 0, -1]\nintensity = 0.01\n'] * directional
+    lights += ['[[lights]]\ntype = "point"\nposition = [0, 0, 3]\nintensity = 0.01\n'] * point
+    return ("".join(lights) + f'[[objects]]\n{CUBE}'
+            f'material = {{ shading = "{shading}", ks = 0.5 }}\n')
+
+
+@pytest.mark.parametrize("backend", ["gpu", "reference"])
+@pytest.mark.parametrize("directional, point, used", [(0, 3000, 36000), (113, 0, 904), (0, 75, 900),
+                                                      (56, 38, 904)])
+def test_more_lights_than_the_limit_is_one_line(capsys, work, backend, directional, point, used):
+    (work / "lights.toml").write_text(lights_scene(directional, point))
+    line = refused(capsys, ["render", "lights.toml", "--size", "16x12", "--backend", backend], work)
+    assert line == (f"renderer: lights.toml: lights: too many lights: {directional} directional "
+                    f"and {point} point lights take {used} uniform components (8 per directional "
+                    f"light, 12 per point light); the limit is 896 (GL's guaranteed 1024 per "
+                    f"shader stage less 128 for the other uniforms), e.g. 112 directional or 74 "
+                    f"point lights")
+
+
+def test_a_scene_made_in_python_is_held_to_the_same_limit(gl_contexts):
+    import reference
+    from renderer.core.scene import PointLight
+    from renderer.errors import SceneError
+    from renderer.gpu.pipeline import GpuRenderer
+    scene = load_scene("sphere")
+    scene.point_lights = [PointLight()] * 75
+    with pytest.raises(SceneError, match="too many lights"):
+        reference.render(scene, 8, 6)
+    with pytest.raises(SceneError, match="too many lights"):
+        GpuRenderer(scene, 8, 6, context=gl_contexts["egl"])
+
+
+@pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
+@pytest.mark.parametrize("directional, point", [(112, 0), (0, 74), (56, 37)])
+def test_lights_up_to_the_limit_compile_and_render(gl_contexts, work, shading, directional, point):
+    from renderer.gpu.pipeline import GpuRenderer
+    (work / "lights.toml").write_text(lights_scene(directional, point, shading))
+    scene = load_scene(work / "lights.toml")
+    for ctx in gl_contexts.values():
+        with GpuRenderer(scene, 16, 12, context=ctx) as gpu:
+            assert gpu.render().rgba8[..., 3].any()

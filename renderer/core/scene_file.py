@@ -24,6 +24,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer.core import transforms
+from renderer.core.gl_rules import too_many_lights
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, load_mesh
@@ -332,6 +333,9 @@ class _Reader:
                 scene.directional_lights.append(light)
             else:
                 scene.point_lights.append(light)
+        problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
+        if problem:
+            self.fail("lights", problem)
         raw_objects = self.list_of_tables(data.get("objects", []), "objects", "objects")
         scene.objects = [self.scene_object(raw, f"objects[{i}]", i, materials)
                          for i, raw in enumerate(raw_objects)]

@@ -28,8 +28,7 @@ from reference.output import compose_frame
 from reference.rasterizer import is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
-from renderer.core.gl_rules import SUBPIXEL_BITS, too_many_lights
-from renderer.errors import SceneError
+from renderer.core.gl_rules import SUBPIXEL_BITS, check_light_count
 from renderer.core.visibility import visible_objects
 
 
@@ -71,9 +70,7 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     """Render `scene` at width x height with the NumPy reference pipeline, each pixel sampled
     at `sample_offset` (dx, dy) pixels from its centre (Scene.matrices)."""
     start = time.perf_counter()
-    problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
-    if problem:                          # the GPU's limit, held alike (renderer/core/gl_rules.py)
-        raise SceneError(problem, file=scene.source or None)
+    check_light_count(scene)             # the GPU's limit, held alike (renderer/core/gl_rules.py)
     dtype = np.dtype(dtype)
     frame_matrices = scene.matrices(width, height, sample_offset)
     # Camera-relative positions, as the GPU gets them (renderer.core.scene.FrameMatrices).

@@ -168,3 +168,12 @@ def too_many_lights(directional: int, point: int) -> str | None:
             f"stage less {OTHER_UNIFORM_COMPONENTS} for the other uniforms), e.g. "
             f"{LIGHT_UNIFORM_COMPONENTS // COMPONENTS_PER_DIRECTIONAL_LIGHT} directional or "
             f"{LIGHT_UNIFORM_COMPONENTS // COMPONENTS_PER_POINT_LIGHT} point lights")
+
+
+def check_light_count(scene) -> None:
+    """A SceneError (naming the scene's file, if any) when `scene` has more lights than
+    too_many_lights allows: what GpuRenderer and the reference check before drawing."""
+    from renderer.errors import SceneError
+    problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
+    if problem:
+        raise SceneError(problem, file=getattr(scene, "source", "") or None)

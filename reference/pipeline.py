@@ -30,7 +30,7 @@ from reference.output import compose_frame
 from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
-from renderer.core.gl_rules import SUBPIXEL_BITS
+from renderer.core.gl_rules import SUBPIXEL_BITS, check_light_count
 from renderer.core.memory import REFERENCE_TILE_PIXELS
 from renderer.core.visibility import visible_objects
 
@@ -107,6 +107,7 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     `tile_pixels` pixels is drawn band by band (the same image: every stage after culling
     works pixel by pixel), so its memory beyond the output arrays stays bounded."""
     start = time.perf_counter()
+    check_light_count(scene)             # the GPU's limit, held alike (renderer/core/gl_rules.py)
     dtype = np.dtype(dtype)
     frame_matrices = scene.matrices(width, height, sample_offset)
     # Camera-relative positions, as the GPU gets them (renderer.core.scene.FrameMatrices).

@@ -242,6 +242,7 @@ def warn_if_nothing_drawn(scene, frame) -> None:
 
 def cmd_render(args) -> int:
     from renderer.core.imageio import check_outputs, image_format, outputs
+    from renderer.core.paths import output_stem
     if args.output is not None:              # a name Pillow cannot write: said before any work
         image_format(args.output, alpha=args.background == "transparent")
     if args.depth is not None and args.depth.suffix.lower() != ".npy":
@@ -250,7 +251,7 @@ def cmd_render(args) -> int:
     check_outputs(args.output, args.depth)   # a folder, a file as parent, the same file twice
     scene = _load(args.scene)
     check_memory(scene, args.size, [args.backend])
-    output = args.output or Path(f"{scene.name}.png")
+    output = args.output or Path(f"{output_stem(scene)}.png")
     check_outputs(output, args.depth)
     if args.backend == "gpu":
         frame = _render_gpu(scene, args.size, args.context)[0]
@@ -312,12 +313,13 @@ def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
     from renderer.core.imageio import check_folder, check_outputs, outputs
+    from renderer.core.paths import output_stem
     from renderer.core.jsonio import finite_or_none, to_json
     if args.out is not None:
         check_folder(args.out)
     scene = _load(args.scene)
     check_memory(scene, args.size, ["gpu", "reference"])
-    out = check_folder(args.out or Path(f"compare-{scene.name}"))
+    out = check_folder(args.out or Path(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
@@ -343,7 +345,7 @@ def cmd_compare(args) -> int:
     figures["passes"] = not failures
     print(to_json(figures))
     if failures:
-        print(f"renderer compare: {scene.name} fails the pipeline tolerance: {'; '.join(failures)}",
+        print(f"renderer compare: {output_stem(scene)} fails the pipeline tolerance: {'; '.join(failures)}",
               file=sys.stderr)
         return 1
     return 0
@@ -353,11 +355,12 @@ def cmd_shaders(args) -> int:
     """One set of files per shader variant the scene draws with, named after the variant,
     and a line per variant naming the objects that use it."""
     from renderer.core.imageio import check_folder, outputs
+    from renderer.core.paths import output_stem
     from renderer.gpu.shaders import ShaderVariant, program_sources
     if args.out is not None:
         check_folder(args.out)
     scene = _load(args.scene)
-    out = check_folder(args.out or Path(f"shaders-{scene.name}"))
+    out = check_folder(args.out or Path(f"shaders-{output_stem(scene)}"))
     users: dict[ShaderVariant, list[str]] = {}
     for obj in scene.objects:
         if obj.mesh.triangle_count:
@@ -427,6 +430,19 @@ def cmd_extremes(args) -> int:
     return 0 if all_pass(cases) else 1
 
 
+# Options that name a file or folder to write (or, --cache, to read and write): each goes
+# through renderer.core.paths.checked_path before the command starts. Scene arguments and
+# mesh files are checked where they are read (resolve_scene, load_scene, load_mesh).
+PATH_OPTIONS = ("output", "depth", "out", "screenshot", "stats", "cache")
+
+
+def _check_paths(args) -> None:
+    from renderer.core.paths import checked_path
+    for name in PATH_OPTIONS:
+        if getattr(args, name, None) is not None:
+            setattr(args, name, checked_path(getattr(args, name)))
+
+
 COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
             "scenes": cmd_scenes, "extremes": cmd_extremes}
 
@@ -437,6 +453,7 @@ def main(argv=None) -> int:
             args = build_parser().parse_args(argv)
         except SystemExit as done:       # --help, --version: printed; their status
             return done.code
+        _check_paths(args)
         from renderer.core.memory import limit_set
         with limit_set(getattr(args, "max_memory", None)):
             return COMMANDS[args.command](args)

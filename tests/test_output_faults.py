@@ -17,7 +17,6 @@ tmpfs where the sandbox lets us mount one.
 
 import errno
 import os
-import shutil
 import signal
 import subprocess
 import sys

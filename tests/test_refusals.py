@@ -3,7 +3,6 @@ crash. Each refusal is exit status 2 and exactly one line on stderr, naming the 
 key and the reason, whatever the input holds (line breaks in keys, corrupt mesh files,
 numbers float32 cannot hold, a GL driver that crashes)."""
 
-import os
 
 import pytest
 

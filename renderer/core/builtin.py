@@ -15,6 +15,7 @@ import tomllib
 from pathlib import Path
 
 from renderer.core import resources
+from renderer.core.paths import checked_path
 from renderer.errors import SceneError
 
 DEFAULT_SCENE = "sphere"
@@ -51,7 +52,7 @@ def resolve_scene(arg: str | None) -> Path:
     scenes = builtin_scenes()
     if arg is None:
         return scenes[DEFAULT_SCENE]
-    path = Path(arg)
+    path = checked_path(arg, error=SceneError)
     if path.is_file():
         return path
     if is_scene_name(arg) and arg in scenes:
@@ -68,7 +69,7 @@ def scene_description(path: Path) -> str:
     """The scene's one-line `description` key ("" if it has none or cannot be read)."""
     try:
         data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):
+    except (OSError, ValueError, RecursionError):     # TOMLDecodeError, UnicodeDecodeError are ValueErrors
         return ""
     description = data.get("description", "")
     return " ".join(description.split()) if isinstance(description, str) else ""

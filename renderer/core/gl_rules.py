@@ -126,3 +126,54 @@ def to_unorm8(c: np.ndarray) -> np.ndarray:
     """GL's float -> unorm8 (OpenGL 4.5 §2.3.5.1, without dithering, which the GPU path
     disables): floor(clamp(c, 0, 1) * 255 + 0.5)."""
     return np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+
+
+# --- uniform storage: how many lights a scene may have ---------------------------------------
+#
+# The light arrays are uniforms (renderer/core/uniforms.py, glsl/lighting.glsl) sized at
+# compile time, and a shader stage has a limited number of uniform components
+# (GL_MAX_{VERTEX,GEOMETRY,FRAGMENT}_UNIFORM_COMPONENTS); a program over the limit fails to
+# link with a compiler log dozens of lines long. The limit here is GL's guaranteed minimum,
+# not what one context reports (llvmpipe reports 16384), so that a scene that loads renders
+# on every GL 4.5 implementation and the reference, which cannot ask GL, holds the same rule.
+#
+# Cost, counted as implementations allocate the default uniform block: each element of a
+# vec3 array takes a whole vec4 slot (4 components). A directional light has two vec3 arrays
+# (direction, intensity): 8 components; a point light three (position, intensity,
+# attenuation): 12. Lighting is computed in one stage (vertex for Gouraud, geometry for flat,
+# fragment for Phong), which also holds at most 96 components of other uniforms (matrices,
+# eye, ambient, material, counts, padded alike); 128 are kept for them.
+
+GL_MIN_UNIFORM_COMPONENTS = 1024         # GL 4.5's minimum of GL_MAX_*_UNIFORM_COMPONENTS
+OTHER_UNIFORM_COMPONENTS = 128           # kept for the uniforms that are not lights
+LIGHT_UNIFORM_COMPONENTS = GL_MIN_UNIFORM_COMPONENTS - OTHER_UNIFORM_COMPONENTS   # 896
+COMPONENTS_PER_DIRECTIONAL_LIGHT = 8     # 2 vec3 array elements, a vec4 slot each
+COMPONENTS_PER_POINT_LIGHT = 12          # 3 vec3 array elements
+
+
+def light_components(directional: int, point: int) -> int:
+    """Uniform components the light arrays of a scene take in the lighting stage."""
+    return directional * COMPONENTS_PER_DIRECTIONAL_LIGHT + point * COMPONENTS_PER_POINT_LIGHT
+
+
+def too_many_lights(directional: int, point: int) -> str | None:
+    """Why a scene with these light counts cannot be drawn, or None when it can."""
+    used = light_components(directional, point)
+    if used <= LIGHT_UNIFORM_COMPONENTS:
+        return None
+    return (f"too many lights: {directional} directional and {point} point lights take {used} "
+            f"uniform components ({COMPONENTS_PER_DIRECTIONAL_LIGHT} per directional light, "
+            f"{COMPONENTS_PER_POINT_LIGHT} per point light); the limit is "
+            f"{LIGHT_UNIFORM_COMPONENTS} (GL's guaranteed {GL_MIN_UNIFORM_COMPONENTS} per shader "
+            f"stage less {OTHER_UNIFORM_COMPONENTS} for the other uniforms), e.g. "
+            f"{LIGHT_UNIFORM_COMPONENTS // COMPONENTS_PER_DIRECTIONAL_LIGHT} directional or "
+            f"{LIGHT_UNIFORM_COMPONENTS // COMPONENTS_PER_POINT_LIGHT} point lights")
+
+
+def check_light_count(scene) -> None:
+    """A SceneError (naming the scene's file, if any) when `scene` has more lights than
+    too_many_lights allows: what GpuRenderer and the reference check before drawing."""
+    from renderer.errors import SceneError
+    problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
+    if problem:
+        raise SceneError(problem, file=getattr(scene, "source", "") or None)

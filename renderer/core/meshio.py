@@ -28,6 +28,7 @@ import numpy as np
 import trimesh
 
 from renderer.core import memory
+from renderer.core.paths import checked_path
 from renderer.errors import SceneError, show_number
 from renderer.core.scene import Mesh
 
@@ -66,7 +67,10 @@ def load_mesh(path, *, source: str | None = None, key: str | None = None,
     """
     if not 0.0 < crease_angle <= 180.0:
         raise ValueError(f"crease_angle must be in (0, 180] degrees, got {crease_angle!r}")
-    path = Path(path)
+    if source is not None:
+        path = checked_path(path, file=source, key=key, error=SceneError)
+    else:
+        path = checked_path(path, key=key, error=SceneError)
     try:
         with _quiet_libraries():
             return _load_checked(path, crease_angle)

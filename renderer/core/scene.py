@@ -158,21 +158,30 @@ class Scene:
     source: str = ""             # file it was read from, if any
 
     def world_matrices(self) -> list[np.ndarray]:
-        """World matrix of each object, parents applied (M_world = M_parent_world · M_local)."""
+        """World matrix of each object, parents applied (M_world = M_parent_world · M_local).
+
+        Iterative, so that a parent chain of any length works: each object's chain is walked
+        up to the first object whose world matrix is known (or a root), then multiplied back
+        down in the same order as the recursive definition. A parent cycle is a ValueError
+        (scene files refuse one first: renderer/core/scene_file.py)."""
         by_name = {obj.name: obj for obj in self.objects}
         cache: dict[str, np.ndarray] = {}
-
-        def world(obj: SceneObject, chain: tuple = ()) -> np.ndarray:
-            if obj.name in cache:
-                return cache[obj.name]
-            if obj.name in chain:
-                raise ValueError(f"parent cycle through object {obj.name!r}")
-            local = obj.transform.matrix()
-            m = local if obj.parent is None else world(by_name[obj.parent], chain + (obj.name,)) @ local
-            cache[obj.name] = m
-            return m
-
-        return [world(obj) for obj in self.objects]
+        for start in self.objects:
+            chain: list[SceneObject] = []          # start, its parent, ... up to a known one
+            on_chain: set[str] = set()
+            obj: SceneObject | None = start
+            while obj is not None and obj.name not in cache:
+                if obj.name in on_chain:
+                    raise ValueError(f"parent cycle through object {obj.name!r}")
+                chain.append(obj)
+                on_chain.add(obj.name)
+                obj = None if obj.parent is None else by_name[obj.parent]
+            above = None if obj is None else cache[obj.name]
+            for link in reversed(chain):
+                local = link.transform.matrix()
+                above = local if above is None else above @ local
+                cache[link.name] = above
+        return [cache[obj.name] for obj in self.objects]
 
     def matrices(self, width: int, height: int, sample_offset=(0.0, 0.0)) -> FrameMatrices:
         """View, projection and per-object matrices, camera-relative (FrameMatrices), in float64.

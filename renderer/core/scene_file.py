@@ -24,10 +24,12 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer.core import transforms
+from renderer.core.gl_rules import too_many_lights
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core import memory
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
+from renderer.core.paths import checked_path
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
@@ -64,6 +66,13 @@ PRIMITIVE_LIMITS = {
               "major_segments": (True, 3, MAX_SEGMENTS), "minor_segments": (True, 3, MAX_SEGMENTS)},
 }
 
+# Arrays and tables nest at most this many levels (the top-level table is level 1; a
+# scene's deepest value, objects[i].mesh.file or a shear factor, is at level 4 or 5).
+MAX_NESTING = 32
+
+# A parent cycle longer than this shows its first and last names only.
+MAX_CYCLE_SHOWN = 8
+
 # A model matrix whose linear part has a determinant at or below this is refused.
 MIN_DETERMINANT = 1e-9
 
@@ -89,7 +98,7 @@ def load_scene(scene) -> Scene:
     ("spher: no such scene file or built-in scene; did you mean 'sphere'? ..."); any other
     path that does not exist gives "FILE: scene file not found".
     """
-    path = Path(scene)
+    path = checked_path(scene, error=SceneError)
     if not path.is_file() and is_scene_name(str(scene)):
         path = resolve_scene(str(scene))
     source = str(path)
@@ -106,6 +115,9 @@ def load_scene(scene) -> Scene:
         raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(_toml_syntax_reason(exc), file=source) from None
+    except RecursionError:               # tomllib recurses once per level of nesting
+        raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
+                         f"nests at most {MAX_NESTING} levels", file=source) from None
     scene = scene_from_dict(data, source=source, base_dir=path.parent)
     if "name" not in data:
         scene.name = path.stem
@@ -119,7 +131,27 @@ def scene_from_dict(data: dict, source: str = "<dict>", base_dir=None) -> Scene:
     (default: the current directory).
     """
     reader = _Reader(source, Path.cwd() if base_dir is None else Path(base_dir))
+    _check_nesting(data, reader)
     return reader.scene(data)
+
+
+def _check_nesting(data: Any, reader: "_Reader") -> None:
+    """Refuse arrays and tables nested more than MAX_NESTING levels (the top-level table is
+    level 1), naming the key path where it happens. Walked with a stack, not recursion, so
+    that data nested thousands deep is refused rather than overflowing Python's stack."""
+    stack = [(data, "", 1)]
+    while stack:
+        value, path, depth = stack.pop()
+        if isinstance(value, dict):
+            children = [(v, _join(path, str(k))) for k, v in value.items()]
+        elif isinstance(value, (list, tuple)):
+            children = [(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        else:
+            continue
+        if depth > MAX_NESTING:
+            shown = path if len(path) <= 60 else path[:57] + "..."
+            reader.fail(shown, f"arrays or tables nested more than {MAX_NESTING} levels deep")
+        stack.extend((v, p, depth + 1) for v, p in children)
 
 
 def _toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
@@ -319,6 +351,9 @@ class _Reader:
                 scene.directional_lights.append(light)
             else:
                 scene.point_lights.append(light)
+        problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
+        if problem:
+            self.fail("lights", problem)
         raw_objects = self.list_of_tables(data.get("objects", []), "objects", "objects")
         scene.objects = [self.scene_object(raw, f"objects[{i}]", i, materials)
                          for i, raw in enumerate(raw_objects)]
@@ -560,11 +595,13 @@ class _Reader:
         text = self.string(value, path)
         if not text:
             self.fail(path, "is empty; expected a mesh file path")
+        checked_path(text, file=self.source, key=path, error=SceneError)
         candidates = [Path(text)] if Path(text).is_absolute() else [self.base_dir / text]
         assets = _builtin_assets_dir()
         if assets is not None and not Path(text).is_absolute():
             candidates.append(assets / text)
         for candidate in candidates:
+            checked_path(candidate, file=self.source, key=path, error=SceneError)
             if candidate.exists():
                 return load_mesh(candidate, source=self.source, key=path,
                                  crease_angle=crease_angle)
@@ -585,16 +622,30 @@ class _Reader:
             if obj.parent is not None and obj.parent not in first_index:
                 self.fail(f"objects[{i}].parent",
                           _no_such("object", obj.parent, first_index, "objects in this scene"))
-        for i, obj in enumerate(objects):
-            chain = [obj.name]
-            parent = obj.parent
-            while parent is not None:
-                chain.append(parent)
-                if parent == obj.name:
-                    self.fail(f"objects[{i}].parent", f"parent cycle: {' -> '.join(chain)}")
-                parent = objects[first_index[parent]].parent
-                if len(chain) > len(objects) + 1:   # a cycle further up; reported at its own index
-                    break
+        # A parent cycle is reported at the first object on it, as the chain from that object
+        # back to itself. Each object is visited once (a chain of any length, no recursion):
+        # walk up from each object not yet visited until a root, an object visited before,
+        # or an object on this walk (a cycle).
+        parent_index = [None if obj.parent is None else first_index[obj.parent] for obj in objects]
+        walk_of = [-1] * len(objects)                    # which walk first visited an object
+        cycles: list[list[int]] = []
+        for start in range(len(objects)):
+            walk, at = [], start
+            while at is not None and walk_of[at] < 0:
+                walk_of[at] = start
+                walk.append(at)
+                at = parent_index[at]
+            if at is not None and walk_of[at] == start:  # came back onto this walk: a cycle
+                cycles.append(walk[walk.index(at):])
+        if cycles:
+            first = min(min(cycle) for cycle in cycles)
+            cycle = next(c for c in cycles if first in c)
+            k = cycle.index(first)
+            names = [objects[j].name for j in cycle[k:] + cycle[:k]] + [objects[first].name]
+            if len(names) > MAX_CYCLE_SHOWN + 1:         # one line of reasonable length
+                names = [*names[:MAX_CYCLE_SHOWN // 2], f"... ({len(names) - 1} objects) ...",
+                         *names[-(MAX_CYCLE_SHOWN // 2):]]
+            self.fail(f"objects[{first}].parent", f"parent cycle: {' -> '.join(names)}")
 
 
 def _within(values) -> bool:

@@ -54,7 +54,7 @@ import numpy as np
 from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
 from renderer.errors import ContextError
 from renderer.core.frame import Frame
-from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping
+from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.core.transforms import jitter, to_glsl
@@ -146,6 +146,7 @@ class GpuRenderer:
                  specialise: bool = True):
         if int(width) < 1 or int(height) < 1:
             raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        check_light_count(scene)         # before a program fails to link (renderer/core/gl_rules.py)
         self.scene = scene
         self.width, self.height = int(width), int(height)
         self.specialise = bool(specialise)

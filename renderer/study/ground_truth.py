@@ -20,6 +20,7 @@ import numpy as np
 
 import reference
 from renderer.core.imageio import write_npy
+from renderer.core.paths import output_stem
 from renderer.core.scene import Scene
 from renderer.study.supersample import clamped
 from renderer.study.tessellation import FINEST, scene_at_level
@@ -56,7 +57,7 @@ def scene_digest(scene: Scene) -> str:
 def cache_path(scene: Scene, width: int, height: int, cache_dir) -> Path:
     key = hashlib.sha256(f"{scene_digest(truth_scene(scene))} {width}x{height} "
                          f"grid={TRUTH_GRID} v{TRUTH_VERSION}".encode()).hexdigest()[:24]
-    return Path(cache_dir) / f"{scene.name}-{width}x{height}-{key}.npy"
+    return Path(cache_dir) / f"{output_stem(scene)}-{width}x{height}-{key}.npy"
 
 
 def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:

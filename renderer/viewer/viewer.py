@@ -26,6 +26,7 @@ import numpy as np
 from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.core.imageio import write_image
+from renderer.core.paths import output_stem
 from renderer.viewer.orbit import OrbitCamera
 from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
@@ -275,7 +276,7 @@ class Viewer:
         if path is None:
             while True:
                 self._screenshots += 1
-                path = Path(f"view-{self.authored.name}-{self._screenshots:03d}.png")
+                path = Path(f"view-{output_stem(self.authored)}-{self._screenshots:03d}.png")
                 if not path.exists():
                     break
         write_image(path, self.window_image())

@@ -1,0 +1,286 @@
+"""Issue 13, "tracebacks on input": a bad scene file, mesh or path is one line on stderr
+naming the file, the key and the reason, exit status 2, nothing written. Each case here is
+one a fuzzer found raising instead (RecursionError, OSError, ValueError, a shader compiler's
+error log) or writing where it should not; each goes through the command line in-process."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from renderer.cli import main
+from renderer.core.scene_file import MAX_NESTING, load_scene
+
+CUBE = 'mesh = { primitive = "cube" }\n'
+
+
+def refused(capsys, args, cwd: Path) -> str:
+    """Run the command line; assert status 2, one stderr line, no traceback, nothing written
+    in `cwd` (no image, no temporary file). Returns the line."""
+    before = sorted(p.name for p in cwd.iterdir())
+    status = main([str(a) for a in args])
+    err = capsys.readouterr().err
+    assert status == 2, err
+    assert len(err.splitlines()) == 1, err
+    assert "Traceback" not in err
+    assert sorted(p.name for p in cwd.iterdir()) == before
+    return err.strip()
+
+
+@pytest.fixture
+def work(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def render(*args):
+    return ["render", "--backend", "reference", "--size", "16x12", *args]
+
+
+# -- 1. deep nesting --------------------------------------------------------------------------
+
+@pytest.mark.parametrize("value", ["[" * 1000 + "]" * 1000,
+                                   "{a = " * 1000 + "1" + "}" * 1000],
+                         ids=["arrays", "inline tables"])
+def test_toml_nested_a_thousand_deep_is_one_line(capsys, work, value):
+    (work / "deep.toml").write_text(f"x = {value}\n")
+    line = refused(capsys, render("deep.toml"), work)
+    assert line == (f"renderer: deep.toml: arrays or tables nested too deeply for the TOML "
+                    f"parser; a scene file nests at most {MAX_NESTING} levels")
+
+
+def test_nesting_over_the_limit_is_refused_at_its_key(capsys, work):
+    # 40 levels: the parser copes, the reader refuses, naming where it is too deep.
+    (work / "deep.toml").write_text("[camera]\neye = " + "[" * 40 + "]" * 40 + "\n")
+    line = refused(capsys, render("deep.toml"), work)
+    assert line.startswith("renderer: deep.toml: camera.eye[0][0]")
+    assert line.endswith(f"arrays or tables nested more than {MAX_NESTING} levels deep")
+
+
+def test_nesting_at_the_limit_is_the_usual_type_error(capsys, work):
+    # camera (2) eye (3) and 29 more arrays: level 32, allowed; then eye is simply wrong.
+    (work / "deep.toml").write_text("[camera]\neye = " + "[" * 30 + "]" * 30 + "\n")
+    line = refused(capsys, render("deep.toml"), work)
+    assert line == ("renderer: deep.toml: camera.eye: expected a list of 3 numbers, "
+                    "got a list of 1 item")
+
+
+# -- 2. deep parent chains and long cycles ----------------------------------------------------
+
+def chain_scene(n: int, cycle: bool = False) -> str:
+    """n objects, o{i} the parent of o{i+1}, listed children first; with `cycle`, o0's parent
+    is the last one."""
+    lines = []
+    for i in reversed(range(n)):
+        lines.append(f'[[objects]]\nname = "o{i}"\n{CUBE}translate = [0.001, 0, 0]\n')
+        if i > 0:
+            lines.append(f'parent = "o{i - 1}"\n')
+        elif cycle:
+            lines.append(f'parent = "o{n - 1}"\n')
+    return "".join(lines)
+
+
+def test_a_thousand_deep_parent_chain_renders(capsys, work):
+    (work / "chain.toml").write_text(chain_scene(1000))
+    scene = load_scene(work / "chain.toml")
+    world = scene.world_matrices()
+    # o999 is listed first and has the longest chain: 1000 translations of 0.001 along x.
+    assert world[0][0, 3] == pytest.approx(1.0)
+    assert main(render("chain.toml", "-o", "chain.png", "-q")) == 0
+    assert (work / "chain.png").is_file()
+
+
+def test_world_matrices_multiply_in_the_recursive_order():
+    # M_world = M_parent_world @ M_local, bit for bit, for a chain with rotations and scales.
+    scene = load_scene("hierarchy")
+    by_name = {obj.name: obj for obj in scene.objects}
+
+    def recursive(obj):
+        local = obj.transform.matrix()
+        return local if obj.parent is None else recursive(by_name[obj.parent]) @ local
+
+    for obj, world in zip(scene.objects, scene.world_matrices()):
+        assert np.array_equal(world, recursive(obj))
+    assert any(obj.parent for obj in scene.objects)
+
+
+def test_a_thousand_long_parent_cycle_is_one_short_line(capsys, work):
+    (work / "cycle.toml").write_text(chain_scene(1000, cycle=True))
+    line = refused(capsys, render("cycle.toml"), work)
+    # objects[999] is o0, the first on the cycle in the order of the objects' list
+    assert line == ("renderer: cycle.toml: objects[0].parent: parent cycle: o999 -> o998 -> "
+                    "o997 -> o996 -> ... (1000 objects) ... -> o2 -> o1 -> o0 -> o999")
+
+
+def test_a_chain_into_a_cycle_is_reported_at_the_cycle(capsys, work):
+    (work / "cycle.toml").write_text(
+        f'[[objects]]\nname = "tail"\nparent = "a"\n{CUBE}'
+        f'[[objects]]\nname = "a"\nparent = "b"\n{CUBE}'
+        f'[[objects]]\nname = "b"\nparent = "a"\n{CUBE}')
+    line = refused(capsys, render("cycle.toml"), work)
+    assert line == "renderer: cycle.toml: objects[1].parent: parent cycle: a -> b -> a"
+
+
+# -- 4. paths the operating system cannot take ------------------------------------------------
+
+LONG_NAME = "n" * 300                       # over NAME_MAX (255 bytes)
+LONG_PATH = "d/" * 2100 + "s.toml"          # over PATH_MAX (4096 bytes), no name too long
+
+
+@pytest.mark.parametrize("arg, reason", [
+    ("a\0b.toml", "the path contains a null byte"),
+    (LONG_NAME + ".toml", "a name in the path is 305 bytes long"),
+    (LONG_PATH, "the path is 4206 bytes long; the longest a path can be is 4095 bytes (PATH_MAX)"),
+], ids=["null byte", "name over NAME_MAX", "path over PATH_MAX"])
+def test_a_scene_argument_the_system_cannot_take_is_one_line(capsys, work, arg, reason):
+    line = refused(capsys, render(arg), work)
+    assert line.startswith("renderer: ")
+    assert reason in line
+
+
+@pytest.mark.parametrize("mesh, reason", [
+    ("m\\u0000.obj", "the path contains a null byte"),
+    (LONG_NAME + ".obj", "a name in the path is 304 bytes long"),
+    (LONG_PATH[:-6] + "m.obj", "the path is 4205 bytes long"),
+], ids=["null byte", "name over NAME_MAX", "path over PATH_MAX"])
+def test_a_mesh_path_the_system_cannot_take_is_one_line(capsys, work, mesh, reason):
+    (work / "s.toml").write_text(f'[[objects]]\nmesh = {{ file = "{mesh}" }}\n')
+    line = refused(capsys, render("s.toml"), work)
+    assert line.startswith("renderer: s.toml: objects[0].mesh.file: ")
+    assert reason in line
+
+
+@pytest.mark.parametrize("option", ["-o", "--depth"])
+@pytest.mark.parametrize("value, reason", [
+    ("o\0.png", "the path contains a null byte"),
+    (LONG_NAME + ".png", "a name in the path is 304 bytes long"),
+    (LONG_PATH[:-6] + "o.png", "the path is 4205 bytes long"),
+], ids=["null byte", "name over NAME_MAX", "path over PATH_MAX"])
+def test_an_output_path_the_system_cannot_take_is_one_line(capsys, work, option, value, reason):
+    if option == "--depth":
+        value = value[:-4] + ".npy"
+    line = refused(capsys, render("sphere", option, value), work)
+    assert reason in line
+
+
+@pytest.mark.parametrize("args", [
+    ["compare", "sphere", "--out", "x\0"],
+    ["shaders", "sphere", "--out", LONG_NAME],
+    ["report", "sphere", "--out", "r", "--cache", "c\0"],
+    ["extremes", "--out", LONG_PATH],
+    ["view", "sphere", "--frames", "1", "--screenshot", "s\0.png"],
+    ["view", "sphere", "--frames", "1", "--stats", LONG_NAME + ".json"],
+], ids=["compare --out", "shaders --out", "report --cache", "extremes --out",
+        "view --screenshot", "view --stats"])
+def test_every_path_option_is_checked(capsys, work, args):
+    line = refused(capsys, args, work)
+    assert "null byte" in line or "bytes long" in line
+
+
+def test_a_folder_that_cannot_be_searched_is_one_line(capsys, work, monkeypatch):
+    # The tests run as root, whom chmod 000 does not stop: the probe says permission denied
+    # as stat() does for anyone else in a folder without search (x) permission.
+    from renderer.core import paths
+    locked = work / "locked"
+    locked.mkdir()
+    (work / "s.toml").write_text('[[objects]]\nmesh = { file = "locked/m.obj" }\n')
+    real = paths._stat
+
+    def probe(path):
+        if str(locked) in str(Path(path).absolute()):
+            raise PermissionError(13, "Permission denied", str(path))
+        return real(path)
+
+    monkeypatch.setattr(paths, "_stat", probe)
+    denied = "permission denied: a folder on the way cannot be searched"
+    line = refused(capsys, render("locked/s.toml"), work)
+    assert line == f"renderer: locked/s.toml: {denied}"
+    line = refused(capsys, render("s.toml"), work)
+    assert line == f"renderer: s.toml: objects[0].mesh.file: locked/m.obj: {denied}"
+    line = refused(capsys, render("sphere", "-o", "locked/out.png"), work)
+    assert line == f"renderer: locked/out.png: {denied}"
+
+
+def test_an_unsearchable_folder_for_real(capsys, work):
+    import os
+    if os.geteuid() == 0:
+        pytest.skip("root may search any folder; the probe's seam is tested above")
+    locked = work / "locked"
+    locked.mkdir()
+    locked.chmod(0)
+    try:
+        line = refused(capsys, render("locked/s.toml"), work)
+        assert "permission denied" in line
+    finally:
+        locked.chmod(0o755)
+
+
+# -- 5. default output names come from the file's name, not the scene's `name` ---------------
+
+@pytest.mark.parametrize("name", ["../../x", "/tmp/abs", "", "n" * 300, "a\\u0000b", ".hidden"])
+def test_the_scene_name_never_decides_where_render_writes(capsys, tmp_path, monkeypatch, name):
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    monkeypatch.chdir(work)
+    (work / "my scene.toml").write_text(f'name = "{name}"\n[[objects]]\n{CUBE}')
+    assert main(render("my scene.toml", "-q")) == 0, capsys.readouterr().err
+    assert sorted(p.name for p in tmp_path.rglob("*") if p.is_file()) == ["my scene.toml",
+                                                                          "my_scene.png"]
+
+
+def test_default_names_of_compare_and_shaders_come_from_the_file(capsys, work):
+    (work / "s.toml").write_text(f'name = "../evil"\n[[objects]]\n{CUBE}')
+    assert main(["shaders", "s.toml"]) == 0
+    assert (work / "shaders-s").is_dir()
+    assert not (work.parent / "evil").exists() and not list(work.glob("shaders-.*"))
+
+
+def test_a_built_in_scene_writes_under_its_name(capsys, work):
+    assert main(render("-q")) == 0
+    assert [p.name for p in work.iterdir()] == ["sphere.png"]
+
+
+# -- 3. more lights than GL guarantees uniform storage for ------------------------------------
+
+def lights_scene(directional: int, point: int, shading: str = "phong") -> str:
+    lights = ['[[lights]]\ntype = "directional"\ndirection = [0, 0, -1]\nintensity = 0.01\n'] * directional
+    lights += ['[[lights]]\ntype = "point"\nposition = [0, 0, 3]\nintensity = 0.01\n'] * point
+    return ("".join(lights) + f'[[objects]]\n{CUBE}'
+            f'material = {{ shading = "{shading}", ks = 0.5 }}\n')
+
+
+@pytest.mark.parametrize("backend", ["gpu", "reference"])
+@pytest.mark.parametrize("directional, point, used", [(0, 3000, 36000), (113, 0, 904), (0, 75, 900),
+                                                      (56, 38, 904)])
+def test_more_lights_than_the_limit_is_one_line(capsys, work, backend, directional, point, used):
+    (work / "lights.toml").write_text(lights_scene(directional, point))
+    line = refused(capsys, ["render", "lights.toml", "--size", "16x12", "--backend", backend], work)
+    assert line == (f"renderer: lights.toml: lights: too many lights: {directional} directional "
+                    f"and {point} point lights take {used} uniform components (8 per directional "
+                    f"light, 12 per point light); the limit is 896 (GL's guaranteed 1024 per "
+                    f"shader stage less 128 for the other uniforms), e.g. 112 directional or 74 "
+                    f"point lights")
+
+
+def test_a_scene_made_in_python_is_held_to_the_same_limit(gl_contexts):
+    import reference
+    from renderer.core.scene import PointLight
+    from renderer.errors import SceneError
+    from renderer.gpu.pipeline import GpuRenderer
+    scene = load_scene("sphere")
+    scene.point_lights = [PointLight()] * 75
+    with pytest.raises(SceneError, match="too many lights"):
+        reference.render(scene, 8, 6)
+    with pytest.raises(SceneError, match="too many lights"):
+        GpuRenderer(scene, 8, 6, context=gl_contexts["egl"])
+
+
+@pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
+@pytest.mark.parametrize("directional, point", [(112, 0), (0, 74), (56, 37)])
+def test_lights_up_to_the_limit_compile_and_render(gl_contexts, work, shading, directional, point):
+    from renderer.gpu.pipeline import GpuRenderer
+    (work / "lights.toml").write_text(lights_scene(directional, point, shading))
+    scene = load_scene(work / "lights.toml")
+    for ctx in gl_contexts.values():
+        with GpuRenderer(scene, 16, 12, context=ctx) as gpu:
+            assert gpu.render().rgba8[..., 3].any()

@@ -56,7 +56,7 @@ SCENES_DIR = REPO / "assets" / "scenes"
 BASE_SEED = 13_000                  # issue 13
 DEFAULT_CASES = 300
 SLOW_CASES = 3000
-RUNAWAY_SECONDS = 10.0              # a case running longer is a runaway
+RUNAWAY_SECONDS = 5.0               # a case running longer is a runaway
 RUNAWAY_BYTES = 1 << 30             # address space a case may add (RLIMIT_AS): more is a runaway
 GPU_FRACTION = 0.04                 # cases run through the GL backend (render --backend gpu, compare)
 # --max-memory is being added on another branch; switch this on (or FUZZ_MAX_MEMORY=1) when it is in.
@@ -936,19 +936,23 @@ def run_case(case: Case, root: Path, main=None) -> list[str]:
 
 
 def run_seeds(seeds, tmp_path: Path) -> None:
-    failures = []
+    failures, lines = [], []
     by_class: dict[str, list[int]] = {}
+    seeds = list(seeds)
     for seed in seeds:
         case = make_case(seed)
         problems = run_case(case, tmp_path / f"case{seed}")
         if problems:
             failures.append(f"{case.describe()[:1500]}\nPROBLEMS:\n  " + "\n  ".join(problems))
             by_class.setdefault(case.kind.split(":")[0], []).append(seed)
+            last = problems[0].strip().splitlines()[-1] if problems[0].startswith("exception") else problems[0]
+            lines.append(f"seed {seed} [{case.kind[:70]}]: {last[:160]}")
     if failures:
-        summary = "; ".join(f"{k}: {len(v)} (e.g. seeds {v[:5]})" for k, v in sorted(by_class.items()))
+        summary = "\n".join(f"  {k}: {len(v)} (seeds {v[:8]})" for k, v in sorted(by_class.items()))
         pytest.fail(f"{len(failures)} of {len(seeds)} fuzz cases break issue 13's rules "
-                    f"(rerun one: FUZZ_SEEDS=SEED pytest tests/test_fuzz.py -k seeds)\n"
-                    f"by class: {summary}\n\n" + "\n\n".join(failures[:30]), pytrace=False)
+                    f"(rerun one: FUZZ_SEEDS=SEED pytest tests/test_fuzz.py -k seeds; print it: "
+                    f"python tests/test_fuzz.py SEED)\nby class:\n{summary}\n\n" + "\n".join(lines)
+                    + "\n\nThe first ones in full:\n\n" + "\n\n".join(failures[:20]), pytrace=False)
 
 
 # =========================================================================== the tests

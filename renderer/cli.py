@@ -14,6 +14,7 @@ its output names are checked before any work, and its files are renamed into pla
 from __future__ import annotations
 
 import argparse
+import contextlib
 import os
 import statistics
 import sys
@@ -455,7 +456,8 @@ def main(argv=None) -> int:
             return done.code
         _check_paths(args)
         from renderer.core.memory import limit_set
-        with limit_set(getattr(args, "max_memory", None)):
+        max_memory = getattr(args, "max_memory", None)       # else the limit in force stays
+        with limit_set(max_memory) if max_memory is not None else contextlib.nullcontext():
             return COMMANDS[args.command](args)
     except UsageError as error:
         print(f"{error.prog}: {escaped(error.reason)}", file=sys.stderr)

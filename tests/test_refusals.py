@@ -45,8 +45,8 @@ def test_a_plain_message_is_unchanged():
         "scene.toml: camera.eye: reason"
 
 
-def test_a_key_with_a_newline_is_quoted_on_one_line(cli, tmp_path):
-    line = refused(render(cli, tmp_path, '"a\\nb" = 1\n'))
+def test_a_key_with_a_newline_is_quoted_on_one_line(cli_here, tmp_path):
+    line = refused(render(cli_here, tmp_path, '"a\\nb" = 1\n'))
     assert line.startswith("renderer: scene.toml: 'a\\nb': unknown key;")
 
 
@@ -103,13 +103,15 @@ LIMIT = "too large for the GPU's float32 arithmetic; numbers must satisfy |x| <=
      "its transform (with its parents') takes it beyond 1e+30 in the GPU's float32 coordinates; "
      "scale, translate or the camera put it too far away or make it too large"),
 ])
-def test_numbers_float32_cannot_hold_are_refused_with_the_limit(cli, tmp_path, scene, key, reason):
-    assert refused(render(cli, tmp_path, scene)) == f"renderer: scene.toml: {key}: {reason}"
+def test_numbers_float32_cannot_hold_are_refused_with_the_limit(cli_here, tmp_path, scene, key,
+                                                               reason):
+    assert refused(render(cli_here, tmp_path, scene)) == f"renderer: scene.toml: {key}: {reason}"
 
 
 # --- a GL driver that crashes ----------------------------------------------------------------
 
-@pytest.mark.parametrize("kind", ["auto", "osmesa", "egl"])
+@pytest.mark.parametrize("kind", ["auto", pytest.param("osmesa", marks=pytest.mark.slow),
+                                  pytest.param("egl", marks=pytest.mark.slow)])
 def test_a_driver_mesa_lacks_is_one_line_not_a_crash(cli, tmp_path, monkeypatch, kind):
     """OSMesa dies of SIGSEGV with this; the context is probed in a child process first.
     EGL refuses politely (eglInitialize fails), but its libEGL warnings stay off the terminal."""

@@ -52,7 +52,7 @@ import moderngl
 import numpy as np
 
 from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
-from renderer.errors import ContextError
+from renderer.errors import ContextError, SystemFault
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
@@ -185,11 +185,17 @@ class GpuRenderer:
 
     def _build_targets(self) -> None:
         size = (self.width, self.height)
-        self._color = self.ctx.renderbuffer(size, 4)                       # RGBA8
-        self._depth = self.ctx.depth_renderbuffer(size)
-        self.depth_format = make_float_depth(self.ctx, self._depth, self.width, self.height)
-        self._renderbuffers += [self._color, self._depth]
-        self._framebuffers[False] = self.ctx.framebuffer([self._color], self._depth)
+        try:
+            self._color = self.ctx.renderbuffer(size, 4)                       # RGBA8
+            self._depth = self.ctx.depth_renderbuffer(size)
+            self.depth_format = make_float_depth(self.ctx, self._depth, self.width, self.height)
+            self._renderbuffers += [self._color, self._depth]
+            self._framebuffers[False] = self.ctx.framebuffer([self._color], self._depth)
+        except moderngl.Error as error:
+            # Within GL_MAX_RENDERBUFFER_SIZE, yet the implementation could not give the storage
+            # (llvmpipe at 16384x8192: "framebuffer is not complete"): the system's limit.
+            raise SystemFault(f"this GL could not make a {self.width}x{self.height} framebuffer "
+                              f"({error}); it may be out of memory: try a smaller --size") from None
 
     def _linear_framebuffer(self) -> moderngl.Framebuffer:
         fbo = self._framebuffers.get(True)

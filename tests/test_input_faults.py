@@ -80,6 +80,7 @@ def chain_scene(n: int, cycle: bool = False) -> str:
     return "".join(lines)
 
 
+@pytest.mark.slow           # a few seconds; the fuzz test's default run has parent chains too
 def test_a_thousand_deep_parent_chain_renders(capsys, work):
     (work / "chain.toml").write_text(chain_scene(1000))
     scene = load_scene(work / "chain.toml")

@@ -12,7 +12,8 @@ from renderer.gpu.shaders import (ProgramCache, ShaderSourceError, ShaderVariant
 TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geometry.py",
          "fragment.glsl": "reference/fragment.py", "lighting.glsl": "reference/lighting.py"}
 # The ray tracer's stages (includes: no #version of their own).
-RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py"}
+RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
+                  "raytrace/intersect.glsl": "reference/raytrace/intersect.py"}
 
 
 def write(folder, files):

@@ -11,6 +11,9 @@ from renderer.gpu.shaders import (ProgramCache, ShaderSourceError, ShaderVariant
 
 TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geometry.py",
          "fragment.glsl": "reference/fragment.py", "lighting.glsl": "reference/lighting.py"}
+# The ray tracer's stages (includes: no #version of their own).
+RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
+                  "raytrace/intersect.glsl": "reference/raytrace/intersect.py"}
 
 
 def write(folder, files):
@@ -149,3 +152,34 @@ def test_every_variant_compiles_and_is_cached(gl_contexts):
 def test_resource_folders_are_found():
     assert (glsl_dir() / "vertex.glsl").is_file()
     assert assets_dir().is_dir() and assets_dir().name == "assets"
+
+
+def test_raytrace_stages_and_their_twins_name_each_other():
+    root = glsl_dir().parent
+    for name, twin in RAYTRACE_TWINS.items():
+        assert (glsl_dir() / name).read_text().splitlines()[0] == f"// Twin: {twin}", name
+        assert (root / twin).read_text().splitlines()[0] == f'"""# Twin: glsl/{name}', twin
+    assert sorted(p.relative_to(glsl_dir()).as_posix()
+                  for p in (glsl_dir() / "raytrace").glob("*.glsl")) == sorted(RAYTRACE_TWINS)
+
+
+def test_include_from_a_subfolder_and_from_glsl_anywhere(tmp_path):
+    """A file in a subfolder includes its neighbours by name; a file elsewhere (a test's shader)
+    reaches glsl/'s files by their path under glsl/; the folder beside the file comes first."""
+    (tmp_path / "sub").mkdir()
+    write(tmp_path, {"main.glsl": '#version 330 core\n#include "sub/a.glsl"\nvoid main() {}\n',
+                     "sub/a.glsl": '#include "b.glsl"\nfloat a() { return b(); }\n',
+                     "sub/b.glsl": "float b() { return 2.0; }\n"})
+    source = shader_source("main.glsl", directory=tmp_path)
+    assert code_lines(source.text) == ["#version 330 core", "float b() { return 2.0; }",
+                                       "float a() { return b(); }", "void main() {}"]
+    write(tmp_path, {"test.frag": '#version 330 core\n#include "raytrace/random.glsl"\n'
+                                  'void main() {}\n'})
+    source = shader_source("test.frag", directory=tmp_path)
+    assert "uint pcg_hash(uint v)" in source.text
+    assert source.files[1] == "glsl/raytrace/random.glsl"
+    (tmp_path / "raytrace").mkdir()
+    write(tmp_path, {"raytrace/random.glsl": "float mine() { return 1.0; }\n",
+                     "other.frag": '#version 330 core\n#include "raytrace/random.glsl"\n'})
+    source = shader_source("other.frag", directory=tmp_path)     # the neighbour wins
+    assert "float mine()" in source.text and "pcg_hash" not in source.text

@@ -1,8 +1,10 @@
 """GLSL sources from glsl/: `#include` expansion, `#define` injection, programs per variant.
 
 Shaders exist only as files in glsl/. A source is prepared in two steps:
-1. every line `#include "name.glsl"` is replaced by that file from the same folder
-   (recursively; each file at most once per shader, a cycle or a missing file is an error);
+1. every line `#include "name.glsl"` is replaced by that file from the same folder, or else
+   from glsl/ (so `#include "raytrace/random.glsl"` works from any folder, e.g. a test's
+   shader) (recursively; each file at most once per shader, a cycle or a missing file is an
+   error);
 2. the variant's `#define`s go right after the `#version` line (GLSL allows nothing but
    comments before it).
 `#line` directives keep compiler messages pointing at the right file and line: source-string
@@ -64,12 +66,16 @@ def _expand(path: Path, files: list[Path], stack: tuple[Path, ...]) -> list[str]
             raise ShaderSourceError(f'{where}: malformed include {line.strip()!r}; '
                                     'write #include "name.glsl"')
         target = (path.parent / name_match.group(1)).resolve()
+        if not target.is_file():            # then from glsl/: "raytrace/random.glsl" anywhere
+            beside_library = (glsl_dir() / name_match.group(1)).resolve()
+            if beside_library.is_file():
+                target = beside_library
         if target in stack:
             chain = " -> ".join(_display(p) for p in stack + (target,))
             raise ShaderSourceError(f"{where}: include cycle {chain}")
         if not target.is_file():
             raise ShaderSourceError(f'{where}: #include "{name_match.group(1)}": no such file '
-                                    f"in {path.parent}")
+                                    f"in {path.parent} or {glsl_dir()}")
         if target in files:             # already included once: include guard by default
             out.append(f"// {line.strip()} (already included)")
             continue

@@ -1,0 +1,2 @@
+"""The ray tracer's NumPy twin, stage by stage (glsl/raytrace/ holds the GLSL of the same names):
+random.py (the counter-based hash) and intersect.py (ray against plane, sphere, triangle)."""

@@ -1,0 +1,84 @@
+"""# Twin: glsl/raytrace/optics.glsl
+
+Reflection, refraction, Schlick's Fresnel approximation and the self-intersection offset
+(docs/conventions.md, "Rays"), vectorised over rays, with the GLSL's formulas in the GLSL's order.
+D is the incoming direction (towards the surface), N the unit normal on the incoming side
+(D.N <= 0), eta = n1 / n2. Computed in the float dtype of D (float64 for integer input); the
+offset is float32 only (it works on float32 bits), as in the GLSL.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+RAY_OFFSET_ORIGIN = np.float32(1.0 / 32.0)
+RAY_OFFSET_FLOAT_SCALE = np.float32(1.0 / 65536.0)
+RAY_OFFSET_INT_SCALE = np.float32(256.0)
+
+
+def _float_dtype(*arrays) -> np.dtype:
+    dtype = np.result_type(*arrays)
+    return dtype if dtype.kind == "f" else np.dtype(np.float64)
+
+
+def _dot(a, b):
+    """Sum of the three products in x, y, z order (as GLSL's dot)."""
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
+def _as(dtype, *values):
+    return [np.asarray(v, dtype=dtype) for v in values]
+
+
+def ray_reflect(D, N):
+    """R = D - 2 (D.N) N (D any length, N unit)."""
+    dtype = _float_dtype(D, N)
+    D, N = _as(dtype, D, N)
+    return D - (dtype.type(2) * _dot(D, N))[..., None] * N
+
+
+def ray_refract(D, N, eta):
+    """Snell's law for unit D, N with D.N <= 0: (refracted, T). cos_i = -D.N,
+    k = 1 - eta^2 (1 - cos_i^2); where k < 0 (total internal reflection) refracted is False and T
+    the reflection of D, else T = eta D + (eta cos_i - sqrt(k)) N."""
+    dtype = _float_dtype(D, N)
+    D, N, eta = _as(dtype, D, N, eta)
+    one = dtype.type(1)
+    cos_i = -_dot(D, N)
+    k = one - eta * eta * (one - cos_i * cos_i)
+    refracted = k >= 0
+    root = np.sqrt(np.where(refracted, k, 0)).astype(dtype)
+    T = eta[..., None] * D + (eta * cos_i - root)[..., None] * N
+    return refracted, np.where(refracted[..., None], T, ray_reflect(D, N))
+
+
+def fresnel_schlick(D, N, eta):
+    """Schlick: R0 + (1 - R0) (1 - cos)^5, R0 = ((1 - eta) / (1 + eta))^2, cos on the less dense
+    side (cos_i for eta <= 1, cos_t for eta > 1), 1 under total internal reflection."""
+    dtype = _float_dtype(D, N)
+    D, N, eta = _as(dtype, D, N, eta)
+    one = dtype.type(1)
+    r0 = (one - eta) / (one + eta)
+    r0 = r0 * r0
+    c = -_dot(D, N)
+    eta = np.broadcast_to(eta, c.shape)
+    k = one - eta * eta * (one - c * c)
+    tir = (eta > 1) & (k < 0)
+    c = np.where(eta > 1, np.sqrt(np.where(k < 0, 0, k)).astype(dtype), c)
+    m = one - c
+    m2 = m * m
+    return np.where(tir, one, r0 + (one - r0) * (m2 * m2 * m)).astype(dtype)
+
+
+def offset_ray_origin(p, n):
+    """Waechter and Binder, Ray Tracing Gems ch. 6: p moved along the unit geometric normal n (on
+    the side the new ray leaves to) by int(256 n) ulps per coordinate (float32 bits as int32),
+    or by n / 65536 where |p| < 1/32. float32 in and out, bit for bit the GLSL."""
+    p = np.asarray(p, dtype=np.float32)
+    n = np.asarray(n, dtype=np.float32)
+    of_i = (RAY_OFFSET_INT_SCALE * n).astype(np.int32)          # truncation towards zero
+    with np.errstate(over="ignore"):
+        bits = p.view(np.int32) + np.where(p < 0, -of_i, of_i)
+    p_i = bits.astype(np.int32).view(np.float32)
+    p_f = p + RAY_OFFSET_FLOAT_SCALE * n
+    return np.where(np.abs(p) < RAY_OFFSET_ORIGIN, p_f, p_i)

@@ -556,7 +556,8 @@ BAD_SCENES = [
      "objects[0].mesh.crease_angle: is for mesh files (mesh = { file = ... }); a primitive has "
      "exact normals, its flat faces already separate"),
     ("no mesh", '[[objects]]\nname = "ghost"\n',
-     'objects[0].mesh: missing; give mesh = {primitive = "..."} or mesh = {file = "..."}'),
+     'objects[0].mesh: missing; give mesh = {primitive = "..."}, mesh = {file = "..."} or '
+     'shape = {type = "sphere"}'),
     # materials
     ("negative kd", "[materials.red]\nkd = [0.5, -0.2, 0.0]\n",
      "materials.red.kd: must be >= 0 in every component, item 1 is -0.2"),

@@ -1,6 +1,8 @@
 """The scene model shared by the GPU path and the reference.
 
 A scene is plain data: camera, objects (mesh + transform + material), lights, background.
+An object may also carry an analytic shape (`Sphere`, `Plane`) for the ray tracer; its `mesh`
+is then the shape's tessellation, which the rasteriser draws (renderer/core/shapes.py).
 Both pipelines read it, and both take their matrices from `Scene.matrices()` so that the
 only thing they do differently is the pipeline itself. Units and conventions:
 docs/conventions.md; the file format: docs/scene-format.md.
@@ -54,12 +56,30 @@ class Material:
     n: float = 32.0
     two_sided: bool = False
     shading: ShadingMode = "phong"
+    # The ray tracer's terms (the rasteriser ignores them): reflectance k_r and transmittance
+    # k_t (RGB, linear), index of refraction `ior` (> 0). Energy rule: k_r + k_t <= 1 in each
+    # channel (ENERGY_SLACK allowed for decimal rounding), so that the reflected and refracted
+    # rays together never carry more than the light arriving (docs/scene-format.md).
+    kr: tuple = (0.0, 0.0, 0.0)
+    kt: tuple = (0.0, 0.0, 0.0)
+    ior: float = 1.5
 
     @property
     def has_specular(self) -> bool:
         """Whether the lighting has a specular term at all (some k_s not 0). Both pipelines
         leave the term out otherwise (renderer/gpu/shaders.py, reference/lighting.py)."""
         return any(float(k) != 0.0 for k in self.ks)
+
+
+ENERGY_SLACK = 1e-9
+
+
+def energy_excess(kr, kt) -> int | None:
+    """The first channel in which k_r + k_t > 1 (beyond ENERGY_SLACK), else None."""
+    for channel, (r, t) in enumerate(zip(kr, kt)):
+        if float(r) + float(t) > 1.0 + ENERGY_SLACK:
+            return channel
+    return None
 
 
 @dataclass
@@ -96,14 +116,92 @@ class Transform:
                                        self.translate)
 
 
+@dataclass(frozen=True)
+class Sphere:
+    """An analytic sphere (P - C)·(P - C) = r² in the object's own coordinates, r > 0."""
+    centre: tuple = (0.0, 0.0, 0.0)
+    radius: float = 1.0
+
+
+@dataclass(frozen=True)
+class Plane:
+    """An analytic plane P·N + d = 0 (the notes' form) in the object's own coordinates;
+    N not zero, need not be unit. Its front (lit) side is the one N points to."""
+    normal: tuple = (0.0, 1.0, 0.0)
+    offset: float = 0.0
+
+
+Shape = Sphere | Plane
+
+# A sphere stays a sphere only under a similarity: the world matrix's linear part A must be
+# s·R (R a rotation, s > 0), tested as |A^T A - s² I| <= SIMILARITY_TOLERANCE · s² entrywise
+# with s² = trace(A^T A) / 3. Rounding in rotations and parent chains stays far below it.
+SIMILARITY_TOLERANCE = 1e-9
+
+
+@dataclass(frozen=True)
+class WorldSphere:
+    """A sphere for the ray tracer: centre camera-relative (world centre - origin), radius in
+    scene units."""
+    centre: np.ndarray
+    radius: float
+
+
+@dataclass(frozen=True)
+class WorldPlane:
+    """A plane for the ray tracer, P·N + d = 0 with P camera-relative (world P - origin) and N
+    a unit vector (the side the object's N points to stays its front)."""
+    normal: np.ndarray
+    offset: float
+
+
+def world_shape(shape: Shape, model: np.ndarray, origin=(0.0, 0.0, 0.0)) -> WorldSphere | WorldPlane:
+    """The shape through the world matrix `model` (parents applied), relative to `origin`.
+
+    Sphere: under a similarity A = s·R it stays analytic (centre M·C, radius s·r); any other
+    linear part (non-uniform scale, shear, a zero scale) is a ValueError: an ellipsoid is not
+    a sphere, and the rule is to refuse rather than trace something else (make it a mesh:
+    `mesh = { primitive = "icosphere" }`). Plane: any affine M with det A > 0 maps it to a
+    plane: N' = cof(A) N (the normal matrix rule, conventions.md), d' = det(A) d - N'·t, then
+    normalised; A that flattens the plane onto a line or point (N' = 0) is a ValueError.
+    """
+    m = np.asarray(model, dtype=np.float64)
+    a, t = m[:3, :3], m[:3, 3]
+    origin = np.asarray(origin, dtype=np.float64)
+    if isinstance(shape, Sphere):
+        gram = a.T @ a
+        s2 = float(np.trace(gram)) / 3.0
+        if not s2 > 0.0 or np.abs(gram - s2 * np.eye(3)).max() > SIMILARITY_TOLERANCE * s2 \
+                or np.linalg.det(a) <= 0.0:
+            raise ValueError("a sphere's transform (with its parents') must be a uniform scale, "
+                             "rotation and translation; a non-uniform or zero scale or a shear "
+                             "would make an ellipsoid (use mesh = { primitive = \"icosphere\" } "
+                             "for one)")
+        centre = a @ np.asarray(shape.centre, dtype=np.float64) + (t - origin)
+        return WorldSphere(centre, float(shape.radius) * math.sqrt(s2))
+    if isinstance(shape, Plane):
+        cofactor = np.cross(a[[1, 2, 0]], a[[2, 0, 1]])     # cof(A) = det(A) A^-T
+        det = float(np.linalg.det(a))
+        n = cofactor @ np.asarray(shape.normal, dtype=np.float64)
+        length = float(np.linalg.norm(n))
+        if not length > 0.0 or not math.isfinite(length):
+            raise ValueError("the transform (with its parents') flattens the plane onto a line "
+                             "or a point: its normal has no direction left")
+        d = det * float(shape.offset) - float(n @ t)       # world: N'·P + d = 0
+        d += float(n @ origin)                              # camera-relative: P = P_rel + origin
+        return WorldPlane(n / length, d / length)
+    raise TypeError(f"not a shape: {shape!r}")
+
+
 @dataclass
 class SceneObject:
     name: str
-    mesh: Mesh
+    mesh: Mesh                   # what the rasteriser draws; for a shape, its tessellation
     material: Material = field(default_factory=Material)
     transform: Transform = field(default_factory=Transform)
     parent: str | None = None    # name of another object; its world matrix applies after ours
     cull: Cull = "none"          # which faces GL culls (window-space winding; CCW is front)
+    shape: Shape | None = None   # an analytic shape the ray tracer intersects; None: triangles
 
 
 @dataclass
@@ -200,6 +298,14 @@ class Scene:
                      for m in self.world_matrices()],
             origin=origin,
         )
+
+    def world_shapes(self) -> list[WorldSphere | WorldPlane | None]:
+        """Each object's analytic shape in camera-relative world coordinates (relative to the
+        eye, as `matrices()` hands meshes to the pipelines), None for an object of triangles;
+        a ValueError where a transform breaks the shape (`world_shape`)."""
+        origin = np.asarray(self.camera.eye, dtype=np.float64)
+        return [None if obj.shape is None else world_shape(obj.shape, m, origin)
+                for obj, m in zip(self.objects, self.world_matrices())]
 
     def shading_modes(self) -> list[str]:
         """The shading modes the scene uses, in a fixed order."""

@@ -32,8 +32,10 @@ from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
 from renderer.core.paths import checked_path
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
-from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, PointLight,
-                            Scene, SceneObject, Transform)
+from renderer.core import shapes
+from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, Plane,
+                            PointLight, Scene, SceneObject, Sphere, Transform, energy_excess,
+                            world_shape)
 
 PROJECTIONS = ("perspective", "parallel")
 CULL_MODES = ("none", "back", "front")
@@ -42,14 +44,19 @@ LIGHT_TYPES = ("directional", "point")
 TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials", "lights",
             "objects")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z")
-MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading")
+MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior")
 LIGHT_KEYS = {
     "directional": ("type", "direction", "intensity"),
     "point": ("type", "position", "intensity", "attenuation"),
 }
-OBJECT_KEYS = ("name", "mesh", "material", "scale", "shear", "rotate", "translate", "parent",
+OBJECT_KEYS = ("name", "mesh", "shape", "material", "scale", "shear", "rotate", "translate", "parent",
                "cull")
 MESH_FILE_KEYS = ("file", "crease_angle")
+SHAPE_TYPES = ("sphere", "plane")
+SHAPE_KEYS = {
+    "sphere": ("type", "centre", "radius", "subdivisions"),
+    "plane": ("type", "normal", "offset", "size", "segments"),
+}
 
 # Limits on primitive arguments: (integer?, smallest, largest). Lengths must be > 0; counts
 # are capped so that a typo cannot ask for a hundred million triangles.
@@ -358,6 +365,7 @@ class _Reader:
         scene.objects = [self.scene_object(raw, f"objects[{i}]", i, materials)
                          for i, raw in enumerate(raw_objects)]
         self.check_names_and_parents(scene.objects, raw_objects)
+        self.check_shapes(scene)
         self.check_float32_range(scene)
         scene.source = self.source
         return scene
@@ -441,6 +449,18 @@ class _Reader:
         if "shading" in raw:
             mat.shading = self.choice(raw["shading"], _join(path, "shading"), "shading",
                                       SHADING_MODES)
+        for coefficient in ("kr", "kt"):
+            if coefficient in raw:
+                setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
+        if "ior" in raw:
+            mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
+        channel = energy_excess(mat.kr, mat.kt)
+        if channel is not None:
+            where = _join(path, "kt" if "kt" in raw else "kr")
+            self.fail(where, f"kr + kt is {mat.kr[channel] + mat.kt[channel]:g} in channel "
+                             f"{'rgb'[channel]}; the energy rule is kr + kt <= 1 in each channel "
+                             f"(the reflected and refracted rays together carry at most the "
+                             f"light that arrives)")
         return mat
 
     def light(self, raw: dict, path: str) -> DirectionalLight | PointLight:
@@ -478,15 +498,22 @@ class _Reader:
         raw = self.table(raw, path, OBJECT_KEYS)
         key = lambda k: _join(path, k)   # noqa: E731
         name = self.string(raw["name"], key("name")) if "name" in raw else f"object{index}"
-        if "mesh" not in raw:
-            self.fail(key("mesh"), "missing; give mesh = {primitive = \"...\"} or "
-                                   "mesh = {file = \"...\"}")
-        mesh = self.mesh(raw["mesh"], key("mesh"))
+        if "mesh" in raw and "shape" in raw:
+            self.fail(key("shape"), "give either mesh or shape, not both: a shape's mesh is "
+                                    "its own tessellation")
+        if "mesh" not in raw and "shape" not in raw:
+            self.fail(key("mesh"), "missing; give mesh = {primitive = \"...\"}, "
+                                   "mesh = {file = \"...\"} or shape = {type = \"sphere\"}")
+        shape = None
+        if "shape" in raw:
+            shape, mesh = self.shape(raw["shape"], key("shape"))
+        else:
+            mesh = self.mesh(raw["mesh"], key("mesh"))
         material = Material()
         if "material" in raw:
             material = self.object_material(raw["material"], key("material"), materials)
         obj = SceneObject(name=name, mesh=mesh, material=material,
-                          transform=self.transform(raw, path))
+                          transform=self.transform(raw, path), shape=shape)
         if "parent" in raw:
             obj.parent = self.string(raw["parent"], key("parent"))
         if "cull" in raw:
@@ -528,6 +555,71 @@ class _Reader:
         if "translate" in raw:
             t.translate = self.vec3(raw["translate"], key("translate"))
         return t
+
+    # ---- analytic shapes
+
+    def shape(self, raw: Any, path: str) -> tuple[Sphere | Plane, Mesh]:
+        """An analytic shape and the mesh the rasteriser draws for it (renderer/core/shapes.py),
+        counted with the primitives before it is built."""
+        if not isinstance(raw, dict):
+            self.fail(path, f"expected a table such as {{type = \"sphere\", radius = 1.0}}, "
+                            f"got {describe_value(raw)}")
+        if "type" not in raw:
+            self.fail(_join(path, "type"), f"missing; expected one of: {', '.join(SHAPE_TYPES)}")
+        kind = self.choice(raw["type"], _join(path, "type"), "shape type", SHAPE_TYPES)
+        raw = self.table(raw, path, SHAPE_KEYS[kind])
+        key = lambda k: _join(path, k)   # noqa: E731
+        if kind == "sphere":
+            shape = Sphere()
+            if "centre" in raw:
+                shape = Sphere(self.vec3(raw["centre"], key("centre")), shape.radius)
+            if "radius" in raw:
+                shape = Sphere(shape.centre, self.number(raw["radius"], key("radius"), above=0.0))
+            subdivisions = shapes.SPHERE_SUBDIVISIONS
+            if "subdivisions" in raw:
+                subdivisions = self.integer(raw["subdivisions"], key("subdivisions"),
+                                            *PRIMITIVE_LIMITS["icosphere"]["subdivisions"][1:])
+            args = {"subdivisions": subdivisions}
+        else:
+            shape = Plane()
+            if "normal" in raw:
+                normal = self.vec3(raw["normal"], key("normal"))
+                if not any(normal):
+                    self.fail(key("normal"), "must not be zero length: the plane is P·N + d = 0")
+                shape = Plane(normal, shape.offset)
+            if "offset" in raw:
+                shape = Plane(shape.normal, self.number(raw["offset"], key("offset")))
+            args = {"size": shapes.PLANE_SIZE, "segments": shapes.PLANE_SEGMENTS}
+            if "size" in raw:
+                args["size"] = self.number(raw["size"], key("size"), above=0.0)
+            if "segments" in raw:
+                args["segments"] = self.integer(raw["segments"], key("segments"),
+                                                *PRIMITIVE_LIMITS["plane"]["segments"][1:])
+            n = np.asarray(shape.normal, dtype=np.float64)
+            foot = abs(shape.offset) / float(np.linalg.norm(n))
+            if foot + args["size"] > MAX_NUMBER:
+                self.fail(path, f"the plane's square reaches {show_number(foot + args['size'])} "
+                                f"from the origin, beyond |x| <= {MAX_NUMBER:g} (float32)")
+        self.primitive_triangles += shapes.TRIANGLES[kind](**args)
+        too_much = memory.over_limit(self.primitive_triangles * memory.SCENE_BYTES_PER_TRIANGLE)
+        if too_much:
+            self.fail(path, f"the scene's primitives up to here make up to "
+                            f"{self.primitive_triangles:,} triangles: building them {too_much}")
+        if kind == "sphere":
+            mesh = shapes.sphere_mesh(shape, **args)
+        else:
+            mesh = shapes.plane_mesh(shape, **args)
+        return shape, mesh
+
+    def check_shapes(self, scene: Scene) -> None:
+        """Each analytic shape must survive its world transform (scene.world_shape): a sphere
+        only a similarity, a plane anything that does not flatten it."""
+        for i, (obj, model) in enumerate(zip(scene.objects, scene.world_matrices())):
+            if obj.shape is not None:
+                try:
+                    world_shape(obj.shape, model)
+                except ValueError as exc:
+                    self.fail(f"objects[{i}].shape", str(exc))
 
     # ---- meshes
 

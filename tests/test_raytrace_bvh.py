@@ -46,10 +46,9 @@ def test_the_builder_makes_the_hand_written_layout():
     assert bvh.nodes.tolist() == HAND.nodes.tolist()
     assert bvh.triangles.tolist() == HAND.triangles.tolist()
     assert bvh.depth == 1 and bvh.original_index.tolist() == [1, 0]
-    # with leaves of up to 4 the split is still cheaper (1 + (1 + 1) / 5 < 2 tests); one triangle
-    # is a leaf
-    assert build_bvh(TWO).nodes.tolist() == HAND.nodes.tolist()
-    assert build_bvh(TWO[1:]).nodes.tolist() == [[[0, 0, 0, 0], [1, 1, 0, 1]]]
+    # with leaves of up to 4 (the default) two triangles are one leaf, in their own order
+    assert build_bvh(TWO).nodes.tolist() == [[[0, 0, 0, 0], [5, 1, 0, 2]]]
+    assert build_bvh(TWO).original_index.tolist() == [0, 1]
     # texels: node i at texels 2i, 2i + 1, row by row
     assert texels(HAND.nodes, width=4).shape == (2, 4, 4)
     assert texels(HAND.nodes, width=4)[1, 1].tolist() == HAND.nodes[2, 1].tolist()

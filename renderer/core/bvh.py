@@ -19,15 +19,16 @@ As a texture (`texels`): the texels of an array in order, row by row, TEXTURE_WI
 for a short array) to a row, the last row padded with zeros; texel k is at
 (k % width, k // width), the width read back by the shader with textureSize.
 
-The build: each node's triangles are split by the binned SAH (BINS bins per axis over the
-centroids' bounds; the split of least  A_left N_left + A_right N_right, A half the surface area;
-ties to the lower axis, then the lower bin), and a node becomes a leaf when it holds at most
-`max_leaf_size` triangles and no split is cheaper than intersecting them all
-(TRAVERSAL_COST + split cost / A_node >= N). Where the centroids cannot be binned apart (all in
-one bin on every axis), or the tree would grow deeper than MAX_DEPTH - 24, the triangles are
-halved in centroid order along the widest axis (the object median). Deterministic: the same
-triangles give the same bytes. The depth never exceeds MAX_DEPTH, so a traversal stack of
-MAX_DEPTH entries suffices.
+The build: a node with more than `max_leaf_size` triangles is split by the binned SAH (BINS
+bins per axis over its centroids' bounds; the split of least A_left N_left + A_right N_right,
+A half the surface area; ties to the lower axis, then the lower bin); one with at most
+`max_leaf_size` is a leaf. (Leaving the leaf decision to the SAH as well made the 20,480-
+triangle icosphere's build 3.5 times slower for no faster traversal: benchmarks/bench_bvh.py.)
+Where the centroids cannot be binned apart (all in one bin on every axis), or the tree would
+grow deeper than MAX_DEPTH - 24, the triangles are halved in centroid order along the widest
+axis (the object median). Deterministic: the same triangles give the same bytes. The depth
+never exceeds MAX_DEPTH (the build refuses otherwise), so a traversal stack of MAX_DEPTH
+entries suffices.
 """
 
 from __future__ import annotations
@@ -39,7 +40,6 @@ import numpy as np
 BINS = 16
 MAX_LEAF_SIZE = 4
 MAX_DEPTH = 64                  # the GLSL's BVH_STACK_SIZE
-TRAVERSAL_COST = 1.0            # in units of one triangle test
 TEXTURE_WIDTH = 1024
 MAX_EXACT_INDEX = 1 << 24       # float32 holds every integer below it
 
@@ -146,12 +146,10 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) ->
         nodes.append([lo, 0, hi, 0])
         n = len(ids)
         split = None
-        if n > 1:
+        if n > max_leaf_size:
             if depth < MAX_DEPTH - 24:
                 split = _sah_split(centroids[ids], tri_min[ids], tri_max[ids], bins)
-            if n <= max_leaf_size and (split is None or TRAVERSAL_COST + split[2] / _half_area(lo, hi) >= n):
-                split = False
-            elif split is None:
+            if split is None:
                 split = (None, _median_split(centroids[ids]), None)
         if not split:
             nodes[index][1], nodes[index][3] = placed, n

@@ -1,2 +1,3 @@
 """The ray tracer's NumPy twin, stage by stage (glsl/raytrace/ holds the GLSL of the same names):
-random.py (the counter-based hash) and intersect.py (ray against plane, sphere, triangle)."""
+random.py (the counter-based hash), intersect.py (ray against plane, sphere, triangle) and
+bvh.py (the closest hit through a BVH)."""

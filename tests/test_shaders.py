@@ -13,7 +13,8 @@ TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geome
          "fragment.glsl": "reference/fragment.py", "lighting.glsl": "reference/lighting.py"}
 # The ray tracer's stages (includes: no #version of their own).
 RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
-                  "raytrace/intersect.glsl": "reference/raytrace/intersect.py"}
+                  "raytrace/intersect.glsl": "reference/raytrace/intersect.py",
+                  "raytrace/bvh.glsl": "reference/raytrace/bvh.py"}
 
 
 def write(folder, files):

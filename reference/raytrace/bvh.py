@@ -46,7 +46,7 @@ def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
     inside = (O >= bmin) & (O <= bmax)
     tn = np.where(parallel, np.where(inside, F32(-np.inf), F32(np.inf)), tn)
     tf = np.where(parallel, np.where(inside, F32(np.inf), F32(-np.inf)), tf)
-    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]), np.maximum(tn[..., 2], F32(s_min) if np.ndim(s_min) == 0 else np.asarray(s_min, F32)))
+    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]), np.maximum(tn[..., 2], np.asarray(s_min, F32)))
     with np.errstate(over="ignore"):
         far = np.minimum(np.minimum(tf[..., 0], tf[..., 1]), tf[..., 2]) * BOX_FAR_SCALE
     far = np.minimum(far, np.asarray(s_max, F32))
@@ -78,7 +78,8 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
         if count.size:
             r = np.repeat(ray[leaf], count)
             starts = np.cumsum(count) - count
-            t = np.repeat(n0[leaf, 3].astype(np.int64), count) + np.arange(count.sum()) - np.repeat(starts, count)
+            t = (np.repeat(n0[leaf, 3].astype(np.int64) - starts, count)
+                 + np.arange(count.sum()))
             v = tris[t]
             h, s, uv = ray_triangle(O[r], D[r], v[:, 0, :3], v[:, 1, :3], v[:, 2, :3], s_min, best_s[r])
             r, s, uv, t = r[h], s[h], uv[h], t[h]
@@ -114,7 +115,8 @@ def closest_hit_brute_force(vertices, O, D, s_min=0.0, s_max=np.inf, chunk=1 << 
         shape = (len(O[i:i + step]), T, 3)
         o = np.broadcast_to(O[i:i + step, None], shape)
         d = np.broadcast_to(D[i:i + step, None], shape)
-        h, s, uv = ray_triangle(o, d, V[None, :, 0], V[None, :, 1], V[None, :, 2], F32(s_min), F32(s_max))
+        h, s, uv = ray_triangle(o, d, V[None, :, 0], V[None, :, 1], V[None, :, 2],
+                                F32(s_min), F32(s_max))
         k = np.argmin(s, axis=1)
         rows = np.arange(len(k))
         hit = h[rows, k]

@@ -15,7 +15,8 @@ TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geome
 RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
                   "raytrace/intersect.glsl": "reference/raytrace/intersect.py",
                   "raytrace/camera.glsl": "reference/raytrace/camera.py",
-                  "raytrace/optics.glsl": "reference/raytrace/optics.py"}
+                  "raytrace/optics.glsl": "reference/raytrace/optics.py",
+                  "raytrace/bvh.glsl": "reference/raytrace/bvh.py"}
 
 
 def write(folder, files):

@@ -1,3 +1,4 @@
 """The ray tracer's NumPy twin, stage by stage (glsl/raytrace/ holds the GLSL of the same names):
 random.py (the counter-based hash), intersect.py (ray against plane, sphere, triangle), camera.py
-(primary rays) and optics.py (reflection, refraction, Schlick, the self-intersection offset)."""
+(primary rays), optics.py (reflection, refraction, Schlick, the self-intersection offset) and
+bvh.py (the closest hit through a BVH)."""

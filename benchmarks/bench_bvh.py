@@ -1,0 +1,127 @@
+"""The BVH's build time and its speed-up over brute force on the 20,480-triangle icosphere, printed.
+
+    .venv/bin/python benchmarks/bench_bvh.py [--rays 4096] [--brute-rays 256] [--context egl]
+
+Builds the BVH of icosphere(subdivisions=5) (renderer/core/bvh.py) and times the closest hit of
+seeded random rays (a third from inside the sphere, a third aimed at it, a third anywhere):
+- twin (NumPy, reference/raytrace/bvh.py): the BVH's wavefront traversal against brute force
+  (every ray against every triangle, closest_hit_brute_force) on --brute-rays of the rays;
+- GPU (llvmpipe, glsl/raytrace/bvh.glsl through tests/glsl/raytrace_bvh.frag): the BVH against
+  a shader that loops over every triangle (tests/glsl/raytrace_brute.frag).
+Rays per second are the median of 3 runs (brute force: 1). Not a test: this machine is shared
+and noisy.
+"""
+
+from __future__ import annotations
+
+import argparse
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from reference.raytrace.bvh import closest_hit, closest_hit_brute_force
+from renderer.core.bvh import build_bvh, mesh_vertices
+from renderer.core.primitives import icosphere
+from renderer.gpu.bvh import bvh_textures
+from renderer.gpu.context import make_context
+from renderer.gpu.shaders import shader_source
+
+GLSL = Path(__file__).resolve().parent.parent / "tests" / "glsl"
+F32 = np.float32
+
+
+def rays(count: int, seed: int = 20):
+    rng = np.random.default_rng(seed)
+    O = rng.uniform(-1.5, 1.5, (count, 3)).astype(F32)
+    D = rng.normal(size=(count, 3)).astype(F32)
+    O[::3] *= F32(0.5)
+    D[1::3] = -O[1::3] + rng.normal(scale=0.3, size=D[1::3].shape).astype(F32)
+    return O, D
+
+
+def timed(function, repeats: int):
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = function()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), result
+
+
+def gpu_pass(ctx, fragment: str, O, D, bvh, width: int):
+    """A callable that traces the rays (count a multiple of width) on the GPU, and its cleanup."""
+    height = len(O) // width
+    program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
+                          fragment_shader=shader_source(fragment, directory=GLSL).text)
+    textures = [ctx.texture((width, height), 3, a[: width * height].tobytes(), dtype="f4") for a in (O, D)]
+    nodes, triangles = bvh_textures(ctx, bvh)
+    textures += [nodes, triangles]
+    output = ctx.texture((width, height), 4, dtype="f4")
+    framebuffer = ctx.framebuffer([output])
+    vao = ctx.vertex_array(program, [])
+    for unit, (texture, name) in enumerate(zip(textures, ("u_origins", "u_directions", "u_nodes", "u_triangles"))):
+        texture.filter = (ctx.NEAREST, ctx.NEAREST)
+        texture.use(unit)
+        if program.get(name, None) is not None:
+            program[name].value = unit
+    program["u_s_min"].value = 0.0
+    program["u_s_max"].value = 1e30
+    if program.get("u_count", None) is not None:
+        program["u_count"].value = len(bvh.triangles)
+
+    def run():
+        framebuffer.use()
+        vao.render(vertices=3)
+        return np.frombuffer(output.read(), F32).reshape(-1, 4)
+
+    def release():
+        for thing in (vao, framebuffer, program, *textures, output):
+            thing.release()
+    return run, release
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rays", type=int, default=4096)
+    parser.add_argument("--brute-rays", type=int, default=256)
+    parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
+    args = parser.parse_args()
+
+    mesh = icosphere(subdivisions=5)
+    V = mesh_vertices(mesh.positions, mesh.faces)
+    build_s, bvh = timed(lambda: build_bvh(V), 1)
+    print(f"icosphere(5): {len(V)} triangles; BVH build {build_s:.2f} s: {len(bvh.nodes)} nodes, "
+          f"depth {bvh.depth}, {int(bvh.is_leaf.sum())} leaves")
+
+    O, D = rays(args.rays)
+    t_bvh, (hit, s, _, tri) = timed(lambda: closest_hit(bvh, O, D), 3)
+    n = args.brute_rays
+    t_brute, (hit_b, s_b, _, tri_b) = timed(lambda: closest_hit_brute_force(V, O[:n], D[:n]), 1)
+    agree = (hit[:n] == hit_b).all() and (s[:n][hit_b] == s_b[hit_b]).all()
+    twin_bvh, twin_brute = len(O) / t_bvh, n / t_brute
+    print(f"twin (NumPy): BVH {twin_bvh:,.0f} rays/s, brute force {twin_brute:,.0f} rays/s, "
+          f"speed-up {twin_bvh / twin_brute:.0f}x (hit rate {hit.mean():.2f}; same hits: {agree})")
+
+    ctx = make_context(args.context)
+    width = 64
+    run, release = gpu_pass(ctx, "raytrace_bvh.frag", O, D, bvh, width)
+    run()                                                   # compile and warm up
+    t_gpu, out = timed(run, 3)
+    release()
+    count = (len(O) // width) * width
+    brute_count = max(width, (n // width) * width)
+    run, release = gpu_pass(ctx, "raytrace_brute.frag", O[:brute_count], D[:brute_count], bvh, width)
+    t_gpu_brute, out_b = timed(run, 1)
+    release()
+    same = (out[: brute_count, 1] == out_b[:, 1]).mean()
+    gpu_bvh, gpu_brute = count / t_gpu, brute_count / t_gpu_brute
+    print(f"GPU ({args.context}, llvmpipe): BVH {gpu_bvh:,.0f} rays/s, brute force "
+          f"{gpu_brute:,.0f} rays/s, speed-up {gpu_bvh / gpu_brute:.0f}x "
+          f"(same triangle as brute force: {same:.3f})")
+    ctx.release()
+
+
+if __name__ == "__main__":
+    main()

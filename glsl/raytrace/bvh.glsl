@@ -1,0 +1,114 @@
+// Twin: reference/raytrace/bvh.py
+// The closest hit of a ray P = O + s D against the triangles of a BVH (docs/conventions.md,
+// "Rays"), traversed depth first with a fixed stack, the nearer child first. The BVH is two
+// RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width)):
+//   nodes:     texel 2i = [min.xyz, a], texel 2i + 1 = [max.xyz, count]; count > 0: a leaf of
+//              triangles a .. a + count - 1; count == 0: left child i + 1, right child a
+//   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, 0], [C.xyz, 0]
+// The builder keeps the depth below BVH_STACK_SIZE (renderer/core/bvh.py, MAX_DEPTH).
+// Needs raytrace/intersect.glsl (ray_triangle).
+#include "raytrace/intersect.glsl"
+
+#ifndef BVH_STACK_SIZE
+#define BVH_STACK_SIZE 64
+#endif
+
+// 1 + 3 * 2^-23: the far end of a slab interval is widened by this (Ize, "Robust BVH Ray
+// Traversal", JCGT 2013) so that rounding does not lose a triangle on a box's face.
+const float BVH_BOX_FAR_SCALE = 1.00000036;
+
+vec4 bvh_texel(sampler2D texture_, int k) {
+    int width = textureSize(texture_, 0).x;
+    return texelFetch(texture_, ivec2(k % width, k / width), 0);
+}
+
+// Slab test with inv_D = 1 / D (IEEE: +-inf where D's component is 0). An axis with infinite
+// inv_D is parallel to its slab: the whole line if min <= O <= max there, nothing otherwise
+// (the products, NaN where O is on a face, are not used). Hit when near <= far.
+bool bvh_ray_box(vec3 O, vec3 inv_D, vec3 bmin, vec3 bmax, float s_min, float s_max,
+                 out float near) {
+    float inf = uintBitsToFloat(0x7F800000u);
+    vec3 lo = (bmin - O) * inv_D;
+    vec3 hi = (bmax - O) * inv_D;
+    vec3 tn = min(lo, hi);
+    vec3 tf = max(lo, hi);
+    bvec3 parallel = isinf(inv_D);
+    bvec3 inside = bvec3(step(bmin, O) * step(O, bmax));
+    tn = mix(tn, mix(vec3(inf), vec3(-inf), inside), parallel);
+    tf = mix(tf, mix(vec3(-inf), vec3(inf), inside), parallel);
+    near = max(max(tn.x, tn.y), max(tn.z, s_min));
+    float far = min(min(min(tf.x, tf.y), tf.z) * BVH_BOX_FAR_SCALE, s_max);
+    return near <= far;
+}
+
+// Whether a triangle is hit with s_min < s < s_max; s the nearest hit's parameter (s_max on a
+// miss), uv its barycentric (u, v), triangle its original index (-1 on a miss).
+bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float s_min,
+                     float s_max, out float s, out vec2 uv, out int triangle) {
+    vec3 inv_D = 1.0 / D;
+    s = s_max;
+    uv = vec2(0.0);
+    triangle = -1;
+    int stack[BVH_STACK_SIZE];
+    float stack_near[BVH_STACK_SIZE];
+    int top = 0;
+    float near;
+    if (!bvh_ray_box(O, inv_D, bvh_texel(nodes, 0).xyz, bvh_texel(nodes, 1).xyz, s_min, s, near))
+        return false;
+    int node = 0;
+    while (true) {
+        vec4 n0 = bvh_texel(nodes, 2 * node);
+        vec4 n1 = bvh_texel(nodes, 2 * node + 1);
+        int count = int(n1.w);
+        bool descend = false;
+        if (count > 0) {
+            int first = int(n0.w);
+            for (int k = 0; k < count; ++k) {
+                int j = first + k;
+                vec4 A = bvh_texel(triangles, 3 * j);
+                vec3 B = bvh_texel(triangles, 3 * j + 1).xyz;
+                vec3 C = bvh_texel(triangles, 3 * j + 2).xyz;
+                float hit_s;
+                vec2 hit_uv;
+                if (ray_triangle(O, D, A.xyz, B, C, s_min, s, hit_s, hit_uv)) {
+                    s = hit_s;
+                    uv = hit_uv;
+                    triangle = int(A.w);
+                }
+            }
+        } else {
+            int left = node + 1;
+            int right = int(n0.w);
+            float near_left, near_right;
+            bool hit_left = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * left).xyz,
+                                        bvh_texel(nodes, 2 * left + 1).xyz, s_min, s, near_left);
+            bool hit_right = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * right).xyz,
+                                         bvh_texel(nodes, 2 * right + 1).xyz, s_min, s, near_right);
+            if (hit_left && hit_right) {
+                bool right_first = near_right < near_left;
+                node = right_first ? right : left;
+                if (top < BVH_STACK_SIZE) {
+                    stack[top] = right_first ? left : right;
+                    stack_near[top] = right_first ? near_left : near_right;
+                    ++top;
+                }
+                descend = true;
+            } else if (hit_left || hit_right) {
+                node = hit_left ? left : right;
+                descend = true;
+            }
+        }
+        if (descend) continue;
+        // pop the next node still nearer than the closest hit so far
+        bool found = false;
+        while (top > 0 && !found) {
+            --top;
+            if (stack_near[top] <= s) {
+                node = stack[top];
+                found = true;
+            }
+        }
+        if (!found) break;
+    }
+    return triangle >= 0;
+}

@@ -1,0 +1,126 @@
+"""# Twin: glsl/raytrace/bvh.glsl
+
+The closest hit of rays against the triangles of a BVH (renderer/core/bvh.py: the layout), in
+float32, vectorised over rays: a wavefront of (ray, node) pairs, one level of the tree per step
+(no Python loop over rays or nodes). The ray-box test and the triangle test are the GLSL's
+(`ray_box` below; `ray_triangle` of intersect.py), so each pair decides as the GLSL does;
+the order differs (the GLSL goes depth first, nearer child first), which changes the answer
+only where two triangles are hit at the same s (an edge or vertex they share): either is the
+closest hit then.
+
+Ray-box (slab) test with 1/D precomputed, IEEE: 1/(+-0) = +-inf. An axis whose 1/D is
+infinite (D's component 0, or so small that 1/D overflows) is parallel to its slab: it admits
+the whole line when O lies in the closed slab [min, max], and nothing otherwise (the products
+(min - O)/D would be 0 * inf = NaN where O is on the slab's face; they are not used).
+Otherwise lo = (min - O) * invD, hi = (max - O) * invD, near = max(s_min, min(lo, hi) over
+axes), far = min(s_max, BOX_FAR_SCALE * max-side), and the box is hit when near <= far. The
+far end is widened by BOX_FAR_SCALE = 1 + 3 * 2^-23 (about 1 + 2 gamma_3, Ize, "Robust BVH Ray
+Traversal", JCGT 2(2) 2013) so that rounding in the slabs (and a 1/D that llvmpipe computes an
+ulp off) does not lose a triangle lying on a box's face.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference.raytrace.intersect import ray_triangle
+
+F32 = np.float32
+BOX_FAR_SCALE = F32(1 + 3 * 2.0 ** -23)
+
+
+def inverse_direction(D):
+    with np.errstate(divide="ignore", over="ignore"):
+        return (F32(1) / np.asarray(D, F32)).astype(F32)
+
+
+def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
+    """(hit, near) for rays (..., 3) against boxes (..., 3), all float32, as the GLSL's
+    bvh_ray_box."""
+    O, inv_D, bmin, bmax = (np.asarray(a, F32) for a in (O, inv_D, bmin, bmax))
+    with np.errstate(invalid="ignore", over="ignore"):
+        lo = (bmin - O) * inv_D
+        hi = (bmax - O) * inv_D
+        tn, tf = np.minimum(lo, hi), np.maximum(lo, hi)
+    parallel = np.isinf(inv_D)
+    inside = (O >= bmin) & (O <= bmax)
+    tn = np.where(parallel, np.where(inside, F32(-np.inf), F32(np.inf)), tn)
+    tf = np.where(parallel, np.where(inside, F32(np.inf), F32(-np.inf)), tf)
+    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]), np.maximum(tn[..., 2], np.asarray(s_min, F32)))
+    with np.errstate(over="ignore"):
+        far = np.minimum(np.minimum(tf[..., 0], tf[..., 1]), tf[..., 2]) * BOX_FAR_SCALE
+    far = np.minimum(far, np.asarray(s_max, F32))
+    return near <= far, near
+
+
+def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
+    """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
+    s_min < s < s_max, the nearest such s (s_max on a miss), its (u, v), and the triangle's
+    original index (-1 on a miss). Everything float32 as the GLSL."""
+    O = np.asarray(O, F32).reshape(-1, 3)
+    D = np.asarray(D, F32).reshape(-1, 3)
+    R = len(O)
+    inv_D = inverse_direction(D)
+    s_min = F32(s_min)
+    best_s = np.full(R, F32(s_max), F32)
+    best_uv = np.zeros((R, 2), F32)
+    best_tri = np.full(R, -1, np.int64)
+    nodes, tris = bvh.nodes, bvh.triangles
+    ray = np.arange(R)
+    node = np.zeros(R, np.int64)
+    while ray.size:
+        n0, n1 = nodes[node, 0], nodes[node, 1]
+        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min, best_s[ray])
+        ray, node, n0, n1 = ray[hit], node[hit], n0[hit], n1[hit]
+        leaf = n1[:, 3] > 0
+        # leaves: every (ray, triangle) pair, then the nearest hit per ray
+        count = n1[leaf, 3].astype(np.int64)
+        if count.size:
+            r = np.repeat(ray[leaf], count)
+            starts = np.cumsum(count) - count
+            t = (np.repeat(n0[leaf, 3].astype(np.int64) - starts, count)
+                 + np.arange(count.sum()))
+            v = tris[t]
+            h, s, uv = ray_triangle(O[r], D[r], v[:, 0, :3], v[:, 1, :3], v[:, 2, :3], s_min, best_s[r])
+            r, s, uv, t = r[h], s[h], uv[h], t[h]
+            if r.size:
+                order = np.lexsort((t, s, r))           # per ray: nearest s, then leaf order
+                r, s, uv, t = r[order], s[order], uv[order], t[order]
+                first = np.r_[True, r[1:] != r[:-1]]
+                r, s, uv, t = r[first], s[first], uv[first], t[first]
+                better = s < best_s[r]
+                r, s, uv, t = r[better], s[better], uv[better], t[better]
+                best_s[r], best_uv[r], best_tri[r] = s, uv, t
+        # interior nodes: both children (left = i + 1, right = a)
+        inner = ~leaf
+        ray = np.repeat(ray[inner], 2)
+        node = np.stack([node[inner] + 1, n0[inner, 3].astype(np.int64)], axis=1).reshape(-1)
+    hit = best_tri >= 0
+    original = np.where(hit, tris[np.maximum(best_tri, 0), 0, 3].astype(np.int64), -1)
+    return hit, best_s, best_uv, original
+
+
+def closest_hit_brute_force(vertices, O, D, s_min=0.0, s_max=np.inf, chunk=1 << 20):
+    """(hit, s, uv, triangle): every ray against every triangle (T, 3, 3) with ray_triangle in
+    float32, the nearest hit (the lowest index among equal s)."""
+    V = np.asarray(vertices, F32)
+    O = np.asarray(O, F32).reshape(-1, 3)
+    D = np.asarray(D, F32).reshape(-1, 3)
+    R, T = len(O), len(V)
+    s_out = np.full(R, F32(s_max), F32)
+    uv_out = np.zeros((R, 2), F32)
+    tri_out = np.full(R, -1, np.int64)
+    step = max(1, chunk // T)
+    for i in range(0, R, step):
+        shape = (len(O[i:i + step]), T, 3)
+        o = np.broadcast_to(O[i:i + step, None], shape)
+        d = np.broadcast_to(D[i:i + step, None], shape)
+        h, s, uv = ray_triangle(o, d, V[None, :, 0], V[None, :, 1], V[None, :, 2],
+                                F32(s_min), F32(s_max))
+        k = np.argmin(s, axis=1)
+        rows = np.arange(len(k))
+        hit = h[rows, k]
+        s_out[i:i + step] = s[rows, k]
+        uv_out[i:i + step] = uv[rows, k]
+        tri_out[i:i + step] = np.where(hit, k, -1)
+    return tri_out >= 0, s_out, uv_out, tri_out

@@ -1,0 +1,276 @@
+"""The BVH (renderer/core/bvh.py: binned SAH build and flat layout; glsl/raytrace/bvh.glsl and
+its twin reference/raytrace/bvh.py: closest-hit traversal): a tiny layout checked by hand, the
+builder's invariants, the twin against brute force (every ray against every triangle) on seeded
+random rays for a triangle soup and the 20,480-triangle icosphere, and the GLSL on llvmpipe
+(EGL, OSMesa) against the twin.
+
+Ties: a ray through an edge or vertex that triangles share hits them all at the same s (docs/
+conventions.md, "Rays"); any of them is the closest hit, so where two answers name different
+triangles, each must be hit by the ray at the other's s (exactly, for the twin against brute
+force, which share ray_triangle; within the GPU tolerance for the GLSL)."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from reference.raytrace.bvh import closest_hit, closest_hit_brute_force, inverse_direction, ray_box
+from reference.raytrace.intersect import ray_triangle
+from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, mesh_vertices, texels
+from renderer.core.primitives import icosphere
+
+GLSL = Path(__file__).parent / "glsl"
+F32 = np.float32
+EPS32 = float(np.finfo(np.float32).eps)
+INF = np.inf
+K = 8                               # the GPU tolerance of tests/test_raytrace_intersect.py
+
+
+# -- a tiny layout by hand ---------------------------------------------------------------------
+
+TWO = np.array([[(4, 0, 0), (5, 0, 0), (4, 1, 0)],          # original 0, right of x = 2
+                [(0, 0, 0), (1, 0, 0), (0, 1, 0)]], F32)     # original 1, left
+
+HAND = Bvh(nodes=np.array([
+    [[0, 0, 0, 2], [5, 1, 0, 0]],       # 0: interior, bounds (0,0,0)-(5,1,0); left 1, right 2
+    [[0, 0, 0, 0], [1, 1, 0, 1]],       # 1: leaf, triangle 0 (original 1)
+    [[4, 0, 0, 1], [5, 1, 0, 1]],       # 2: leaf, triangle 1 (original 0)
+], F32), triangles=np.array([
+    [[0, 0, 0, 1], [1, 0, 0, 0], [0, 1, 0, 0]],
+    [[4, 0, 0, 0], [5, 0, 0, 0], [4, 1, 0, 0]],
+], F32), depth=1)
+
+
+def test_the_builder_makes_the_hand_written_layout():
+    bvh = build_bvh(TWO, max_leaf_size=1)
+    assert bvh.nodes.tolist() == HAND.nodes.tolist()
+    assert bvh.triangles.tolist() == HAND.triangles.tolist()
+    assert bvh.depth == 1 and bvh.original_index.tolist() == [1, 0]
+    # with leaves of up to 4 (the default) two triangles are one leaf, in their own order
+    assert build_bvh(TWO).nodes.tolist() == [[[0, 0, 0, 0], [5, 1, 0, 2]]]
+    assert build_bvh(TWO).original_index.tolist() == [0, 1]
+    # texels: node i at texels 2i, 2i + 1, row by row
+    assert texels(HAND.nodes, width=4).shape == (2, 4, 4)
+    assert texels(HAND.nodes, width=4)[1, 1].tolist() == HAND.nodes[2, 1].tolist()
+    assert texels(HAND.nodes, width=4)[1, 2:].tolist() == [[0] * 4] * 2
+
+
+def test_traversal_of_the_hand_written_layout():
+    down = (0, 0, -1)
+    O = np.array([(0.25, 0.25, 1), (4.25, 0.25, 2), (2, 0.5, 1), (0, 0.25, 1),   # x on a face
+                  (-1, 0.25, 1), (0.25, 0.25, -1), (-3, 0.25, 1)], F32)   # the last: s = 4 at (4.25, 0.25, 0)
+    D = np.array([down, down, down, down, down, (0, 0, 1), (1.8125, 0, -0.25)], F32)
+    hit, s, uv, tri = closest_hit(HAND, O, D)
+    assert hit.tolist() == [True, True, False, True, False, True, True]
+    assert tri.tolist() == [1, 0, -1, 1, -1, 1, 0]
+    assert s.tolist() == [1, 2, INF, 1, INF, 1, 4]
+    assert uv[:2].tolist() == [[0.25, 0.25], [0.25, 0.25]] and uv[3].tolist() == [0, 0.25]
+    # the open interval: s_max = 1 refuses the hit at s = 1, s_min = 1 too
+    assert not closest_hit(HAND, O[:1], D[:1], 0, 1)[0][0]
+    assert not closest_hit(HAND, O[:1], D[:1], 1, INF)[0][0]
+
+
+def test_ray_box_slabs_and_parallel_axes():
+    bmin, bmax = np.zeros(3, F32), np.ones(3, F32)
+    O = np.array([(-1, 0.5, 0.5), (-1, 0, 0.5), (-1, 1, 1), (-1, 1.5, 0.5), (0.5, 0.5, 0.5),
+                  (2, 0.5, 0.5)], F32)
+    D = np.array([(1, 0, 0), (1, 0, 0), (2, -0.0, 0), (1, 0, 0), (0, 0, 1), (1, 0, 0)], F32)
+    hit, near = ray_box(O, inverse_direction(D), bmin, bmax, F32(0), F32(INF))
+    # through; on the face y = 0 (closed); on the edge y = z = 1 (-0.0 as 0); outside the y slab;
+    # from inside (near = s_min); box behind
+    assert hit.tolist() == [True, True, True, False, True, False]
+    assert near[:3].tolist() == [1, 1, 0.5] and near[4] == 0
+
+
+# -- the builder's invariants ------------------------------------------------------------------
+
+def soup(count, seed):
+    rng = np.random.default_rng(seed)
+    centres = rng.uniform(-1, 1, (count, 1, 3))
+    return (centres + rng.normal(scale=0.1, size=(count, 3, 3))).astype(F32)
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    mesh = icosphere(subdivisions=5)
+    vertices = mesh_vertices(mesh.positions, mesh.faces)
+    assert len(vertices) == 20480
+    return vertices, build_bvh(vertices)
+
+
+def check_invariants(vertices, bvh, max_leaf_size=4):
+    T, N = len(vertices), len(bvh.nodes)
+    leaf = bvh.is_leaf
+    first = bvh.nodes[leaf, 0, 3].astype(int)
+    count = bvh.nodes[leaf, 1, 3].astype(int)
+    assert (count >= 1).all() and (count <= max_leaf_size).all()
+    # the leaves' ranges tile 0..T-1 in node order, and every triangle is in exactly one
+    assert first.tolist() == (np.cumsum(count) - count).tolist() and count.sum() == T
+    assert sorted(bvh.original_index.tolist()) == list(range(T))
+    assert (bvh.vertices == vertices[bvh.original_index]).all()
+    # children: left i + 1, right a > i + 1; each node exactly one parent (a tree, pre-order)
+    inner = np.flatnonzero(~leaf)
+    right = bvh.nodes[inner, 0, 3].astype(int)
+    children = np.concatenate([inner + 1, right])
+    assert (right > inner + 1).all() and sorted(children.tolist()) == list(range(1, N))
+    lo, hi = bvh.bounds_min, bvh.bounds_max
+    for child in (inner + 1, right):
+        assert (lo[inner] <= lo[child]).all() and (hi[child] <= hi[inner]).all()
+    owner = np.repeat(np.flatnonzero(leaf), count)
+    assert (lo[owner] <= bvh.vertices.min(1)).all() and (bvh.vertices.max(1) <= hi[owner]).all()
+    assert lo[0].tolist() == vertices.min((0, 1)).tolist() and hi[0].tolist() == vertices.max((0, 1)).tolist()
+    assert bvh.depth < MAX_DEPTH
+
+
+def test_builder_invariants_soup_sphere_and_degenerate(sphere):
+    for seed, size in ((1, 1), (2, 7), (3, 1000)):
+        vertices = soup(size, seed)
+        check_invariants(vertices, build_bvh(vertices))
+    check_invariants(*sphere)
+    same = np.repeat(soup(1, 4), 50, axis=0)                # 50 copies: the object median
+    check_invariants(same, build_bvh(same))
+    check_invariants(soup(100, 5), build_bvh(soup(100, 5), max_leaf_size=1), max_leaf_size=1)
+    vertices, bvh = sphere
+    assert build_bvh(vertices[:2000]).nodes.tobytes() == build_bvh(vertices[:2000]).nodes.tobytes()
+    with pytest.raises(ValueError):
+        build_bvh(np.zeros((0, 3, 3)))
+
+
+# -- the twin against brute force --------------------------------------------------------------
+
+def random_rays(count, seed, spread=2.0):
+    """Origins in a cube, directions normal; every 10th ray along an axis (D's other components
+    exactly 0: the slab test's parallel case), every 10th in a coordinate plane."""
+    rng = np.random.default_rng(seed)
+    O = rng.uniform(-spread, spread, (count, 3)).astype(F32)
+    D = rng.normal(size=(count, 3)).astype(F32)
+    D[::10, 1:] = 0
+    D[5::10, rng.integers(0, 3)] = 0
+    return O, D
+
+
+def assert_same_closest_hit(V, O, D, answer, expected):
+    hit, s, _, tri = answer
+    hit_b, s_b, _, tri_b = expected
+    assert (hit == hit_b).all()
+    differ = hit & (tri != tri_b)
+    assert (s[hit & ~differ] == s_b[hit & ~differ]).all()
+    if differ.any():                                # ties: the other triangle is hit at that s
+        _, s_other, _ = ray_triangle(O[differ], D[differ], *(V[tri[differ], k] for k in range(3)), F32(0), F32(INF))
+        assert (s_other == s[differ]).all() and (np.abs(s[differ] - s_b[differ]) <= 2 * np.spacing(s_b[differ])).all()
+    return differ.sum()
+
+
+def test_twin_equals_brute_force_on_a_soup():
+    V = soup(1000, 6)
+    O, D = random_rays(3000, 7)
+    answer = closest_hit(build_bvh(V), O, D)
+    assert 0.1 < answer[0].mean() < 0.9
+    assert assert_same_closest_hit(V, O, D, answer, closest_hit_brute_force(V, O, D)) == 0
+
+
+def test_twin_equals_brute_force_on_the_icosphere(sphere):
+    V, bvh = sphere
+    O, D = random_rays(600, 8, spread=1.5)            # some inside the sphere, most outside
+    O[::3] *= F32(0.5)                                  # a third inside
+    D[1::3] = -O[1::3] + np.random.default_rng(9).normal(scale=0.3, size=(200, 3)).astype(F32)  # aimed at it
+    answer = closest_hit(bvh, O, D)
+    assert 0.5 < answer[0].mean() < 0.95
+    assert_same_closest_hit(V, O, D, answer, closest_hit_brute_force(V, O, D))
+
+
+# -- the GLSL against the twin -----------------------------------------------------------------
+
+WIDTH, HEIGHT = 64, 64
+
+
+def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30):
+    from renderer.gpu.bvh import bvh_textures
+    from renderer.gpu.shaders import shader_source
+    program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
+                          fragment_shader=shader_source("raytrace_bvh.frag", directory=GLSL).text)
+    h, w = O.shape[:2]
+    inputs = [ctx.texture((w, h), 3, np.ascontiguousarray(a, F32).tobytes(), dtype="f4") for a in (O, D)]
+    inputs += bvh_textures(ctx, bvh)
+    output = ctx.texture((w, h), 4, dtype="f4")
+    framebuffer = ctx.framebuffer([output])
+    vao = ctx.vertex_array(program, [])
+    try:
+        for unit, (texture, name) in enumerate(zip(inputs, ("u_origins", "u_directions", "u_nodes", "u_triangles"))):
+            texture.filter = (ctx.NEAREST, ctx.NEAREST)
+            texture.use(unit)
+            program[name].value = unit
+        program["u_s_min"].value = s_min
+        program["u_s_max"].value = s_max
+        framebuffer.use()
+        vao.render(vertices=3)
+        ctx.finish()
+        return np.frombuffer(output.read(), F32).reshape(h, w, 4)
+    finally:
+        for thing in (vao, framebuffer, program, *inputs, output):
+            thing.release()
+
+
+def norm(v):
+    return np.sqrt((np.asarray(v, np.float64) ** 2).sum(-1))
+
+
+def triangle_bounds(O, D, V, s):
+    """The forward rounding-error bounds of tests/test_raytrace_intersect.py for s and for the
+    distance to the nearest edge, and that distance, per ray against its triangle V (R, 3, 3)."""
+    O64, D64, V64 = (np.asarray(a, np.float64) for a in (O, D, V))
+    e1, e2 = V64[:, 1] - V64[:, 0], V64[:, 2] - V64[:, 0]
+    t = O64 - V64[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        det = (np.cross(D64, e2) * e1).sum(-1)
+        s_bound = (norm(e2) * norm(t) * norm(e1) + np.abs(s) * norm(e1) * norm(D64) * norm(e2)) / np.abs(det)
+        u = (t * np.cross(D64, e2)).sum(-1) / det
+        v = (D64 * np.cross(t, e1)).sum(-1) / det
+        uv_bound = (norm(t) + norm(e1) + norm(e2)) * norm(D64) * np.maximum(norm(e1), norm(e2)) / np.abs(det)
+    edge = np.minimum(np.minimum(np.abs(u), np.abs(v)), np.abs(1 - u - v))
+    return s_bound, edge, uv_bound
+
+
+@pytest.mark.parametrize("scene", ["soup", "icosphere"])
+def test_glsl_traversal_agrees_with_the_twin(gl_contexts, sphere, scene):
+    """Hit or miss agree but where the hit triangle is hit within rounding of its edge (a ray
+    can slip between two triangles: Moeller-Trumbore is not watertight); the triangle agrees
+    but at ties, where the other is hit within the tolerance at the same s; s within K eps32
+    times the triangle's forward error bound."""
+    if scene == "soup":
+        V = soup(2000, 10)
+        bvh = build_bvh(V)
+        O, D = random_rays(WIDTH * HEIGHT, 11)
+    else:
+        V, bvh = sphere
+        O, D = random_rays(WIDTH * HEIGHT, 12, spread=1.5)
+        O[::3] *= F32(0.5)
+        D[1::3] = -O[1::3] + np.random.default_rng(13).normal(scale=0.3, size=D[1::3].shape).astype(F32)
+    hit, s, uv, tri = closest_hit(bvh, O, D, 0.0, F32(1e30))
+    assert 0.1 < hit.mean() < 0.95
+    for kind, ctx in gl_contexts.items():
+        out = gpu_closest_hits(ctx, bvh, O.reshape(HEIGHT, WIDTH, 3), D.reshape(HEIGHT, WIDTH, 3)).reshape(-1, 4)
+        gpu_s, gpu_tri = out[:, 0], out[:, 1].astype(np.int64)
+        gpu_hit = gpu_tri >= 0
+        assert (gpu_s[~gpu_hit] == F32(1e30)).all(), kind
+        # hit/miss: only where the hitting side's triangle is hit within rounding of an edge
+        one = gpu_hit != hit
+        assert one.sum() <= 0.002 * len(hit), (kind, one.sum())
+        if one.any():
+            which = np.where(hit[one], tri[one], gpu_tri[one])
+            _, edge, uv_bound = triangle_bounds(O[one], D[one], V[which], s[one])
+            assert (edge <= K * EPS32 * uv_bound).all(), (kind, "hit/miss off an edge")
+        both = gpu_hit & hit
+        s_bound, _, _ = triangle_bounds(O[both], D[both], V[tri[both]], s[both])
+        error = np.abs(gpu_s[both].astype(np.float64) - s[both])
+        same = gpu_tri[both] == tri[both]
+        assert (error[same] <= K * EPS32 * s_bound[same]).all(), (kind, error[same].max())
+        # ties: the GPU's triangle is hit by the twin's ray at (about) the twin's s
+        if (~same).any():
+            O_t, D_t = O[both][~same], D[both][~same]
+            V_t = V[gpu_tri[both][~same]]
+            other_hit, other_s, _ = ray_triangle(O_t, D_t, V_t[:, 0], V_t[:, 1], V_t[:, 2], F32(0), F32(INF))
+            other_bound, edge, uv_bound = triangle_bounds(O_t, D_t, V_t, other_s)
+            assert ((other_hit | (edge <= K * EPS32 * uv_bound))).all(), kind
+            assert (np.abs(other_s - s[both][~same]) <= K * EPS32 * (other_bound + s_bound[~same])).all(), kind
+            assert (~same).sum() <= 0.002 * len(hit), (kind, (~same).sum())

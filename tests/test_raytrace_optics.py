@@ -14,7 +14,6 @@ from reference.raytrace.camera import camera_ray, pixel_windows
 from reference.raytrace.intersect import ray_plane, ray_sphere
 from reference.raytrace.optics import (fresnel_schlick, offset_ray_origin, ray_reflect,
                                        ray_refract)
-from renderer.core import transforms
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.sampling import jittered
 from renderer.core.scene import Camera, Scene

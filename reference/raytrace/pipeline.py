@@ -29,7 +29,10 @@ DEFAULT_MAX_DEPTH = 4
 
 
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
-           max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, rs=None) -> Frame:
+           max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
+           rs=None) -> Frame:
+    """The frame (module docstring); `rs` a ray_scene(scene) made before, `shadows`=False
+    traces no shadow rays."""
     start = time.perf_counter()
     rs = rs if rs is not None else ray_scene(scene)
     offsets = np.asarray(sample_pattern(pattern, samples, seed), F32)
@@ -43,7 +46,7 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
     windows = np.stack([np.stack([x + dx, y + dy], -1) for dx, dy in offsets])   # (S, H, W, 2)
     O, D = camera_ray(windows.reshape(-1, 2), uniforms)
     cam = scene.camera
-    colour, hit, s = trace(rs, lights, O, D, cam.near, cam.far, scene.background, max_depth)
+    colour, hit, s = trace(rs, lights, O, D, cam.near, cam.far, scene.background, max_depth, shadows)
     n = len(offsets)
     colour = colour.reshape(n, height * width, 3)
     total = colour[0].copy()

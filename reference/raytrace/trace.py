@@ -128,9 +128,10 @@ def shadow_visibility(rs, lights: Lights, Ng):
     return visibility
 
 
-def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int):
+def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True):
     """Trace rays O, D (R, 3) float32: (colour (R, 3), hit (R,), s (R,)) with hit and s of
-    each ray's first hit (primary rays between s_min and s_max; secondary rays from 0 to inf)."""
+    each ray's first hit (primary rays between s_min and s_max; secondary rays from 0 to inf).
+    shadows=False lights every point by every light (no shadow rays; the GLSL without SHADOWS)."""
     O = np.asarray(O, F32)
     D = np.asarray(D, F32)
     R = len(O)
@@ -154,7 +155,8 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int):
         Du = normalize(D)
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
-        local = lighting(P, N, O, materials(rs, obj, specular), lights, shadow_visibility(rs, lights, Ng))
+        local = lighting(P, N, O, materials(rs, obj, specular), lights,
+                         shadow_visibility(rs, lights, Ng) if shadows else None)
         np.add.at(colour, owner, weight * local)
         if depth == max_depth:
             break

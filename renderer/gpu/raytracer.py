@@ -50,7 +50,7 @@ class RayTracer:
     def __init__(self, scene: Scene, width: int, height: int, *,
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
-                 seed: int = DEFAULT_SEED):
+                 seed: int = DEFAULT_SEED, shadows: bool = True):
         if int(width) < 1 or int(height) < 1:
             raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
         if not 1 <= int(samples) <= MAX_SAMPLES:
@@ -62,6 +62,7 @@ class RayTracer:
         self.width, self.height = int(width), int(height)
         self.offsets = np.asarray(sample_pattern(pattern, int(samples), seed), np.float32)
         self.max_depth = int(max_depth)
+        self.shadows = bool(shadows)
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._resources: list = []
@@ -80,7 +81,7 @@ class RayTracer:
             "NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
             "NUM_POINT_LIGHTS": len(scene.point_lights),
             "SPECULAR": rs.specular,
-            "SHADOWS": bool(scene.directional_lights or scene.point_lights),
+            "SHADOWS": self.shadows and bool(scene.directional_lights or scene.point_lights),
             "MATERIAL_VARIABLES": True,
             "NUM_SPHERES": len(rs.sphere_radius),
             "NUM_PLANES": len(rs.plane_offset),

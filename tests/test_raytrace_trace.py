@@ -175,3 +175,27 @@ def test_rasteriser_and_ray_tracer_agree_on_primary_visibility(gl_contexts):
         traced = tracer.render()
     assert_within_tolerance(traced, rasterised)
     assert_within_tolerance(reference_raytrace(s, 64, 48, shadows=False), rasterised)
+
+
+def test_command_line_ray_traces_and_compares(tmp_path, capsys):
+    """`renderer render/compare --method raytrace` in this process (small frames); options of
+    the ray tracer are refused with the rasteriser, a pattern that cannot make N samples too."""
+    import json
+    from renderer.cli import main
+    assert main(["render", "sphere", "--method", "raytrace", "--spp", "4", "--pattern", "jittered",
+                 "--size", "32x24", "--backend", "reference", "-o", str(tmp_path / "rt.png"), "-q"]) == 0
+    assert (tmp_path / "rt.png").is_file()
+    capsys.readouterr()
+    assert main(["compare", "sphere", "--method", "raytrace", "--size", "32x24",
+                 "--out", str(tmp_path / "cmp")]) == 0
+    figures = json.loads(capsys.readouterr().out)
+    assert figures["method"] == "raytrace" and figures["passes"]
+    for bad in (["--spp", "4"], ["--method", "raytrace", "--spp", "2"], ["--method", "raytrace", "--max-depth", "17"]):
+        assert main(["render", "sphere", "--size", "8x8", "-o", str(tmp_path / "x.png"), *bad]) == 2
+
+
+def test_memory_estimates_of_the_ray_tracer():
+    from renderer.core import memory
+    assert memory.raytrace_gpu_bytes(640, 480, 0, samples=16) == memory.raytrace_gpu_bytes(640, 480, 0)
+    assert memory.raytrace_reference_bytes(640, 480, 0, samples=16) > memory.raytrace_reference_bytes(640, 480, 0)
+    assert memory.raytrace_reference_bytes(10, 10, 1000) > memory.raytrace_reference_bytes(10, 10, 0)

@@ -26,6 +26,7 @@ from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
 
 F32 = np.float32
 DEFAULT_MAX_DEPTH = 4
+CHUNK_RAYS = 1 << 16         # camera rays traced at once (bounds the working memory)
 
 
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
@@ -46,7 +47,9 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
     windows = np.stack([np.stack([x + dx, y + dy], -1) for dx, dy in offsets])   # (S, H, W, 2)
     O, D = camera_ray(windows.reshape(-1, 2), uniforms)
     cam = scene.camera
-    colour, hit, s = trace(rs, lights, O, D, cam.near, cam.far, scene.background, max_depth, shadows)
+    parts = [trace(rs, lights, O[k:k + CHUNK_RAYS], D[k:k + CHUNK_RAYS], cam.near, cam.far,
+                   scene.background, max_depth, shadows) for k in range(0, len(O), CHUNK_RAYS)]
+    colour, hit, s = (np.concatenate(part) for part in zip(*parts))
     n = len(offsets)
     colour = colour.reshape(n, height * width, 3)
     total = colour[0].copy()

@@ -6,6 +6,13 @@
 // SPECULAR compiles the k_s term in; without it (every k_s is 0) neither R, V nor pow exist.
 // ALL_FEATURES (the build that does not specialise, renderer/gpu/shaders.py) keeps the arrays at
 // their full size and reads how many lights there are from uniforms at run time.
+// The ray tracer (glsl/raytrace/trace.glsl) adds two switches; without them this file compiles
+// to exactly the rasteriser's code:
+//   MATERIAL_VARIABLES: u_ka, u_kd, u_ks, u_n and u_eye are global variables the caller sets
+//     per hit (the hit's material; the viewer is the ray's origin) instead of uniforms;
+//   SHADOWS: each light's diffuse and specular terms are multiplied by its visibility, 0 or 1,
+//     from light_visibility_directional(i, P, N) / light_visibility_point(i, P, N), which the
+//     including shader defines (shadow rays); a point in shadow keeps only the ambient term.
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
 #define NUM_DIRECTIONAL_LIGHTS 0
@@ -15,12 +22,22 @@
 #endif
 
 // The material: the notes' reflection coefficients (linear RGB) and Phong exponent n.
+#ifdef MATERIAL_VARIABLES
+vec3 u_ka;
+vec3 u_kd;
+#ifdef SPECULAR
+vec3 u_ks;
+float u_n;
+vec3 u_eye;                          // the viewer: the ray's origin
+#endif
+#else
 uniform vec3 u_ka;
 uniform vec3 u_kd;
 #ifdef SPECULAR
 uniform vec3 u_ks;
 uniform float u_n;
 uniform vec3 u_eye;                  // E, the camera's eye, world space
+#endif
 #endif
 
 uniform vec3 u_ambient;              // I_a
@@ -43,6 +60,11 @@ uniform vec3 u_directional_intensity[NUM_DIRECTIONAL_LIGHTS];   // I_l
 uniform vec3 u_point_position[NUM_POINT_LIGHTS];                // Q, world space
 uniform vec3 u_point_intensity[NUM_POINT_LIGHTS];               // I_l
 uniform vec3 u_point_attenuation[NUM_POINT_LIGHTS];             // (c, l, q)
+#endif
+
+#ifdef SHADOWS
+float light_visibility_directional(int i, vec3 P, vec3 N);
+float light_visibility_point(int i, vec3 P, vec3 N);
 #endif
 
 // normalize(v), except that a zero vector stays zero (GLSL's normalize(0) is NaN): a normal
@@ -84,7 +106,12 @@ vec3 lighting(vec3 P, vec3 N) {
 #if NUM_DIRECTIONAL_LIGHTS > 0
     for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
         vec3 L = normalize(-u_directional_direction[i]);
+#ifdef SHADOWS
+        I += light_visibility_directional(i, P, N)
+             * light_contribution(N, L, V, u_directional_intensity[i]);
+#else
         I += light_contribution(N, L, V, u_directional_intensity[i]);       // att = 1
+#endif
     }
 #endif
 #if NUM_POINT_LIGHTS > 0
@@ -94,7 +121,11 @@ vec3 lighting(vec3 P, vec3 N) {
         vec3 L = d > 0.0 ? to_light / d : N;         // a light on the surface: fully incident
         vec3 c_l_q = u_point_attenuation[i];
         float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
+#ifdef SHADOWS
+        I += light_visibility_point(i, P, N) * light_contribution(N, L, V, att * u_point_intensity[i]);
+#else
         I += light_contribution(N, L, V, att * u_point_intensity[i]);
+#endif
     }
 #endif
     return I;

@@ -120,16 +120,26 @@ def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> n
 
 
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
-             lights: Lights) -> np.ndarray:
-    """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3)."""
+             lights: Lights, visibility=None) -> np.ndarray:
+    """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3).
+
+    `visibility` (the shader's SHADOWS; the ray tracer's shadow rays): None lights every point
+    by every light (the rasteriser's path, unchanged), else a callable
+    visibility(kind, i, P, N) -> (..., 1) 0 or 1 per point for light i of kind "directional"
+    or "point", which multiplies that light's diffuse and specular terms (the GLSL's
+    light_visibility_directional / light_visibility_point): in shadow, ambient only.
+    E and the material's arrays may vary per point (broadcast against P)."""
     V = normalize_or_zero(E - P)
     I = np.broadcast_to(lights.u_ambient * material.u_ka, np.broadcast_shapes(P.shape, N.shape))
     I = I.astype(P.dtype, copy=True)
-    for direction, intensity in zip(lights.u_directional_direction, lights.u_directional_intensity):
+    for i, (direction, intensity) in enumerate(zip(lights.u_directional_direction,
+                                                   lights.u_directional_intensity)):
         L = directional_light_vector(direction)
-        I += light_contribution(N, L, V, 1.0, intensity, material)
-    for position, intensity, attenuation in zip(lights.u_point_position, lights.u_point_intensity,
-                                                lights.u_point_attenuation):
+        term = light_contribution(N, L, V, 1.0, intensity, material)
+        I += term if visibility is None else visibility("directional", i, P, N) * term
+    for i, (position, intensity, attenuation) in enumerate(zip(
+            lights.u_point_position, lights.u_point_intensity, lights.u_point_attenuation)):
         L, att = point_light_vector(P, N, position, attenuation)
-        I += light_contribution(N, L, V, att, intensity, material)
+        term = light_contribution(N, L, V, att, intensity, material)
+        I += term if visibility is None else visibility("point", i, P, N) * term
     return I

@@ -102,8 +102,22 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
                        help="headless GL context (default: EGL, then OSMesa)")
 
+    def raytrace_options(p):
+        p.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+                       help="raster (default): the rasteriser; raytrace: the ray tracer (shadows, "
+                            "reflection, refraction; docs/conventions.md, \"Rays\")")
+        p.add_argument("--spp", type=positive_int, default=1, metavar="N",
+                       help="ray tracer: samples per pixel (default 1)")
+        p.add_argument("--pattern", choices=("regular", "random", "jittered", "poisson"),
+                       default="regular", help="ray tracer: sample pattern (default regular)")
+        p.add_argument("--max-depth", type=int, default=4, metavar="D",
+                       help="ray tracer: bounces of reflection and refraction, 0 to 16 (default 4)")
+        p.add_argument("--seed", type=int, default=None, metavar="S",
+                       help="ray tracer: seed of the random and jittered patterns")
+
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
+    raytrace_options(render)
     render.add_argument("-o", "--output", type=output_path, metavar="OUT.png",
                         help="image to write, in the format its suffix names (.png, .jpg, .webp, "
                              ".tif, ...; default: SCENE_NAME.png)")
@@ -147,6 +161,7 @@ def build_parser() -> argparse.ArgumentParser:
                     f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
                     "(what fails is said on stderr), 2 for bad input.")
     common(compare)
+    raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
@@ -221,6 +236,45 @@ def _load(scene_arg):
     return load_scene(resolve_scene(scene_arg))
 
 
+def check_raytrace_options(args) -> None:
+    if args.method == "raster" and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
+                                    or args.seed is not None):
+        args.parser.error("--spp, --pattern, --max-depth and --seed are for --method raytrace")
+    if not 0 <= args.max_depth <= 16:
+        args.parser.error(f"--max-depth must be between 0 and 16, got {args.max_depth}")
+    if args.method == "raytrace":
+        from renderer.core.sampling import pattern
+        try:
+            pattern(args.pattern, args.spp, **({} if args.seed is None else {"seed": args.seed}))
+        except ValueError as error:
+            args.parser.error(f"--spp {args.spp} --pattern {args.pattern}: {error}")
+
+
+def _raytrace_options(args) -> dict:
+    from renderer.core.sampling import DEFAULT_SEED
+    return {"samples": args.spp, "pattern": args.pattern, "max_depth": args.max_depth,
+            "seed": DEFAULT_SEED if args.seed is None else args.seed}
+
+
+def check_raytrace_memory(scene, size, backends, samples) -> None:
+    from renderer.core import memory
+    triangles = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is None)
+    estimate = {"gpu": memory.raytrace_gpu_bytes, "reference": memory.raytrace_reference_bytes}
+    needed = sum(estimate[backend](*size, triangles, samples=samples) for backend in backends)
+    memory.check(needed, f"ray tracing {scene.name} at {size[0]}x{size[1]}, {samples} spp "
+                         f"({triangles:,} triangles) on {' and '.join(backends)}")
+
+
+def _raytrace_gpu(scene, size, context_kind, options, frames=1):
+    from renderer.gpu.raytracer import RayTracer
+    with RayTracer(scene, *size, context_kind=context_kind, **options) as tracer:
+        timings, frame = [], None
+        for _ in range(frames):
+            frame = tracer.render()
+            timings.append(frame.milliseconds)
+        return frame, statistics.median(timings), tracer.gl_info
+
+
 def _render_gpu(scene, size, context_kind, frames=1):
     from renderer.gpu.pipeline import GpuRenderer
     with GpuRenderer(scene, *size, context_kind=context_kind) as gpu:
@@ -250,11 +304,21 @@ def cmd_render(args) -> int:
         raise UserError("--depth writes a NumPy array; name the file with .npy, e.g. depth.npy",
                         file=str(args.depth))
     check_outputs(args.output, args.depth)   # a folder, a file as parent, the same file twice
+    check_raytrace_options(args)
     scene = _load(args.scene)
-    check_memory(scene, args.size, [args.backend])
+    if args.method == "raytrace":
+        check_raytrace_memory(scene, args.size, [args.backend], args.spp)
+    else:
+        check_memory(scene, args.size, [args.backend])
     output = args.output or Path(f"{output_stem(scene)}.png")
     check_outputs(output, args.depth)
-    if args.backend == "gpu":
+    if args.method == "raytrace":
+        if args.backend == "gpu":
+            frame = _raytrace_gpu(scene, args.size, args.context, _raytrace_options(args))[0]
+        else:
+            from reference.raytrace.pipeline import render as reference_raytrace
+            frame = reference_raytrace(scene, *args.size, **_raytrace_options(args))
+    elif args.backend == "gpu":
         frame = _render_gpu(scene, args.size, args.context)[0]
     else:
         import reference
@@ -266,7 +330,8 @@ def cmd_render(args) -> int:
             out.npy(args.depth, frame.depth)
     if not args.quiet:
         written = f"{output} and {args.depth}" if args.depth else f"{output}"
-        print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {args.backend}, "
+        method = "" if args.method == "raster" else f"raytrace {args.spp} spp, "
+        print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {method}{args.backend}, "
               f"{frame.milliseconds:.1f} ms)", file=sys.stderr)
     return 0
 
@@ -318,15 +383,26 @@ def cmd_compare(args) -> int:
     from renderer.core.jsonio import finite_or_none, to_json
     if args.out is not None:
         check_folder(args.out)
+    check_raytrace_options(args)
     scene = _load(args.scene)
-    check_memory(scene, args.size, ["gpu", "reference"])
+    if args.method == "raytrace":
+        check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)
+    else:
+        check_memory(scene, args.size, ["gpu", "reference"])
     out = check_folder(args.out or Path(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
-    gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
-    start = time.perf_counter()
-    ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
+    if args.method == "raytrace":
+        from reference.raytrace.pipeline import render as reference_raytrace
+        gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
+                                                   _raytrace_options(args), frames=3)
+        start = time.perf_counter()
+        ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args))
+    else:
+        gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
+        start = time.perf_counter()
+        ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
     reference_ms = (time.perf_counter() - start) * 1000.0
     warn_if_nothing_drawn(scene, gpu_frame)
     tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
@@ -338,7 +414,7 @@ def cmd_compare(args) -> int:
         written.png(names[1], ref_frame.rgba8)
         written.png(names[2], heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
                                        tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
-    figures = {"scene": scene.name, "size": list(args.size), **result.as_dict(),
+    figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}

@@ -16,7 +16,8 @@ RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
                   "raytrace/intersect.glsl": "reference/raytrace/intersect.py",
                   "raytrace/camera.glsl": "reference/raytrace/camera.py",
                   "raytrace/optics.glsl": "reference/raytrace/optics.py",
-                  "raytrace/bvh.glsl": "reference/raytrace/bvh.py"}
+                  "raytrace/bvh.glsl": "reference/raytrace/bvh.py",
+                  "raytrace/trace.glsl": "reference/raytrace/trace.py"}
 
 
 def write(folder, files):

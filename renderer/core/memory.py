@@ -114,6 +114,32 @@ def reference_bytes(width: int, height: int, triangles: int, *, linear: bool = F
             + triangles * REFERENCE_BYTES_PER_TRIANGLE)
 
 
+# The ray tracer (rough, from a 640x480 frame of tests/test_raytrace_trace.py's SHAPES scene,
+# about 55 MiB over a chunk of 65,536 camera rays, doubled for scenes of many triangles):
+RAYTRACE_FIXED = 128 * MIB
+RAYTRACE_BYTES_PER_PIXEL = 64                   # float colour and depth targets, read-back, rgba8
+RAYTRACE_BYTES_PER_TRIANGLE = 640               # ray_scene (float64), BVH, textures
+RAYTRACE_REFERENCE_BYTES_PER_CAMERA_RAY = 64    # windows, O, D, colour, hit, s of every sample
+RAYTRACE_REFERENCE_CHUNK_RAYS = 1 << 16         # reference/raytrace/pipeline.py, CHUNK_RAYS
+RAYTRACE_REFERENCE_WORKING_BYTES_PER_RAY = 2048
+
+
+def raytrace_gpu_bytes(width: int, height: int, triangles: int, *, samples: int = 1) -> int:
+    """The GPU ray tracer (renderer/gpu/raytracer.py): samples are looped in the shader, so
+    they cost nothing here."""
+    return RAYTRACE_FIXED + width * height * RAYTRACE_BYTES_PER_PIXEL + triangles * RAYTRACE_BYTES_PER_TRIANGLE
+
+
+def raytrace_reference_bytes(width: int, height: int, triangles: int, *, samples: int = 1) -> int:
+    """The reference ray tracer (reference/raytrace/pipeline.py): every sample's camera ray
+    held at once, traced a chunk at a time."""
+    rays = width * height * samples
+    return (RAYTRACE_FIXED + width * height * RAYTRACE_BYTES_PER_PIXEL
+            + rays * RAYTRACE_REFERENCE_BYTES_PER_CAMERA_RAY
+            + min(rays, RAYTRACE_REFERENCE_CHUNK_RAYS) * RAYTRACE_REFERENCE_WORKING_BYTES_PER_RAY
+            + triangles * RAYTRACE_BYTES_PER_TRIANGLE)
+
+
 def over_limit(needed: int) -> str | None:
     """None when `needed` bytes fit under the limit, else the end of a refusal:
     "needs about 19.1 GiB of memory, over the limit of 12.0 GiB (...)"."""

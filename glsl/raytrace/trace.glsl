@@ -1,0 +1,233 @@
+// Twin: reference/raytrace/trace.py
+// The ray tracer proper (docs/conventions.md, "Rays"): the closest hit among the analytic
+// spheres, then planes, then the scene's triangles through its BVH; Phong shading through
+// lighting.glsl (MATERIAL_VARIABLES: the hit's material; SHADOWS: a shadow ray per light); then
+// reflected (k_r + k_t F) and transmitted (k_t (1 - F)) rays, F Schlick's, to MAX_DEPTH bounces,
+// depth first through a fixed-size stack in a loop of fixed length (no recursion in GLSL).
+// Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
+// SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR.
+
+#include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
+#include "raytrace/optics.glsl"
+#ifdef MESHES
+uniform sampler2D u_nodes;           // renderer/core/bvh.py's layout
+uniform sampler2D u_triangles;
+uniform sampler2D u_triangle_data;   // per original triangle: A, B, C, (nA, object), nB, nC
+#endif
+
+#ifndef NUM_SPHERES
+#define NUM_SPHERES 0
+#endif
+#ifndef NUM_PLANES
+#define NUM_PLANES 0
+#endif
+#ifndef MAX_DEPTH
+#define MAX_DEPTH 4
+#endif
+
+#if NUM_SPHERES > 0
+uniform vec4 u_spheres[NUM_SPHERES];            // (centre, radius), camera-relative
+uniform int u_sphere_object[NUM_SPHERES];
+#endif
+#if NUM_PLANES > 0
+uniform vec4 u_planes[NUM_PLANES];              // (unit N, d): P.N + d = 0
+uniform int u_plane_object[NUM_PLANES];
+#endif
+uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, 0), (kt, 0)
+uniform vec3 u_background;
+
+#include "lighting.glsl"
+
+const int TRACE_MISS = 0;
+const int TRACE_SPHERE = 1;
+const int TRACE_PLANE = 2;
+const int TRACE_TRIANGLE = 3;
+const float TRACE_INF = uintBitsToFloat(0x7f800000u);
+
+vec4 trace_texel(sampler2D texture_, int k) {
+    int width = textureSize(texture_, 0).x;
+    return texelFetch(texture_, ivec2(k % width, k / width), 0);
+}
+
+// The nearest hit with s_min < s < s_max: its kind (TRACE_MISS on a miss), the sphere's,
+// plane's or original triangle's index, s (s_max on a miss) and the triangle's (u, v).
+int scene_hit(vec3 O, vec3 D, float s_min, float s_max, out int index, out float s, out vec2 uv) {
+    s = s_max;
+    index = -1;
+    uv = vec2(0.0);
+    int kind = TRACE_MISS;
+    float s_k;
+#if NUM_SPHERES > 0
+    for (int k = 0; k < NUM_SPHERES; ++k) {
+        if (ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, s_min, s, s_k)) {
+            s = s_k; kind = TRACE_SPHERE; index = k;
+        }
+    }
+#endif
+#if NUM_PLANES > 0
+    for (int k = 0; k < NUM_PLANES; ++k) {
+        if (ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s, s_k)) {
+            s = s_k; kind = TRACE_PLANE; index = k;
+        }
+    }
+#endif
+#ifdef MESHES
+    vec2 uv_t;
+    int triangle;
+    if (bvh_closest_hit(u_nodes, u_triangles, O, D, s_min, s, s_k, uv_t, triangle)) {
+        s = s_k; kind = TRACE_TRIANGLE; index = triangle; uv = uv_t;
+    }
+#endif
+    return kind;
+}
+
+// The hit point, the outward geometric and shading unit normals, the object.
+void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
+             out vec3 P, out vec3 Ng, out vec3 Ns, out int obj) {
+    P = O + s * D;
+    Ng = vec3(0.0);
+    Ns = vec3(0.0);
+    obj = 0;
+#if NUM_SPHERES > 0
+    if (kind == TRACE_SPHERE) {
+        Ng = sphere_normal(P, u_spheres[index].xyz, u_spheres[index].w);
+        Ns = Ng;
+        obj = u_sphere_object[index];
+    }
+#endif
+#if NUM_PLANES > 0
+    if (kind == TRACE_PLANE) {
+        Ng = plane_normal(u_planes[index].xyz);
+        Ns = Ng;
+        obj = u_plane_object[index];
+    }
+#endif
+#ifdef MESHES
+    if (kind == TRACE_TRIANGLE) {
+        vec3 A = trace_texel(u_triangle_data, 6 * index).xyz;
+        vec3 B = trace_texel(u_triangle_data, 6 * index + 1).xyz;
+        vec3 C = trace_texel(u_triangle_data, 6 * index + 2).xyz;
+        Ng = triangle_normal(A, B, C);
+        vec4 nA = trace_texel(u_triangle_data, 6 * index + 3);
+        vec3 nB = trace_texel(u_triangle_data, 6 * index + 4).xyz;
+        vec3 nC = trace_texel(u_triangle_data, 6 * index + 5).xyz;
+        Ns = normalize_or_zero((1.0 - uv.x - uv.y) * nA.xyz + uv.x * nB + uv.y * nC);
+        obj = int(nA.w);
+    }
+#endif
+}
+
+bool occluded(vec3 O, vec3 D, float s_max) {
+    int index;
+    float s;
+    vec2 uv;
+    return scene_hit(O, D, 0.0, s_max, index, s, uv) != TRACE_MISS;
+}
+
+vec3 g_geometric_normal;             // the outward Ng of the point being lit
+
+#if NUM_DIRECTIONAL_LIGHTS > 0
+float light_visibility_directional(int i, vec3 P, vec3 N) {
+    vec3 L = normalize(-u_directional_direction[i]);
+    vec3 n = dot(g_geometric_normal, L) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
+    return occluded(offset_ray_origin(P, n), L, TRACE_INF) ? 0.0 : 1.0;
+}
+#endif
+#if NUM_POINT_LIGHTS > 0
+float light_visibility_point(int i, vec3 P, vec3 N) {
+    vec3 Q = u_point_position[i];
+    vec3 n = dot(g_geometric_normal, Q - P) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
+    vec3 O = offset_ray_origin(P, n);
+    vec3 to_light = Q - O;
+    float d = sqrt(dot(to_light, to_light));
+    return (d > 0.0 && occluded(O, to_light / d, d)) ? 0.0 : 1.0;
+}
+#endif
+
+#define TRACE_STACK (MAX_DEPTH + 2)
+#define TRACE_MAX_RAYS ((2 << MAX_DEPTH) - 1)
+
+// The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
+// from 0 to infinity); hit and s: the first ray's hit.
+vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s_hit) {
+    vec3 colour = vec3(0.0);
+    vec3 stack_O[TRACE_STACK];
+    vec3 stack_D[TRACE_STACK];
+    vec3 stack_w[TRACE_STACK];
+    int stack_depth[TRACE_STACK];
+    stack_O[0] = O0;
+    stack_D[0] = D0;
+    stack_w[0] = vec3(1.0);
+    stack_depth[0] = 0;
+    int top = 1;
+    hit = false;
+    s_hit = s_max;
+    for (int k = 0; k < TRACE_MAX_RAYS; ++k) {
+        if (top == 0) break;
+        --top;
+        vec3 O = stack_O[top];
+        vec3 D = stack_D[top];
+        vec3 w = stack_w[top];
+        int depth = stack_depth[top];
+        int index;
+        float s;
+        vec2 uv;
+        int kind = scene_hit(O, D, depth == 0 ? s_min : 0.0, depth == 0 ? s_max : TRACE_INF,
+                             index, s, uv);
+        if (depth == 0) {
+            hit = kind != TRACE_MISS;
+            s_hit = s;
+        }
+        if (kind == TRACE_MISS) {
+            colour += w * u_background;
+            continue;
+        }
+        vec3 P, Ng, Ns;
+        int obj;
+        surface(O, D, kind, index, s, uv, P, Ng, Ns, obj);
+        vec3 Du = normalize(D);
+        bool back = dot(Du, Ng) > 0.0;
+        vec4 m0 = trace_texel(u_materials, 5 * obj);
+        vec4 m1 = trace_texel(u_materials, 5 * obj + 1);
+        vec4 m2 = trace_texel(u_materials, 5 * obj + 2);
+        u_ka = m0.xyz;
+        u_kd = m1.xyz;
+#ifdef SPECULAR
+        u_ks = m2.xyz;
+        u_n = m0.w;
+        u_eye = O;
+#endif
+        vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
+        g_geometric_normal = Ng;
+        colour += w * lighting(P, N);
+#ifdef SECONDARY
+        if (depth < MAX_DEPTH) {
+            vec3 kr = trace_texel(u_materials, 5 * obj + 3).xyz;
+            vec3 kt = trace_texel(u_materials, 5 * obj + 4).xyz;
+            vec3 N_in = back ? -Ns : Ns;
+            vec3 Ng_in = back ? -Ng : Ng;
+            float eta = back ? m2.w : 1.0 / m2.w;
+            float F = fresnel_schlick(Du, N_in, eta);
+            vec3 w_r = w * (kr + kt * F);
+            vec3 w_t = w * (kt * (1.0 - F));
+            vec3 T;
+            bool refracted = ray_refract(Du, N_in, eta, T);
+            if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
+                stack_O[top] = offset_ray_origin(P, -Ng_in);
+                stack_D[top] = T;
+                stack_w[top] = w_t;
+                stack_depth[top] = depth + 1;
+                ++top;
+            }
+            if (any(greaterThan(w_r, vec3(0.0)))) {
+                stack_O[top] = offset_ray_origin(P, Ng_in);
+                stack_D[top] = ray_reflect(Du, N_in);
+                stack_w[top] = w_r;
+                stack_depth[top] = depth + 1;
+                ++top;
+            }
+        }
+#endif
+    }
+    return colour;
+}

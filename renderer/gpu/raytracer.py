@@ -1,0 +1,188 @@
+"""The GPU ray tracer (glsl/raytrace/raytrace.frag and trace.glsl; twin: reference/raytrace/
+pipeline.py): one full-screen pass that traces every sample of every pixel (the samples looped
+in the shader), into a float colour target (average linear colour, coverage) and a float depth
+target (the view depth of the nearest first hit), read back row 0 at the top; rgba8 is
+gl_rules.to_unorm8 of the clamped linear colour, alpha 255 where a camera ray hit.
+
+GL resources are made once in the constructor: the program, specialised by #defines for what
+the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, NUM_SAMPLES);
+the uniforms (camera rays from renderer/core/camera_rays.py, lights from renderer/core/
+uniforms.py, shapes, sample offsets); the materials, the BVH (renderer/gpu/bvh.py) and the
+triangles' vertices and normals as float textures.
+"""
+
+from __future__ import annotations
+
+import time
+
+import moderngl
+import numpy as np
+
+from renderer.core.bvh import texels
+from renderer.core.camera_rays import camera_ray_uniforms
+from renderer.core.frame import Frame
+from renderer.core.gl_rules import check_light_count, to_unorm8
+from renderer.core.raytrace_scene import ray_scene
+from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
+from renderer.core.scene import Scene
+from renderer.core.transforms import to_glsl
+from renderer.core.uniforms import light_uniforms
+from renderer.gpu.bvh import bvh_textures
+from renderer.gpu.context import activate, context_kind, make_context, release_context
+from renderer.gpu.shaders import shader_source
+
+DEFAULT_MAX_DEPTH = 4
+MAX_SAMPLES = 256
+
+
+def _texture(ctx, array):
+    data = texels(array)
+    texture = ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(), dtype="f4")
+    texture.filter = (ctx.NEAREST, ctx.NEAREST)
+    texture.repeat_x = texture.repeat_y = False
+    return texture
+
+
+class RayTracer:
+    """Ray traces one scene at one size; see the module docstring."""
+
+    def __init__(self, scene: Scene, width: int, height: int, *,
+                 context: moderngl.Context | None = None, context_kind: str = "auto",
+                 samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
+                 seed: int = DEFAULT_SEED, shadows: bool = True):
+        if int(width) < 1 or int(height) < 1:
+            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        if not 1 <= int(samples) <= MAX_SAMPLES:
+            raise ValueError(f"samples must be between 1 and {MAX_SAMPLES}, got {samples}")
+        if not 0 <= int(max_depth) <= 16:
+            raise ValueError(f"max_depth must be between 0 and 16, got {max_depth}")
+        check_light_count(scene)
+        self.scene = scene
+        self.width, self.height = int(width), int(height)
+        self.offsets = np.asarray(sample_pattern(pattern, int(samples), seed), np.float32)
+        self.max_depth = int(max_depth)
+        self.shadows = bool(shadows)
+        self._owns_context = context is None
+        self.ctx = make_context(context_kind) if context is None else context
+        self._resources: list = []
+        self._released = False
+        try:
+            activate(self.ctx)
+            self._build()
+        except BaseException:
+            self.release()
+            raise
+
+    def _build(self) -> None:
+        ctx, scene = self.ctx, self.scene
+        rs = self.ray_scene = ray_scene(scene)
+        self.defines = {
+            "NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
+            "NUM_POINT_LIGHTS": len(scene.point_lights),
+            "SPECULAR": rs.specular,
+            "SHADOWS": self.shadows and bool(scene.directional_lights or scene.point_lights),
+            "MATERIAL_VARIABLES": True,
+            "NUM_SPHERES": len(rs.sphere_radius),
+            "NUM_PLANES": len(rs.plane_offset),
+            "MESHES": rs.bvh is not None,
+            "SECONDARY": rs.secondary and self.max_depth > 0,
+            "MAX_DEPTH": self.max_depth,
+            "NUM_SAMPLES": len(self.offsets),
+        }
+        self.program = ctx.program(
+            vertex_shader=shader_source("raytrace/fullscreen.vert").text,
+            fragment_shader=shader_source("raytrace/raytrace.frag", self.defines).text)
+        self._resources.append(self.program)
+        program = self.program
+        matrices = scene.matrices(self.width, self.height)
+        rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
+        values = {name: to_glsl(value) for name, value in rays.items()}
+        for name, value in light_uniforms(scene, matrices.origin).items():
+            if value.size:
+                values[name] = np.asarray(value, np.float32).tobytes()
+        values["u_background"] = np.asarray(scene.background, np.float32).tobytes()
+        values["u_near"] = np.float32(scene.camera.near).tobytes()
+        values["u_far"] = np.float32(scene.camera.far).tobytes()
+        values["u_sample_offsets"] = self.offsets.tobytes()
+        if len(rs.sphere_radius):
+            values["u_spheres"] = np.concatenate([rs.sphere_centre, rs.sphere_radius[:, None]], 1).astype(np.float32).tobytes()
+            values["u_sphere_object"] = rs.sphere_object.astype(np.int32).tobytes()
+        if len(rs.plane_offset):
+            values["u_planes"] = np.concatenate([rs.plane_normal, rs.plane_offset[:, None]], 1).astype(np.float32).tobytes()
+            values["u_plane_object"] = rs.plane_object.astype(np.int32).tobytes()
+        for name, value in values.items():
+            if name in program:
+                program[name].write(value)
+        zero = np.zeros((len(rs.n), 1))
+        materials = np.stack([np.concatenate(part, 1) for part in (
+            (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
+            (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
+        textures = {"u_materials": _texture(ctx, materials)}
+        if rs.bvh is not None:
+            textures["u_nodes"], textures["u_triangles"] = bvh_textures(ctx, rs.bvh)
+            T = len(rs.triangles)
+            data = np.zeros((T, 6, 4))
+            data[:, :3, :3] = rs.triangles
+            data[:, 3:, :3] = rs.triangle_normals
+            data[:, 3, 3] = rs.triangle_object
+            textures["u_triangle_data"] = _texture(ctx, data)
+        self._textures = []
+        for unit, (name, texture) in enumerate(textures.items()):
+            self._resources.append(texture)
+            self._textures.append((unit, texture))
+            if name in program:
+                program[name].value = unit
+        self._colour = ctx.texture((self.width, self.height), 4, dtype="f4")
+        self._depth = ctx.texture((self.width, self.height), 1, dtype="f4")
+        self._fbo = ctx.framebuffer([self._colour, self._depth])
+        self._vao = ctx.vertex_array(program, [])
+        self._resources += [self._colour, self._depth, self._fbo, self._vao]
+        self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
+                         "GL_VERSION": ctx.info["GL_VERSION"],
+                         "context": context_kind(ctx)}
+
+    @property
+    def gl_info(self) -> dict:
+        return dict(self._gl_info)
+
+    def render(self) -> Frame:
+        """Trace the frame: rgba8, linear (average linear colour, alpha the coverage) and
+        depth, row 0 at the top."""
+        if self._released:
+            raise RuntimeError("this RayTracer was released")
+        start = time.perf_counter()
+        activate(self.ctx)
+        for unit, texture in self._textures:
+            texture.use(unit)
+        self._fbo.use()
+        self.ctx.viewport = (0, 0, self.width, self.height)
+        self._vao.render(vertices=3)
+        h, w = self.height, self.width
+        linear = np.frombuffer(self._fbo.read(components=4, attachment=0, dtype="f4"), np.float32).reshape(h, w, 4)
+        depth = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="f4"), np.float32).reshape(h, w)
+        linear = np.ascontiguousarray(linear[::-1])
+        depth = np.ascontiguousarray(depth[::-1])
+        rgba8 = to_unorm8(linear)
+        rgba8[..., 3] = np.where(linear[..., 3] > 0, 255, 0)
+        return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info)
+
+    def release(self) -> None:
+        """Free every GL object; the context too if this tracer made it. Idempotent."""
+        if self._released:
+            return
+        self._released = True
+        try:
+            activate(self.ctx)
+            for thing in reversed(self._resources):
+                thing.release()
+        finally:
+            self._resources = []
+            if self._owns_context:
+                release_context(self.ctx)
+
+    def __enter__(self) -> "RayTracer":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.release()

@@ -117,11 +117,26 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
 #endif
 }
 
+// Whether anything is hit with 0 < s < s_max (a shadow ray): the first hit found answers (any
+// hit, not the nearest: the analytic shapes first, the BVH only if none of them is hit).
 bool occluded(vec3 O, vec3 D, float s_max) {
-    int index;
-    float s;
-    vec2 uv;
-    return scene_hit(O, D, 0.0, s_max, index, s, uv) != TRACE_MISS;
+    float s_k;
+#if NUM_SPHERES > 0
+    for (int k = 0; k < NUM_SPHERES; ++k) {
+        if (ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, 0.0, s_max, s_k)) return true;
+    }
+#endif
+#if NUM_PLANES > 0
+    for (int k = 0; k < NUM_PLANES; ++k) {
+        if (ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, 0.0, s_max, s_k)) return true;
+    }
+#endif
+#ifdef MESHES
+    vec2 uv_t;
+    int triangle;
+    if (bvh_closest_hit(u_nodes, u_triangles, O, D, 0.0, s_max, s_k, uv_t, triangle)) return true;
+#endif
+    return false;
 }
 
 vec3 g_geometric_normal;             // the outward Ng of the point being lit

@@ -177,8 +177,10 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
     int top = 1;
     hit = false;
     s_hit = s_max;
+    // The stack's emptiness is tested at the end of the body, not at the top, and no
+    // `continue`: llvmpipe runs a loop's body with lanes masked off until every lane of its
+    // SIMD group has left, so a test at the top costs one more whole body, masked, per group.
     for (int k = 0; k < TRACE_MAX_RAYS; ++k) {
-        if (top == 0) break;
         --top;
         vec3 O = stack_O[top];
         vec3 D = stack_D[top];
@@ -195,54 +197,55 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
         }
         if (kind == TRACE_MISS) {
             colour += w * u_background;
-            continue;
-        }
-        vec3 P, Ng, Ns;
-        int obj;
-        surface(O, D, kind, index, s, uv, P, Ng, Ns, obj);
-        vec3 Du = normalize(D);
-        bool back = dot(Du, Ng) > 0.0;
-        vec4 m0 = trace_texel(u_materials, 5 * obj);
-        vec4 m1 = trace_texel(u_materials, 5 * obj + 1);
-        vec4 m2 = trace_texel(u_materials, 5 * obj + 2);
-        u_ka = m0.xyz;
-        u_kd = m1.xyz;
+        } else {
+            vec3 P, Ng, Ns;
+            int obj;
+            surface(O, D, kind, index, s, uv, P, Ng, Ns, obj);
+            vec3 Du = normalize(D);
+            bool back = dot(Du, Ng) > 0.0;
+            vec4 m0 = trace_texel(u_materials, 5 * obj);
+            vec4 m1 = trace_texel(u_materials, 5 * obj + 1);
+            vec4 m2 = trace_texel(u_materials, 5 * obj + 2);
+            u_ka = m0.xyz;
+            u_kd = m1.xyz;
 #ifdef SPECULAR
-        u_ks = m2.xyz;
-        u_n = m0.w;
-        u_eye = O;
+            u_ks = m2.xyz;
+            u_n = m0.w;
+            u_eye = O;
 #endif
-        vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
-        g_geometric_normal = Ng;
-        colour += w * lighting(P, N);
+            vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
+            g_geometric_normal = Ng;
+            colour += w * lighting(P, N);
 #ifdef SECONDARY
-        if (depth < MAX_DEPTH) {
-            vec3 kr = trace_texel(u_materials, 5 * obj + 3).xyz;
-            vec3 kt = trace_texel(u_materials, 5 * obj + 4).xyz;
-            vec3 N_in = back ? -Ns : Ns;
-            vec3 Ng_in = back ? -Ng : Ng;
-            float eta = back ? m2.w : 1.0 / m2.w;
-            float F = fresnel_schlick(Du, N_in, eta);
-            vec3 w_r = w * (kr + kt * F);
-            vec3 w_t = w * (kt * (1.0 - F));
-            vec3 T;
-            bool refracted = ray_refract(Du, N_in, eta, T);
-            if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
-                stack_O[top] = offset_ray_origin(P, -Ng_in);
-                stack_D[top] = T;
-                stack_w[top] = w_t;
-                stack_depth[top] = depth + 1;
-                ++top;
+            if (depth < MAX_DEPTH) {
+                vec3 kr = trace_texel(u_materials, 5 * obj + 3).xyz;
+                vec3 kt = trace_texel(u_materials, 5 * obj + 4).xyz;
+                vec3 N_in = back ? -Ns : Ns;
+                vec3 Ng_in = back ? -Ng : Ng;
+                float eta = back ? m2.w : 1.0 / m2.w;
+                float F = fresnel_schlick(Du, N_in, eta);
+                vec3 w_r = w * (kr + kt * F);
+                vec3 w_t = w * (kt * (1.0 - F));
+                vec3 T;
+                bool refracted = ray_refract(Du, N_in, eta, T);
+                if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
+                    stack_O[top] = offset_ray_origin(P, -Ng_in);
+                    stack_D[top] = T;
+                    stack_w[top] = w_t;
+                    stack_depth[top] = depth + 1;
+                    ++top;
+                }
+                if (any(greaterThan(w_r, vec3(0.0)))) {
+                    stack_O[top] = offset_ray_origin(P, Ng_in);
+                    stack_D[top] = ray_reflect(Du, N_in);
+                    stack_w[top] = w_r;
+                    stack_depth[top] = depth + 1;
+                    ++top;
+                }
             }
-            if (any(greaterThan(w_r, vec3(0.0)))) {
-                stack_O[top] = offset_ray_origin(P, Ng_in);
-                stack_D[top] = ray_reflect(Du, N_in);
-                stack_w[top] = w_r;
-                stack_depth[top] = depth + 1;
-                ++top;
-            }
-        }
 #endif
+        }
+        if (top == 0) break;
     }
     return colour;
 }

@@ -219,7 +219,6 @@ def test_the_classic_scene_loads_and_the_twins_agree_on_it(gl_contexts):
         frame = tracer.render()
         assert tracer.defines["SECONDARY"] and not tracer.defines["MESHES"]
     assert_within_tolerance(frame, reference)
-    with RayTracer(s, 32, 24, context=gl_contexts["egl"]) as fast, \
-            RayTracer(s, 32, 24, context=gl_contexts["egl"], specialise=False) as every:
+    with RayTracer(s, 64, 48, context=gl_contexts["egl"], specialise=False) as every:
         assert every.defines["MESHES"]                  # a placeholder BVH no ray hits
-        assert np.array_equal(fast.render().linear, every.render().linear)
+        assert np.array_equal(every.render().linear, frame.linear)

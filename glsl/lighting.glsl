@@ -13,6 +13,8 @@
 //   SHADOWS: each light's diffuse and specular terms are multiplied by its visibility, 0 or 1,
 //     from light_visibility_directional(i, P, N) / light_visibility_point(i, P, N), which the
 //     including shader defines (shadow rays); a point in shadow keeps only the ambient term.
+//     A light whose terms are 0 at P (behind the surface, or a material with k_d = k_s = 0)
+//     casts no shadow ray: its visibility could change nothing.
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
 #define NUM_DIRECTIONAL_LIGHTS 0
@@ -107,8 +109,10 @@ vec3 lighting(vec3 P, vec3 N) {
     for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
         vec3 L = normalize(-u_directional_direction[i]);
 #ifdef SHADOWS
-        I += light_visibility_directional(i, P, N)
-             * light_contribution(N, L, V, u_directional_intensity[i]);
+        vec3 term = light_contribution(N, L, V, u_directional_intensity[i]);
+        if (term != vec3(0.0)) {                     // no shadow ray for a light that adds 0
+            I += light_visibility_directional(i, P, N) * term;
+        }
 #else
         I += light_contribution(N, L, V, u_directional_intensity[i]);       // att = 1
 #endif
@@ -122,7 +126,10 @@ vec3 lighting(vec3 P, vec3 N) {
         vec3 c_l_q = u_point_attenuation[i];
         float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
 #ifdef SHADOWS
-        I += light_visibility_point(i, P, N) * light_contribution(N, L, V, att * u_point_intensity[i]);
+        vec3 term = light_contribution(N, L, V, att * u_point_intensity[i]);
+        if (term != vec3(0.0)) {
+            I += light_visibility_point(i, P, N) * term;
+        }
 #else
         I += light_contribution(N, L, V, att * u_point_intensity[i]);
 #endif

@@ -125,9 +125,11 @@ def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUnif
 
     `visibility` (the shader's SHADOWS; the ray tracer's shadow rays): None lights every point
     by every light (the rasteriser's path, unchanged), else a callable
-    visibility(kind, i, P, N) -> (..., 1) 0 or 1 per point for light i of kind "directional"
-    or "point", which multiplies that light's diffuse and specular terms (the GLSL's
-    light_visibility_directional / light_visibility_point): in shadow, ambient only.
+    visibility(kind, i, P, N, needed) -> (..., 1) 0 or 1 per point for light i of kind
+    "directional" or "point", which multiplies that light's diffuse and specular terms (the
+    GLSL's light_visibility_directional / light_visibility_point): in shadow, ambient only.
+    `needed` (...,) is where the light's terms are not 0: elsewhere visibility can change
+    nothing, and the GLSL casts no shadow ray (the callable may answer anything there).
     E and the material's arrays may vary per point (broadcast against P)."""
     V = normalize_or_zero(E - P)
     I = np.broadcast_to(lights.u_ambient * material.u_ka, np.broadcast_shapes(P.shape, N.shape))
@@ -136,10 +138,10 @@ def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUnif
                                                    lights.u_directional_intensity)):
         L = directional_light_vector(direction)
         term = light_contribution(N, L, V, 1.0, intensity, material)
-        I += term if visibility is None else visibility("directional", i, P, N) * term
+        I += term if visibility is None else visibility("directional", i, P, N, (term != 0).any(-1)) * term
     for i, (position, intensity, attenuation) in enumerate(zip(
             lights.u_point_position, lights.u_point_intensity, lights.u_point_attenuation)):
         L, att = point_light_vector(P, N, position, attenuation)
         term = light_contribution(N, L, V, att, intensity, material)
-        I += term if visibility is None else visibility("point", i, P, N) * term
+        I += term if visibility is None else visibility("point", i, P, N, (term != 0).any(-1)) * term
     return I

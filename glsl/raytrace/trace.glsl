@@ -117,11 +117,26 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
 #endif
 }
 
+// Whether anything is hit with 0 < s < s_max (a shadow ray): the first hit found answers (any
+// hit, not the nearest: the analytic shapes first, the BVH only if none of them is hit).
 bool occluded(vec3 O, vec3 D, float s_max) {
-    int index;
-    float s;
-    vec2 uv;
-    return scene_hit(O, D, 0.0, s_max, index, s, uv) != TRACE_MISS;
+    float s_k;
+#if NUM_SPHERES > 0
+    for (int k = 0; k < NUM_SPHERES; ++k) {
+        if (ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, 0.0, s_max, s_k)) return true;
+    }
+#endif
+#if NUM_PLANES > 0
+    for (int k = 0; k < NUM_PLANES; ++k) {
+        if (ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, 0.0, s_max, s_k)) return true;
+    }
+#endif
+#ifdef MESHES
+    vec2 uv_t;
+    int triangle;
+    if (bvh_closest_hit(u_nodes, u_triangles, O, D, 0.0, s_max, s_k, uv_t, triangle)) return true;
+#endif
+    return false;
 }
 
 vec3 g_geometric_normal;             // the outward Ng of the point being lit
@@ -162,8 +177,10 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
     int top = 1;
     hit = false;
     s_hit = s_max;
+    // The stack's emptiness is tested at the end of the body, not at the top, and no
+    // `continue`: llvmpipe runs a loop's body with lanes masked off until every lane of its
+    // SIMD group has left, so a test at the top costs one more whole body, masked, per group.
     for (int k = 0; k < TRACE_MAX_RAYS; ++k) {
-        if (top == 0) break;
         --top;
         vec3 O = stack_O[top];
         vec3 D = stack_D[top];
@@ -180,54 +197,55 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
         }
         if (kind == TRACE_MISS) {
             colour += w * u_background;
-            continue;
-        }
-        vec3 P, Ng, Ns;
-        int obj;
-        surface(O, D, kind, index, s, uv, P, Ng, Ns, obj);
-        vec3 Du = normalize(D);
-        bool back = dot(Du, Ng) > 0.0;
-        vec4 m0 = trace_texel(u_materials, 5 * obj);
-        vec4 m1 = trace_texel(u_materials, 5 * obj + 1);
-        vec4 m2 = trace_texel(u_materials, 5 * obj + 2);
-        u_ka = m0.xyz;
-        u_kd = m1.xyz;
+        } else {
+            vec3 P, Ng, Ns;
+            int obj;
+            surface(O, D, kind, index, s, uv, P, Ng, Ns, obj);
+            vec3 Du = normalize(D);
+            bool back = dot(Du, Ng) > 0.0;
+            vec4 m0 = trace_texel(u_materials, 5 * obj);
+            vec4 m1 = trace_texel(u_materials, 5 * obj + 1);
+            vec4 m2 = trace_texel(u_materials, 5 * obj + 2);
+            u_ka = m0.xyz;
+            u_kd = m1.xyz;
 #ifdef SPECULAR
-        u_ks = m2.xyz;
-        u_n = m0.w;
-        u_eye = O;
+            u_ks = m2.xyz;
+            u_n = m0.w;
+            u_eye = O;
 #endif
-        vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
-        g_geometric_normal = Ng;
-        colour += w * lighting(P, N);
+            vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
+            g_geometric_normal = Ng;
+            colour += w * lighting(P, N);
 #ifdef SECONDARY
-        if (depth < MAX_DEPTH) {
-            vec3 kr = trace_texel(u_materials, 5 * obj + 3).xyz;
-            vec3 kt = trace_texel(u_materials, 5 * obj + 4).xyz;
-            vec3 N_in = back ? -Ns : Ns;
-            vec3 Ng_in = back ? -Ng : Ng;
-            float eta = back ? m2.w : 1.0 / m2.w;
-            float F = fresnel_schlick(Du, N_in, eta);
-            vec3 w_r = w * (kr + kt * F);
-            vec3 w_t = w * (kt * (1.0 - F));
-            vec3 T;
-            bool refracted = ray_refract(Du, N_in, eta, T);
-            if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
-                stack_O[top] = offset_ray_origin(P, -Ng_in);
-                stack_D[top] = T;
-                stack_w[top] = w_t;
-                stack_depth[top] = depth + 1;
-                ++top;
+            if (depth < MAX_DEPTH) {
+                vec3 kr = trace_texel(u_materials, 5 * obj + 3).xyz;
+                vec3 kt = trace_texel(u_materials, 5 * obj + 4).xyz;
+                vec3 N_in = back ? -Ns : Ns;
+                vec3 Ng_in = back ? -Ng : Ng;
+                float eta = back ? m2.w : 1.0 / m2.w;
+                float F = fresnel_schlick(Du, N_in, eta);
+                vec3 w_r = w * (kr + kt * F);
+                vec3 w_t = w * (kt * (1.0 - F));
+                vec3 T;
+                bool refracted = ray_refract(Du, N_in, eta, T);
+                if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
+                    stack_O[top] = offset_ray_origin(P, -Ng_in);
+                    stack_D[top] = T;
+                    stack_w[top] = w_t;
+                    stack_depth[top] = depth + 1;
+                    ++top;
+                }
+                if (any(greaterThan(w_r, vec3(0.0)))) {
+                    stack_O[top] = offset_ray_origin(P, Ng_in);
+                    stack_D[top] = ray_reflect(Du, N_in);
+                    stack_w[top] = w_r;
+                    stack_depth[top] = depth + 1;
+                    ++top;
+                }
             }
-            if (any(greaterThan(w_r, vec3(0.0)))) {
-                stack_O[top] = offset_ray_origin(P, Ng_in);
-                stack_D[top] = ray_reflect(Du, N_in);
-                stack_w[top] = w_r;
-                stack_depth[top] = depth + 1;
-                ++top;
-            }
-        }
 #endif
+        }
+        if (top == 0) break;
     }
     return colour;
 }

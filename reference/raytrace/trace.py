@@ -14,7 +14,8 @@ over pixels or rays.
   -Ns where the back is seen (D.Ng > 0) of a two-sided material; a shadow ray per light from
   offset_ray_origin(P, Ng on the light's side): directional, towards L with s_max = inf; point,
   towards the light, unit direction, s_max = the distance. Any hit is a shadow (every surface
-  is opaque to shadow rays); in shadow a light adds nothing but its ambient share;
+  is opaque to shadow rays); in shadow a light adds nothing but its ambient share; a light
+  whose terms are 0 at P (behind it; k_d = k_s = 0) casts no shadow ray, as the GLSL;
 - secondary rays (depth < max_depth): with Du = normalize(D), N and Ng flipped to the incoming
   side, eta = 1/ior entering (front seen), ior leaving, F = fresnel_schlick(Du, N, eta):
   reflected weight k_r + k_t F along ray_reflect(Du, N) from offset_ray_origin(P, Ng);
@@ -109,21 +110,23 @@ def materials(rs, obj, specular: bool) -> MaterialUniforms:
 def shadow_visibility(rs, lights: Lights, Ng):
     """The visibility callable of lighting.py for hits with outward geometric normals Ng: one
     shadow ray per point and light (the GLSL's light_visibility_directional / _point)."""
-    def visibility(kind, i, P, N):
+    def visibility(kind, i, P, N, needed):
+        blocked = np.zeros(len(P), bool)
+        P, n = P[needed], Ng[needed]
         if kind == "directional":
             L = normalize(-lights.u_directional_direction[i])
-            n = np.where((_dot(Ng, L) >= 0)[:, None], Ng, -Ng)
+            n = np.where((_dot(n, L) >= 0)[:, None], n, -n)
             O = offset_ray_origin(P, n)
-            blocked = occluded(rs, O, np.broadcast_to(L, O.shape).astype(F32), F32(np.inf))
+            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(F32), F32(np.inf))
         else:
             Q = lights.u_point_position[i]
-            n = np.where((_dot(Ng, Q - P) >= 0)[:, None], Ng, -Ng)
+            n = np.where((_dot(n, Q - P) >= 0)[:, None], n, -n)
             O = offset_ray_origin(P, n)
             to_light = Q - O
             d = np.sqrt(_dot(to_light, to_light))
             with np.errstate(divide="ignore", invalid="ignore"):
                 L = to_light / d[:, None]
-            blocked = occluded(rs, O, L, d) & (d > 0)
+            blocked[needed] = occluded(rs, O, L, d) & (d > 0)
         return np.where(blocked, F32(0), F32(1))[:, None]
     return visibility
 

@@ -10,6 +10,12 @@ MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, 
 the uniforms (camera rays from renderer/core/camera_rays.py, lights from renderer/core/
 uniforms.py, shapes, sample offsets); the materials, the BVH (renderer/gpu/bvh.py) and the
 triangles' vertices and normals as float textures.
+
+`specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
+every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
+`shadows`), SECONDARY (where max_depth > 0) and MESHES (the BVH walk; a scene without triangles
+gets a one-triangle BVH of a degenerate triangle, which no ray hits). The light, sphere and
+plane counts stay compile-time constants. The image is the same.
 """
 
 from __future__ import annotations
@@ -19,7 +25,7 @@ import time
 import moderngl
 import numpy as np
 
-from renderer.core.bvh import texels
+from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import check_light_count, to_unorm8
@@ -50,7 +56,7 @@ class RayTracer:
     def __init__(self, scene: Scene, width: int, height: int, *,
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
-                 seed: int = DEFAULT_SEED, shadows: bool = True):
+                 seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True):
         if int(width) < 1 or int(height) < 1:
             raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
         if not 1 <= int(samples) <= MAX_SAMPLES:
@@ -63,6 +69,7 @@ class RayTracer:
         self.offsets = np.asarray(sample_pattern(pattern, int(samples), seed), np.float32)
         self.max_depth = int(max_depth)
         self.shadows = bool(shadows)
+        self.specialise = bool(specialise)
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._resources: list = []
@@ -77,16 +84,17 @@ class RayTracer:
     def _build(self) -> None:
         ctx, scene = self.ctx, self.scene
         rs = self.ray_scene = ray_scene(scene)
+        every = not self.specialise
         self.defines = {
             "NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
             "NUM_POINT_LIGHTS": len(scene.point_lights),
-            "SPECULAR": rs.specular,
+            "SPECULAR": rs.specular or every,
             "SHADOWS": self.shadows and bool(scene.directional_lights or scene.point_lights),
             "MATERIAL_VARIABLES": True,
             "NUM_SPHERES": len(rs.sphere_radius),
             "NUM_PLANES": len(rs.plane_offset),
-            "MESHES": rs.bvh is not None,
-            "SECONDARY": rs.secondary and self.max_depth > 0,
+            "MESHES": rs.bvh is not None or every,
+            "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
             "NUM_SAMPLES": len(self.offsets),
         }
@@ -119,13 +127,17 @@ class RayTracer:
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
             (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
         textures = {"u_materials": _texture(ctx, materials)}
-        if rs.bvh is not None:
-            textures["u_nodes"], textures["u_triangles"] = bvh_textures(ctx, rs.bvh)
-            T = len(rs.triangles)
-            data = np.zeros((T, 6, 4))
-            data[:, :3, :3] = rs.triangles
-            data[:, 3:, :3] = rs.triangle_normals
-            data[:, 3, 3] = rs.triangle_object
+        if self.defines["MESHES"]:
+            triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object
+            bvh = rs.bvh
+            if bvh is None:                           # all features, no triangles: a placeholder
+                triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
+                bvh = build_bvh(triangles)
+            textures["u_nodes"], textures["u_triangles"] = bvh_textures(ctx, bvh)
+            data = np.zeros((len(triangles), 6, 4))
+            data[:, :3, :3] = triangles
+            data[:, 3:, :3] = normals
+            data[:, 3, 3] = owner
             textures["u_triangle_data"] = _texture(ctx, data)
         self._textures = []
         for unit, (name, texture) in enumerate(textures.items()):

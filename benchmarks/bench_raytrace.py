@@ -1,0 +1,154 @@
+"""The ray tracer's speed per scene, GPU and reference, printed (issue 14's benchmark).
+
+    .venv/bin/python benchmarks/bench_raytrace.py [--size 640x480] [--frames 5] [--quick] [--context egl]
+
+Scenes: the classic scene (assets/raytrace/classic.toml: a floor plane, a diffuse, a mirror and
+a glass sphere, two lights, hard shadows), the built-in `sphere` (3,968 triangles) and a
+20,480-triangle icosphere (subdivisions 5) lit as `sphere`, built here. For each at 1 and 16
+samples per pixel (regular pattern, max depth 4):
+- GPU (renderer/gpu/raytracer.py): the median of --frames frames after a warm-up frame,
+  RayTracer.render() (the draw and the read-back);
+- reference (reference/raytrace/pipeline.py): one frame (the ray scene and BVH made before,
+  not timed); --quick leaves out the 16-spp reference frames;
+- rays per frame, counted in the reference (every ray it intersects with the scene: camera
+  rays, reflected and refracted rays, shadow rays), the same for the GPU (same algorithm);
+  where --quick skips the 16-spp reference, estimated as 16 times the 1-spp count (marked ~);
+- rays per second = rays per frame / time per frame; ref/GPU = the ratio of the times.
+Then, at 1 spp, the GPU specialised (the default: only what the scene uses compiled in) against
+all features compiled in (RayTracer(..., specialise=False)), frames alternating; the images
+must be identical. The BVH's speed-up over brute force: benchmarks/bench_bvh.py.
+Not a test: this machine is shared and noisy; the load average is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+import reference.raytrace.trace as trace_module
+from reference.raytrace.pipeline import render as reference_render
+from renderer.cli import parse_size
+from renderer.core.raytrace_scene import ray_scene
+from renderer.core.scene_file import load_scene, scene_from_dict
+from renderer.gpu.context import make_context
+from renderer.gpu.raytracer import RayTracer
+
+CLASSIC = Path(__file__).resolve().parent.parent / "assets" / "raytrace" / "classic.toml"
+
+
+def icosphere_scene():
+    """The built-in `sphere` scene's camera, lights and material on icosphere(5): 20,480 triangles."""
+    return scene_from_dict({
+        "background": [0.04, 0.05, 0.08], "ambient": [0.12, 0.12, 0.14],
+        "camera": {"eye": [0.0, 0.4, 4.2], "look": [0.0, 0.0, 0.0], "fov_y": 40.0},
+        "materials": {"red": {"ka": [0.8, 0.15, 0.1], "kd": [0.75, 0.12, 0.08],
+                              "ks": [0.7, 0.7, 0.7], "n": 40.0}},
+        "lights": [{"type": "directional", "direction": [1.0, -1.0, -1.2], "intensity": [0.85, 0.85, 0.8]},
+                   {"type": "point", "position": [3.0, 0.5, 2.5], "intensity": [0.45, 0.5, 0.65],
+                    "attenuation": [1.0, 0.0, 0.02]}],
+        "objects": [{"name": "ball", "mesh": {"primitive": "icosphere", "radius": 1.0, "subdivisions": 5},
+                     "material": "red"}]})
+
+
+class RayCount:
+    """Counts the rays the reference intersects with the scene (trace.py's scene_hit: camera,
+    secondary and, through occluded, shadow rays) while in a `with` block."""
+
+    def __enter__(self):
+        self.total = self.shadow = 0
+        self._scene_hit, self._occluded = trace_module.scene_hit, trace_module.occluded
+
+        def scene_hit(rs, O, *args):
+            self.total += len(O)
+            return self._scene_hit(rs, O, *args)
+
+        def occluded(rs, O, *args):
+            self.shadow += len(O)
+            return self._occluded(rs, O, *args)
+        trace_module.scene_hit, trace_module.occluded = scene_hit, occluded
+        return self
+
+    def __exit__(self, *exc):
+        trace_module.scene_hit, trace_module.occluded = self._scene_hit, self._occluded
+
+
+def gpu_ms(tracer, frames: int):
+    tracer.render()                                            # warm-up
+    times = []
+    for _ in range(frames):
+        start = time.perf_counter()
+        tracer.render()
+        times.append((time.perf_counter() - start) * 1000.0)
+    return statistics.median(times)
+
+
+def machine() -> str:
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    return f"{platform.node()}: {os.cpu_count()} CPUs, load average {load}"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=parse_size, default=(640, 480))
+    parser.add_argument("--frames", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="no 16-spp reference frames")
+    parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
+    args = parser.parse_args()
+    W, H = args.size
+    ctx = make_context(args.context)
+    print(f"{machine()}; {ctx.info['GL_RENDERER']}; {time.strftime('%Y-%m-%d %H:%M')}")
+    scenes = {"classic": load_scene(CLASSIC), "sphere (3,968 tri)": load_scene("sphere"),
+              "icosphere (20,480 tri)": icosphere_scene()}
+    print(f"{W}x{H}, max depth 4, regular samples; GPU: median of {args.frames} frames after a "
+          f"warm-up ({args.context}); reference: 1 frame")
+    header = (f"{'scene':24} {'spp':>3} {'rays/frame':>12} {'GPU ms':>9} {'GPU Mrays/s':>11} "
+              f"{'ref ms':>10} {'ref Mrays/s':>11} {'ref/GPU':>8}")
+    print(header)
+    print("-" * len(header))
+    counts = {}
+    for name, scene in scenes.items():
+        rs = ray_scene(scene)
+        for spp in (1, 16):
+            with RayTracer(scene, W, H, context=ctx, samples=spp) as tracer:
+                g = gpu_ms(tracer, args.frames)
+            if spp == 16 and args.quick:
+                rays, r, mark = 16 * counts[name], None, "~"
+            else:
+                with RayCount() as count:
+                    start = time.perf_counter()
+                    reference_render(scene, W, H, samples=spp, rs=rs)
+                    r = (time.perf_counter() - start) * 1000.0
+                rays, mark = count.total, " "
+                counts.setdefault(name, rays)
+            ref = (f"{r:10.0f} {rays / r / 1000:11.2f} {r / g:7.1f}x" if r is not None
+                   else f"{'-':>10} {'-':>11} {'-':>8}")
+            print(f"{name:24} {spp:3d} {mark}{rays:11,d} {g:9.1f} {rays / g / 1000:11.2f} {ref}",
+                  flush=True)
+    print(f"\nspecialisation, GPU, 1 spp (frames alternate; median of {args.frames}):")
+    for name, scene in scenes.items():
+        with RayTracer(scene, W, H, context=ctx) as fast, \
+                RayTracer(scene, W, H, context=ctx, specialise=False) as every:
+            a, b = fast.render(), every.render()
+            same = np.array_equal(a.rgba8, b.rgba8) and np.array_equal(a.linear, b.linear)
+            t_fast, t_every = [], []
+            for _ in range(args.frames):
+                for tracer, times in ((fast, t_fast), (every, t_every)):
+                    start = time.perf_counter()
+                    tracer.render()
+                    times.append((time.perf_counter() - start) * 1000.0)
+            f, e = statistics.median(t_fast), statistics.median(t_every)
+            left_out = [k for k in ("SPECULAR", "SHADOWS", "MESHES", "SECONDARY") if every.defines[k] and not fast.defines[k]]
+            print(f"  {name:24} specialised {f:7.1f} ms, all features {e:7.1f} ms: {e / f:.2f}x "
+                  f"(left out: {', '.join(left_out) or 'nothing'}; identical images: {same})")
+    print(f"\n{machine()}")
+    ctx.release()
+
+
+if __name__ == "__main__":
+    main()

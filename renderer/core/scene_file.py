@@ -91,6 +91,8 @@ MIN_DETERMINANT = 1e-9
 # ratio and the GPU's own arithmetic.
 MAX_NUMBER = MAX_COORDINATE
 MAX_COMPOSED = 1e30
+# The reason a number over MAX_NUMBER is refused, the same wherever it stands.
+TOO_LARGE = f"too large for the GPU's float32 arithmetic; numbers must satisfy |x| <= {MAX_NUMBER:g}"
 
 
 # --------------------------------------------------------------------------- entry points
@@ -276,8 +278,7 @@ class _Reader:
         if not math.isfinite(x):
             self.fail(path, f"expected a finite number, got {show_number(x)}")
         if abs(x) > MAX_NUMBER:
-            self.fail(path, f"{show_number(x)} is too large for the GPU's float32 arithmetic; "
-                            f"numbers must satisfy |x| <= {MAX_NUMBER:g}")
+            self.fail(path, f"{show_number(x)} is {TOO_LARGE}")
         if minimum is not None and x < minimum:
             self.fail(path, f"must be >= {minimum:g}, got {x:g}")
         if above is not None and x <= above:
@@ -309,8 +310,7 @@ class _Reader:
             if not math.isfinite(x):
                 self.fail(path, f"expected finite numbers, item {i} is {show_number(x)}")
             if abs(x) > MAX_NUMBER:
-                self.fail(path, f"item {i} is {show_number(x)}, too large for the GPU's float32 "
-                                f"arithmetic; numbers must satisfy |x| <= {MAX_NUMBER:g}")
+                self.fail(path, f"item {i} is {show_number(x)}, {TOO_LARGE}")
             if minimum is not None and x < minimum:
                 self.fail(path, f"must be >= {minimum:g} in every component, "
                                 f"item {i} is {show_number(x)}")

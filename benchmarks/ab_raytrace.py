@@ -73,9 +73,10 @@ def worker(args) -> None:
     print(json.dumps({"rgba8": hashlib.sha256(frame.rgba8.tobytes()).hexdigest(),
                       "renderer": ctx.info["GL_RENDERER"]}), flush=True)
     for _ in sys.stdin:
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         tracer.render()
-        print((time.perf_counter() - start) * 1000.0, flush=True)
+        print(json.dumps([(time.perf_counter() - start) * 1000.0,
+                          (time.process_time() - cpu) * 1000.0]), flush=True)
     tracer.release()
 
 
@@ -89,10 +90,11 @@ def start(tree: Path, args) -> tuple[subprocess.Popen, dict]:
     return process, json.loads(process.stdout.readline())
 
 
-def frame_ms(process: subprocess.Popen) -> float:
+def frame_ms(process: subprocess.Popen) -> tuple[float, float]:
+    """(wall, CPU) milliseconds of one frame."""
     process.stdin.write("\n")
     process.stdin.flush()
-    return float(process.stdout.readline())
+    return tuple(json.loads(process.stdout.readline()))
 
 
 def load() -> str:
@@ -136,12 +138,14 @@ def main() -> None:
         for process in processes:
             process.stdin.close()
             process.wait()
-    a, b = (statistics.median(t) for t in times)
-    paired = statistics.median(x / y for x, y in zip(*times))
-    for name, t in zip(("A " + names[0], "B " + names[1]), times):
-        print(f"  {name:24} median {statistics.median(t):7.1f} ms  (min {min(t):6.1f}, max {max(t):6.1f})")
-    print(f"  A/B: {a / b:.3f} (medians), {paired:.3f} (median of paired rounds); "
-          f"identical rgba8: {infos[0]['rgba8'] == infos[1]['rgba8']}; load average {load()}")
+    for column, what in enumerate(("wall", "CPU")):
+        t_a, t_b = ([t[column] for t in ts] for ts in times)
+        a, b = statistics.median(t_a), statistics.median(t_b)
+        paired = statistics.median(x / y for x, y in zip(t_a, t_b))
+        print(f"  {what:4} A {a:7.1f} ms (min {min(t_a):6.1f})  B {b:7.1f} ms (min {min(t_b):6.1f})  "
+              f"A/B {a / b:.3f} (medians), {paired:.3f} (paired rounds)")
+    print(f"  A = {names[0]}, B = {names[1]}; identical rgba8: {infos[0]['rgba8'] == infos[1]['rgba8']}; "
+          f"load average {load()}")
 
 
 if __name__ == "__main__":

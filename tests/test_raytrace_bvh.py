@@ -55,6 +55,16 @@ def test_the_builder_makes_the_hand_written_layout():
     assert texels(HAND.nodes, width=4)[1, 2:].tolist() == [[0] * 4] * 2
 
 
+def test_texture_rows_are_a_power_of_two_wide():
+    """The shader finds texel k at (k & (width - 1), k >> log2(width)): a short array gets the
+    smallest power of two that holds it, a long one rows of TEXTURE_WIDTH."""
+    assert texels(HAND.nodes).shape == (1, 8, 4)                     # 6 texels
+    assert texels(np.zeros((1, 4))).shape == (1, 1, 4)
+    assert texels(np.zeros((1025, 4))).shape == (2, 1024, 4)
+    with pytest.raises(ValueError, match="power of two"):
+        texels(HAND.nodes, width=6)
+
+
 def test_traversal_of_the_hand_written_layout():
     down = (0, 0, -1)
     O = np.array([(0.25, 0.25, 1), (4.25, 0.25, 2), (2, 0.5, 1), (0, 0.25, 1),   # x on a face

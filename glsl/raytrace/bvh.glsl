@@ -1,7 +1,8 @@
 // Twin: reference/raytrace/bvh.py
 // The closest hit of a ray P = O + s D against the triangles of a BVH (docs/conventions.md,
 // "Rays"), traversed depth first with a fixed stack, the nearer child first. The BVH is two
-// RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width)):
+// RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width),
+// the width a power of two):
 //   nodes:     texel 2i = [min.xyz, a], texel 2i + 1 = [max.xyz, count]; count > 0: a leaf of
 //              triangles a .. a + count - 1; count == 0: left child i + 1, right child a
 //   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, 0], [C.xyz, 0]
@@ -17,9 +18,14 @@
 // Traversal", JCGT 2013) so that rounding does not lose a triangle on a box's face.
 const float BVH_BOX_FAR_SCALE = 1.00000036;
 
+// Texel k (>= 0) of a texture in that layout. The width is a power of two, so k % width and
+// k / width are a mask and a shift (llvmpipe has no vector integer division: it would divide
+// lane by lane, twice per fetch); log2(width) is the exponent of float(width), exact for a
+// power of two (GLSL 3.30 has no findLSB).
 vec4 bvh_texel(sampler2D texture_, int k) {
     int width = textureSize(texture_, 0).x;
-    return texelFetch(texture_, ivec2(k % width, k / width), 0);
+    int log2_width = (floatBitsToInt(float(width)) >> 23) - 127;
+    return texelFetch(texture_, ivec2(k & (width - 1), k >> log2_width), 0);
 }
 
 // Slab test with inv_D = 1 / D (IEEE: +-inf where D's component is 0). An axis with infinite

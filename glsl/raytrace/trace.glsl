@@ -44,9 +44,9 @@ const int TRACE_PLANE = 2;
 const int TRACE_TRIANGLE = 3;
 const float TRACE_INF = uintBitsToFloat(0x7f800000u);
 
+// Texel k of the materials or triangle data: the BVH textures' layout (bvh.glsl, bvh_texel).
 vec4 trace_texel(sampler2D texture_, int k) {
-    int width = textureSize(texture_, 0).x;
-    return texelFetch(texture_, ivec2(k % width, k / width), 0);
+    return bvh_texel(texture_, k);
 }
 
 // The nearest hit with s_min < s < s_max: its kind (TRACE_MISS on a miss), the sphere's,

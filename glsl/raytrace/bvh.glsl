@@ -68,9 +68,12 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
         int count = int(n1.w);
         bool descend = false;
         if (count > 0) {
-            int first = int(n0.w);
-            for (int k = 0; k < count; ++k) {
-                int j = first + k;
+            // the leaf's triangles; the test at the end of the body, as a do-while, since
+            // llvmpipe runs a body with lanes masked off until every lane of its SIMD group has
+            // left: a test at the top ran one whole body more (a triangle, three fetches)
+            int j = int(n0.w);
+            int end = j + count;
+            do {
                 vec4 A = bvh_texel(triangles, 3 * j);
                 vec3 B = bvh_texel(triangles, 3 * j + 1).xyz;
                 vec3 C = bvh_texel(triangles, 3 * j + 2).xyz;
@@ -81,7 +84,8 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
                     uv = hit_uv;
                     triangle = int(A.w);
                 }
-            }
+                ++j;
+            } while (j < end);
         } else {
             int left = node + 1;
             int right = int(n0.w);

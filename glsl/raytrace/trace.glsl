@@ -118,7 +118,8 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
 }
 
 // Whether anything is hit with 0 < s < s_max (a shadow ray): the first hit found answers (any
-// hit, not the nearest: the analytic shapes first, the BVH only if none of them is hit).
+// hit, not the nearest: the analytic shapes first, the BVH's any-hit walk only if none of them
+// is hit).
 bool occluded(vec3 O, vec3 D, float s_max) {
     float s_k;
 #if NUM_SPHERES > 0
@@ -132,9 +133,7 @@ bool occluded(vec3 O, vec3 D, float s_max) {
     }
 #endif
 #ifdef MESHES
-    vec2 uv_t;
-    int triangle;
-    if (bvh_closest_hit(u_nodes, u_triangles, O, D, 0.0, s_max, s_k, uv_t, triangle)) return true;
+    if (bvh_any_hit(u_nodes, u_triangles, O, D, 0.0, s_max)) return true;
 #endif
     return false;
 }

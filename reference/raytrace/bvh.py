@@ -6,7 +6,8 @@ float32, vectorised over rays: a wavefront of (ray, node) pairs, one level of th
 (`ray_box` below; `ray_triangle` of intersect.py), so each pair decides as the GLSL does;
 the order differs (the GLSL goes depth first, nearer child first), which changes the answer
 only where two triangles are hit at the same s (an edge or vertex they share): either is the
-closest hit then.
+closest hit then. `any_hit` (shadow rays) answers whether closest_hit would hit, dropping each
+ray from the wavefront at its first hit, as the GLSL's bvh_any_hit stops at its first.
 
 Ray-box (slab) test with 1/D precomputed, IEEE: 1/(+-0) = +-inf. An axis whose 1/D is
 infinite (D's component 0, or so small that 1/D overflows) is parallel to its slab: it admits
@@ -53,6 +54,29 @@ def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
     return near <= far, near
 
 
+def _visit(nodes, O, inv_D, ray, node, s_min, s_max):
+    """The (ray, node) pairs whose box the ray meets, with each node's first texel and whether
+    it is a leaf."""
+    n0, n1 = nodes[node, 0], nodes[node, 1]
+    hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min, s_max)
+    return ray[hit], node[hit], n0[hit], n1[hit, 3] > 0
+
+
+def _leaf_pairs(ray, n0, leaf, count):
+    """(ray, triangle) for every triangle of every leaf pair: triangles a .. a + count - 1."""
+    count = count[leaf].astype(np.int64)
+    starts = np.cumsum(count) - count
+    first = n0[leaf, 3].astype(np.int64)
+    return np.repeat(ray[leaf], count), np.repeat(first - starts, count) + np.arange(count.sum())
+
+
+def _children(ray, node, n0, inner):
+    """The next level of the wavefront: both children (left = i + 1, right = a) of each
+    interior pair."""
+    children = np.stack([node[inner] + 1, n0[inner, 3].astype(np.int64)], axis=1).reshape(-1)
+    return np.repeat(ray[inner], 2), children
+
+
 def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
     """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
     s_min < s < s_max, the nearest such s (s_max on a miss), its (u, v), and the triangle's
@@ -69,17 +93,10 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
     ray = np.arange(R)
     node = np.zeros(R, np.int64)
     while ray.size:
-        n0, n1 = nodes[node, 0], nodes[node, 1]
-        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min, best_s[ray])
-        ray, node, n0, n1 = ray[hit], node[hit], n0[hit], n1[hit]
-        leaf = n1[:, 3] > 0
+        ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min, best_s[ray])
         # leaves: every (ray, triangle) pair, then the nearest hit per ray
-        count = n1[leaf, 3].astype(np.int64)
-        if count.size:
-            r = np.repeat(ray[leaf], count)
-            starts = np.cumsum(count) - count
-            t = (np.repeat(n0[leaf, 3].astype(np.int64) - starts, count)
-                 + np.arange(count.sum()))
+        r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
+        if r.size:
             v = tris[t]
             h, s, uv = ray_triangle(O[r], D[r], v[:, 0, :3], v[:, 1, :3], v[:, 2, :3], s_min, best_s[r])
             r, s, uv, t = r[h], s[h], uv[h], t[h]
@@ -91,13 +108,35 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
                 better = s < best_s[r]
                 r, s, uv, t = r[better], s[better], uv[better], t[better]
                 best_s[r], best_uv[r], best_tri[r] = s, uv, t
-        # interior nodes: both children (left = i + 1, right = a)
-        inner = ~leaf
-        ray = np.repeat(ray[inner], 2)
-        node = np.stack([node[inner] + 1, n0[inner, 3].astype(np.int64)], axis=1).reshape(-1)
+        ray, node = _children(ray, node, n0, ~leaf)
     hit = best_tri >= 0
     original = np.where(hit, tris[np.maximum(best_tri, 0), 0, 3].astype(np.int64), -1)
     return hit, best_s, best_uv, original
+
+
+def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
+    """Whether each ray O, D (R, 3) hits a triangle with s_min < s < s_max (s_max a number or
+    one per ray): closest_hit's `hit`, found as the GLSL's bvh_any_hit finds it, a ray leaving
+    the walk at its first hit. Everything float32 as the GLSL."""
+    O = np.asarray(O, F32).reshape(-1, 3)
+    D = np.asarray(D, F32).reshape(-1, 3)
+    R = len(O)
+    inv_D = inverse_direction(D)
+    s_min = F32(s_min)
+    s_max = np.broadcast_to(np.asarray(s_max, F32), (R,))
+    blocked = np.zeros(R, bool)
+    nodes, tris = bvh.nodes, bvh.triangles
+    ray = np.arange(R)
+    node = np.zeros(R, np.int64)
+    while ray.size:
+        ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min, s_max[ray])
+        r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
+        if r.size:
+            v = tris[t]
+            h, _, _ = ray_triangle(O[r], D[r], v[:, 0, :3], v[:, 1, :3], v[:, 2, :3], s_min, s_max[r])
+            blocked[r[h]] = True
+        ray, node = _children(ray, node, n0, ~leaf & ~blocked[ray])
+    return blocked
 
 
 def closest_hit_brute_force(vertices, O, D, s_min=0.0, s_max=np.inf, chunk=1 << 20):

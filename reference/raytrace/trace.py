@@ -29,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
-from reference.raytrace.bvh import closest_hit as bvh_closest_hit
+from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, sphere_normal,
                                           triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
@@ -67,8 +67,20 @@ def scene_hit(rs, O, D, s_min, s_max):
 
 
 def occluded(rs, O, D, s_max):
-    """Whether anything is hit with 0 < s < s_max (a shadow ray)."""
-    return scene_hit(rs, O, D, 0.0, s_max)[0] != MISS
+    """Whether anything is hit with 0 < s < s_max (a shadow ray; s_max a number or one per ray):
+    any hit, not the nearest, as the GLSL: the spheres, the planes, then the BVH's any-hit walk
+    for the rays none of them blocks."""
+    zero = F32(0)
+    s_max = np.broadcast_to(np.asarray(s_max, F32), (len(O),))
+    blocked = np.zeros(len(O), bool)
+    for k in range(len(rs.sphere_radius)):
+        blocked |= ray_sphere(O, D, rs.sphere_centre[k].astype(F32), F32(rs.sphere_radius[k]), zero, s_max)[0]
+    for k in range(len(rs.plane_offset)):
+        blocked |= ray_plane(O, D, rs.plane_normal[k].astype(F32), F32(rs.plane_offset[k]), zero, s_max)[0]
+    if rs.bvh is not None:
+        rest = ~blocked
+        blocked[rest] = bvh_any_hit(rs.bvh, O[rest], D[rest], zero, s_max[rest])
+    return blocked
 
 
 def surface(rs, O, D, kind, index, s, uv):

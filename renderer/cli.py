@@ -25,6 +25,7 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -111,7 +112,8 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--pattern", choices=("regular", "random", "jittered", "poisson"),
                        default="regular", help="ray tracer: sample pattern (default regular)")
         p.add_argument("--max-depth", type=int, default=4, metavar="D",
-                       help="ray tracer: bounces of reflection and refraction, 0 to 16 (default 4)")
+                       help="ray tracer: bounces of reflection and refraction, 0 to "
+                            f"{MAX_DEPTH_LIMIT} (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
                        help="ray tracer: seed of the random and jittered patterns")
 
@@ -240,8 +242,8 @@ def check_raytrace_options(args) -> None:
     if args.method == "raster" and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
                                     or args.seed is not None):
         args.parser.error("--spp, --pattern, --max-depth and --seed are for --method raytrace")
-    if not 0 <= args.max_depth <= 16:
-        args.parser.error(f"--max-depth must be between 0 and 16, got {args.max_depth}")
+    if not 0 <= args.max_depth <= MAX_DEPTH_LIMIT:
+        args.parser.error(f"--max-depth must be between 0 and {MAX_DEPTH_LIMIT}, got {args.max_depth}")
     if args.method == "raytrace":
         from renderer.core.sampling import pattern
         try:

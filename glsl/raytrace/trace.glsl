@@ -2,8 +2,9 @@
 // The ray tracer proper (docs/conventions.md, "Rays"): the closest hit among the analytic
 // spheres, then planes, then the scene's triangles through its BVH; Phong shading through
 // lighting.glsl (MATERIAL_VARIABLES: the hit's material; SHADOWS: a shadow ray per light); then
-// reflected (k_r + k_t F) and transmitted (k_t (1 - F)) rays, F Schlick's, to MAX_DEPTH bounces,
-// depth first through a fixed-size stack in a loop of fixed length (no recursion in GLSL).
+// reflected (k_r + k_t F) and transmitted (k_t (1 - F)) rays, F Schlick's, to MAX_DEPTH bounces
+// and down to a weight cut-off, depth first through a fixed-size stack in a loop of bounded
+// length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
 // SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR.
 
@@ -159,8 +160,20 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
 }
 #endif
 
+// Hall and Greenberg's adaptive tree depth (1983): a secondary ray whose weight is below
+// TRACE_WEIGHT_CUTOFF in every channel is not spawned (renderer/core/ray_depth.py: the rule,
+// its RAY_WEIGHT_CUTOFF and max_rays, which these mirror). The energy rule kr + kt <= 1 makes
+// the children's weights sum to at most their parent's in each channel, so at most
+// 3 / cutoff = 1536 rays of one depth reach the cut-off: depth d has at most min(2^d, 1536)
+// rays (2^d up to d = 10), which bounds the loop for any MAX_DEPTH.
+const float TRACE_WEIGHT_CUTOFF = 1.0 / 512.0;
+#define TRACE_RAYS_PER_DEPTH 1536
 #define TRACE_STACK (MAX_DEPTH + 2)
+#if MAX_DEPTH <= 10
 #define TRACE_MAX_RAYS ((2 << MAX_DEPTH) - 1)
+#else
+#define TRACE_MAX_RAYS (2047 + (MAX_DEPTH - 10) * TRACE_RAYS_PER_DEPTH)
+#endif
 
 // The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
 // from 0 to infinity); hit and s: the first ray's hit.
@@ -228,14 +241,14 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 vec3 w_t = w * (kt * (1.0 - F));
                 vec3 T;
                 bool refracted = ray_refract(Du, N_in, eta, T);
-                if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
+                if (any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted) {
                     stack_O[top] = offset_ray_origin(P, -Ng_in);
                     stack_D[top] = T;
                     stack_w[top] = w_t;
                     stack_depth[top] = depth + 1;
                     ++top;
                 }
-                if (any(greaterThan(w_r, vec3(0.0)))) {
+                if (any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)))) {
                     stack_O[top] = offset_ray_origin(P, Ng_in);
                     stack_D[top] = ray_reflect(Du, N_in);
                     stack_w[top] = w_r;

@@ -1,7 +1,7 @@
 """# Twin: glsl/raytrace/trace.glsl
 
-The ray tracer proper (docs/conventions.md, "Rays", "Tracing"), in float32 as the GLSL,
-vectorised over rays: a wavefront per bounce (every ray of one depth at once), no Python loop
+The ray tracer proper (docs/conventions.md, "Rays", "Tracing"), in float32 as the GLSL (or in
+float64, the ground truth: the dtype of the rays given), vectorised over rays: a wavefront per bounce (every ray of one depth at once), no Python loop
 over pixels or rays.
 
 - closest hit: the analytic spheres, then the planes (intersect.py), then the scene's triangles
@@ -33,6 +33,7 @@ from reference.raytrace.bvh import closest_hit as bvh_closest_hit
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, sphere_normal,
                                           triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
+from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
 F32 = np.float32
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
@@ -45,22 +46,24 @@ def _dot(a, b):
 def scene_hit(rs, O, D, s_min, s_max):
     """(kind, index, s, uv) of the nearest hit with s_min < s < s_max of rays O, D (R, 3):
     kind MISS/SPHERE/PLANE/TRIANGLE, index the sphere's, plane's or original triangle's, s the
-    hit (s_max on a miss)."""
-    R = len(O)
-    s = np.broadcast_to(np.asarray(s_max, F32), (R,)).astype(F32)
+    hit (s_max on a miss). In the dtype of O: float32, or float64 with the scene's float64
+    surfaces."""
+    R, t = len(O), O.dtype.type
+    s = np.broadcast_to(np.asarray(s_max, t), (R,)).astype(t)
     kind = np.zeros(R, np.int64)
     index = np.full(R, -1, np.int64)
-    uv = np.zeros((R, 2), F32)
+    uv = np.zeros((R, 2), t)
     for k in range(len(rs.sphere_radius)):
-        hit, s_k = ray_sphere(O, D, rs.sphere_centre[k].astype(F32), F32(rs.sphere_radius[k]), F32(s_min), s)
+        hit, s_k = ray_sphere(O, D, rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k]), t(s_min), s)
         s = np.where(hit, s_k, s)
         kind[hit], index[hit] = SPHERE, k
     for k in range(len(rs.plane_offset)):
-        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(F32), F32(rs.plane_offset[k]), F32(s_min), s)
+        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), t(s_min), s)
         s = np.where(hit, s_k, s)
         kind[hit], index[hit] = PLANE, k
     if rs.bvh is not None:
-        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, s)
+        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, s,
+                                              vertices=None if t is F32 else rs.triangles)
         s = np.where(hit, s_t, s)
         kind[hit], index[hit], uv[hit] = TRIANGLE, tri[hit], uv_t[hit]
     return kind, index, s, uv
@@ -75,41 +78,45 @@ def surface(rs, O, D, kind, index, s, uv):
     """(P, Ng, Ns, obj) at hits (no misses): the hit point, the outward geometric and shading
     unit normals, the object index."""
     P = O + s[:, None] * D
+    t = P.dtype.type
     Ng = np.zeros_like(P)
     Ns = np.zeros_like(P)
     obj = np.zeros(len(P), np.int64)
     m = kind == SPHERE
     if m.any():
         k = index[m]
-        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(F32), rs.sphere_radius[k].astype(F32)[:, None])
+        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(t), rs.sphere_radius[k].astype(t)[:, None])
         Ns[m] = Ng[m]
         obj[m] = rs.sphere_object[k]
     m = kind == PLANE
     if m.any():
         k = index[m]
-        Ng[m] = plane_normal(rs.plane_normal[k].astype(F32))
+        Ng[m] = plane_normal(rs.plane_normal[k].astype(t))
         Ns[m] = Ng[m]
         obj[m] = rs.plane_object[k]
     m = kind == TRIANGLE
     if m.any():
         k = index[m]
-        V = rs.triangles[k].astype(F32)
+        V = rs.triangles[k].astype(t)
         Ng[m] = triangle_normal(V[:, 0], V[:, 1], V[:, 2])
-        n = rs.triangle_normals[k].astype(F32)
+        n = rs.triangle_normals[k].astype(t)
         u, v = uv[m, 0:1], uv[m, 1:2]
-        Ns[m] = normalize_or_zero((F32(1) - u - v) * n[:, 0] + u * n[:, 1] + v * n[:, 2])
+        Ns[m] = normalize_or_zero((t(1) - u - v) * n[:, 0] + u * n[:, 1] + v * n[:, 2])
         obj[m] = rs.triangle_object[k]
     return P, Ng, Ns, obj
 
 
-def materials(rs, obj, specular: bool) -> MaterialUniforms:
-    return MaterialUniforms(rs.ka[obj].astype(F32), rs.kd[obj].astype(F32), rs.ks[obj].astype(F32),
-                            rs.n[obj].astype(F32)[:, None], specular=specular)
+def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
+    return MaterialUniforms(rs.ka[obj].astype(dtype), rs.kd[obj].astype(dtype), rs.ks[obj].astype(dtype),
+                            rs.n[obj].astype(dtype)[:, None], specular=specular)
 
 
-def shadow_visibility(rs, lights: Lights, Ng):
+def shadow_visibility(rs, lights: Lights, Ng, record=None):
     """The visibility callable of lighting.py for hits with outward geometric normals Ng: one
-    shadow ray per point and light (the GLSL's light_visibility_directional / _point)."""
+    shadow ray per point and light (the GLSL's light_visibility_directional / _point).
+    `record(needed, event)`, if given, hears each shadow ray's outcome (ray_tree_event)."""
+    t = Ng.dtype.type
+
     def visibility(kind, i, P, N, needed):
         blocked = np.zeros(len(P), bool)
         P, n = P[needed], Ng[needed]
@@ -117,7 +124,7 @@ def shadow_visibility(rs, lights: Lights, Ng):
             L = normalize(-lights.u_directional_direction[i])
             n = np.where((_dot(n, L) >= 0)[:, None], n, -n)
             O = offset_ray_origin(P, n)
-            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(F32), F32(np.inf))
+            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf))
         else:
             Q = lights.u_point_position[i]
             n = np.where((_dot(n, Q - P) >= 0)[:, None], n, -n)
@@ -127,57 +134,104 @@ def shadow_visibility(rs, lights: Lights, Ng):
             with np.errstate(divide="ignore", invalid="ignore"):
                 L = to_light / d[:, None]
             blocked[needed] = occluded(rs, O, L, d) & (d > 0)
-        return np.where(blocked, F32(0), F32(1))[:, None]
+        if record is not None:
+            light = i if kind == "directional" else len(lights.u_directional_direction) + i
+            record(blocked, ray_tree_event(SHADOW, light))
+        return np.where(blocked, t(0), t(1))[:, None]
     return visibility
 
 
-def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True):
-    """Trace rays O, D (R, 3) float32: (colour (R, 3), hit (R,), s (R,)) with hit and s of
-    each ray's first hit (primary rays between s_min and s_max; secondary rays from 0 to inf).
-    shadows=False lights every point by every light (no shadow rays; the GLSL without SHADOWS)."""
-    O = np.asarray(O, F32)
-    D = np.asarray(D, F32)
+# -- the ray tree's hash ------------------------------------------------------------------------
+# Which surface each ray of a camera ray's tree hit (or none), and which shadow rays were
+# blocked, hashed into one uint64 per camera ray: two precisions that disagree on a grazing ray
+# (a hit in one and a miss or another surface in the other; a shadow ray blocked in one only;
+# one child spawned in one only) give different hashes (docs/conventions.md, "Grazing rays").
+# A shadow ray not cast (its light adds nothing at the point) counts as not blocked: whether a
+# term of 1e-50 underflows to 0 (float32) or not (float64) changes nothing one can see.
+# Every ray has a path id (the root's ROOT_PATH; a child's the mix of its parent's and of
+# which child it is); each event adds mix(path + event) to the sum, modulo 2^64, so that the
+# order in which the rays are traced (the GLSL's depth first, the twin's wavefronts) does not
+# matter. mix is splitmix64's finaliser (Steele, Lea and Flood 2014).
+SHADOW = 4                    # event kinds: MISS, SPHERE, PLANE, TRIANGLE; SHADOW + blocked
+ROOT_PATH = np.uint64(0x9E3779B97F4A7C15)
+
+
+def mix64(z):
+    z = np.asarray(z, np.uint64)
+    with np.errstate(over="ignore"):                 # products modulo 2^64, as meant
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+def ray_tree_event(kind, index):
+    """The uint64 event of a ray that hit surface (kind, index), or of a shadow ray."""
+    kind = np.asarray(kind, np.uint64)
+    return (kind << np.uint64(32)) | (np.asarray(index, np.int64) & 0xFFFFFFFF).astype(np.uint64)
+
+
+def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
+          ray_trees=None):
+    """Trace rays O, D (R, 3): (colour (R, 3), hit (R,), s (R,)) with hit and s of each ray's
+    first hit (primary rays between s_min and s_max; secondary rays from 0 to inf). float32 as
+    the GLSL, or float64 for float64 rays (and then `lights` in float64). shadows=False lights
+    every point by every light (no shadow rays; the GLSL without SHADOWS). `ray_trees`, an
+    (R,) uint64 array, has each ray tree's hash added to it (the comment above).
+    A secondary ray is spawned only when some channel of its weight is at least
+    RAY_WEIGHT_CUTOFF (renderer/core/ray_depth.py)."""
+    t = np.asarray(O).dtype.type if np.asarray(O).dtype == np.float64 else F32
+    O = np.asarray(O, t)
+    D = np.asarray(D, t)
     R = len(O)
-    colour = np.zeros((R, 3), F32)
-    background = np.asarray(background, F32)
+    colour = np.zeros((R, 3), t)
+    background = np.asarray(background, t)
     specular = rs.specular
     owner = np.arange(R)
-    weight = np.ones((R, 3), F32)
+    path = np.full(R, ROOT_PATH, np.uint64)
+    weight = np.ones((R, 3), t)
     first_hit, first_s = None, None
-    lo, hi = F32(s_min), F32(s_max)
+    lo, hi = t(s_min), t(s_max)
+    trees = np.zeros(R, np.uint64) if ray_trees is None else ray_trees
+
+    def record(rays, event):
+        np.add.at(trees, owner[rays], mix64(path[rays] + mix64(event)))
+
     for depth in range(max_depth + 1):
         if not len(O):
             break
         kind, index, s, uv = scene_hit(rs, O, D, lo, hi)
+        record(slice(None), ray_tree_event(kind, index))
         hit = kind != MISS
         if depth == 0:
             first_hit, first_s = hit.copy(), s.copy()
         np.add.at(colour, owner[~hit], weight[~hit] * background)
-        O, D, kind, index, s, uv, owner, weight = (a[hit] for a in (O, D, kind, index, s, uv, owner, weight))
+        O, D, kind, index, s, uv, owner, path, weight = (
+            a[hit] for a in (O, D, kind, index, s, uv, owner, path, weight))
         P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv)
         Du = normalize(D)
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
-        local = lighting(P, N, O, materials(rs, obj, specular), lights,
-                         shadow_visibility(rs, lights, Ng) if shadows else None)
+        local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
+                         shadow_visibility(rs, lights, Ng, record) if shadows else None)
         np.add.at(colour, owner, weight * local)
         if depth == max_depth:
             break
-        # secondary rays
+        # secondary rays, down to the weight cut-off
         N_in = np.where(back[:, None], -Ns, Ns)
         Ng_in = np.where(back[:, None], -Ng, Ng)
-        ior = rs.ior[obj].astype(F32)
-        eta = np.where(back, ior, F32(1) / ior)
+        ior = rs.ior[obj].astype(t)
+        eta = np.where(back, ior, t(1) / ior)
         F = fresnel_schlick(Du, N_in, eta)[:, None]
-        kr, kt = rs.kr[obj].astype(F32), rs.kt[obj].astype(F32)
+        kr, kt = rs.kr[obj].astype(t), rs.kt[obj].astype(t)
         w_r = weight * (kr + kt * F)
-        w_t = weight * (kt * (F32(1) - F))
+        w_t = weight * (kt * (t(1) - F))
         refracted, T = ray_refract(Du, N_in, eta)
-        go_r = (w_r > 0).any(-1)
-        go_t = (w_t > 0).any(-1) & refracted
+        go_r = w_r.max(-1) >= RAY_WEIGHT_CUTOFF
+        go_t = (w_t.max(-1) >= RAY_WEIGHT_CUTOFF) & refracted
         O = np.concatenate([offset_ray_origin(P[go_r], Ng_in[go_r]), offset_ray_origin(P[go_t], -Ng_in[go_t])])
-        D = np.concatenate([ray_reflect(Du[go_r], N_in[go_r]), T[go_t]]).astype(F32)
+        D = np.concatenate([ray_reflect(Du[go_r], N_in[go_r]), T[go_t]]).astype(t)
         owner = np.concatenate([owner[go_r], owner[go_t]])
+        path = np.concatenate([mix64(path[go_r] ^ np.uint64(1)), mix64(path[go_t] ^ np.uint64(2))])
         weight = np.concatenate([w_r[go_r], w_t[go_t]])
-        lo, hi = F32(0), F32(np.inf)
+        lo, hi = t(0), t(np.inf)
     return colour, first_hit, first_s

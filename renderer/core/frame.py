@@ -29,6 +29,10 @@ class Frame:
     gl_info: for a GPU frame, the GL implementation that drew it (GpuRenderer.gl_info:
             GL_VENDOR, GL_RENDERER, GL_VERSION, context, depth_format); None from the
             reference. Golden tests record it beside each golden.
+    ray_tree: from the reference ray tracer only, (H, W) uint64: per pixel a hash of which
+            surface each ray of its samples' ray trees hit and which shadow rays were
+            blocked (reference/raytrace/trace.py). Where the float32 and float64 frames'
+            differ, the two precisions disagree on a grazing ray (docs/conventions.md).
     """
     rgba8: np.ndarray
     linear: np.ndarray | None = None
@@ -36,6 +40,7 @@ class Frame:
     milliseconds: float = 0.0
     rgba8_tie: np.ndarray | None = None
     gl_info: dict | None = None
+    ray_tree: np.ndarray | None = None
 
     def image(self, background: str = "opaque") -> np.ndarray:
         """The pixels an image file of this frame holds: (H, W, 3) for an opaque background,

@@ -29,6 +29,7 @@ from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import check_light_count, to_unorm8
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
 from renderer.core.scene import Scene
@@ -61,8 +62,8 @@ class RayTracer:
             raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
         if not 1 <= int(samples) <= MAX_SAMPLES:
             raise ValueError(f"samples must be between 1 and {MAX_SAMPLES}, got {samples}")
-        if not 0 <= int(max_depth) <= 16:
-            raise ValueError(f"max_depth must be between 0 and 16, got {max_depth}")
+        if not 0 <= int(max_depth) <= MAX_DEPTH_LIMIT:
+            raise ValueError(f"max_depth must be between 0 and {MAX_DEPTH_LIMIT}, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
         self.width, self.height = int(width), int(height)

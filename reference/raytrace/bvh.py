@@ -72,7 +72,7 @@ def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
 
 def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
-    s_min < s < s_max, the nearest such s (s_max on a miss), its (u, v), and the triangle's
+    s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v), and the triangle's
     original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
     `vertices` (T, 3, 3), by original index, replace the BVH's float32 triangles (the float64
     twin passes the scene's float64 ones; the boxes are widened to hold them)."""
@@ -81,7 +81,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     D = np.asarray(D, dtype).reshape(-1, 3)
     R = len(O)
     inv_D = inverse_direction(D)
-    s_min = dtype.type(s_min)
+    s_min = np.broadcast_to(np.asarray(s_min, dtype), (R,))
     best_s = np.full(R, dtype.type(s_max), dtype)
     best_uv = np.zeros((R, 2), dtype)
     best_tri = np.full(R, -1, np.int64)
@@ -96,7 +96,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     node = np.zeros(R, np.int64)
     while ray.size:
         n0, n1 = nodes[node, 0], nodes[node, 1]
-        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min, best_s[ray])
+        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min[ray], best_s[ray])
         ray, node, n0, n1 = ray[hit], node[hit], n0[hit], n1[hit]
         leaf = n1[:, 3] > 0
         # leaves: every (ray, triangle) pair, then the nearest hit per ray
@@ -107,7 +107,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
             t = (np.repeat(n0[leaf, 3].astype(np.int64) - starts, count)
                  + np.arange(count.sum()))
             v = tris[t]
-            h, s, uv = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min, best_s[r])
+            h, s, uv = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], best_s[r])
             r, s, uv, t = r[h], s[h], uv[h], t[h]
             if r.size:
                 order = np.lexsort((t, s, r))           # per ray: nearest s, then leaf order

@@ -101,6 +101,24 @@ def ray_sphere(O, D, C, r, s_min, s_max):
     return _select(hit, s, s_max)
 
 
+def ray_sphere_from_surface(O, D, C, r, s_min, s_max):
+    """A ray that starts on the sphere (no offset): its origin is the root c / q, so the one
+    other point it can meet is s1 = q / a (ahead when it goes inwards, b < 0; behind when it
+    leaves outwards: a sphere is convex). c = f.f - r^2, which cancels there, is not used."""
+    dtype = _float_dtype(O, D)
+    O, D, C, r, s_min, s_max = _as(dtype, O, D, C, r, s_min, s_max)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        f = O - C
+        a = _dot(D, D)
+        b = _dot(f, D)
+        l = f - (b / a)[..., None] * D
+        delta = r * r - _dot(l, l)
+        sign = np.where(b >= 0, dtype.type(1), dtype.type(-1))
+        far = -(b + sign * np.sqrt(np.maximum(a * delta, 0))) / a
+        hit = (delta >= 0) & (far > s_min) & (far < s_max)
+    return _select(hit, far, s_max)
+
+
 def sphere_normal(P, C, r):
     """The outward unit normal at points P on the sphere."""
     return (np.asarray(P) - C) / r

@@ -30,48 +30,88 @@ import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import closest_hit as bvh_closest_hit
-from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, sphere_normal,
-                                          triangle_normal)
+from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, ray_sphere_from_surface,
+                                          sphere_normal, triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
 F32 = np.float32
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
+# Hits closer than this, relative, are a tie, kept by the surface found first (scene_hit; the
+# GLSL's TRACE_HIT_TIE): 64 eps32, above the few ulps by which the rounding of a triangle's
+# vertices and of the two intersection formulas moves a triangle lying in a plane off it.
+HIT_TIE = 2.0 ** -18
 
 
 def _dot(a, b):
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
-def scene_hit(rs, O, D, s_min, s_max):
+def leaving_s_min(O):
+    """s_min of a secondary or shadow ray (unit direction) from O: HIT_TIE |O|. A surface met
+    closer than that to the point the ray leaves ties with the surface it leaves (positions
+    are camera-relative, so |O| is the scale of their rounding), which keeps it."""
+    return O.dtype.type(HIT_TIE) * np.sqrt(_dot(O, O))
+
+
+def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
     """(kind, index, s, uv) of the nearest hit with s_min < s < s_max of rays O, D (R, 3):
     kind MISS/SPHERE/PLANE/TRIANGLE, index the sphere's, plane's or original triangle's, s the
     hit (s_max on a miss). In the dtype of O: float32, or float64 with the scene's float64
-    surfaces."""
+    surfaces. `from_shape` (R,): the analytic shape each ray starts on (shape_id; -1 for none),
+    met again only at a sphere's far side (ray_sphere_from_surface). Ties (HIT_TIE): a surface
+    replaces the nearest found so far only when nearer by more than HIT_TIE relative."""
     R, t = len(O), O.dtype.type
     s = np.broadcast_to(np.asarray(s_max, t), (R,)).astype(t)
+    s_min = np.broadcast_to(np.asarray(s_min, t), (R,))
+    limit = s.copy()
+    keep = t(1) - t(HIT_TIE)
+    from_shape = np.full(R, -1) if from_shape is None else from_shape
     kind = np.zeros(R, np.int64)
     index = np.full(R, -1, np.int64)
     uv = np.zeros((R, 2), t)
+
+    def found(hit, s_k, what, k):
+        nonlocal s, limit
+        s = np.where(hit, s_k, s)
+        limit = np.where(hit, s_k * keep, limit)
+        kind[hit], index[hit] = what, k
+
     for k in range(len(rs.sphere_radius)):
-        hit, s_k = ray_sphere(O, D, rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k]), t(s_min), s)
-        s = np.where(hit, s_k, s)
-        kind[hit], index[hit] = SPHERE, k
+        C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
+        hit, s_k = ray_sphere(O, D, C, r, s_min, limit)
+        on = from_shape == k
+        if on.any():
+            hit_on, s_on = ray_sphere_from_surface(O[on], D[on], C, r, s_min[on], limit[on])
+            hit[on], s_k[on] = hit_on, s_on
+        found(hit, s_k, SPHERE, k)
     for k in range(len(rs.plane_offset)):
-        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), t(s_min), s)
-        s = np.where(hit, s_k, s)
-        kind[hit], index[hit] = PLANE, k
+        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, limit)
+        found(hit & (from_shape != len(rs.sphere_radius) + k), s_k, PLANE, k)
     if rs.bvh is not None:
-        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, s,
+        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, limit,
                                               vertices=None if t is F32 else rs.triangles)
         s = np.where(hit, s_t, s)
         kind[hit], index[hit], uv[hit] = TRIANGLE, tri[hit], uv_t[hit]
     return kind, index, s, uv
 
 
-def occluded(rs, O, D, s_max):
-    """Whether anything is hit with 0 < s < s_max (a shadow ray)."""
-    return scene_hit(rs, O, D, 0.0, s_max)[0] != MISS
+def shape_id(rs, kind, index):
+    """The analytic shape of hits (kind, index), as from_shape: sphere k is k, plane k is
+    (number of spheres) + k; -1 for a triangle or a miss (the GLSL's g_shape)."""
+    return np.where(kind == SPHERE, index, np.where(kind == PLANE, len(rs.sphere_radius) + index, -1))
+
+
+def ray_origin(P, n, shape):
+    """Where a secondary or shadow ray leaving P on the side of n starts: P itself on an
+    analytic shape (scene_hit never meets it there again), else Waechter and Binder's offset."""
+    return np.where((shape >= 0)[:, None], P, offset_ray_origin(P, n))
+
+
+def occluded(rs, O, D, s_max, from_shape=None):
+    """Whether anything is hit with leaving_s_min(O) < s < s_max (a shadow ray from a point of
+    from_shape)."""
+    return scene_hit(rs, O, D, leaving_s_min(O), s_max, from_shape)[0] != MISS
 
 
 def surface(rs, O, D, kind, index, s, uv):
@@ -111,29 +151,30 @@ def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
                             rs.n[obj].astype(dtype)[:, None], specular=specular)
 
 
-def shadow_visibility(rs, lights: Lights, Ng, record=None):
-    """The visibility callable of lighting.py for hits with outward geometric normals Ng: one
-    shadow ray per point and light (the GLSL's light_visibility_directional / _point).
-    `record(needed, event)`, if given, hears each shadow ray's outcome (ray_tree_event)."""
+def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
+    """The visibility callable of lighting.py for hits with outward geometric normals Ng on
+    analytic shapes `shape` (shape_id): one shadow ray per point and light (the GLSL's
+    light_visibility_directional / _point). `record(needed, event)`, if given, hears each
+    shadow ray's outcome (ray_tree_event)."""
     t = Ng.dtype.type
 
     def visibility(kind, i, P, N, needed):
         blocked = np.zeros(len(P), bool)
-        P, n = P[needed], Ng[needed]
+        P, n, on = P[needed], Ng[needed], shape[needed]
         if kind == "directional":
             L = normalize(-lights.u_directional_direction[i])
             n = np.where((_dot(n, L) >= 0)[:, None], n, -n)
-            O = offset_ray_origin(P, n)
-            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf))
+            O = ray_origin(P, n, on)
+            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on)
         else:
             Q = lights.u_point_position[i]
             n = np.where((_dot(n, Q - P) >= 0)[:, None], n, -n)
-            O = offset_ray_origin(P, n)
+            O = ray_origin(P, n, on)
             to_light = Q - O
             d = np.sqrt(_dot(to_light, to_light))
             with np.errstate(divide="ignore", invalid="ignore"):
                 L = to_light / d[:, None]
-            blocked[needed] = occluded(rs, O, L, d) & (d > 0)
+            blocked[needed] = occluded(rs, O, L, d, on) & (d > 0)
         if record is not None:
             light = i if kind == "directional" else len(lights.u_directional_direction) + i
             record(blocked, ray_tree_event(SHADOW, light))
@@ -187,6 +228,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
     background = np.asarray(background, t)
     specular = rs.specular
     owner = np.arange(R)
+    from_shape = np.full(R, -1)
     path = np.full(R, ROOT_PATH, np.uint64)
     weight = np.ones((R, 3), t)
     first_hit, first_s = None, None
@@ -199,7 +241,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
     for depth in range(max_depth + 1):
         if not len(O):
             break
-        kind, index, s, uv = scene_hit(rs, O, D, lo, hi)
+        kind, index, s, uv = scene_hit(rs, O, D, lo, hi, from_shape)
         record(slice(None), ray_tree_event(kind, index))
         hit = kind != MISS
         if depth == 0:
@@ -208,11 +250,12 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         O, D, kind, index, s, uv, owner, path, weight = (
             a[hit] for a in (O, D, kind, index, s, uv, owner, path, weight))
         P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv)
+        shape = shape_id(rs, kind, index)
         Du = normalize(D)
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
         local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
-                         shadow_visibility(rs, lights, Ng, record) if shadows else None)
+                         shadow_visibility(rs, lights, Ng, shape, record) if shadows else None)
         np.add.at(colour, owner, weight * local)
         if depth == max_depth:
             break
@@ -228,10 +271,12 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         refracted, T = ray_refract(Du, N_in, eta)
         go_r = w_r.max(-1) >= RAY_WEIGHT_CUTOFF
         go_t = (w_t.max(-1) >= RAY_WEIGHT_CUTOFF) & refracted
-        O = np.concatenate([offset_ray_origin(P[go_r], Ng_in[go_r]), offset_ray_origin(P[go_t], -Ng_in[go_t])])
+        O = np.concatenate([ray_origin(P[go_r], Ng_in[go_r], shape[go_r]),
+                            ray_origin(P[go_t], -Ng_in[go_t], shape[go_t])])
         D = np.concatenate([ray_reflect(Du[go_r], N_in[go_r]), T[go_t]]).astype(t)
         owner = np.concatenate([owner[go_r], owner[go_t]])
+        from_shape = np.concatenate([shape[go_r], shape[go_t]])
         path = np.concatenate([mix64(path[go_r] ^ np.uint64(1)), mix64(path[go_t] ^ np.uint64(2))])
         weight = np.concatenate([w_r[go_r], w_t[go_t]])
-        lo, hi = t(0), t(np.inf)
+        lo, hi = leaving_s_min(O), t(np.inf)
     return colour, first_hit, first_s

@@ -203,6 +203,9 @@ def build_parser() -> argparse.ArgumentParser:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
+    extremes.add_argument("--method", choices=("both", "raster", "raytrace"), default="both",
+                          help="which cases: rasterised, ray traced (scene files named rt_*), or "
+                               "both (default)")
     for name in ("render", "view", "compare", "shaders", "report", "extremes"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
@@ -502,7 +505,8 @@ def cmd_extremes(args) -> int:
     try:
         for kind in kinds:
             contexts[kind] = make_context(kind)
-        cases = measure_extremes(extreme_scenes(extra), args.size, contexts)
+        methods = ("raster", "raytrace") if args.method == "both" else (args.method,)
+        cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods)
     finally:
         for ctx in contexts.values():
             release_context(ctx)

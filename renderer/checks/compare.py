@@ -5,6 +5,12 @@ intThresholdPositionDeviationCompare): a pixel passes when some pixel within ±N
 the other image matches within the threshold on every channel, checked both ways
 (GPU → reference and reference → GPU). That forgives an edge that moved by one pixel, which
 sub-pixel rounding may do, and nothing else.
+
+A second acceptable reference (`reference_tie`, and for depth `reference_tie_depth`) is
+accepted wherever it differs from the first: the rasteriser reference's rgba8_tie at depth
+ties, and for the ray tracer the float64 reference's colour and depth at grazing pixels, where
+the float32 and float64 references' ray trees differ (`grazing_ray_pixels`,
+`either_precision`; docs/conventions.md, "Grazing rays").
 """
 
 from __future__ import annotations

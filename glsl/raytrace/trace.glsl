@@ -75,8 +75,10 @@ int scene_hit(vec3 O, vec3 D, float s_min, float s_max, int from_shape,
     float s_k;
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        if (k == from_shape ? ray_sphere_from_surface(O, D, u_spheres[k].xyz, u_spheres[k].w, s_min, s_limit, s_k)
-                            : ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, s_min, s_limit, s_k)) {
+        vec3 C = u_spheres[k].xyz;
+        float r = u_spheres[k].w;
+        if (k == from_shape ? ray_sphere_from_surface(O, D, C, r, s_min, s_limit, s_k)
+                            : ray_sphere(O, D, C, r, s_min, s_limit, s_k)) {
             s = s_k; s_limit = s_k * (1.0 - TRACE_HIT_TIE); kind = TRACE_SPHERE; index = k;
         }
     }
@@ -143,8 +145,10 @@ bool occluded(vec3 O, vec3 D, float s_max, int from_shape) {
     float s_min = trace_s_min(O);
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        if (k == from_shape ? ray_sphere_from_surface(O, D, u_spheres[k].xyz, u_spheres[k].w, s_min, s_max, s_k)
-                            : ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, s_min, s_max, s_k)) return true;
+        vec3 C = u_spheres[k].xyz;
+        float r = u_spheres[k].w;
+        if (k == from_shape ? ray_sphere_from_surface(O, D, C, r, s_min, s_max, s_k)
+                            : ray_sphere(O, D, C, r, s_min, s_max, s_k)) return true;
     }
 #endif
 #if NUM_PLANES > 0

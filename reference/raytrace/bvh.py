@@ -1,12 +1,12 @@
 """# Twin: glsl/raytrace/bvh.glsl
 
 The closest hit of rays against the triangles of a BVH (renderer/core/bvh.py: the layout), in
-float32 as the GLSL (or float64, the ground truth), vectorised over rays: a wavefront of (ray, node) pairs, one level of the tree per step
-(no Python loop over rays or nodes). The ray-box test and the triangle test are the GLSL's
-(`ray_box` below; `ray_triangle` of intersect.py), so each pair decides as the GLSL does;
-the order differs (the GLSL goes depth first, nearer child first), which changes the answer
-only where two triangles are hit at the same s (an edge or vertex they share): either is the
-closest hit then.
+float32 as the GLSL (or float64, the ground truth), vectorised over rays: a wavefront of
+(ray, node) pairs, one level of the tree per step (no Python loop over rays or nodes). The
+ray-box test and the triangle test are the GLSL's (`ray_box` below; `ray_triangle` of
+intersect.py), so each pair decides as the GLSL does; the order differs (the GLSL goes depth
+first, nearer child first), which changes the answer only where two triangles are hit at the
+same s (an edge or vertex they share): either is the closest hit then.
 
 Ray-box (slab) test with 1/D precomputed, IEEE: 1/(+-0) = +-inf. An axis whose 1/D is
 infinite (D's component 0, or so small that 1/D overflows) is parallel to its slab: it admits
@@ -63,7 +63,8 @@ def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
     inside = (O >= bmin) & (O <= bmax)
     tn = np.where(parallel, np.where(inside, -inf, inf), tn)
     tf = np.where(parallel, np.where(inside, inf, -inf), tf)
-    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]), np.maximum(tn[..., 2], np.asarray(s_min, dtype)))
+    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]),
+                      np.maximum(tn[..., 2], np.asarray(s_min, dtype)))
     with np.errstate(over="ignore"):
         far = np.minimum(np.minimum(tf[..., 0], tf[..., 1]), tf[..., 2]) * _far_scale(dtype)
     far = np.minimum(far, np.asarray(s_max, dtype))
@@ -72,8 +73,8 @@ def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
 
 def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
-    s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v), and the triangle's
-    original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
+    s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v),
+    and the triangle's original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
     `vertices` (T, 3, 3), by original index, replace the BVH's float32 triangles (the float64
     twin passes the scene's float64 ones; the boxes are widened to hold them)."""
     dtype = _dtype(O)

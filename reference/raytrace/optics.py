@@ -18,10 +18,12 @@ RAY_OFFSET_INT_SCALE = np.float32(256.0)
 # float64: the same number of ulps (int_scale) and origin; near 0 the additive step shrinks
 # with the epsilon, 2^-16 eps64 / eps32 = 2^-45, so that it stays the same multiple of the
 # ulps of the points near 1/32 (float64 points need not move as far as float32 ones).
-_OFFSET = {np.dtype(np.float32): (np.int32, RAY_OFFSET_ORIGIN, RAY_OFFSET_FLOAT_SCALE, RAY_OFFSET_INT_SCALE),
-           np.dtype(np.float64): (np.int64, np.float64(RAY_OFFSET_ORIGIN),
-                                  np.float64(RAY_OFFSET_FLOAT_SCALE) * (np.finfo(np.float64).eps / np.finfo(np.float32).eps),
-                                  np.float64(RAY_OFFSET_INT_SCALE))}
+_EPS_RATIO = np.finfo(np.float64).eps / np.finfo(np.float32).eps          # 2^-29
+_OFFSET = {  # dtype: (its integer view, origin, float_scale, int_scale)
+    np.dtype(np.float32): (np.int32, RAY_OFFSET_ORIGIN, RAY_OFFSET_FLOAT_SCALE, RAY_OFFSET_INT_SCALE),
+    np.dtype(np.float64): (np.int64, np.float64(RAY_OFFSET_ORIGIN),
+                           np.float64(RAY_OFFSET_FLOAT_SCALE) * _EPS_RATIO, np.float64(RAY_OFFSET_INT_SCALE)),
+}
 
 
 def _float_dtype(*arrays) -> np.dtype:

@@ -1,8 +1,8 @@
 """# Twin: glsl/raytrace/trace.glsl
 
 The ray tracer proper (docs/conventions.md, "Rays", "Tracing"), in float32 as the GLSL (or in
-float64, the ground truth: the dtype of the rays given), vectorised over rays: a wavefront per bounce (every ray of one depth at once), no Python loop
-over pixels or rays.
+float64, the ground truth: the dtype of the rays given), vectorised over rays: a wavefront per
+bounce (every ray of one depth at once), no Python loop over pixels or rays.
 
 - closest hit: the analytic spheres, then the planes (intersect.py), then the scene's triangles
   through its BVH (bvh.py) with s_max the nearest hit so far;
@@ -30,8 +30,8 @@ import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import closest_hit as bvh_closest_hit
-from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, ray_sphere_from_surface,
-                                          sphere_normal, triangle_normal)
+from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere,
+                                          ray_sphere_from_surface, sphere_normal, triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
@@ -125,7 +125,8 @@ def surface(rs, O, D, kind, index, s, uv):
     m = kind == SPHERE
     if m.any():
         k = index[m]
-        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(t), rs.sphere_radius[k].astype(t)[:, None])
+        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(t),
+                              rs.sphere_radius[k].astype(t)[:, None])
         Ns[m] = Ng[m]
         obj[m] = rs.sphere_object[k]
     m = kind == PLANE

@@ -194,7 +194,8 @@ def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: d
         method = "raytrace" if is_ray_traced(name) else "raster"
         if method not in methods:
             continue
-        base = {"case": name, "file": str(path), "method": method, "stability": STABILITY.get(name, "")}
+        base = {"case": name, "file": str(path), "method": method,
+                "stability": STABILITY.get(name, "")}
         try:
             scene = load_scene(path)
         except SceneError as error:
@@ -266,8 +267,8 @@ def markdown_table(cases: list[dict], size: tuple[int, int]) -> str:
             ("yes" if case["passes"] else "no (expected)")
         ties = case["grazing_pixels"] if case["method"] == "raytrace" else case["tie_pixels"]
         lines.append(
-            f"| {case['case']} | {case['method']} | {case['tests']} | {finite} | {worst['mismatched_pixels']} "
-            f"| {worst['raw_mismatched_fraction']:.4f} | {ties} "
+            f"| {case['case']} | {case['method']} | {case['tests']} | {finite} "
+            f"| {worst['mismatched_pixels']} | {worst['raw_mismatched_fraction']:.4f} | {ties} "
             f"| {truth['rmse']:.3f} / {truth['max_abs']} "
             f"| {worst['depth_max_rel']:.2e} | {verdict} | {case['stability']} |")
     return "\n".join(lines) + "\n"

@@ -216,3 +216,29 @@ def test_command_line_end_to_end(tmp_path, capsys):
     assert main(["compare", str(path), "--methods", "--size", "8x8", "--out", str(tmp_path / "no")]) == 2
     assert "radius" in capsys.readouterr().err
     assert not (tmp_path / "no").exists()
+
+
+def test_notes_name_the_known_differences_a_scene_has():
+    """The parallel projection's viewer where some material has a highlight; the shadow
+    terminator where some smooth-shaded mesh is in a scene with shadow pixels."""
+    from renderer.checks.methods import PARALLEL_VIEWER, SHADOW_TERMINATOR, notes
+    meshes = scene_from_dict(MESHES)
+    assert notes(meshes, {"shadows": 1}) == [SHADOW_TERMINATOR]
+    assert notes(meshes, {"shadows": 0}) == []
+    parallel = json.loads(json.dumps(MESHES))
+    parallel["camera"] |= {"projection": "parallel", "height": 3.0}
+    assert notes(scene_from_dict(parallel), {"shadows": 0}) == [PARALLEL_VIEWER]
+    shapes = scene([BALL_ABOVE_FLOOR, FLOOR], MATERIALS, [FROM_ABOVE])
+    assert notes(shapes, {"shadows": 1}) == []
+
+
+@pytest.mark.parametrize("ks", [0.0, 0.8])
+def test_a_parallel_projection_s_highlights_differ(gl_contexts, ks):
+    """PARALLEL_VIEWER holds: a plane seen in a parallel projection, lit from above: without
+    a highlight the two methods agree on every pixel, with one they do not."""
+    s = scene_from_dict({"camera": {"eye": [0, 2, 3], "look": [0, 0, 0], "projection": "parallel", "height": 2.0},
+                         "materials": {"floor": {"kd": [0.5, 0.5, 0.5], "ks": [ks] * 3, "n": 4.0}},
+                         "lights": [{"type": "directional", "direction": [0, -1, -0.3]}], "objects": [FLOOR]})
+    counts = compare_methods(s, W, H, context=gl_contexts["egl"]).counts()
+    assert (counts["tessellation"] > 100) == (ks > 0)
+    assert sum(counts.values()) == counts["tessellation"]

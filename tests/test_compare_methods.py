@@ -115,6 +115,7 @@ def test_a_sphere_above_a_plane_lit_from_above_shadows_the_plane_under_it(gl_con
     counts = result.counts()
     assert counts["reflection"] == counts["shading"] == counts["sampling"] == 0
     assert counts["shadows"] == result.as_dict()["differing_pixels"] - counts["edges"] - counts["tessellation"]
+    assert result.renders == 3          # raster, centre, shadows: the other steps change nothing here
 
 
 def test_a_mirror_sphere_differs_by_reflection_on_the_sphere_only(gl_contexts):
@@ -131,6 +132,7 @@ def test_a_mirror_sphere_differs_by_reflection_on_the_sphere_only(gl_contexts):
     assert not (reflection & ~on_ball).any()
     assert reflection.sum() >= 0.9 * on_ball.sum()
     assert result.counts()["shadows"] == 0
+    assert result.renders == 3          # raster, centre, raytrace
 
 
 MESHES = {"ambient": [0.1, 0.1, 0.1], "camera": {"eye": [0.3, 0.5, 3.5], "look": [0, 0, 0], "fov_y": 40.0},

@@ -103,7 +103,7 @@ def build_parser() -> argparse.ArgumentParser:
                        help="headless GL context (default: EGL, then OSMesa)")
 
     def raytrace_options(p):
-        p.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+        p.add_argument("--method", choices=("raster", "raytrace"),
                        help="raster (default): the rasteriser; raytrace: the ray tracer (shadows, "
                             "reflection, refraction; docs/conventions.md, \"Rays\")")
         p.add_argument("--spp", type=positive_int, default=1, metavar="N",
@@ -159,11 +159,17 @@ def build_parser() -> argparse.ArgumentParser:
                     "reference.png and diff.png, and print the figures as one JSON object. "
                     "Exit status: 0 when the two agree within the pipeline tolerance "
                     f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
-                    "(what fails is said on stderr), 2 for bad input.")
+                    "(what fails is said on stderr), 2 for bad input. With --methods: the "
+                    "rasteriser against the ray tracer instead, status 0.")
     common(compare)
     raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
+    compare.add_argument("--methods", action="store_true",
+                         help="the rasteriser against the ray tracer (--spp, --pattern, --max-depth, "
+                              "--seed), both on the GPU: where they differ and why (shadows, "
+                              "reflection, edges, tessellation, ...); writes raster.png, raytrace.png, "
+                              "causes.png and methods.json (default folder: compare-methods-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
                          metavar="LEVELS",
                          help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
@@ -237,12 +243,20 @@ def _load(scene_arg):
 
 
 def check_raytrace_options(args) -> None:
-    if args.method == "raster" and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
+    """Refuses what does not go together; --method's default (raster) is set here, so that
+    `compare --methods` can refuse a --method given."""
+    methods = getattr(args, "methods", False)
+    if methods and args.method is not None:
+        args.parser.error(f"--methods renders both methods; leave out --method {args.method}")
+    args.method = args.method or "raster"
+    traced = methods or args.method == "raytrace"
+    if not traced and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
                                     or args.seed is not None):
-        args.parser.error("--spp, --pattern, --max-depth and --seed are for --method raytrace")
+        also = " or --methods" if hasattr(args, "methods") else ""
+        args.parser.error(f"--spp, --pattern, --max-depth and --seed are for --method raytrace{also}")
     if not 0 <= args.max_depth <= 16:
         args.parser.error(f"--max-depth must be between 0 and 16, got {args.max_depth}")
-    if args.method == "raytrace":
+    if traced:
         from renderer.core.sampling import pattern
         try:
             pattern(args.pattern, args.spp, **({} if args.seed is None else {"seed": args.seed}))
@@ -375,6 +389,31 @@ def cmd_view(args) -> int:
     return 0
 
 
+def cmd_compare_methods(args) -> int:
+    """`compare --methods` (from cmd_compare, its options checked): the table on stdout, its
+    figures and images in --out; status 0 (an explanation, not a check)."""
+    from renderer.checks.methods import cause_image, compare_methods
+    from renderer.core.imageio import check_folder, check_outputs, outputs
+    from renderer.core.jsonio import json_text
+    from renderer.core.paths import output_stem
+    scene = _load(args.scene)
+    check_memory(scene, args.size, ["gpu"])
+    check_raytrace_memory(scene, args.size, ["gpu"], args.spp)
+    out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
+    names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
+    check_outputs(*names)
+    result = compare_methods(scene, *args.size, context_kind=args.context, threshold=args.threshold,
+                             **_raytrace_options(args))
+    warn_if_nothing_drawn(scene, result.raytrace)
+    with outputs(*names) as written:             # all four or none
+        written.png(names[0], result.raster.image())
+        written.png(names[1], result.raytrace.image())
+        written.png(names[2], cause_image(result.causes, result.raytrace.rgba8))
+        written.text(names[3], json_text(result.as_dict()))
+    print(result.table())
+    return 0
+
+
 def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
@@ -384,6 +423,8 @@ def cmd_compare(args) -> int:
     if args.out is not None:
         check_folder(args.out)
     check_raytrace_options(args)
+    if args.methods:
+        return cmd_compare_methods(args)
     scene = _load(args.scene)
     if args.method == "raytrace":
         check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)

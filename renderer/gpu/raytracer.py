@@ -8,8 +8,11 @@ GL resources are made once in the constructor: the program, specialised by #defi
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
 MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, NUM_SAMPLES);
 the uniforms (camera rays from renderer/core/camera_rays.py, lights from renderer/core/
-uniforms.py, shapes, sample offsets); the materials, the BVH (renderer/gpu/bvh.py) and the
-triangles' vertices and normals as float textures.
+uniforms.py, shapes, sample offsets); the materials, the BVH (nodes and triangles, `texels`
+of renderer/core/bvh.py's layout, as renderer/gpu/bvh.py) and the triangles' vertices and
+normals as float textures. A viewer moving the camera calls update() (and resize()), which
+keeps all of them and writes new contents: the same image as a RayTracer made afresh, without
+the BVH build or (unless the light counts changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
@@ -34,7 +37,6 @@ from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import light_uniforms
-from renderer.gpu.bvh import bvh_textures
 from renderer.gpu.context import activate, context_kind, make_context, release_context
 from renderer.gpu.shaders import shader_source
 
@@ -82,10 +84,26 @@ class RayTracer:
             raise
 
     def _build(self) -> None:
-        ctx, scene = self.ctx, self.scene
-        rs = self.ray_scene = ray_scene(scene)
-        every = not self.specialise
-        self.defines = {
+        ctx = self.ctx
+        rs = self.ray_scene = ray_scene(self.scene)
+        self._surfaces = self._surfaces_now()
+        self.defines = self._defines(rs)
+        self._compile()
+        self._textures, self._units = [], {}          # (unit, texture); sampler -> unit
+        for unit, (name, array) in enumerate(self._texture_arrays(rs).items()):
+            texture = _texture(ctx, array)
+            self._resources.append(texture)
+            self._textures.append((unit, texture))
+            self._units[name] = unit
+        self._write_uniforms(rs)
+        self._build_targets()
+        self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
+                         "GL_VERSION": ctx.info["GL_VERSION"],
+                         "context": context_kind(ctx)}
+
+    def _defines(self, rs) -> dict:
+        scene, every = self.scene, not self.specialise
+        return {
             "NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
             "NUM_POINT_LIGHTS": len(scene.point_lights),
             "SPECULAR": rs.specular or every,
@@ -98,11 +116,24 @@ class RayTracer:
             "MAX_DEPTH": self.max_depth,
             "NUM_SAMPLES": len(self.offsets),
         }
-        self.program = ctx.program(
+
+    def _compile(self) -> None:
+        """The program for self.defines and its vertex array (those of before released)."""
+        for name in ("_vao", "program"):
+            old = getattr(self, name, None)
+            if old is not None:
+                self._resources.remove(old)
+                old.release()
+        self.program = self.ctx.program(
             vertex_shader=shader_source("raytrace/fullscreen.vert").text,
             fragment_shader=shader_source("raytrace/raytrace.frag", self.defines).text)
         self._resources.append(self.program)
-        program = self.program
+        self._vao = self.ctx.vertex_array(self.program, [])
+        self._resources.append(self._vao)
+
+    def _write_uniforms(self, rs) -> None:
+        """Camera rays, lights, shapes and sample offsets; the textures' units."""
+        scene, program = self.scene, self.program
         matrices = scene.matrices(self.width, self.height)
         rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
         values = {name: to_glsl(value) for name, value in rays.items()}
@@ -122,37 +153,86 @@ class RayTracer:
         for name, value in values.items():
             if name in program:
                 program[name].write(value)
+        for name, unit in self._units.items():
+            if name in program:
+                program[name].value = unit
+
+    def _texture_arrays(self, rs) -> dict:
+        """The float textures' contents by sampler name (`texels` lays them out)."""
         zero = np.zeros((len(rs.n), 1))
         materials = np.stack([np.concatenate(part, 1) for part in (
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
             (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
-        textures = {"u_materials": _texture(ctx, materials)}
+        arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object
             bvh = rs.bvh
             if bvh is None:                           # all features, no triangles: a placeholder
                 triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
                 bvh = build_bvh(triangles)
-            textures["u_nodes"], textures["u_triangles"] = bvh_textures(ctx, bvh)
+            arrays["u_nodes"], arrays["u_triangles"] = bvh.nodes, bvh.triangles
             data = np.zeros((len(triangles), 6, 4))
             data[:, :3, :3] = triangles
             data[:, 3:, :3] = normals
             data[:, 3, 3] = owner
-            textures["u_triangle_data"] = _texture(ctx, data)
-        self._textures = []
-        for unit, (name, texture) in enumerate(textures.items()):
-            self._resources.append(texture)
-            self._textures.append((unit, texture))
-            if name in program:
-                program[name].value = unit
+            arrays["u_triangle_data"] = data
+        return arrays
+
+    def _build_targets(self) -> None:
+        """The framebuffer at the image size and its float targets (self._targets)."""
+        ctx = self.ctx
         self._colour = ctx.texture((self.width, self.height), 4, dtype="f4")
         self._depth = ctx.texture((self.width, self.height), 1, dtype="f4")
-        self._fbo = ctx.framebuffer([self._colour, self._depth])
-        self._vao = ctx.vertex_array(program, [])
-        self._resources += [self._colour, self._depth, self._fbo, self._vao]
-        self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
-                         "GL_VERSION": ctx.info["GL_VERSION"],
-                         "context": context_kind(ctx)}
+        self._targets = [self._colour, self._depth]
+        self._fbo = ctx.framebuffer(self._targets)
+        self._resources += [*self._targets, self._fbo]
+
+    # -- a viewer's changes ------------------------------------------------------------------
+    def update(self) -> None:
+        """Take the scene again after its camera, lights or materials changed in place (a
+        viewer's orbit and keys; its objects, meshes and shapes must be the ones this tracer
+        was made with): the image is then, bit for bit, that of a RayTracer made afresh for
+        the scene. Cheaper: the BVH's tree is kept and only refitted to the triangles relative
+        to the new eye (renderer/core/raytrace_scene.py), the textures are written again in
+        place, and the program is compiled again only when its #defines changed (a light
+        switched on or off)."""
+        if self._released:
+            raise RuntimeError("this RayTracer was released")
+        now = self._surfaces_now()
+        if len(now) != len(self._surfaces) or any(
+                a is not b for old, new in zip(self._surfaces, now) for a, b in zip(old, new)):
+            raise ValueError("the scene's objects changed since this RayTracer was made; "
+                             "make a new one")
+        check_light_count(self.scene)
+        activate(self.ctx)
+        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh)
+        defines = self._defines(rs)
+        if defines != self.defines:
+            self.defines = defines
+            self._compile()
+        for (_, texture), array in zip(self._textures, self._texture_arrays(rs).values()):
+            texture.write(texels(array).tobytes())
+        self._write_uniforms(rs)
+
+    def _surfaces_now(self) -> list[tuple]:
+        """What update() must find unchanged: each object, its mesh and its shape (identity)."""
+        return [(obj, obj.mesh, obj.shape) for obj in self.scene.objects]
+
+    def resize(self, width: int, height: int) -> None:
+        """Trace at another size from now on (a viewer's window was resized): the targets are
+        made again and update() recomputes the camera rays."""
+        width, height = int(width), int(height)
+        if width < 1 or height < 1:
+            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        if (width, height) == (self.width, self.height):
+            return
+        activate(self.ctx)
+        for thing in (self._fbo, *self._targets):
+            self._resources.remove(thing)
+            thing.release()
+        self.width, self.height = width, height
+        self._build_targets()
+        self.update()
 
     @property
     def gl_info(self) -> dict:

@@ -152,6 +152,9 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--triple-buffering", action="store_true",
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
+    view.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+                      help="start with the rasteriser (default) or the ray tracer, which refines "
+                           "while the view is still, one sample per pixel a frame (the M key)")
 
     compare = sub.add_parser(
         "compare", help="render through the GPU and the reference and compare",
@@ -344,6 +347,8 @@ def cmd_view(args) -> int:
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     check_memory(scene, args.size, ["gpu"])
+    if args.method == "raytrace":
+        check_raytrace_memory(scene, args.size, ["gpu"], 1)
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
@@ -352,24 +357,27 @@ def cmd_view(args) -> int:
     check_outputs(args.screenshot, args.stats if scripted else None)
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,
-                screenshot=None if scripted else args.screenshot) as viewer:
+                screenshot=None if scripted else args.screenshot, method=args.method) as viewer:
         if not scripted:
             print(f"renderer view: {scene.name}; H for help, Esc to quit")
         try:
             stats = viewer.run(args.frames, args.orbit, None)     # the screenshot: below, with --stats
         except KeyboardInterrupt:              # Ctrl-C in the terminal: as good as Esc
             return 0
-        figures = viewer.figures
+        figures, samples = viewer.figures, viewer.samples
         shown = viewer.shown_image() if scripted and args.screenshot is not None else None
     if scripted:
         with outputs(args.screenshot, args.stats) as out:    # both or neither
             if shown is not None:
                 out.image(args.screenshot, shown)
             if args.stats is not None:
-                out.text(args.stats, json_text(stats.summary() | {"reference": figures}))
+                out.text(args.stats, json_text(stats.summary() | {"reference": figures,
+                                                                  "raytrace_spp": samples}))
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
+        if samples is not None:
+            print(f"ray tracing: {samples} spp")
         if args.screenshot is not None:
             print(f"wrote {args.screenshot}")
     return 0

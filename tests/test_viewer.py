@@ -364,3 +364,50 @@ def test_the_reference_is_asked_again_only_for_a_new_image(on_x_display):
         viewer.frame()
         assert viewer.figures is None                 # none yet for the view on the screen
         assert viewer.background.wait(timeout=60) is not None
+
+
+# -- the ray tracer: progressive refinement ------------------------------------------------------
+def test_ray_tracing_refines_while_still_and_starts_again_when_the_camera_moves(on_x_display):
+    """M (or method="raytrace") traces one sample per pixel a frame into the running mean;
+    the window shows the mean, the title counts its samples (up to the cap: one sample where
+    RayTracer.render has no first_sample), a camera move starts again, and the first sample
+    of a view is the headless RayTracer's frame."""
+    from renderer.gpu.raytracer import RayTracer
+    from renderer.viewer.progressive import CAP, PATTERN, SAMPLES_PER_FRAME
+    messages = []
+    with Viewer(scene("coloured_lights"), *SIZE, vsync=False, method="raytrace",
+                on_message=messages.append) as viewer:
+        viewer.run(frames=3)
+        assert viewer.samples == min(3, CAP)
+        assert f"ray tracing: {viewer.samples} spp" in viewer.title()
+        assert (viewer.shown_image() == viewer.accumulator.rgba8[..., :3]).all()
+        assert any(line.startswith("ray tracer ready") for line in messages)
+
+        viewer.run(frames=2, orbit=10.0)                  # moving: one sample, the new view's
+        assert viewer.samples == 1 and viewer.idle == (CAP == 1)
+        shown = viewer.shown_image()
+        moved = replace(scene("coloured_lights"), camera=viewer.orbit.camera)
+        with RayTracer(moved, *SIZE, samples=SAMPLES_PER_FRAME, pattern=PATTERN) as tracer:
+            assert (shown == tracer.render().rgba8[..., :3]).all()
+
+        press(viewer, glfw.KEY_M)                         # the rasteriser, the same view
+        assert_matches(shown_after_a_frame(viewer), headless(moved))
+        assert viewer.samples is None and "ray tracing" not in viewer.title()
+        press(viewer, glfw.KEY_M)                         # back: the mean goes on
+        viewer.frame()
+        assert viewer.samples == min(2, CAP)
+        tracer = viewer._tracer
+    assert tracer._released                               # closed with the viewer
+
+
+def test_scripted_ray_tracing_from_the_command_line(x_display, tmp_path, cli):
+    from renderer.viewer.progressive import CAP
+    shot, stats = tmp_path / "shot.png", tmp_path / "stats.json"
+    result = cli("view", "sphere", "--size", "80x60", "--method", "raytrace", "--frames", "4",
+                 "--reference", "difference", "--screenshot", str(shot), "--stats", str(stats),
+                 display=x_display)
+    assert result.returncode == 0, result.stderr
+    assert f"ray tracing: {min(4, CAP)} spp" in result.stdout.splitlines()
+    summary = json.loads(stats.read_text())
+    assert summary["raytrace_spp"] == min(4, CAP) and summary["reference"] is None
+    assert read_png(shot).shape[:2] == (60, 80)

@@ -111,6 +111,10 @@ class Window:
     def poll(self) -> None:
         glfw.poll_events()
 
+    def wait(self, timeout: float) -> None:
+        """Sleep until an event comes or `timeout` seconds pass (an idle viewer)."""
+        glfw.wait_events_timeout(timeout)
+
     def swap(self) -> None:
         activate(self.ctx)                 # a headless context may have been bound meanwhile
         glfw.swap_buffers(self._handle)

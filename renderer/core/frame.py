@@ -12,6 +12,14 @@ import numpy as np
 BACKGROUNDS = ("opaque", "transparent")
 
 
+def image_size(width, height) -> tuple[int, int]:
+    """(width, height) as ints, each at least 1 pixel, or a ValueError: the size a renderer
+    is made or resized at."""
+    if int(width) < 1 or int(height) < 1:
+        raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+    return int(width), int(height)
+
+
 @dataclass
 class Frame:
     """One rendered image. Row 0 is the top row in every array (docs/conventions.md).

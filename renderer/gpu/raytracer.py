@@ -30,7 +30,7 @@ import numpy as np
 
 from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
-from renderer.core.frame import Frame
+from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
@@ -59,15 +59,14 @@ class RayTracer:
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
                  seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True):
-        if int(width) < 1 or int(height) < 1:
-            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        width, height = image_size(width, height)
         if not 1 <= int(samples) <= MAX_SAMPLES:
             raise ValueError(f"samples must be between 1 and {MAX_SAMPLES}, got {samples}")
         if not 0 <= int(max_depth) <= 16:
             raise ValueError(f"max_depth must be between 0 and 16, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
-        self.width, self.height = int(width), int(height)
+        self.width, self.height = width, height
         self.offsets = np.asarray(sample_pattern(pattern, int(samples), seed), np.float32)
         self.max_depth = int(max_depth)
         self.shadows = bool(shadows)
@@ -221,9 +220,7 @@ class RayTracer:
     def resize(self, width: int, height: int) -> None:
         """Trace at another size from now on (a viewer's window was resized): the targets are
         made again and update() recomputes the camera rays."""
-        width, height = int(width), int(height)
-        if width < 1 or height < 1:
-            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        width, height = image_size(width, height)
         if (width, height) == (self.width, self.height):
             return
         activate(self.ctx)

@@ -4,9 +4,9 @@
 // [-0.5, 0.5)^2, bit for bit the twin's. SAMPLE_TABLE (regular, poisson): u_sample_offsets[k],
 // the same in every pixel and frame. Otherwise stratified (random: one 1 x 1 cell; jittered;
 // adaptive's two sets): samples k < FIRST_SAMPLES in cell k of a FIRST_COLUMNS x FIRST_ROWS
-// grid, the others in cell k - FIRST_SAMPLES of a REST_COLUMNS x REST_ROWS grid, row by row,
-// placed in the cell by the PCG numbers of (pixel, sample index u_first_sample + k, bounce 0,
-// u_seed), dimension 0 for x and 1 for y.
+// grid, the others in cell k - FIRST_SAMPLES of a REST_COLUMNS x REST_ROWS grid (row by row,
+// the cell number modulo the grid's cells), placed in the cell by the PCG numbers of (pixel,
+// sample index u_first_sample + k, bounce 0, u_seed), dimension 0 for x and 1 for y.
 #include "raytrace/random.glsl"
 
 #ifndef NUM_SAMPLES
@@ -42,6 +42,7 @@ vec2 sample_offset(uvec2 pixel, int k) {
         j -= uint(FIRST_SAMPLES);
         grid = uvec2(REST_COLUMNS, REST_ROWS);
     }
+    j %= grid.x * grid.y;                  // random: every sample in the one 1 x 1 cell
     uint stream = random_stream(pixel.x, pixel.y, u_first_sample + uint(k), 0u, u_seed);
     return vec2(stratum_offset(random_uint(stream, 0u), j % grid.x, grid.x),
                 stratum_offset(random_uint(stream, 1u), j / grid.x, grid.y));

@@ -6,7 +6,7 @@ the rule's constants: renderer/core/ray_sampling.py), vectorised over pixels: th
 
 A table pattern (regular, poisson) gives offset k of its table. A stratified one (random,
 jittered, adaptive) puts sample k in a cell (a, b) of a columns x rows grid (row by row:
-a = j mod columns, b = j div columns, j = k or k - first_set) and in the cell at the uniform
+a = j mod columns, b = j div columns, j = k or k - first_set, modulo columns x rows) and in the cell at the uniform
 numbers h0, h1 (random_uint of random_stream(x, y, first_sample + k, 0, seed), dimensions 0
 and 1), each coordinate by `stratum_offset`: 24-bit fixed point by integer division, exact
 in both twins.
@@ -45,6 +45,7 @@ def sample_offset(x, y, k: int, first_sample: int, sampling) -> np.ndarray:
     j, (columns, rows) = k, sampling.first_strata
     if k >= sampling.first_set:
         j, (columns, rows) = k - sampling.first_set, sampling.rest_strata
+    j %= columns * rows                      # random: every sample in the one 1 x 1 cell
     stream = random_stream(x, y, first_sample + k, 0, sampling.seed)
     return np.stack([stratum_offset(random_uint(stream, 0), j % columns, columns),
                      stratum_offset(random_uint(stream, 1), j // columns, rows)], axis=-1)

@@ -37,6 +37,8 @@ class Frame:
     gl_info: for a GPU frame, the GL implementation that drew it (GpuRenderer.gl_info:
             GL_VENDOR, GL_RENDERER, GL_VERSION, context, depth_format); None from the
             reference. Golden tests record it beside each golden.
+    samples: from the ray tracer (either twin), (H, W) int32 camera rays traced per pixel:
+            N everywhere but with the adaptive pattern; None from the rasteriser.
     """
     rgba8: np.ndarray
     linear: np.ndarray | None = None
@@ -44,6 +46,7 @@ class Frame:
     milliseconds: float = 0.0
     rgba8_tie: np.ndarray | None = None
     gl_info: dict | None = None
+    samples: np.ndarray | None = None
 
     def image(self, background: str = "opaque") -> np.ndarray:
         """The pixels an image file of this frame holds: (H, W, 3) for an opaque background,

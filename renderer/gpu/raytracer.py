@@ -1,18 +1,21 @@
 """The GPU ray tracer (glsl/raytrace/raytrace.frag and trace.glsl; twin: reference/raytrace/
 pipeline.py): one full-screen pass that traces every sample of every pixel (the samples looped
-in the shader), into a float colour target (average linear colour, coverage) and a float depth
-target (the view depth of the nearest first hit), read back row 0 at the top; rgba8 is
-gl_rules.to_unorm8 of the clamped linear colour, alpha 255 where a camera ray hit.
+in the shader, placed by glsl/raytrace/sampling.glsl), into a float colour target (average
+linear colour, coverage), a float depth target (the view depth of the nearest first hit) and,
+for the adaptive pattern, a float target of the samples traced per pixel, read back row 0 at
+the top; rgba8 is gl_rules.to_unorm8 of the clamped linear colour, alpha 255 where a camera ray
+hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, no recompile).
 
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
-MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, NUM_SAMPLES);
-the uniforms (camera rays from renderer/core/camera_rays.py, lights from renderer/core/
-uniforms.py, shapes, sample offsets); the materials, the BVH (nodes and triangles, `texels`
-of renderer/core/bvh.py's layout, as renderer/gpu/bvh.py) and the triangles' vertices and
-normals as float textures. A viewer moving the camera calls update() (and resize()), which
-keeps all of them and writes new contents: the same image as a RayTracer made afresh, without
-the BVH build or (unless the light counts changed) the compile.
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, and the sample
+pattern's constants from renderer/core/ray_sampling.py); the uniforms (camera rays from
+renderer/core/camera_rays.py, lights from renderer/core/uniforms.py, shapes, the pattern's); the
+materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
+renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
+the camera calls update() (and resize()), which keeps all of them and writes new contents: the
+same image as a RayTracer made afresh, without the BVH build or (unless the light counts
+changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
@@ -32,8 +35,9 @@ from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
+from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
-from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
+from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import light_uniforms
@@ -41,7 +45,6 @@ from renderer.gpu.context import activate, context_kind, make_context, release_c
 from renderer.gpu.shaders import shader_source
 
 DEFAULT_MAX_DEPTH = 4
-MAX_SAMPLES = 256
 
 
 def _texture(ctx, array):
@@ -58,16 +61,15 @@ class RayTracer:
     def __init__(self, scene: Scene, width: int, height: int, *,
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
-                 seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True):
+                 seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True,
+                 adaptive_threshold: float | None = None):
         width, height = image_size(width, height)
-        if not 1 <= int(samples) <= MAX_SAMPLES:
-            raise ValueError(f"samples must be between 1 and {MAX_SAMPLES}, got {samples}")
         if not 0 <= int(max_depth) <= 16:
             raise ValueError(f"max_depth must be between 0 and 16, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
         self.width, self.height = width, height
-        self.offsets = np.asarray(sample_pattern(pattern, int(samples), seed), np.float32)
+        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
         self.max_depth = int(max_depth)
         self.shadows = bool(shadows)
         self.specialise = bool(specialise)
@@ -113,7 +115,7 @@ class RayTracer:
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
-            "NUM_SAMPLES": len(self.offsets),
+            **self.sampling.defines(),
         }
 
     def _compile(self) -> None:
@@ -131,7 +133,7 @@ class RayTracer:
         self._resources.append(self._vao)
 
     def _write_uniforms(self, rs) -> None:
-        """Camera rays, lights, shapes and sample offsets; the textures' units."""
+        """Camera rays, lights, shapes and the sample pattern; the textures' units."""
         scene, program = self.scene, self.program
         matrices = scene.matrices(self.width, self.height)
         rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
@@ -142,7 +144,7 @@ class RayTracer:
         values["u_background"] = np.asarray(scene.background, np.float32).tobytes()
         values["u_near"] = np.float32(scene.camera.near).tobytes()
         values["u_far"] = np.float32(scene.camera.far).tobytes()
-        values["u_sample_offsets"] = self.offsets.tobytes()
+        values.update({name: value.tobytes() for name, value in self.sampling.uniforms().items()})
         if len(rs.sphere_radius):
             values["u_spheres"] = np.concatenate([rs.sphere_centre, rs.sphere_radius[:, None]], 1).astype(np.float32).tobytes()
             values["u_sphere_object"] = rs.sphere_object.astype(np.int32).tobytes()
@@ -183,6 +185,8 @@ class RayTracer:
         self._colour = ctx.texture((self.width, self.height), 4, dtype="f4")
         self._depth = ctx.texture((self.width, self.height), 1, dtype="f4")
         self._targets = [self._colour, self._depth]
+        if self.sampling.adaptive:                    # the samples traced per pixel
+            self._targets.append(ctx.texture((self.width, self.height), 1, dtype="f4"))
         self._fbo = ctx.framebuffer(self._targets)
         self._resources += [*self._targets, self._fbo]
 
@@ -235,13 +239,17 @@ class RayTracer:
     def gl_info(self) -> dict:
         return dict(self._gl_info)
 
-    def render(self) -> Frame:
-        """Trace the frame: rgba8, linear (average linear colour, alpha the coverage) and
-        depth, row 0 at the top."""
+    def render(self, first_sample: int = 0) -> Frame:
+        """Trace the frame of sample indices first_sample .. first_sample + N - 1: rgba8,
+        linear (average linear colour, alpha the coverage), depth and samples (traced per
+        pixel), row 0 at the top."""
         if self._released:
             raise RuntimeError("this RayTracer was released")
+        first_sample = check_first_sample(first_sample, self.sampling.samples)
         start = time.perf_counter()
         activate(self.ctx)
+        if "u_first_sample" in self.program:
+            self.program["u_first_sample"].value = first_sample
         for unit, texture in self._textures:
             texture.use(unit)
         self._fbo.use()
@@ -252,9 +260,15 @@ class RayTracer:
         depth = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="f4"), np.float32).reshape(h, w)
         linear = np.ascontiguousarray(linear[::-1])
         depth = np.ascontiguousarray(depth[::-1])
+        if self.sampling.adaptive:
+            traced = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), np.float32)
+            samples = np.ascontiguousarray(traced.reshape(h, w)[::-1]).astype(np.int32)
+        else:
+            samples = np.full((h, w), self.sampling.samples, np.int32)
         rgba8 = to_unorm8(linear)
         rgba8[..., 3] = np.where(linear[..., 3] > 0, 255, 0)
-        return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info)
+        return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info,
+                     samples=samples)
 
     def release(self) -> None:
         """Free every GL object; the context too if this tracer made it. Idempotent."""

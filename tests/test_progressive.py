@@ -1,8 +1,7 @@
 """renderer/viewer/progressive.py: the viewer's running mean of ray-traced frames, fed frames by
-hand and by a stand-in tracer (no GL): the mean of linear colour weighted by samples, coverage
+hand and by a stand-in tracer, and one-sample frames of a RayTracer against its frame of all
+those samples (EGL): the mean of linear colour weighted by samples, coverage
 where any sample hit, restarts, the cap, and the sample indices each frame asks for."""
-
-import inspect
 
 import numpy as np
 import pytest
@@ -10,7 +9,7 @@ import pytest
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
 from renderer.gpu.raytracer import RayTracer
-from renderer.viewer.progressive import CAP, MAX_SPP, PROGRESSIVE, Accumulator
+from renderer.viewer.progressive import MAX_SPP, PATTERN, SAMPLES_PER_FRAME, Accumulator
 
 
 def frame(colour, covered=True, size=(3, 2)):
@@ -69,18 +68,31 @@ def test_trace_asks_for_new_samples_each_frame_and_stops_at_the_cap():
     for _ in range(5):
         acc.trace(tracer)
     assert acc.samples == 3 and acc.done
-    assert tracer.asked == ([0, 1, 2] if PROGRESSIVE else [0, 0, 0])
-    if PROGRESSIVE:
-        assert acc.linear[0, 0, 0] == pytest.approx((0 + 1 + 2) / 3 / 8)
+    assert tracer.asked == [0, 1, 2]
+    assert acc.linear[0, 0, 0] == pytest.approx((0 + 1 + 2) / 3 / 8)
     acc.restart()
     acc.trace(tracer)
     assert tracer.asked[-1] == 0 and acc.samples == 1
 
 
-def test_the_cap_is_one_sample_unless_the_tracer_draws_new_ones():
-    """RayTracer.render(first_sample) traces new samples; without it every frame is the same
-    image and there is nothing to refine."""
-    assert PROGRESSIVE == ("first_sample" in inspect.signature(RayTracer.render).parameters)
-    assert CAP == (MAX_SPP if PROGRESSIVE else 1) and Accumulator().cap == CAP
+def test_one_sample_frames_add_up_to_the_frame_of_all_their_samples(gl_contexts):
+    """Frames of sample 0, 1, 2, 3 averaged are the 4-sample frame of the same pattern, up to
+    the float32 sums (the GLSL sums its samples in float32, the mean here in float64)."""
+    from renderer.core.scene_file import scene_from_dict
+    scene = scene_from_dict({"camera": {"eye": [0, 0, 4]}, "objects": [
+        {"shape": {"type": "sphere", "radius": 1.0}, "material": {"kd": [0.9, 0.5, 0.2]}}],
+        "lights": [{"type": "directional", "direction": [-1, -1, -1]}]})
+    acc = Accumulator()
+    assert acc.cap == MAX_SPP and not acc.done
+    with RayTracer(scene, 24, 18, context=gl_contexts["egl"], samples=SAMPLES_PER_FRAME,
+                   pattern=PATTERN) as tracer:
+        for _ in range(4):
+            acc.trace(tracer)
+        first = tracer.render(first_sample=0)
+    with RayTracer(scene, 24, 18, context=gl_contexts["egl"], samples=4, pattern=PATTERN) as tracer:
+        whole = tracer.render()
+    assert acc.samples == 4 and (acc.linear != first.linear).any()
+    assert np.allclose(acc.linear, whole.linear, rtol=0, atol=1e-6)
+    assert np.abs(acc.rgba8.astype(int) - whole.rgba8).max() <= 1
     with pytest.raises(ValueError):
         Accumulator(cap=0)

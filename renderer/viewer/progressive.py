@@ -7,27 +7,21 @@ the picture of a render with that many samples per pixel, up to the order of the
 The viewer restarts it whenever the picture would change (camera, size, shading, lights,
 materials) and stops tracing once `cap` samples are in.
 
-Each frame must bring new samples: `RayTracer.render(first_sample=k)` traces samples k, k + 1,
-... of each pixel's sequence. A RayTracer without that argument traces the same sample every
-frame, and adding it again would change nothing, so there the cap is one sample
-(`PROGRESSIVE` says which this RayTracer is).
+Each frame brings new samples: `RayTracer.render(first_sample=k)` traces sample indices k,
+k + 1, ... of each pixel's sequence (docs/conventions.md, "Progressive frames"), k the samples
+summed so far.
 """
 
 from __future__ import annotations
-
-import inspect
 
 import numpy as np
 
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
-from renderer.gpu.raytracer import RayTracer
 
-PROGRESSIVE = "first_sample" in inspect.signature(RayTracer.render).parameters
 MAX_SPP = 256                   # samples per pixel at which the viewer stops refining
 PATTERN = "random"              # a new random position in the pixel for every sample
 SAMPLES_PER_FRAME = 1           # so that the picture follows a moving camera at once
-CAP = MAX_SPP if PROGRESSIVE else 1
 
 
 class Accumulator:
@@ -40,7 +34,7 @@ class Accumulator:
         acc.linear, acc.rgba8       # the mean so far, row 0 at the top
     """
 
-    def __init__(self, cap: int = CAP):
+    def __init__(self, cap: int = MAX_SPP):
         if cap < 1:
             raise ValueError(f"the cap must be at least 1 sample, got {cap}")
         self.cap = int(cap)
@@ -70,11 +64,9 @@ class Accumulator:
         self.samples += samples
 
     def trace(self, tracer) -> None:
-        """Add the tracer's next frame: its samples from the count so far on (PROGRESSIVE)."""
-        if self.done:
-            return
-        frame = tracer.render(first_sample=self.samples) if PROGRESSIVE else tracer.render()
-        self.add(frame, SAMPLES_PER_FRAME)
+        """Add the tracer's next frame: its sample indices from the count so far on."""
+        if not self.done:
+            self.add(tracer.render(first_sample=self.samples), SAMPLES_PER_FRAME)
 
     @property
     def linear(self) -> np.ndarray:

@@ -14,7 +14,7 @@ by a RayTracer made on first use in the window's context (renderer/gpu/raytracer
 to the running mean of the view's samples (renderer/viewer/progressive.py); the window shows
 the mean, and the title the samples per pixel so far. A change of the picture (camera, size,
 shading, lights, materials) takes the tracer's update() and starts the mean again; once it
-holds progressive.CAP samples nothing more is traced and the interactive loop waits for
+holds progressive.MAX_SPP samples nothing more is traced and the interactive loop waits for
 events. The reference view compares the rasteriser only: it is off while ray tracing.
 
 `Viewer.run(frames=N, orbit=DEG, screenshot=PATH)` is the scripted mode of the command line:
@@ -32,6 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
+from renderer.gpu.context import activate
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.raytracer import RayTracer
 from renderer.core.imageio import write_image
@@ -329,7 +330,8 @@ class Viewer:
     def shown_image(self) -> np.ndarray:
         """What the window shows now, (H, W, 3) uint8: the image just swapped in is the front
         buffer; it is drawn again (the same frame, no orbit step) to read it from the back
-        buffer."""
+        buffer (in the window's context: a headless render may have bound another since)."""
+        activate(self.ctx)
         self._compose(self.presenter.shown)
         return self.window_image()
 

@@ -268,8 +268,10 @@ class Viewer:
             started = time.perf_counter()
             self._tracer = RayTracer(self.shown, *size, context=self.ctx,
                                      samples=SAMPLES_PER_FRAME, pattern=PATTERN)
+            rs = self._tracer.ray_scene
             self.say(f"ray tracer ready in {time.perf_counter() - started:.1f} s "
-                     f"({len(self._tracer.ray_scene.triangles):,} triangles in its BVH)")
+                     f"({len(rs.triangles):,} triangles, {len(rs.sphere_radius)} spheres, "
+                     f"{len(rs.plane_offset)} planes)")
         elif self._traced_version != self._version:
             if size != (self._tracer.width, self._tracer.height):
                 self._tracer.resize(*size)                       # (and update)

@@ -131,13 +131,15 @@ def grazing_ray_pixels(reference32, reference64) -> np.ndarray:
 
 def either_precision(frame, other) -> tuple[np.ndarray | None, np.ndarray | None, int]:
     """(rgba8, depth, pixels) for two reference ray-traced frames, float32 and float64 either
-    way round: `frame`'s rgba8 and depth with `other`'s at their grazing pixels, the second
-    acceptable reference that compare_frames takes as reference_tie and reference_tie_depth,
-    and how many pixels graze; (None, None, 0) where none does."""
+    way round: the second acceptable reference that compare_frames takes as reference_tie and
+    reference_tie_depth, and how many pixels graze. At grazing pixels `other`'s colour and
+    depth; elsewhere `frame`'s own alternative (rgba8_tie: the adaptive pattern's other
+    decision) or its image. (frame.rgba8_tie, None, 0) where no pixel grazes."""
     grazing = grazing_ray_pixels(frame, other)
     if not grazing.any():
-        return None, None, 0
-    return (np.where(grazing[..., None], other.rgba8, frame.rgba8),
+        return frame.rgba8_tie, None, 0
+    base = frame.rgba8 if frame.rgba8_tie is None else frame.rgba8_tie
+    return (np.where(grazing[..., None], other.rgba8, base),
             np.where(grazing, other.depth, frame.depth), int(grazing.sum()))
 
 

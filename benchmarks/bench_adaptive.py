@@ -6,7 +6,7 @@
 Scenes: the classic scene (assets/scenes/classic.toml, or assets/raytrace/classic.toml where
 it has not moved yet) and the built-in `sphere` (3,968 triangles). Per scene, N = 16:
 - jittered 4 (the first set alone), jittered 16 (the full N), and adaptive 16 at each
-  threshold of --thresholds (in 8-bit steps, 1/255 each; 1 is the default);
+  threshold of --thresholds (in 8-bit steps, 1/255 each; 2 is the default);
 - samples per pixel: the mean of Frame.samples, and the share of pixels refined;
 - GPU ms (renderer/gpu/raytracer.py): the median of --frames frames after a warm-up, the
   patterns' frames interleaved so that the machine's load falls on all alike;

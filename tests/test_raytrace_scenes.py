@@ -23,7 +23,6 @@ from reference.raytrace.trace import trace
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.camera_rays import camera_ray_uniforms
-from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene import Plane, Sphere
 from renderer.core.scene_file import scene_from_dict
 

@@ -74,6 +74,7 @@ def test_only_the_ray_tracing_builtin_scenes_use_shapes_and_ray_tracer_terms():
     """conftest.RAYTRACE_SCENES is the set of built-in scenes made for the ray tracer: each uses
     an analytic shape or k_r, k_t, ior and says `--method raytrace` in its description; every
     other built-in scene uses none of them (the rasteriser's scenes stay as they were)."""
+    descriptions = scene_descriptions()
     for name, path in builtin_scenes().items():
         scene = load_scene(path)
         terms = {(m.kr, m.kt, m.ior) for m in (obj.material for obj in scene.objects)}
@@ -81,7 +82,7 @@ def test_only_the_ray_tracing_builtin_scenes_use_shapes_and_ray_tracer_terms():
                             or terms != {((0.0,) * 3, (0.0,) * 3, 1.5)})
         made_for_it = name in RAYTRACE_SCENES
         assert uses_ray_tracing == made_for_it, name
-        assert ("--method raytrace" in scene_descriptions()[name]) == made_for_it, name
+        assert ("--method raytrace" in descriptions[name]) == made_for_it, name
         if not made_for_it:
             assert all(s is None for s in scene.world_shapes())
     assert RAYTRACE_SCENES <= set(builtin_scenes())

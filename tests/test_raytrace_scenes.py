@@ -32,13 +32,9 @@ F32 = np.float32
 SCENES = sorted(RAYTRACE_SCENES)
 
 
-def comparison(frame, reference):
-    return compare_frames(frame.rgba8, reference.rgba8, frame.depth, reference.depth,
-                          PIPELINE_TOLERANCE.threshold, PIPELINE_TOLERANCE.deviation)
-
-
 def assert_within_tolerance(frame, reference):
-    result = comparison(frame, reference)
+    result = compare_frames(frame.rgba8, reference.rgba8, frame.depth, reference.depth,
+                            PIPELINE_TOLERANCE.threshold, PIPELINE_TOLERANCE.deviation)
     assert PIPELINE_TOLERANCE.passes(result), (PIPELINE_TOLERANCE.failures(result), result.as_dict())
 
 

@@ -25,6 +25,8 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
+from renderer.core.ray_sampling import RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -103,17 +105,22 @@ def build_parser() -> argparse.ArgumentParser:
                        help="headless GL context (default: EGL, then OSMesa)")
 
     def raytrace_options(p):
-        p.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+        p.add_argument("--method", choices=("raster", "raytrace"),
                        help="raster (default): the rasteriser; raytrace: the ray tracer (shadows, "
                             "reflection, refraction; docs/conventions.md, \"Rays\")")
         p.add_argument("--spp", type=positive_int, default=1, metavar="N",
                        help="ray tracer: samples per pixel (default 1)")
-        p.add_argument("--pattern", choices=("regular", "random", "jittered", "poisson"),
-                       default="regular", help="ray tracer: sample pattern (default regular)")
+        p.add_argument("--pattern", choices=RAY_PATTERNS, default="regular",
+                       help="ray tracer: sample positions (default regular; docs/conventions.md, "
+                            "\"Sample positions\")")
+        p.add_argument("--adaptive-threshold", type=float, default=None, metavar="T",
+                       help="ray tracer, --pattern adaptive: refine a pixel whose first 4 samples' "
+                            "clamped colours differ by more than T in some channel (default 2/255)")
         p.add_argument("--max-depth", type=int, default=4, metavar="D",
-                       help="ray tracer: bounces of reflection and refraction, 0 to 16 (default 4)")
+                       help="ray tracer: bounces of reflection and refraction, 0 to "
+                            f"{MAX_DEPTH_LIMIT} (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
-                       help="ray tracer: seed of the random and jittered patterns")
+                       help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
@@ -152,6 +159,9 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--triple-buffering", action="store_true",
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
+    view.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+                      help="start with the rasteriser (default) or the ray tracer, which refines "
+                           "while the view is still, one sample per pixel a frame (the M key)")
 
     compare = sub.add_parser(
         "compare", help="render through the GPU and the reference and compare",
@@ -159,11 +169,17 @@ def build_parser() -> argparse.ArgumentParser:
                     "reference.png and diff.png, and print the figures as one JSON object. "
                     "Exit status: 0 when the two agree within the pipeline tolerance "
                     f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
-                    "(what fails is said on stderr), 2 for bad input.")
+                    "(what fails is said on stderr), 2 for bad input. With --methods: the "
+                    "rasteriser against the ray tracer instead, status 0.")
     common(compare)
     raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
                                                    "(default: compare-SCENE_NAME)")
+    compare.add_argument("--methods", action="store_true",
+                         help="the rasteriser against the ray tracer (--spp, --pattern, --max-depth, "
+                              "--seed), both on the GPU: where they differ and why (shadows, "
+                              "reflection, edges, tessellation, ...); writes raster.png, raytrace.png, "
+                              "causes.png and methods.json (default folder: compare-methods-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
                          metavar="LEVELS",
                          help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
@@ -201,6 +217,9 @@ def build_parser() -> argparse.ArgumentParser:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
+    extremes.add_argument("--method", choices=("both", "raster", "raytrace"), default="both",
+                          help="which cases: rasterised, ray traced (scene files named rt_*), or "
+                               "both (default)")
     for name in ("render", "view", "compare", "shaders", "report", "extremes"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
@@ -237,23 +256,45 @@ def _load(scene_arg):
 
 
 def check_raytrace_options(args) -> None:
-    if args.method == "raster" and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
-                                    or args.seed is not None):
-        args.parser.error("--spp, --pattern, --max-depth and --seed are for --method raytrace")
-    if not 0 <= args.max_depth <= 16:
-        args.parser.error(f"--max-depth must be between 0 and 16, got {args.max_depth}")
-    if args.method == "raytrace":
-        from renderer.core.sampling import pattern
+    """Refuses what does not go together; --method's default (raster) is set here, so that
+    `compare --methods` can refuse a --method given."""
+    methods = getattr(args, "methods", False)
+    if methods and args.method is not None:
+        args.parser.error(f"--methods renders both methods; leave out --method {args.method}")
+    args.method = args.method or "raster"
+    traced = methods or args.method == "raytrace"
+    if not traced and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
+                       or args.seed is not None or args.adaptive_threshold is not None):
+        also = " or --methods" if hasattr(args, "methods") else ""
+        args.parser.error("--spp, --pattern, --max-depth, --seed and --adaptive-threshold are for "
+                          f"--method raytrace{also}")
+    if not 0 <= args.max_depth <= MAX_DEPTH_LIMIT:
+        args.parser.error(f"--max-depth must be between 0 and {MAX_DEPTH_LIMIT}, got {args.max_depth}")
+    if args.adaptive_threshold is not None and args.pattern != "adaptive":
+        args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
+    if traced:
+        from renderer.core.ray_sampling import ray_sampling
+        options = _raytrace_options(args)
         try:
-            pattern(args.pattern, args.spp, **({} if args.seed is None else {"seed": args.seed}))
+            ray_sampling(options["pattern"], options["samples"], options["seed"], options["adaptive_threshold"])
         except ValueError as error:
-            args.parser.error(f"--spp {args.spp} --pattern {args.pattern}: {error}")
+            given = [f"--spp {args.spp}", f"--pattern {args.pattern}"]
+            given += [] if args.seed is None else [f"--seed {args.seed}"]
+            given += [] if args.adaptive_threshold is None else [f"--adaptive-threshold {args.adaptive_threshold:g}"]
+            args.parser.error(f"{' '.join(given)}: {error}")
 
 
 def _raytrace_options(args) -> dict:
     from renderer.core.sampling import DEFAULT_SEED
     return {"samples": args.spp, "pattern": args.pattern, "max_depth": args.max_depth,
-            "seed": DEFAULT_SEED if args.seed is None else args.seed}
+            "seed": DEFAULT_SEED if args.seed is None else args.seed,
+            "adaptive_threshold": args.adaptive_threshold}
+
+
+def samples_fired(frame) -> str:
+    """What an adaptive frame traced: 'mean 4.72 spp, 6.0% of pixels refined'."""
+    from renderer.core.ray_sampling import FIRST_SET
+    return f"mean {frame.samples.mean():.2f} spp, {(frame.samples > FIRST_SET).mean():.1%} of pixels refined"
 
 
 def check_raytrace_memory(scene, size, backends, samples) -> None:
@@ -331,6 +372,8 @@ def cmd_render(args) -> int:
     if not args.quiet:
         written = f"{output} and {args.depth}" if args.depth else f"{output}"
         method = "" if args.method == "raster" else f"raytrace {args.spp} spp, "
+        if args.method == "raytrace" and args.pattern == "adaptive":
+            method = f"raytrace adaptive up to {args.spp} spp: {samples_fired(frame)}, "
         print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {method}{args.backend}, "
               f"{frame.milliseconds:.1f} ms)", file=sys.stderr)
     return 0
@@ -344,6 +387,8 @@ def cmd_view(args) -> int:
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     check_memory(scene, args.size, ["gpu"])
+    if args.method == "raytrace":
+        check_raytrace_memory(scene, args.size, ["gpu"], 1)
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
@@ -352,38 +397,68 @@ def cmd_view(args) -> int:
     check_outputs(args.screenshot, args.stats if scripted else None)
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,
-                screenshot=None if scripted else args.screenshot) as viewer:
+                screenshot=None if scripted else args.screenshot, method=args.method) as viewer:
         if not scripted:
             print(f"renderer view: {scene.name}; H for help, Esc to quit")
         try:
             stats = viewer.run(args.frames, args.orbit, None)     # the screenshot: below, with --stats
         except KeyboardInterrupt:              # Ctrl-C in the terminal: as good as Esc
             return 0
-        figures = viewer.figures
+        figures, samples = viewer.figures, viewer.samples
         shown = viewer.shown_image() if scripted and args.screenshot is not None else None
     if scripted:
         with outputs(args.screenshot, args.stats) as out:    # both or neither
             if shown is not None:
                 out.image(args.screenshot, shown)
             if args.stats is not None:
-                out.text(args.stats, json_text(stats.summary() | {"reference": figures}))
+                out.text(args.stats, json_text(stats.summary() | {"reference": figures,
+                                                                  "raytrace_spp": samples}))
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
+        if samples is not None:
+            print(f"ray tracing: {samples} spp")
         if args.screenshot is not None:
             print(f"wrote {args.screenshot}")
     return 0
 
 
+def cmd_compare_methods(args) -> int:
+    """`compare --methods` (from cmd_compare, its options checked): the table on stdout, its
+    figures and images in --out; status 0 (an explanation, not a check)."""
+    from renderer.checks.methods import cause_image, compare_methods
+    from renderer.core.imageio import check_folder, check_outputs, outputs
+    from renderer.core.jsonio import json_text
+    from renderer.core.paths import output_stem
+    scene = _load(args.scene)
+    check_memory(scene, args.size, ["gpu"])
+    check_raytrace_memory(scene, args.size, ["gpu"], args.spp)
+    out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
+    names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
+    check_outputs(*names)
+    result = compare_methods(scene, *args.size, context_kind=args.context, threshold=args.threshold,
+                             **_raytrace_options(args))
+    warn_if_nothing_drawn(scene, result.raytrace)
+    with outputs(*names) as written:             # all four or none
+        written.png(names[0], result.raster.image())
+        written.png(names[1], result.raytrace.image())
+        written.png(names[2], cause_image(result.causes, result.raytrace.rgba8))
+        written.text(names[3], json_text(result.as_dict()))
+    print(result.table())
+    return 0
+
+
 def cmd_compare(args) -> int:
     import reference
-    from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
+    from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision, heat_map
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.paths import output_stem
     from renderer.core.jsonio import finite_or_none, to_json
     if args.out is not None:
         check_folder(args.out)
     check_raytrace_options(args)
+    if args.methods:
+        return cmd_compare_methods(args)
     scene = _load(args.scene)
     if args.method == "raytrace":
         check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)
@@ -393,31 +468,45 @@ def cmd_compare(args) -> int:
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
+    tie, tie_depth, grazing = None, None, 0
     if args.method == "raytrace":
         from reference.raytrace.pipeline import render as reference_raytrace
         gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
                                                    _raytrace_options(args), frames=3)
         start = time.perf_counter()
         ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args))
+        reference_ms = (time.perf_counter() - start) * 1000.0
+        # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
+        # elsewhere the adaptive pattern's other decision, rgba8_tie).
+        truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64")
+        tie, tie_depth, grazing = either_precision(ref_frame, truth)
     else:
         gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
         start = time.perf_counter()
         ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
-    reference_ms = (time.perf_counter() - start) * 1000.0
+        reference_ms = (time.perf_counter() - start) * 1000.0
+        tie = ref_frame.rgba8_tie
     warn_if_nothing_drawn(scene, gpu_frame)
     tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
                             threshold=tolerance.threshold, deviation=tolerance.deviation,
-                            reference_tie=ref_frame.rgba8_tie)
+                            reference_tie=tie, reference_tie_depth=tie_depth)
     with outputs(*names) as written:             # all three or none
         written.png(names[0], gpu_frame.rgba8)
         written.png(names[1], ref_frame.rgba8)
         written.png(names[2], heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
-                                       tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
+                                       tolerance.deviation, reference_tie=tie))
     figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
-               "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
+               "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
+               "grazing_ray_pixels": grazing,
+               "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
+    if args.method == "raytrace":        # adaptive: the samples traced, and where the twins chose differently
+        figures |= {"gpu_samples_per_pixel": float(gpu_frame.samples.mean()),
+                    "reference_samples_per_pixel": float(ref_frame.samples.mean()),
+                    "refined_differently_pixels": int((gpu_frame.samples != ref_frame.samples).sum()),
+                    "adaptive_tie_pixels": depth_tie_pixels(ref_frame)}
     failures = tolerance.failures(result)
     figures["passes"] = not failures
     print(to_json(figures))
@@ -493,7 +582,8 @@ def cmd_extremes(args) -> int:
     try:
         for kind in kinds:
             contexts[kind] = make_context(kind)
-        cases = measure_extremes(extreme_scenes(extra), args.size, contexts)
+        methods = ("raster", "raytrace") if args.method == "both" else (args.method,)
+        cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods)
     finally:
         for ctx in contexts.values():
             release_context(ctx)

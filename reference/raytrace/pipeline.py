@@ -1,11 +1,24 @@
 """# Twin: renderer/gpu/raytracer.py
 
-The reference ray tracer's frame (docs/conventions.md, "Rays"): per pixel and sample a camera
-ray through the window point (i + 0.5) + dx, (j + 0.5) + dy (float32, as gl_FragCoord.xy +
-offset), the offsets those of renderer/core/sampling.py's pattern; each traced by trace.py from
-near to far; the samples' linear colours averaged; rgba8 = to_unorm8 of the clamped average
-with alpha 255 where some sample's camera ray hit; depth = the nearest first hit's view depth
-(camera rays have s = -z_eye), +inf where none hit. Row 0 at the top, as every Frame.
+The reference ray tracer's frame (docs/conventions.md, "Rays", "Sample positions"): per pixel
+(i, j) and sample k a camera ray through the window point (i + 0.5) + dx, (j + 0.5) + dy
+(float32, as gl_FragCoord.xy + offset), the offset sampling.py's for sample index
+first_sample + k; each traced by trace.py from near to far; the samples' linear colours summed
+in sample order and averaged; rgba8 = to_unorm8 of the clamped average with alpha 255 where
+some sample's camera ray hit; depth = the nearest first hit's view depth (camera rays have
+s = -z_eye), +inf where none hit; samples = the samples traced per pixel. Row 0 at the top, as
+every Frame.
+
+Adaptive (renderer/core/ray_sampling.py): the first set for every pixel at once, then the rest
+for the pixels whose first samples' clamped colours spread (max - min, the largest channel)
+more than the threshold, masks rather than a loop. The GPU decides on its own float32 colours,
+which may differ from these in the last bits: a pixel whose spread lies within DECISION_MARGIN
+of the threshold is traced both ways, and the frame's rgba8_tie holds the other decision's
+colour there (comparisons accept either, as at a depth tie).
+
+In float32 as the GPU, or in float64 (dtype=np.float64: the uniforms, offsets and lights in
+float64 too), the ground truth; the frame's ray_tree holds each pixel's hash of its samples'
+ray trees (trace.py), which tells where the two precisions disagree on a grazing ray.
 """
 
 from __future__ import annotations
@@ -17,51 +30,110 @@ import numpy as np
 from reference.lighting import Lights
 from reference.output import flip_rows
 from reference.raytrace.camera import camera_ray
-from reference.raytrace.trace import trace
+from reference.raytrace.sampling import sample_offset
+from reference.raytrace.trace import mix64, trace
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
+from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
-from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
+from renderer.core.sampling import DEFAULT_SEED
 
 F32 = np.float32
 DEFAULT_MAX_DEPTH = 4
 CHUNK_RAYS = 1 << 16         # camera rays traced at once (bounds the working memory)
+# How far a spread may be from the threshold for the GPU's float32 colours to decide otherwise
+# (docs/conventions.md, "Sample positions": the colours of one ray agree within ~1e-6).
+DECISION_MARGIN = 2.0 ** -12
 
 
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
            max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
-           rs=None) -> Frame:
-    """The frame (module docstring); `rs` a ray_scene(scene) made before, `shadows`=False
-    traces no shadow rays."""
+           rs=None, first_sample: int = 0, adaptive_threshold: float | None = None,
+           dtype=F32) -> Frame:
+    """The frame (module docstring) of sample indices first_sample .. first_sample + N - 1;
+    `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays; `dtype`
+    float32 (the GPU's twin) or float64."""
     start = time.perf_counter()
+    t = np.dtype(dtype).type
     rs = rs if rs is not None else ray_scene(scene)
-    offsets = np.asarray(sample_pattern(pattern, samples, seed), F32)
+    sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
+    first_sample = check_first_sample(first_sample, sampling.samples)
     matrices = scene.matrices(width, height)
     uniforms = camera_ray_uniforms(matrices.view, matrices.projection, width, height)
-    uniforms = {k: v.astype(F32) for k, v in uniforms.items()}
-    lights = Lights.from_scene(scene, F32, origin=matrices.origin)
-    i = np.arange(width, dtype=F32) + F32(0.5)
-    j = np.arange(height, dtype=F32) + F32(0.5)
-    x, y = np.meshgrid(i, j)                                 # (H, W), row 0 at the bottom
-    windows = np.stack([np.stack([x + dx, y + dy], -1) for dx, dy in offsets])   # (S, H, W, 2)
-    O, D = camera_ray(windows.reshape(-1, 2), uniforms)
+    uniforms = {k: v.astype(t) for k, v in uniforms.items()}
+    lights = Lights.from_scene(scene, t, origin=matrices.origin)
     cam = scene.camera
-    parts = [trace(rs, lights, O[k:k + CHUNK_RAYS], D[k:k + CHUNK_RAYS], cam.near, cam.far,
-                   scene.background, max_depth, shadows) for k in range(0, len(O), CHUNK_RAYS)]
-    colour, hit, s = (np.concatenate(part) for part in zip(*parts))
-    n = len(offsets)
-    colour = colour.reshape(n, height * width, 3)
-    total = colour[0].copy()
-    for k in range(1, n):                                    # in sample order, as the GLSL
-        total += colour[k]
-    average = total / F32(n)
-    hit = hit.reshape(n, -1)
-    covered = hit.any(0)
-    depth = np.where(hit, s.reshape(n, -1), F32(np.inf)).min(0)
-    linear = np.concatenate([average, covered[:, None].astype(F32)], -1).reshape(height, width, 4)
+    y, x = np.divmod(np.arange(width * height, dtype=np.uint32), np.uint32(width))  # row 0 at the bottom
+
+    def traced(pixels, ks):
+        """Each sample k of `ks` at each pixel of `pixels` (flat indices): colour (S, P, 3),
+        hit (S, P), s (S, P), and the hash of each ray tree mixed with its k (S, P)."""
+        if len(pixels) == 0:
+            return (np.zeros((len(ks), 0, 3), t), np.zeros((len(ks), 0), bool),
+                    np.zeros((len(ks), 0), t), np.zeros((len(ks), 0), np.uint64))
+        px, py = x[pixels], y[pixels]
+        centres = np.stack([px, py], -1).astype(t) + t(0.5)
+        windows = np.stack([centres + sample_offset(px, py, k, first_sample, sampling).astype(t) for k in ks])
+        O, D = camera_ray(windows.reshape(-1, 2), uniforms)
+        trees = np.zeros(len(O), np.uint64)
+        parts = [trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near, cam.far,
+                       scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS])
+                 for i in range(0, len(O), CHUNK_RAYS)]
+        colour, hit, s = (np.concatenate(part) for part in zip(*parts))
+        trees = mix64(trees.reshape(len(ks), -1) + np.asarray(ks, np.uint64)[:, None])
+        return (colour.reshape(len(ks), len(pixels), 3), hit.reshape(len(ks), -1),
+                s.reshape(len(ks), -1), trees)
+
+    def accumulate(state, colour, hit, s, trees):
+        """(total, covered, depth, trees) with the samples added, in sample order as the GLSL."""
+        total, covered, depth, tree = (a.copy() for a in state)
+        for k in range(len(colour)):
+            total += colour[k]
+        return (total, covered | hit.any(0), np.minimum(depth, np.where(hit, s, t(np.inf)).min(0)),
+                tree + trees.sum(0, dtype=np.uint64))
+
+    everywhere = np.arange(width * height)
+    colour, hit, s, trees = traced(everywhere, range(sampling.first_set))
+    empty = (np.zeros((width * height, 3), t), np.zeros(width * height, bool),
+             np.full(width * height, t(np.inf)), np.zeros(width * height, np.uint64))
+    first = accumulate(empty, colour, hit, s, trees)
+    count = np.full(width * height, sampling.first_set, np.int32)
+    decided, other = (first, count), None
+    if sampling.adaptive and sampling.samples > sampling.first_set:
+        clamped = np.clip(colour, t(0), t(1))
+        spread = (clamped.max(0) - clamped.min(0)).max(-1)
+        threshold = t(F32(sampling.threshold))
+        refine = spread > threshold
+        near = np.abs(spread.astype(np.float64) - float(threshold)) <= DECISION_MARGIN
+        more = np.flatnonzero(refine | near)
+        rest = accumulate([a[more] for a in first], *traced(more, range(sampling.first_set, sampling.samples)))
+
+        def taking(which):                   # the first set everywhere, refined at `which`
+            state = [a.copy() for a in first]
+            for whole, part in zip(state, rest):
+                whole[which] = part[np.isin(more, which)]
+            n = count.copy()
+            n[which] = sampling.samples
+            return state, n
+        decided = taking(np.flatnonzero(refine))
+        if near.any():
+            other = taking(np.flatnonzero(refine ^ near))
+    frame = _frame(*decided, width, height, t)
+    frame.rgba8_tie = None if other is None else _frame(*other, width, height, t).rgba8
+    frame.milliseconds = (time.perf_counter() - start) * 1000.0
+    return frame
+
+
+def _frame(state, count, width: int, height: int, t=F32) -> Frame:
+    """The Frame of per-pixel (total, covered, depth, trees) and samples traced (flat, row 0
+    at the bottom): the average colour total / count in float32 as the GLSL (or float64)."""
+    total, covered, depth, trees = state
+    average = total / count[:, None].astype(t)
+    linear = np.concatenate([average, covered[:, None].astype(t)], -1).reshape(height, width, 4)
     rgba8 = to_unorm8(linear)
     rgba8[..., 3] = np.where(covered.reshape(height, width), 255, 0)
     return Frame(flip_rows(rgba8), flip_rows(linear.astype(F32)),
                  flip_rows(depth.reshape(height, width).astype(F32)),
-                 (time.perf_counter() - start) * 1000.0)
+                 samples=flip_rows(count.reshape(height, width)),
+                 ray_tree=flip_rows(trees.reshape(height, width)))

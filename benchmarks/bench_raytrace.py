@@ -70,9 +70,9 @@ class RayCount:
         self._scene_hit, self._occluded = trace_module.scene_hit, trace_module.occluded
 
         def counted(function):
-            def count(rs, O, *args):
+            def count(rs, O, *args, **kwargs):
                 self.total += len(O)
-                return function(rs, O, *args)
+                return function(rs, O, *args, **kwargs)
             return count
         trace_module.scene_hit, trace_module.occluded = counted(self._scene_hit), counted(self._occluded)
         return self

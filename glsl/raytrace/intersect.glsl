@@ -41,7 +41,14 @@ float sphere_discriminant(vec3 O, vec3 D, vec3 C, float r) {
 // Roots as the chapter's eq. 7.7 and 7.8 (Press et al.): q = -(b + sign(b) sqrt(a delta)),
 // s0 = c / q, s1 = q / a; no subtraction of nearly equal numbers. A tangent ray (delta == 0)
 // hits. From inside the sphere the nearer root is behind (s <= s_min): the far root is the hit.
-bool ray_sphere(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max, out float s) {
+// A ray that starts on the sphere (on_surface: a secondary or shadow ray leaving a point of it,
+// with no offset) has its origin at the root c / q (c = 0 on the surface, up to the rounding of
+// f.f - r^2, which cancels there), so the one other point of the sphere it can meet is the
+// root s1 = q / a, ahead (s1 > 0) when the ray goes inwards (b < 0) and behind when it leaves
+// outwards (q <= 0): a sphere is convex; c / q is not used. One body for both kinds of ray:
+// llvmpipe would run both of two functions chosen between per ray.
+bool ray_sphere_from(vec3 O, vec3 D, vec3 C, float r, bool on_surface, float s_min, float s_max,
+                     out float s) {
     vec3 f = O - C;
     float a = dot(D, D);
     float b = dot(f, D);
@@ -51,32 +58,21 @@ bool ray_sphere(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max, out f
     float q = -(b + (b >= 0.0 ? 1.0 : -1.0) * sqrt(a * delta));
     float s0 = c / q;
     float s1 = q / a;
-    float near = min(s0, s1);
-    float far = max(s0, s1);
+    float near = on_surface ? s1 : min(s0, s1);
+    float far = on_surface ? s1 : max(s0, s1);
     bool near_hit = delta >= 0.0 && near > s_min && near < s_max;
     bool far_hit = delta >= 0.0 && far > s_min && far < s_max;
     s = near_hit ? near : (far_hit ? far : s_max);
     return near_hit || far_hit;
 }
 
-// A ray that starts on the sphere (a secondary or shadow ray leaving a point of it, with no
-// offset): its origin is the root c / q (c = 0 on the surface, up to the rounding of
-// f.f - r^2, which cancels there), so the one other point of the sphere it can meet is the
-// root s1 = q / a, ahead (s1 > 0) when the ray goes inwards (b < 0) and behind when it leaves
-// outwards (q <= 0): a sphere is convex. c is not used.
+bool ray_sphere(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max, out float s) {
+    return ray_sphere_from(O, D, C, r, false, s_min, s_max, s);
+}
+
 bool ray_sphere_from_surface(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max,
                              out float s) {
-    vec3 f = O - C;
-    float a = dot(D, D);
-    float b = dot(f, D);
-    vec3 l = f - (b / a) * D;
-    float delta = r * r - dot(l, l);
-    s = s_max;
-    if (delta < 0.0) return false;
-    float far = -(b + (b >= 0.0 ? 1.0 : -1.0) * sqrt(a * delta)) / a;
-    if (!(far > s_min && far < s_max)) return false;
-    s = far;
-    return true;
+    return ray_sphere_from(O, D, C, r, true, s_min, s_max, s);
 }
 
 // The outward unit normal at a point P on the sphere.

@@ -30,8 +30,8 @@ import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
-from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere,
-                                          ray_sphere_from_surface, sphere_normal, triangle_normal)
+from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
+                                          triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
@@ -59,7 +59,7 @@ def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
     kind MISS/SPHERE/PLANE/TRIANGLE, index the sphere's, plane's or original triangle's, s the
     hit (s_max on a miss). In the dtype of O: float32, or float64 with the scene's float64
     surfaces. `from_shape` (R,): the analytic shape each ray starts on (shape_id; -1 for none),
-    met again only at a sphere's far side (ray_sphere_from_surface). Ties (HIT_TIE): a surface
+    met again only at a sphere's far side (ray_sphere_from, on_surface). Ties (HIT_TIE): a surface
     replaces the nearest found so far only when nearer by more than HIT_TIE relative."""
     R, t = len(O), O.dtype.type
     s = np.broadcast_to(np.asarray(s_max, t), (R,)).astype(t)
@@ -79,11 +79,7 @@ def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
 
     for k in range(len(rs.sphere_radius)):
         C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
-        hit, s_k = ray_sphere(O, D, C, r, s_min, limit)
-        on = from_shape == k
-        if on.any():
-            hit_on, s_on = ray_sphere_from_surface(O[on], D[on], C, r, s_min[on], limit[on])
-            hit[on], s_k[on] = hit_on, s_on
+        hit, s_k = ray_sphere_from(O, D, C, r, from_shape == k, s_min, limit)
         found(hit, s_k, SPHERE, k)
     for k in range(len(rs.plane_offset)):
         hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, limit)
@@ -120,11 +116,7 @@ def occluded(rs, O, D, s_max, from_shape=None):
     blocked = np.zeros(R, bool)
     for k in range(len(rs.sphere_radius)):
         C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
-        hit = ray_sphere(O, D, C, r, s_min, s_max)[0]
-        on = from_shape == k
-        if on.any():
-            hit[on] = ray_sphere_from_surface(O[on], D[on], C, r, s_min[on], s_max[on])[0]
-        blocked |= hit
+        blocked |= ray_sphere_from(O, D, C, r, from_shape == k, s_min, s_max)[0]
     for k in range(len(rs.plane_offset)):
         hit = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, s_max)[0]
         blocked |= hit & (from_shape != len(rs.sphere_radius) + k)

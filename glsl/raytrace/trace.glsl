@@ -220,48 +220,40 @@ vec3 stack_w[TRACE_STACK];
 int stack_depth[TRACE_STACK];
 int stack_from[TRACE_STACK];            // the analytic shape a ray starts on, or -1
 
+void trace_store(int i, vec3 O, vec3 D, vec3 w, int depth, int from_shape) {
+    stack_O[i] = O;
+    stack_D[i] = D;
+    stack_w[i] = w;
+    stack_depth[i] = depth;
+    stack_from[i] = from_shape;
+}
+
+void trace_load(int i, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape) {
+    O = stack_O[i];
+    D = stack_D[i];
+    w = stack_w[i];
+    depth = stack_depth[i];
+    from_shape = stack_from[i];
+}
+
 void trace_push(int top, vec3 O, vec3 D, vec3 w, int depth, int from_shape) {
 #ifdef TRACE_STACK_SELECT
     for (int i = 0; i < TRACE_STACK; ++i) {
-        if (i == top) {
-            stack_O[i] = O;
-            stack_D[i] = D;
-            stack_w[i] = w;
-            stack_depth[i] = depth;
-            stack_from[i] = from_shape;
-        }
+        if (i == top) trace_store(i, O, D, w, depth, from_shape);
     }
 #else
-    stack_O[top] = O;
-    stack_D[top] = D;
-    stack_w[top] = w;
-    stack_depth[top] = depth;
-    stack_from[top] = from_shape;
+    trace_store(top, O, D, w, depth, from_shape);
 #endif
 }
 
 void trace_pop(int top, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape) {
 #ifdef TRACE_STACK_SELECT
-    O = stack_O[0];
-    D = stack_D[0];
-    w = stack_w[0];
-    depth = stack_depth[0];
-    from_shape = stack_from[0];
-    for (int j = 1; j < TRACE_STACK; ++j) {
-        if (j == top) {
-            O = stack_O[j];
-            D = stack_D[j];
-            w = stack_w[j];
-            depth = stack_depth[j];
-            from_shape = stack_from[j];
-        }
+    trace_load(0, O, D, w, depth, from_shape);
+    for (int i = 1; i < TRACE_STACK; ++i) {
+        if (i == top) trace_load(i, O, D, w, depth, from_shape);
     }
 #else
-    O = stack_O[top];
-    D = stack_D[top];
-    w = stack_w[top];
-    depth = stack_depth[top];
-    from_shape = stack_from[top];
+    trace_load(top, O, D, w, depth, from_shape);
 #endif
 }
 #endif

@@ -62,21 +62,19 @@ def icosphere_scene():
 
 
 class RayCount:
-    """Counts the rays the reference intersects with the scene (trace.py's scene_hit: camera,
-    secondary and, through occluded, shadow rays) while in a `with` block."""
+    """Counts the rays the reference intersects with the scene (trace.py's scene_hit: camera
+    and secondary rays; occluded: shadow rays) while in a `with` block."""
 
     def __enter__(self):
-        self.total = self.shadow = 0
+        self.total = 0
         self._scene_hit, self._occluded = trace_module.scene_hit, trace_module.occluded
 
-        def scene_hit(rs, O, *args):
-            self.total += len(O)
-            return self._scene_hit(rs, O, *args)
-
-        def occluded(rs, O, *args):
-            self.shadow += len(O)
-            return self._occluded(rs, O, *args)
-        trace_module.scene_hit, trace_module.occluded = scene_hit, occluded
+        def counted(function):
+            def count(rs, O, *args, **kwargs):
+                self.total += len(O)
+                return function(rs, O, *args, **kwargs)
+            return count
+        trace_module.scene_hit, trace_module.occluded = counted(self._scene_hit), counted(self._occluded)
         return self
 
     def __exit__(self, *exc):

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from reference.raytrace.bvh import closest_hit, closest_hit_brute_force, inverse_direction, ray_box
+from reference.raytrace.bvh import any_hit, closest_hit, closest_hit_brute_force, inverse_direction, ray_box
 from reference.raytrace.intersect import ray_triangle
 from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, mesh_vertices, refit, texels
 from renderer.core.primitives import icosphere
@@ -55,6 +55,16 @@ def test_the_builder_makes_the_hand_written_layout():
     assert texels(HAND.nodes, width=4)[1, 2:].tolist() == [[0] * 4] * 2
 
 
+def test_texture_rows_are_a_power_of_two_wide():
+    """The shader finds texel k at (k & (width - 1), k >> log2(width)): a short array gets the
+    smallest power of two that holds it, a long one rows of TEXTURE_WIDTH."""
+    assert texels(HAND.nodes).shape == (1, 8, 4)                     # 6 texels
+    assert texels(np.zeros((1, 4))).shape == (1, 1, 4)
+    assert texels(np.zeros((1025, 4))).shape == (2, 1024, 4)
+    with pytest.raises(ValueError, match="power of two"):
+        texels(HAND.nodes, width=6)
+
+
 def test_traversal_of_the_hand_written_layout():
     down = (0, 0, -1)
     O = np.array([(0.25, 0.25, 1), (4.25, 0.25, 2), (2, 0.5, 1), (0, 0.25, 1),   # x on a face
@@ -68,6 +78,10 @@ def test_traversal_of_the_hand_written_layout():
     # the open interval: s_max = 1 refuses the hit at s = 1, s_min = 1 too
     assert not closest_hit(HAND, O[:1], D[:1], 0, 1)[0][0]
     assert not closest_hit(HAND, O[:1], D[:1], 1, INF)[0][0]
+    # any hit (shadow rays): the same answers, s_max one per ray
+    assert any_hit(HAND, O, D).tolist() == hit.tolist()
+    assert any_hit(HAND, O, D, 0, np.array([1, 2.5, 9, 9, 9, 9, 3.5], F32)).tolist() == \
+        [False, True, False, True, False, True, False]
 
 
 def test_ray_box_slabs_and_parallel_axes():
@@ -229,6 +243,17 @@ def test_twin_equals_brute_force_on_a_soup():
     assert assert_same_closest_hit(V, O, D, answer, closest_hit_brute_force(V, O, D)) == 0
 
 
+def test_any_hit_answers_as_closest_hit_does(sphere):
+    """The shadow rays' walk stops at its first hit: whether something is hit is closest_hit's
+    answer, ray for ray, whatever s_max (here from 0.5 to 4, and infinite)."""
+    for V, bvh, (O, D) in ((soup(1000, 6), build_bvh(soup(1000, 6)), random_rays(3000, 14)),
+                           (*sphere, random_rays(3000, 15, spread=1.5))):
+        s_max = np.where(np.arange(len(O)) % 2, np.random.default_rng(16).uniform(0.5, 4, len(O)), np.inf).astype(F32)
+        hit = closest_hit(bvh, O, D, 0, s_max)[0]
+        assert 0.1 < hit.mean() < 0.9
+        assert (any_hit(bvh, O, D, 0, s_max) == hit).all()
+
+
 def test_twin_equals_brute_force_on_the_icosphere(sphere):
     V, bvh = sphere
     O, D = random_rays(600, 8, spread=1.5)            # some inside the sphere, most outside
@@ -244,11 +269,14 @@ def test_twin_equals_brute_force_on_the_icosphere(sphere):
 WIDTH, HEIGHT = 64, 64
 
 
-def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30):
+def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30, any_hit=False):
+    """(s, triangle, u, v) per ray from bvh_closest_hit; any_hit: (1 or 0, 0, 0, 0) from
+    bvh_any_hit."""
     from renderer.gpu.bvh import bvh_textures
     from renderer.gpu.shaders import shader_source
+    fragment = shader_source("raytrace_bvh.frag", {"ANY_HIT": any_hit}, directory=GLSL).text
     program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
-                          fragment_shader=shader_source("raytrace_bvh.frag", directory=GLSL).text)
+                          fragment_shader=fragment)
     h, w = O.shape[:2]
     inputs = [ctx.texture((w, h), 3, np.ascontiguousarray(a, F32).tobytes(), dtype="f4") for a in (O, D)]
     inputs += bvh_textures(ctx, bvh)
@@ -296,7 +324,8 @@ def test_glsl_traversal_agrees_with_the_twin(gl_contexts, sphere, scene):
     """Hit or miss agree but where the hit triangle is hit within rounding of its edge (a ray
     can slip between two triangles: Moeller-Trumbore is not watertight); the triangle agrees
     but at ties, where the other is hit within the tolerance at the same s; s within K eps32
-    times the triangle's forward error bound."""
+    times the triangle's forward error bound. The any-hit walk (shadow rays) answers as the
+    GPU's closest hit does, ray for ray."""
     if scene == "soup":
         V = soup(2000, 10)
         bvh = build_bvh(V)
@@ -313,6 +342,9 @@ def test_glsl_traversal_agrees_with_the_twin(gl_contexts, sphere, scene):
         gpu_s, gpu_tri = out[:, 0], out[:, 1].astype(np.int64)
         gpu_hit = gpu_tri >= 0
         assert (gpu_s[~gpu_hit] == F32(1e30)).all(), kind
+        gpu_any = gpu_closest_hits(ctx, bvh, O.reshape(HEIGHT, WIDTH, 3), D.reshape(HEIGHT, WIDTH, 3),
+                                   any_hit=True).reshape(-1, 4)[:, 0] > 0
+        assert (gpu_any == gpu_hit).all(), kind
         # hit/miss: only where the hitting side's triangle is hit within rounding of an edge
         one = gpu_hit != hit
         assert one.sum() <= 0.002 * len(hit), (kind, one.sum())

@@ -90,7 +90,7 @@ def test_the_float64_bvh_walk_finds_the_brute_force_hit_of_float64_triangles():
 
 
 def test_float32_and_float64_agree_but_at_grazing_rays():
-    scene = load_scene(ROOT / "assets" / "raytrace" / "classic.toml")
+    scene = load_scene("classic")
     frame32 = reference_raytrace(scene, 48, 36, samples=4, pattern="jittered")
     frame64 = reference_raytrace(scene, 48, 36, samples=4, pattern="jittered", dtype=F64)
     tie, tie_depth, _ = either_precision(frame32, frame64)

@@ -19,7 +19,7 @@ from renderer.viewer.controls import ViewState, apply_view, working_copy
 from renderer.viewer.orbit import OrbitCamera
 
 SIZE = (48, 36)
-CLASSIC = Path(__file__).resolve().parent.parent / "assets" / "raytrace" / "classic.toml"
+CLASSIC = Path(__file__).resolve().parent.parent / "assets" / "scenes" / "classic.toml"
 
 
 def classic_with_a_torus():

@@ -1,7 +1,9 @@
 // Twin: reference/raytrace/bvh.py
 // The closest hit of a ray P = O + s D against the triangles of a BVH (docs/conventions.md,
-// "Rays"), traversed depth first with a fixed stack, the nearer child first. The BVH is two
-// RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width)):
+// "Rays"), traversed depth first with a fixed stack, the nearer child first; and whether any
+// triangle is hit (shadow rays), which stops at the first hit it finds. The BVH is two
+// RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width),
+// the width a power of two):
 //   nodes:     texel 2i = [min.xyz, a], texel 2i + 1 = [max.xyz, count]; count > 0: a leaf of
 //              triangles a .. a + count - 1; count == 0: left child i + 1, right child a
 //   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, 0], [C.xyz, 0]
@@ -17,9 +19,14 @@
 // Traversal", JCGT 2013) so that rounding does not lose a triangle on a box's face.
 const float BVH_BOX_FAR_SCALE = 1.00000036;
 
+// Texel k (>= 0) of a texture in that layout. The width is a power of two, so k % width and
+// k / width are a mask and a shift (llvmpipe has no vector integer division: it would divide
+// lane by lane, twice per fetch); log2(width) is the exponent of float(width), exact for a
+// power of two (GLSL 3.30 has no findLSB).
 vec4 bvh_texel(sampler2D texture_, int k) {
     int width = textureSize(texture_, 0).x;
-    return texelFetch(texture_, ivec2(k % width, k / width), 0);
+    int log2_width = (floatBitsToInt(float(width)) >> 23) - 127;
+    return texelFetch(texture_, ivec2(k & (width - 1), k >> log2_width), 0);
 }
 
 // Slab test with inv_D = 1 / D (IEEE: +-inf where D's component is 0). An axis with infinite
@@ -39,6 +46,28 @@ bool bvh_ray_box(vec3 O, vec3 inv_D, vec3 bmin, vec3 bmax, float s_min, float s_
     near = max(max(tn.x, tn.y), max(tn.z, s_min));
     float far = min(min(min(tf.x, tf.y), tf.z) * BVH_BOX_FAR_SCALE, s_max);
     return near <= far;
+}
+
+// Triangle j of the triangles texture: its vertices A, B, C and its original index.
+void bvh_triangle(sampler2D triangles, int j, out vec3 A, out vec3 B, out vec3 C, out int index) {
+    vec4 a = bvh_texel(triangles, 3 * j);
+    A = a.xyz;
+    B = bvh_texel(triangles, 3 * j + 1).xyz;
+    C = bvh_texel(triangles, 3 * j + 2).xyz;
+    index = int(a.w);
+}
+
+// The children left (node + 1) and right (a) of the interior node whose first texel is n0, and
+// whether the ray meets each one's box in [s_min, s_max] (near: where it enters).
+void bvh_children(sampler2D nodes, int node, vec4 n0, vec3 O, vec3 inv_D, float s_min,
+                  float s_max, out int left, out int right, out bool hit_left,
+                  out bool hit_right, out float near_left, out float near_right) {
+    left = node + 1;
+    right = int(n0.w);
+    hit_left = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * left).xyz,
+                           bvh_texel(nodes, 2 * left + 1).xyz, s_min, s_max, near_left);
+    hit_right = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * right).xyz,
+                            bvh_texel(nodes, 2 * right + 1).xyz, s_min, s_max, near_right);
 }
 
 // Whether a triangle is hit with s_min < s < s_max; s the nearest hit's parameter (s_max on a
@@ -62,28 +91,30 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
         int count = int(n1.w);
         bool descend = false;
         if (count > 0) {
-            int first = int(n0.w);
-            for (int k = 0; k < count; ++k) {
-                int j = first + k;
-                vec4 A = bvh_texel(triangles, 3 * j);
-                vec3 B = bvh_texel(triangles, 3 * j + 1).xyz;
-                vec3 C = bvh_texel(triangles, 3 * j + 2).xyz;
+            // the leaf's triangles; the test at the end of the body, as a do-while, since
+            // llvmpipe runs a body with lanes masked off until every lane of its SIMD group has
+            // left: a test at the top ran one whole body more (a triangle, three fetches)
+            int j = int(n0.w);
+            int end = j + count;
+            do {
+                vec3 A, B, C;
+                int index;
+                bvh_triangle(triangles, j, A, B, C, index);
                 float hit_s;
                 vec2 hit_uv;
-                if (ray_triangle(O, D, A.xyz, B, C, s_min, s, hit_s, hit_uv)) {
+                if (ray_triangle(O, D, A, B, C, s_min, s, hit_s, hit_uv)) {
                     s = hit_s;
                     uv = hit_uv;
-                    triangle = int(A.w);
+                    triangle = index;
                 }
-            }
+                ++j;
+            } while (j < end);
         } else {
-            int left = node + 1;
-            int right = int(n0.w);
+            int left, right;
+            bool hit_left, hit_right;
             float near_left, near_right;
-            bool hit_left = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * left).xyz,
-                                        bvh_texel(nodes, 2 * left + 1).xyz, s_min, s, near_left);
-            bool hit_right = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * right).xyz,
-                                         bvh_texel(nodes, 2 * right + 1).xyz, s_min, s, near_right);
+            bvh_children(nodes, node, n0, O, inv_D, s_min, s, left, right, hit_left, hit_right,
+                         near_left, near_right);
             if (hit_left && hit_right) {
                 bool right_first = near_right < near_left;
                 node = right_first ? right : left;
@@ -111,4 +142,58 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
         if (!found) break;
     }
     return triangle >= 0;
+}
+
+// Whether any triangle is hit with s_min < s < s_max (a shadow ray): the same walk, but it stops
+// at the first hit it finds and takes the children in stored order (no nearest-first ordering,
+// no distances on the stack, s_max fixed), so it answers as bvh_closest_hit's return value.
+bool bvh_any_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float s_min,
+                 float s_max) {
+    vec3 inv_D = 1.0 / D;
+    int stack[BVH_STACK_SIZE];
+    int top = 0;
+    float near;
+    if (!bvh_ray_box(O, inv_D, bvh_texel(nodes, 0).xyz, bvh_texel(nodes, 1).xyz, s_min, s_max,
+                     near))
+        return false;
+    int node = 0;
+    bool hit = false;
+    while (true) {
+        vec4 n0 = bvh_texel(nodes, 2 * node);
+        vec4 n1 = bvh_texel(nodes, 2 * node + 1);
+        int count = int(n1.w);
+        bool descend = false;
+        if (count > 0) {
+            int j = int(n0.w);
+            int end = j + count;
+            do {                                    // the test at the end: see bvh_closest_hit
+                vec3 A, B, C;
+                int index;
+                bvh_triangle(triangles, j, A, B, C, index);
+                float hit_s;
+                vec2 hit_uv;
+                hit = ray_triangle(O, D, A, B, C, s_min, s_max, hit_s, hit_uv);
+                ++j;
+            } while (j < end && !hit);
+        } else {
+            int left, right;
+            bool hit_left, hit_right;
+            float near_left, near_right;
+            bvh_children(nodes, node, n0, O, inv_D, s_min, s_max, left, right, hit_left,
+                         hit_right, near_left, near_right);
+            if (hit_left && hit_right && top < BVH_STACK_SIZE) {
+                stack[top] = right;
+                ++top;
+            }
+            node = hit_left ? left : right;
+            descend = hit_left || hit_right;
+        }
+        if (!descend && top > 0) {
+            --top;
+            node = stack[top];
+            descend = true;
+        }
+        if (hit || !descend) break;
+    }
+    return hit;
 }

@@ -4,17 +4,19 @@
 // (P - C).(P - C) - r^2 = 0 and a triangle ABC. Each returns whether the nearest hit with
 // s_min < s < s_max exists; `s` is that hit's parameter, or s_max on a miss (so a caller that
 // passes the nearest hit so far as s_max keeps it on a miss). One ray per call.
+// No early return: llvmpipe runs every branch with its lanes masked off rather than skipping
+// it, and a return inside a caller's loop (trace.glsl's shadow rays) costs flags and masks on
+// top; so each test computes everything and selects (a miss's arithmetic, a division by 0 or
+// the root of a negative number, is computed and not used; the twin computes it the same way).
 
 // Plane P.N + d = 0 (N need not be unit): s = -(O.N + d) / (D.N). A ray parallel to the plane
 // (D.N == 0, also a ray inside it) misses.
 bool ray_plane(vec3 O, vec3 D, vec3 N, float d, float s_min, float s_max, out float s) {
     float denominator = dot(D, N);
-    s = s_max;
-    if (denominator == 0.0) return false;
     float hit = -(dot(O, N) + d) / denominator;
-    if (!(hit > s_min && hit < s_max)) return false;
-    s = hit;
-    return true;
+    bool inside = denominator != 0.0 && hit > s_min && hit < s_max;
+    s = inside ? hit : s_max;
+    return inside;
 }
 
 vec3 plane_normal(vec3 N) {
@@ -39,43 +41,38 @@ float sphere_discriminant(vec3 O, vec3 D, vec3 C, float r) {
 // Roots as the chapter's eq. 7.7 and 7.8 (Press et al.): q = -(b + sign(b) sqrt(a delta)),
 // s0 = c / q, s1 = q / a; no subtraction of nearly equal numbers. A tangent ray (delta == 0)
 // hits. From inside the sphere the nearer root is behind (s <= s_min): the far root is the hit.
-bool ray_sphere(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max, out float s) {
+// A ray that starts on the sphere (on_surface: a secondary or shadow ray leaving a point of it,
+// with no offset) has its origin at the root c / q (c = 0 on the surface, up to the rounding of
+// f.f - r^2, which cancels there), so the one other point of the sphere it can meet is the
+// root s1 = q / a, ahead (s1 > 0) when the ray goes inwards (b < 0) and behind when it leaves
+// outwards (q <= 0): a sphere is convex; c / q is not used. One body for both kinds of ray:
+// llvmpipe would run both of two functions chosen between per ray.
+bool ray_sphere_from(vec3 O, vec3 D, vec3 C, float r, bool on_surface, float s_min, float s_max,
+                     out float s) {
     vec3 f = O - C;
     float a = dot(D, D);
     float b = dot(f, D);
     float c = dot(f, f) - r * r;
     vec3 l = f - (b / a) * D;
     float delta = r * r - dot(l, l);
-    s = s_max;
-    if (delta < 0.0) return false;
     float q = -(b + (b >= 0.0 ? 1.0 : -1.0) * sqrt(a * delta));
     float s0 = c / q;
     float s1 = q / a;
-    float near = min(s0, s1);
-    float far = max(s0, s1);
-    if (near > s_min && near < s_max) { s = near; return true; }
-    if (far > s_min && far < s_max) { s = far; return true; }
-    return false;
+    float near = on_surface ? s1 : min(s0, s1);
+    float far = on_surface ? s1 : max(s0, s1);
+    bool near_hit = delta >= 0.0 && near > s_min && near < s_max;
+    bool far_hit = delta >= 0.0 && far > s_min && far < s_max;
+    s = near_hit ? near : (far_hit ? far : s_max);
+    return near_hit || far_hit;
 }
 
-// A ray that starts on the sphere (a secondary or shadow ray leaving a point of it, with no
-// offset): its origin is the root c / q (c = 0 on the surface, up to the rounding of
-// f.f - r^2, which cancels there), so the one other point of the sphere it can meet is the
-// root s1 = q / a, ahead (s1 > 0) when the ray goes inwards (b < 0) and behind when it leaves
-// outwards (q <= 0): a sphere is convex. c is not used.
+bool ray_sphere(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max, out float s) {
+    return ray_sphere_from(O, D, C, r, false, s_min, s_max, s);
+}
+
 bool ray_sphere_from_surface(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max,
                              out float s) {
-    vec3 f = O - C;
-    float a = dot(D, D);
-    float b = dot(f, D);
-    vec3 l = f - (b / a) * D;
-    float delta = r * r - dot(l, l);
-    s = s_max;
-    if (delta < 0.0) return false;
-    float far = -(b + (b >= 0.0 ? 1.0 : -1.0) * sqrt(a * delta)) / a;
-    if (!(far > s_min && far < s_max)) return false;
-    s = far;
-    return true;
+    return ray_sphere_from(O, D, C, r, true, s_min, s_max, s);
 }
 
 // The outward unit normal at a point P on the sphere.
@@ -93,18 +90,15 @@ bool ray_triangle(vec3 O, vec3 D, vec3 A, vec3 B, vec3 C, float s_min, float s_m
     vec3 e2 = C - A;
     vec3 p = cross(D, e2);
     float det = dot(e1, p);
-    s = s_max;
-    uv = vec2(0.0);
-    if (det == 0.0) return false;
     vec3 t = O - A;
     float u = dot(t, p) / det;
     vec3 q = cross(t, e1);
     float v = dot(D, q) / det;
     float hit = dot(e2, q) / det;
-    if (!(u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > s_min && hit < s_max)) return false;
-    s = hit;
-    uv = vec2(u, v);
-    return true;
+    bool inside = det != 0.0 && u >= 0.0 && v >= 0.0 && u + v <= 1.0 && hit > s_min && hit < s_max;
+    s = inside ? hit : s_max;
+    uv = inside ? vec2(u, v) : vec2(0.0);
+    return inside;
 }
 
 // The unit geometric normal of ABC, on the side from which A, B, C run counter-clockwise.

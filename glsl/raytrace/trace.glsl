@@ -53,9 +53,9 @@ float trace_s_min(vec3 O) {
     return TRACE_HIT_TIE * sqrt(dot(O, O));
 }
 
+// Texel k of the materials or triangle data: the BVH textures' layout (bvh.glsl, bvh_texel).
 vec4 trace_texel(sampler2D texture_, int k) {
-    int width = textureSize(texture_, 0).x;
-    return texelFetch(texture_, ivec2(k % width, k / width), 0);
+    return bvh_texel(texture_, k);
 }
 
 // The nearest hit with s_min < s < s_max: its kind (TRACE_MISS on a miss), the sphere's,
@@ -77,8 +77,7 @@ int scene_hit(vec3 O, vec3 D, float s_min, float s_max, int from_shape,
     for (int k = 0; k < NUM_SPHERES; ++k) {
         vec3 C = u_spheres[k].xyz;
         float r = u_spheres[k].w;
-        if (k == from_shape ? ray_sphere_from_surface(O, D, C, r, s_min, s_limit, s_k)
-                            : ray_sphere(O, D, C, r, s_min, s_limit, s_k)) {
+        if (ray_sphere_from(O, D, C, r, k == from_shape, s_min, s_limit, s_k)) {
             s = s_k; s_limit = s_k * (1.0 - TRACE_HIT_TIE); kind = TRACE_SPHERE; index = k;
         }
     }
@@ -138,31 +137,30 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
 }
 
 // Whether anything is hit with trace_s_min(O) < s < s_max (a shadow ray from a point of
-// `from_shape`, as scene_hit): the first hit found answers (any hit, not the nearest: the
-// analytic shapes first, the BVH only if none of them is hit).
+// `from_shape`, as scene_hit): any hit, not the nearest; the analytic shapes, then the BVH's
+// any-hit walk unless one of them is hit. No early return: llvmpipe runs every test anyway,
+// and a return inside these loops kept them from being unrolled.
 bool occluded(vec3 O, vec3 D, float s_max, int from_shape) {
     float s_k;
     float s_min = trace_s_min(O);
+    bool hit = false;
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        vec3 C = u_spheres[k].xyz;
-        float r = u_spheres[k].w;
-        if (k == from_shape ? ray_sphere_from_surface(O, D, C, r, s_min, s_max, s_k)
-                            : ray_sphere(O, D, C, r, s_min, s_max, s_k)) return true;
+        bool hit_k = ray_sphere_from(O, D, u_spheres[k].xyz, u_spheres[k].w, k == from_shape,
+                                     s_min, s_max, s_k);
+        hit = hit || hit_k;
     }
 #endif
 #if NUM_PLANES > 0
     for (int k = 0; k < NUM_PLANES; ++k) {
-        if (NUM_SPHERES + k != from_shape
-                && ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s_max, s_k)) return true;
+        bool hit_k = ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s_max, s_k);
+        hit = hit || (hit_k && NUM_SPHERES + k != from_shape);
     }
 #endif
 #ifdef MESHES
-    vec2 uv_t;
-    int triangle;
-    if (bvh_closest_hit(u_nodes, u_triangles, O, D, s_min, s_max, s_k, uv_t, triangle)) return true;
+    if (!hit) hit = bvh_any_hit(u_nodes, u_triangles, O, D, s_min, s_max);
 #endif
-    return false;
+    return hit;
 }
 
 vec3 g_geometric_normal;             // the outward Ng of the point being lit

@@ -6,7 +6,9 @@ float32 as the GLSL (or float64, the ground truth), vectorised over rays: a wave
 ray-box test and the triangle test are the GLSL's (`ray_box` below; `ray_triangle` of
 intersect.py), so each pair decides as the GLSL does; the order differs (the GLSL goes depth
 first, nearer child first), which changes the answer only where two triangles are hit at the
-same s (an edge or vertex they share): either is the closest hit then.
+same s (an edge or vertex they share): either is the closest hit then. `any_hit` (shadow rays)
+answers whether closest_hit would hit, dropping each ray from the wavefront at its first hit,
+as the GLSL's bvh_any_hit stops at its first.
 
 Ray-box (slab) test with 1/D precomputed, IEEE: 1/(+-0) = +-inf. An axis whose 1/D is
 infinite (D's component 0, or so small that 1/D overflows) is parallel to its slab: it admits
@@ -71,21 +73,14 @@ def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
     return near <= far, near
 
 
-def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
-    """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
-    s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v),
-    and the triangle's original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
-    `vertices` (T, 3, 3), by original index, replace the BVH's float32 triangles (the float64
-    twin passes the scene's float64 ones; the boxes are widened to hold them)."""
+def _walk(bvh, O, D, s_min, vertices):
+    """What both walks start from: the rays in their dtype (O, D, 1/D, s_min per ray), the
+    nodes and the triangles' vertices (T, 3, 3) in leaf order; with float64 `vertices` (by
+    original index) the boxes widened by a float32 ulp to hold them."""
     dtype = _dtype(O)
     O = np.asarray(O, dtype).reshape(-1, 3)
     D = np.asarray(D, dtype).reshape(-1, 3)
-    R = len(O)
-    inv_D = inverse_direction(D)
-    s_min = np.broadcast_to(np.asarray(s_min, dtype), (R,))
-    best_s = np.full(R, dtype.type(s_max), dtype)
-    best_uv = np.zeros((R, 2), dtype)
-    best_tri = np.full(R, -1, np.int64)
+    s_min = np.broadcast_to(np.asarray(s_min, dtype), (len(O),))
     nodes, tris = bvh.nodes, bvh.triangles[..., :3]
     if vertices is not None:
         lo = np.nextafter(nodes[:, 0, :3], F32(-np.inf))
@@ -93,20 +88,50 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
         nodes = np.stack([np.concatenate([lo, nodes[:, 0, 3:]], -1),
                           np.concatenate([hi, nodes[:, 1, 3:]], -1)], 1)
         tris = np.asarray(vertices, dtype)[bvh.original_index]
+    return dtype, O, D, inverse_direction(D), s_min, nodes, tris
+
+
+def _visit(nodes, O, inv_D, ray, node, s_min, s_max):
+    """The (ray, node) pairs whose box the ray meets, with each node's first texel and whether
+    it is a leaf."""
+    n0, n1 = nodes[node, 0], nodes[node, 1]
+    hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min, s_max)
+    return ray[hit], node[hit], n0[hit], n1[hit, 3] > 0
+
+
+def _leaf_pairs(ray, n0, leaf, count):
+    """(ray, triangle) for every triangle of every leaf pair: triangles a .. a + count - 1."""
+    count = count[leaf].astype(np.int64)
+    starts = np.cumsum(count) - count
+    first = n0[leaf, 3].astype(np.int64)
+    return np.repeat(ray[leaf], count), np.repeat(first - starts, count) + np.arange(count.sum())
+
+
+def _children(ray, node, n0, inner):
+    """The next level of the wavefront: both children (left = i + 1, right = a) of each
+    interior pair."""
+    children = np.stack([node[inner] + 1, n0[inner, 3].astype(np.int64)], axis=1).reshape(-1)
+    return np.repeat(ray[inner], 2), children
+
+
+def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
+    """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
+    s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v),
+    and the triangle's original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
+    `vertices` (T, 3, 3), by original index, replace the BVH's float32 triangles (the float64
+    twin passes the scene's float64 ones; the boxes are widened to hold them)."""
+    dtype, O, D, inv_D, s_min, nodes, tris = _walk(bvh, O, D, s_min, vertices)
+    R = len(O)
+    best_s = np.full(R, dtype.type(s_max), dtype)
+    best_uv = np.zeros((R, 2), dtype)
+    best_tri = np.full(R, -1, np.int64)
     ray = np.arange(R)
     node = np.zeros(R, np.int64)
     while ray.size:
-        n0, n1 = nodes[node, 0], nodes[node, 1]
-        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min[ray], best_s[ray])
-        ray, node, n0, n1 = ray[hit], node[hit], n0[hit], n1[hit]
-        leaf = n1[:, 3] > 0
+        ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min[ray], best_s[ray])
         # leaves: every (ray, triangle) pair, then the nearest hit per ray
-        count = n1[leaf, 3].astype(np.int64)
-        if count.size:
-            r = np.repeat(ray[leaf], count)
-            starts = np.cumsum(count) - count
-            t = (np.repeat(n0[leaf, 3].astype(np.int64) - starts, count)
-                 + np.arange(count.sum()))
+        r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
+        if r.size:
             v = tris[t]
             h, s, uv = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], best_s[r])
             r, s, uv, t = r[h], s[h], uv[h], t[h]
@@ -118,13 +143,31 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
                 better = s < best_s[r]
                 r, s, uv, t = r[better], s[better], uv[better], t[better]
                 best_s[r], best_uv[r], best_tri[r] = s, uv, t
-        # interior nodes: both children (left = i + 1, right = a)
-        inner = ~leaf
-        ray = np.repeat(ray[inner], 2)
-        node = np.stack([node[inner] + 1, n0[inner, 3].astype(np.int64)], axis=1).reshape(-1)
+        ray, node = _children(ray, node, n0, ~leaf)
     hit = best_tri >= 0
     original = np.where(hit, bvh.original_index[np.maximum(best_tri, 0)], -1)
     return hit, best_s, best_uv, original
+
+
+def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
+    """Whether each ray O, D (R, 3) hits a triangle with s_min < s < s_max (scalars or per
+    ray): closest_hit's `hit`, found as the GLSL's bvh_any_hit finds it, a ray leaving the walk
+    at its first hit. Dtypes and `vertices` as closest_hit."""
+    dtype, O, D, inv_D, s_min, nodes, tris = _walk(bvh, O, D, s_min, vertices)
+    R = len(O)
+    s_max = np.broadcast_to(np.asarray(s_max, dtype), (R,))
+    blocked = np.zeros(R, bool)
+    ray = np.arange(R)
+    node = np.zeros(R, np.int64)
+    while ray.size:
+        ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min[ray], s_max[ray])
+        r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
+        if r.size:
+            v = tris[t]
+            h, _, _ = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], s_max[r])
+            blocked[r[h]] = True
+        ray, node = _children(ray, node, n0, ~leaf & ~blocked[ray])
+    return blocked
 
 
 def closest_hit_brute_force(vertices, O, D, s_min=0.0, s_max=np.inf, chunk=1 << 20):

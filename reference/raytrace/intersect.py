@@ -84,11 +84,14 @@ def sphere_discriminant(O, D, C, r):
     return _sphere_terms(*_as(dtype, O, D, C, r))[2]
 
 
-def ray_sphere(O, D, C, r, s_min, s_max):
+def ray_sphere_from(O, D, C, r, on_surface, s_min, s_max):
     """The nearest root in (s_min, s_max) of |O + s D - C|^2 = r^2, by Ray Tracing Gems ch. 7:
     delta = r^2 - |f - (b/a) D|^2 (eq. 7.6), q = -(b + sign(b) sqrt(a delta)), s0 = c / q,
     s1 = q / a (eq. 7.7, 7.8), sign(0) = +1. A tangent ray (delta == 0) hits; from inside, the
-    far root."""
+    far root. A ray that starts on the sphere (on_surface, per ray or for all; no offset): its
+    origin is the root c / q, so the one other point it can meet is s1 = q / a (ahead when it
+    goes inwards, b < 0; behind when it leaves outwards: a sphere is convex); c / q, which
+    cancels there, is not used. One test for both kinds of ray, as the GLSL's."""
     dtype = _float_dtype(O, D)
     O, D, C, r, s_min, s_max = _as(dtype, O, D, C, r, s_min, s_max)
     f, a, delta, q = _sphere_terms(O, D, C, r)
@@ -96,8 +99,8 @@ def ray_sphere(O, D, C, r, s_min, s_max):
         c = _dot(f, f) - r * r
         s0 = c / q
         s1 = q / a
-        near = np.minimum(s0, s1)
-        far = np.maximum(s0, s1)
+        near = np.where(on_surface, s1, np.minimum(s0, s1))
+        far = np.where(on_surface, s1, np.maximum(s0, s1))
         near_hit = (near > s_min) & (near < s_max)
         far_hit = (far > s_min) & (far < s_max)
         hit = (delta >= 0) & (near_hit | far_hit)
@@ -105,17 +108,14 @@ def ray_sphere(O, D, C, r, s_min, s_max):
     return _select(hit, s, s_max)
 
 
+def ray_sphere(O, D, C, r, s_min, s_max):
+    """ray_sphere_from for rays that do not start on the sphere."""
+    return ray_sphere_from(O, D, C, r, False, s_min, s_max)
+
+
 def ray_sphere_from_surface(O, D, C, r, s_min, s_max):
-    """A ray that starts on the sphere (no offset): its origin is the root c / q, so the one
-    other point it can meet is s1 = q / a (ahead when it goes inwards, b < 0; behind when it
-    leaves outwards: a sphere is convex). c = f.f - r^2, which cancels there, is not used."""
-    dtype = _float_dtype(O, D)
-    O, D, C, r, s_min, s_max = _as(dtype, O, D, C, r, s_min, s_max)
-    _, a, delta, q = _sphere_terms(O, D, C, r)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        far = q / a
-        hit = (delta >= 0) & (far > s_min) & (far < s_max)
-    return _select(hit, far, s_max)
+    """ray_sphere_from for rays that start on the sphere."""
+    return ray_sphere_from(O, D, C, r, True, s_min, s_max)
 
 
 def sphere_normal(P, C, r):

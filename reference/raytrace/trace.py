@@ -29,9 +29,9 @@ from __future__ import annotations
 import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
-from reference.raytrace.bvh import closest_hit as bvh_closest_hit
-from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere,
-                                          ray_sphere_from_surface, sphere_normal, triangle_normal)
+from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
+from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
+                                          triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
@@ -59,7 +59,7 @@ def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
     kind MISS/SPHERE/PLANE/TRIANGLE, index the sphere's, plane's or original triangle's, s the
     hit (s_max on a miss). In the dtype of O: float32, or float64 with the scene's float64
     surfaces. `from_shape` (R,): the analytic shape each ray starts on (shape_id; -1 for none),
-    met again only at a sphere's far side (ray_sphere_from_surface). Ties (HIT_TIE): a surface
+    met again only at a sphere's far side (ray_sphere_from, on_surface). Ties (HIT_TIE): a surface
     replaces the nearest found so far only when nearer by more than HIT_TIE relative."""
     R, t = len(O), O.dtype.type
     s = np.broadcast_to(np.asarray(s_max, t), (R,)).astype(t)
@@ -79,11 +79,7 @@ def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
 
     for k in range(len(rs.sphere_radius)):
         C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
-        hit, s_k = ray_sphere(O, D, C, r, s_min, limit)
-        on = from_shape == k
-        if on.any():
-            hit_on, s_on = ray_sphere_from_surface(O[on], D[on], C, r, s_min[on], limit[on])
-            hit[on], s_k[on] = hit_on, s_on
+        hit, s_k = ray_sphere_from(O, D, C, r, from_shape == k, s_min, limit)
         found(hit, s_k, SPHERE, k)
     for k in range(len(rs.plane_offset)):
         hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, limit)
@@ -110,8 +106,25 @@ def ray_origin(P, n, shape):
 
 def occluded(rs, O, D, s_max, from_shape=None):
     """Whether anything is hit with leaving_s_min(O) < s < s_max (a shadow ray from a point of
-    from_shape)."""
-    return scene_hit(rs, O, D, leaving_s_min(O), s_max, from_shape)[0] != MISS
+    from_shape; s_max a number or one per ray): any hit, not the nearest, as the GLSL: the
+    spheres, the planes, then the BVH's any-hit walk for the rays none of them blocks. The
+    answer is scene_hit's (kind != MISS), found with less work."""
+    R, t = len(O), O.dtype.type
+    s_min = leaving_s_min(O)
+    s_max = np.broadcast_to(np.asarray(s_max, t), (R,))
+    from_shape = np.full(R, -1) if from_shape is None else from_shape
+    blocked = np.zeros(R, bool)
+    for k in range(len(rs.sphere_radius)):
+        C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
+        blocked |= ray_sphere_from(O, D, C, r, from_shape == k, s_min, s_max)[0]
+    for k in range(len(rs.plane_offset)):
+        hit = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, s_max)[0]
+        blocked |= hit & (from_shape != len(rs.sphere_radius) + k)
+    if rs.bvh is not None:
+        rest = ~blocked
+        blocked[rest] = bvh_any_hit(rs.bvh, O[rest], D[rest], s_min[rest], s_max[rest],
+                                    vertices=None if t is F32 else rs.triangles)
+    return blocked
 
 
 def surface(rs, O, D, kind, index, s, uv):

@@ -15,9 +15,11 @@ The layout (every number float32; the integers in it are exact, being below 2^24
                [A.xyz, original index], [B.xyz, 0], [C.xyz, 0]
              with the original index the triangle's row in the input.
 
-As a texture (`texels`): the texels of an array in order, row by row, TEXTURE_WIDTH (or fewer,
-for a short array) to a row, the last row padded with zeros; texel k is at
-(k % width, k // width), the width read back by the shader with textureSize.
+As a texture (`texels`): the texels of an array in order, row by row, TEXTURE_WIDTH to a row
+(for a short array, the smallest power of two that holds it), the last row padded with zeros;
+texel k is at (k % width, k // width), the width read back by the shader with textureSize.
+The width is a power of two so that the shader computes that address with a mask and a shift:
+llvmpipe has no vector integer division and divides lane by lane.
 
 The build: a node with more than `max_leaf_size` triangles is split by the binned SAH (BINS
 bins per axis over its centroids' bounds; the split of least A_left N_left + A_right N_right,
@@ -216,9 +218,12 @@ def mesh_vertices(positions, faces) -> np.ndarray:
 
 def texels(array: np.ndarray, width: int = TEXTURE_WIDTH) -> np.ndarray:
     """(rows, width, 4) float32: the RGBA texels of `array` (..., 4) in order, row by row, the
-    last row padded with zeros; width is TEXTURE_WIDTH, or the texel count if fewer."""
+    last row padded with zeros; `width` (a power of two) to a row, or the smallest power of two
+    that holds them all if that is narrower."""
+    if width < 1 or width & (width - 1):
+        raise ValueError(f"the texture width must be a power of two, got {width}")
     flat = np.asarray(array, np.float32).reshape(-1, 4)
-    width = max(1, min(width, len(flat)))
+    width = min(width, 1 << max(len(flat) - 1, 0).bit_length())
     rows = -(-len(flat) // width)
     out = np.zeros((rows * width, 4), np.float32)
     out[: len(flat)] = flat

@@ -124,8 +124,11 @@ def is_inside_edge(edge_value: np.ndarray, inclusive: np.ndarray) -> np.ndarray:
 
 def to_unorm8(c: np.ndarray) -> np.ndarray:
     """GL's float -> unorm8 (OpenGL 4.5 §2.3.5.1, without dithering, which the GPU path
-    disables): floor(clamp(c, 0, 1) * 255 + 0.5)."""
-    return np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5).astype(np.uint8)
+    disables): floor(clamp(c, 0, 1) * 255 + 0.5). In place on one temporary (a frame's worth
+    of fresh arrays per step cost more in page faults than the arithmetic)."""
+    scaled = np.asarray(np.clip(c, 0.0, 1.0) * 255.0)
+    scaled += 0.5
+    return np.floor(scaled, out=scaled).astype(np.uint8)
 
 
 # --- uniform storage: how many lights a scene may have ---------------------------------------

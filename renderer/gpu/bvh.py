@@ -1,5 +1,6 @@
 """A BVH (renderer/core/bvh.py) as the two RGBA32F textures glsl/raytrace/bvh.glsl reads:
-nodes and triangles, texel k at (k % width, k // width) (`renderer.core.bvh.texels`)."""
+nodes and triangles, texel k at (k % width, k // width), the width a power of two
+(`renderer.core.bvh.texels`)."""
 
 from __future__ import annotations
 

@@ -267,7 +267,7 @@ class RayTracer:
         else:
             samples = np.full((h, w), self.sampling.samples, np.int32)
         rgba8 = to_unorm8(linear)
-        rgba8[..., 3] = np.where(linear[..., 3] > 0, 255, 0)
+        rgba8[..., 3] = np.where(linear[..., 3] > 0, np.uint8(255), np.uint8(0))
         return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info,
                      samples=samples)
 

@@ -48,6 +48,20 @@ bool bvh_ray_box(vec3 O, vec3 inv_D, vec3 bmin, vec3 bmax, float s_min, float s_
     return near <= far;
 }
 
+// Node i: its count (> 0: a leaf of `count` triangles from a; 0: an interior node whose right
+// child is a).
+int bvh_node(sampler2D nodes, int node, out int a) {
+    a = int(bvh_texel(nodes, 2 * node).w);
+    return int(bvh_texel(nodes, 2 * node + 1).w);
+}
+
+// Whether the ray meets the root's box in [s_min, s_max].
+bool bvh_meets_root(sampler2D nodes, vec3 O, vec3 inv_D, float s_min, float s_max) {
+    float near;
+    return bvh_ray_box(O, inv_D, bvh_texel(nodes, 0).xyz, bvh_texel(nodes, 1).xyz, s_min, s_max,
+                       near);
+}
+
 // Triangle j of the triangles texture: its vertices A, B, C and its original index.
 void bvh_triangle(sampler2D triangles, int j, out vec3 A, out vec3 B, out vec3 C, out int index) {
     vec4 a = bvh_texel(triangles, 3 * j);
@@ -57,13 +71,13 @@ void bvh_triangle(sampler2D triangles, int j, out vec3 A, out vec3 B, out vec3 C
     index = int(a.w);
 }
 
-// The children left (node + 1) and right (a) of the interior node whose first texel is n0, and
-// whether the ray meets each one's box in [s_min, s_max] (near: where it enters).
-void bvh_children(sampler2D nodes, int node, vec4 n0, vec3 O, vec3 inv_D, float s_min,
+// The children left (node + 1) and right (a) of an interior node, and whether the ray meets
+// each one's box in [s_min, s_max] (near: where it enters).
+void bvh_children(sampler2D nodes, int node, int a, vec3 O, vec3 inv_D, float s_min,
                   float s_max, out int left, out int right, out bool hit_left,
                   out bool hit_right, out float near_left, out float near_right) {
     left = node + 1;
-    right = int(n0.w);
+    right = a;
     hit_left = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * left).xyz,
                            bvh_texel(nodes, 2 * left + 1).xyz, s_min, s_max, near_left);
     hit_right = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * right).xyz,
@@ -81,21 +95,18 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
     int stack[BVH_STACK_SIZE];
     float stack_near[BVH_STACK_SIZE];
     int top = 0;
-    float near;
-    if (!bvh_ray_box(O, inv_D, bvh_texel(nodes, 0).xyz, bvh_texel(nodes, 1).xyz, s_min, s, near))
-        return false;
+    if (!bvh_meets_root(nodes, O, inv_D, s_min, s)) return false;
     int node = 0;
     while (true) {
-        vec4 n0 = bvh_texel(nodes, 2 * node);
-        vec4 n1 = bvh_texel(nodes, 2 * node + 1);
-        int count = int(n1.w);
+        int a;
+        int count = bvh_node(nodes, node, a);
         bool descend = false;
         if (count > 0) {
             // the leaf's triangles; the test at the end of the body, as a do-while, since
             // llvmpipe runs a body with lanes masked off until every lane of its SIMD group has
             // left: a test at the top ran one whole body more (a triangle, three fetches)
-            int j = int(n0.w);
-            int end = j + count;
+            int j = a;
+            int end = a + count;
             do {
                 vec3 A, B, C;
                 int index;
@@ -113,7 +124,7 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
             int left, right;
             bool hit_left, hit_right;
             float near_left, near_right;
-            bvh_children(nodes, node, n0, O, inv_D, s_min, s, left, right, hit_left, hit_right,
+            bvh_children(nodes, node, a, O, inv_D, s_min, s, left, right, hit_left, hit_right,
                          near_left, near_right);
             if (hit_left && hit_right) {
                 bool right_first = near_right < near_left;
@@ -152,20 +163,16 @@ bool bvh_any_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float s_m
     vec3 inv_D = 1.0 / D;
     int stack[BVH_STACK_SIZE];
     int top = 0;
-    float near;
-    if (!bvh_ray_box(O, inv_D, bvh_texel(nodes, 0).xyz, bvh_texel(nodes, 1).xyz, s_min, s_max,
-                     near))
-        return false;
+    if (!bvh_meets_root(nodes, O, inv_D, s_min, s_max)) return false;
     int node = 0;
     bool hit = false;
     while (true) {
-        vec4 n0 = bvh_texel(nodes, 2 * node);
-        vec4 n1 = bvh_texel(nodes, 2 * node + 1);
-        int count = int(n1.w);
+        int a;
+        int count = bvh_node(nodes, node, a);
         bool descend = false;
         if (count > 0) {
-            int j = int(n0.w);
-            int end = j + count;
+            int j = a;
+            int end = a + count;
             do {                                    // the test at the end: see bvh_closest_hit
                 vec3 A, B, C;
                 int index;
@@ -179,7 +186,7 @@ bool bvh_any_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float s_m
             int left, right;
             bool hit_left, hit_right;
             float near_left, near_right;
-            bvh_children(nodes, node, n0, O, inv_D, s_min, s_max, left, right, hit_left,
+            bvh_children(nodes, node, a, O, inv_D, s_min, s_max, left, right, hit_left,
                          hit_right, near_left, near_right);
             if (hit_left && hit_right && top < BVH_STACK_SIZE) {
                 stack[top] = right;

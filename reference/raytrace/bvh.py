@@ -107,6 +107,12 @@ def _leaf_pairs(ray, n0, leaf, count):
     return np.repeat(ray[leaf], count), np.repeat(first - starts, count) + np.arange(count.sum())
 
 
+def _triangles(O, D, tris, r, t, s_min, s_max):
+    """ray_triangle of each (ray r, triangle t) pair, s_min and s_max per ray."""
+    v = tris[t]
+    return ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], s_max[r])
+
+
 def _children(ray, node, n0, inner):
     """The next level of the wavefront: both children (left = i + 1, right = a) of each
     interior pair."""
@@ -132,8 +138,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
         # leaves: every (ray, triangle) pair, then the nearest hit per ray
         r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
         if r.size:
-            v = tris[t]
-            h, s, uv = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], best_s[r])
+            h, s, uv = _triangles(O, D, tris, r, t, s_min, best_s)
             r, s, uv, t = r[h], s[h], uv[h], t[h]
             if r.size:
                 order = np.lexsort((t, s, r))           # per ray: nearest s, then leaf order
@@ -162,10 +167,7 @@ def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     while ray.size:
         ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min[ray], s_max[ray])
         r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
-        if r.size:
-            v = tris[t]
-            h, _, _ = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], s_max[r])
-            blocked[r[h]] = True
+        blocked[r[_triangles(O, D, tris, r, t, s_min, s_max)[0]]] = True
         ray, node = _children(ray, node, n0, ~leaf & ~blocked[ray])
     return blocked
 

@@ -25,6 +25,7 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
+from renderer.core.ray_sampling import RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -108,12 +109,16 @@ def build_parser() -> argparse.ArgumentParser:
                             "reflection, refraction; docs/conventions.md, \"Rays\")")
         p.add_argument("--spp", type=positive_int, default=1, metavar="N",
                        help="ray tracer: samples per pixel (default 1)")
-        p.add_argument("--pattern", choices=("regular", "random", "jittered", "poisson"),
-                       default="regular", help="ray tracer: sample pattern (default regular)")
+        p.add_argument("--pattern", choices=RAY_PATTERNS, default="regular",
+                       help="ray tracer: sample positions (default regular; docs/conventions.md, "
+                            "\"Sample positions\")")
+        p.add_argument("--adaptive-threshold", type=float, default=None, metavar="T",
+                       help="ray tracer, --pattern adaptive: refine a pixel whose first 4 samples' "
+                            "clamped colours differ by more than T in some channel (default 1/255)")
         p.add_argument("--max-depth", type=int, default=4, metavar="D",
                        help="ray tracer: bounces of reflection and refraction, 0 to 16 (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
-                       help="ray tracer: seed of the random and jittered patterns")
+                       help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
@@ -152,6 +157,9 @@ def build_parser() -> argparse.ArgumentParser:
     view.add_argument("--triple-buffering", action="store_true",
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
+    view.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+                      help="start with the rasteriser (default) or the ray tracer, which refines "
+                           "while the view is still, one sample per pixel a frame (the M key)")
 
     compare = sub.add_parser(
         "compare", help="render through the GPU and the reference and compare",
@@ -251,23 +259,37 @@ def check_raytrace_options(args) -> None:
     args.method = args.method or "raster"
     traced = methods or args.method == "raytrace"
     if not traced and (args.spp != 1 or args.pattern != "regular" or args.max_depth != 4
-                                    or args.seed is not None):
+                       or args.seed is not None or args.adaptive_threshold is not None):
         also = " or --methods" if hasattr(args, "methods") else ""
-        args.parser.error(f"--spp, --pattern, --max-depth and --seed are for --method raytrace{also}")
+        args.parser.error("--spp, --pattern, --max-depth, --seed and --adaptive-threshold are for "
+                          f"--method raytrace{also}")
     if not 0 <= args.max_depth <= 16:
         args.parser.error(f"--max-depth must be between 0 and 16, got {args.max_depth}")
+    if args.adaptive_threshold is not None and args.pattern != "adaptive":
+        args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
     if traced:
-        from renderer.core.sampling import pattern
+        from renderer.core.ray_sampling import ray_sampling
+        options = _raytrace_options(args)
         try:
-            pattern(args.pattern, args.spp, **({} if args.seed is None else {"seed": args.seed}))
+            ray_sampling(options["pattern"], options["samples"], options["seed"], options["adaptive_threshold"])
         except ValueError as error:
-            args.parser.error(f"--spp {args.spp} --pattern {args.pattern}: {error}")
+            given = [f"--spp {args.spp}", f"--pattern {args.pattern}"]
+            given += [] if args.seed is None else [f"--seed {args.seed}"]
+            given += [] if args.adaptive_threshold is None else [f"--adaptive-threshold {args.adaptive_threshold:g}"]
+            args.parser.error(f"{' '.join(given)}: {error}")
 
 
 def _raytrace_options(args) -> dict:
     from renderer.core.sampling import DEFAULT_SEED
     return {"samples": args.spp, "pattern": args.pattern, "max_depth": args.max_depth,
-            "seed": DEFAULT_SEED if args.seed is None else args.seed}
+            "seed": DEFAULT_SEED if args.seed is None else args.seed,
+            "adaptive_threshold": args.adaptive_threshold}
+
+
+def samples_fired(frame) -> str:
+    """What an adaptive frame traced: 'mean 4.72 spp, 6.0% of pixels refined'."""
+    from renderer.core.ray_sampling import FIRST_SET
+    return f"mean {frame.samples.mean():.2f} spp, {(frame.samples > FIRST_SET).mean():.1%} of pixels refined"
 
 
 def check_raytrace_memory(scene, size, backends, samples) -> None:
@@ -345,6 +367,8 @@ def cmd_render(args) -> int:
     if not args.quiet:
         written = f"{output} and {args.depth}" if args.depth else f"{output}"
         method = "" if args.method == "raster" else f"raytrace {args.spp} spp, "
+        if args.method == "raytrace" and args.pattern == "adaptive":
+            method = f"raytrace adaptive up to {args.spp} spp: {samples_fired(frame)}, "
         print(f"wrote {written} ({args.size[0]}x{args.size[1]}, {method}{args.backend}, "
               f"{frame.milliseconds:.1f} ms)", file=sys.stderr)
     return 0
@@ -358,6 +382,8 @@ def cmd_view(args) -> int:
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
     check_memory(scene, args.size, ["gpu"])
+    if args.method == "raytrace":
+        check_raytrace_memory(scene, args.size, ["gpu"], 1)
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
@@ -366,24 +392,27 @@ def cmd_view(args) -> int:
     check_outputs(args.screenshot, args.stats if scripted else None)
     with Viewer(scene, *args.size, vsync=not args.no_vsync,
                 buffering=3 if args.triple_buffering else 2, reference=args.reference,
-                screenshot=None if scripted else args.screenshot) as viewer:
+                screenshot=None if scripted else args.screenshot, method=args.method) as viewer:
         if not scripted:
             print(f"renderer view: {scene.name}; H for help, Esc to quit")
         try:
             stats = viewer.run(args.frames, args.orbit, None)     # the screenshot: below, with --stats
         except KeyboardInterrupt:              # Ctrl-C in the terminal: as good as Esc
             return 0
-        figures = viewer.figures
+        figures, samples = viewer.figures, viewer.samples
         shown = viewer.shown_image() if scripted and args.screenshot is not None else None
     if scripted:
         with outputs(args.screenshot, args.stats) as out:    # both or neither
             if shown is not None:
                 out.image(args.screenshot, shown)
             if args.stats is not None:
-                out.text(args.stats, json_text(stats.summary() | {"reference": figures}))
+                out.text(args.stats, json_text(stats.summary() | {"reference": figures,
+                                                                  "raytrace_spp": samples}))
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
+        if samples is not None:
+            print(f"ray tracing: {samples} spp")
         if args.screenshot is not None:
             print(f"wrote {args.screenshot}")
     return 0
@@ -457,8 +486,14 @@ def cmd_compare(args) -> int:
                                        tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
     figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
-               "depth_tie_pixels": depth_tie_pixels(ref_frame), "gpu_ms": gpu_ms, "reference_ms": reference_ms,
+               "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
+               "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
+    if args.method == "raytrace":        # adaptive: the samples traced, and where the twins chose differently
+        figures |= {"gpu_samples_per_pixel": float(gpu_frame.samples.mean()),
+                    "reference_samples_per_pixel": float(ref_frame.samples.mean()),
+                    "refined_differently_pixels": int((gpu_frame.samples != ref_frame.samples).sum()),
+                    "adaptive_tie_pixels": depth_tie_pixels(ref_frame)}
     failures = tolerance.failures(result)
     figures["passes"] = not failures
     print(to_json(figures))

@@ -188,6 +188,19 @@ def test_c_cycles_the_reference_view():
     assert viewer.state.scene_changed
 
 
+def test_m_toggles_the_ray_tracer_and_changes_the_picture():
+    viewer = Viewer()
+    viewer.press(glfw.KEY_M)
+    assert viewer.state.method == "raytrace" and viewer.state.scene_changed
+    assert viewer.messages == ["method: ray tracer; it refines while the view is still (the "
+                               "title counts the samples per pixel)"]
+    viewer.state.scene_changed = False
+    viewer.press(glfw.KEY_M)
+    assert viewer.state.method == "raster" and viewer.state.scene_changed
+    assert viewer.messages[-1] == "method: rasteriser"
+    assert "  M     rasteriser / ray tracer (refines while the view is still)" in help_lines()
+
+
 def test_v_and_b_switch_vsync_and_buffering_without_a_change_flag():
     viewer = Viewer()
     viewer.press(glfw.KEY_V)
@@ -471,12 +484,13 @@ def test_help_with_state_and_lights_shows_them():
     assert lines[lines.index("Lights") + 1:lines.index("Lights") + 3] == [
         "  1   directional light 1: on", "  2   point light 1: off"]
     assert "  shading: Gouraud, wireframe: off, two-sided lighting: as authored" in lines
-    assert "  reference view: off, v-sync: on, buffering: triple" in lines
+    assert "  reference view: off, v-sync: on, buffering: triple, method: rasteriser" in lines
+    assert "method: ray tracer" in help_lines(ViewState(method="raytrace"))[-1]
 
 
 def test_view_state_defaults():
     state = ViewState()
     assert {f.name: getattr(state, f.name) for f in fields(state)} == {
         "shading": None, "wireframe": False, "two_sided": None, "lights_on": [],
-        "reference": "off", "vsync": True, "buffering": 2, "help": False,
+        "reference": "off", "vsync": True, "buffering": 2, "help": False, "method": "raster",
         "screenshot": False, "quit": False, "camera_changed": False, "scene_changed": False}

@@ -16,7 +16,7 @@ import pytest
 
 from reference.raytrace.bvh import closest_hit, closest_hit_brute_force, inverse_direction, ray_box
 from reference.raytrace.intersect import ray_triangle
-from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, mesh_vertices, texels
+from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, mesh_vertices, refit, texels
 from renderer.core.primitives import icosphere
 
 GLSL = Path(__file__).parent / "glsl"
@@ -140,6 +140,60 @@ def test_builder_invariants_soup_sphere_and_degenerate(sphere):
     assert build_bvh(vertices[:2000]).nodes.tobytes() == build_bvh(vertices[:2000]).nodes.tobytes()
     with pytest.raises(ValueError):
         build_bvh(np.zeros((0, 3, 3)))
+
+
+# -- a refit: the tree kept, the boxes made again -----------------------------------------------
+
+def test_a_refit_moves_the_hand_written_boxes_with_the_triangles():
+    moved = refit(HAND, TWO + F32([1, 2, -3]))
+    shift = np.array([1, 2, -3], F32)
+    assert (moved.nodes[:, :, :3] == HAND.nodes[:, :, :3] + shift).all()
+    assert (moved.nodes[:, :, 3] == HAND.nodes[:, :, 3]).all()           # the tree: a, count
+    assert (moved.vertices == HAND.vertices + shift).all()
+    assert moved.original_index.tolist() == [1, 0] and moved.depth == 1
+    assert refit(HAND, TWO).nodes.tobytes() == HAND.nodes.tobytes()
+    with pytest.raises(ValueError, match="2 triangles"):
+        refit(HAND, TWO[:1])
+
+
+def check_tight(bvh):
+    """Every leaf's box is its triangles' bounds, every interior node's its children's union."""
+    lo, hi, a, count = bvh.bounds_min, bvh.bounds_max, bvh.nodes[:, 0, 3], bvh.nodes[:, 1, 3]
+    for i in range(len(bvh.nodes)):
+        if count[i] > 0:
+            inside = bvh.vertices[int(a[i]):int(a[i] + count[i])]
+            expected = inside.min((0, 1)), inside.max((0, 1))
+        else:
+            children = [i + 1, int(a[i])]
+            expected = lo[children].min(0), hi[children].max(0)
+        assert (lo[i] == expected[0]).all() and (hi[i] == expected[1]).all(), i
+
+
+def test_a_refit_of_the_sphere_moved_and_stretched_is_tight(sphere):
+    V, bvh = sphere
+    moved = V * F32([3, 0.5, 1]) + F32([1e3, -7.25, 0.1])
+    check_invariants(moved, refit(bvh, moved))
+    check_tight(refit(bvh, moved))
+    assert (refit(bvh, moved).nodes[:, :, 3] == bvh.nodes[:, :, 3]).all()
+
+
+def test_a_scenes_tree_does_not_depend_on_the_eye():
+    """ray_scene builds the tree over world-space triangles and fits its boxes to the
+    camera-relative ones, so a new eye needs only a refit: the same bytes as a new build
+    (before, a build over camera-relative float32 triangles changed its tree with the eye)."""
+    from dataclasses import replace
+    from renderer.core.builtin import resolve_scene
+    from renderer.core.raytrace_scene import ray_scene
+    from renderer.core.scene_file import load_scene
+    authored = load_scene(resolve_scene("flat_shading"))
+    first = ray_scene(authored).bvh
+    eye = tuple(np.add(authored.camera.eye, (1.3, -0.7, 2.1)))
+    moved = replace(authored, camera=replace(authored.camera, eye=eye))
+    built, refitted = ray_scene(moved).bvh, ray_scene(moved, tree=first).bvh
+    assert built.nodes.tobytes() == refitted.nodes.tobytes()
+    assert built.triangles.tobytes() == refitted.triangles.tobytes()
+    assert (built.nodes[:, :, 3] == first.nodes[:, :, 3]).all()
+    assert not (built.nodes[:, :, :3] == first.nodes[:, :, :3]).all()     # the boxes moved
 
 
 # -- the twin against brute force --------------------------------------------------------------

@@ -326,6 +326,17 @@ def test_t_toggles_two_sided_lighting_for_every_object(viewer):
     assert all(obj.material.two_sided for obj in viewer.shown.objects)
 
 
+def test_a_window_opens_while_a_headless_egl_context_is_current(on_x_display, gl_contexts):
+    """glfw binds a new window's GLX context as it makes it; with an EGL context still current
+    GLX refused (BadAccess) and Xlib ended the process."""
+    from renderer.gpu.context import activate
+    activate(gl_contexts["egl"])
+    with Viewer(scene("sphere"), 32, 24, on_message=lambda line: None) as viewer:
+        viewer.frame()
+        assert_matches(viewer.shown_image(), headless(scene("sphere"), (32, 24),
+                                                      context=gl_contexts["egl"]))
+
+
 def test_closing_the_window_ends_the_run(viewer):
     glfw.set_window_should_close(viewer.window._handle, True)   # what the close button does
     stats = viewer.run()
@@ -364,3 +375,58 @@ def test_the_reference_is_asked_again_only_for_a_new_image(on_x_display):
         viewer.frame()
         assert viewer.figures is None                 # none yet for the view on the screen
         assert viewer.background.wait(timeout=60) is not None
+
+
+# -- the ray tracer: progressive refinement ------------------------------------------------------
+def test_ray_tracing_refines_while_still_and_starts_again_when_the_camera_moves(on_x_display):
+    """M (or method="raytrace") traces one sample per pixel a frame into the running mean;
+    the window shows the mean, the title counts its samples, a camera move starts again with
+    sample 0 of the new view (the headless RayTracer's frame), M back and forth goes on."""
+    from renderer.gpu.raytracer import RayTracer
+    from renderer.viewer.progressive import PATTERN, SAMPLES_PER_FRAME
+    messages = []
+    with Viewer(scene("coloured_lights"), *SIZE, vsync=False, method="raytrace",
+                on_message=messages.append) as viewer:
+        viewer.run(frames=3)
+        assert viewer.samples == 3 and "ray tracing: 3 spp" in viewer.title()
+        assert (viewer.shown_image() == viewer.accumulator.rgba8[..., :3]).all()
+        assert any(line.startswith("ray tracer ready") for line in messages)
+
+        viewer.run(frames=2, orbit=10.0)                  # moving: one sample, the new view's
+        assert viewer.samples == 1 and not viewer.idle
+        moved = replace(scene("coloured_lights"), camera=viewer.orbit.camera)
+        with RayTracer(moved, *SIZE, samples=SAMPLES_PER_FRAME, pattern=PATTERN) as tracer:
+            expected = tracer.render(first_sample=0).rgba8[..., :3]
+        assert (viewer.shown_image() == expected).all()
+
+        press(viewer, glfw.KEY_M)                         # the rasteriser, the same view
+        assert_matches(shown_after_a_frame(viewer), headless(moved))
+        assert viewer.samples is None and "ray tracing" not in viewer.title()
+        press(viewer, glfw.KEY_M)                         # back: the mean goes on
+        viewer.frame()
+        assert viewer.samples == 2
+        tracer = viewer._tracer
+    assert tracer._released                               # closed with the viewer
+
+
+def test_ray_tracing_stops_at_the_cap_and_idles(on_x_display):
+    with Viewer(scene("sphere"), 32, 24, vsync=False, method="raytrace",
+                on_message=lambda line: None) as viewer:
+        viewer.accumulator = type(viewer.accumulator)(cap=2)
+        viewer.run(frames=4)
+        assert viewer.samples == 2 and viewer.idle and "2 spp (done)" in viewer.title()
+        viewer.controls.scroll(0.0, 1.0)                  # zoom: a new view
+        viewer.frame()
+        assert viewer.samples == 1 and not viewer.idle
+
+
+def test_scripted_ray_tracing_from_the_command_line(x_display, tmp_path, cli):
+    shot, stats = tmp_path / "shot.png", tmp_path / "stats.json"
+    result = cli("view", "sphere", "--size", "80x60", "--method", "raytrace", "--frames", "4",
+                 "--reference", "difference", "--screenshot", str(shot), "--stats", str(stats),
+                 display=x_display)
+    assert result.returncode == 0, result.stderr
+    assert "ray tracing: 4 spp" in result.stdout.splitlines()
+    summary = json.loads(stats.read_text())
+    assert summary["raytrace_spp"] == 4 and summary["reference"] is None
+    assert read_png(shot).shape[:2] == (60, 80)

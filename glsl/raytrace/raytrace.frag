@@ -1,36 +1,56 @@
 #version 330 core
 // The ray tracer's full-screen pass (renderer/gpu/raytracer.py; twin: reference/raytrace/
-// pipeline.py): per pixel, NUM_SAMPLES camera rays through gl_FragCoord.xy + u_sample_offsets[k]
-// traced from near to far (trace.glsl), their colours summed in sample order and averaged.
+// pipeline.py): per pixel, camera rays through gl_FragCoord.xy + sample_offset(pixel, k)
+// (sampling.glsl) traced from near to far (trace.glsl), their colours summed in sample order
+// and averaged. Every pixel traces FIRST_SAMPLES samples (NUM_SAMPLES but for ADAPTIVE); with
+// ADAPTIVE, a pixel whose first samples' clamped colours differ by more than
+// u_adaptive_threshold in some channel (max - min over the samples) traces all NUM_SAMPLES.
 // out_color: (average linear colour, 1 where some camera ray hit, else 0); out_depth: the
-// nearest first hit's s (the view depth), +inf where none hit.
-#ifndef NUM_SAMPLES
-#define NUM_SAMPLES 1
-#endif
+// nearest first hit's s (the view depth), +inf where none hit; ADAPTIVE: out_samples, the
+// samples traced.
 #include "raytrace/camera.glsl"
+#include "raytrace/sampling.glsl"
 #include "raytrace/trace.glsl"
 
-uniform vec2 u_sample_offsets[NUM_SAMPLES];
 uniform float u_near;
 uniform float u_far;
 layout(location = 0) out vec4 out_color;
 layout(location = 1) out float out_depth;
+#ifdef ADAPTIVE
+uniform float u_adaptive_threshold;
+layout(location = 2) out float out_samples;
+#endif
 
 void main() {
+    uvec2 pixel = uvec2(gl_FragCoord.xy);
     vec3 total = vec3(0.0);
     bool covered = false;
     float depth = TRACE_INF;
-    for (int k = 0; k < NUM_SAMPLES; ++k) {
+    vec3 low = vec3(1.0);
+    vec3 high = vec3(0.0);
+    int count = FIRST_SAMPLES;
+    for (int k = 0; k < count; ++k) {   // one call site of trace: it is inlined where called
         vec3 O, D;
-        camera_ray(gl_FragCoord.xy + u_sample_offsets[k], O, D);
+        camera_ray(gl_FragCoord.xy + sample_offset(pixel, k), O, D);
         bool hit;
         float s;
-        total += trace(O, D, u_near, u_far, hit, s);
+        vec3 colour = trace(O, D, u_near, u_far, hit, s);
+        total += colour;
         if (hit) {
             covered = true;
             depth = min(depth, s);
         }
+#ifdef ADAPTIVE
+        low = min(low, clamp(colour, 0.0, 1.0));
+        high = max(high, clamp(colour, 0.0, 1.0));
+        vec3 spread = high - low;
+        if (k == FIRST_SAMPLES - 1 && max(spread.r, max(spread.g, spread.b)) > u_adaptive_threshold)
+            count = NUM_SAMPLES;
+#endif
     }
-    out_color = vec4(total / float(NUM_SAMPLES), covered ? 1.0 : 0.0);
+    out_color = vec4(total / float(count), covered ? 1.0 : 0.0);
     out_depth = depth;
+#ifdef ADAPTIVE
+    out_samples = float(count);
+#endif
 }

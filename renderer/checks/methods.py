@@ -33,7 +33,7 @@ from renderer.checks.compare import (DEFAULT_DEVIATION, DEFAULT_THRESHOLD, Compa
                                      channel_difference, compare_frames,
                                      position_deviation_mismatch)
 from renderer.core.frame import Frame
-from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
+from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 
 CHAIN = ("raster", "phong", "centre", "samples", "shadows", "raytrace")
@@ -171,11 +171,13 @@ class MethodComparison:
 
 def compare_methods(scene: Scene, width: int, height: int, *, context=None, context_kind: str = "auto",
                     samples: int = 1, pattern: str = "regular", max_depth: int | None = None,
-                    seed: int = DEFAULT_SEED, threshold: int = DEFAULT_THRESHOLD,
+                    seed: int = DEFAULT_SEED, adaptive_threshold: float | None = None,
+                    threshold: int = DEFAULT_THRESHOLD,
                     deviation: int = DEFAULT_DEVIATION) -> MethodComparison:
     """Render CHAIN on the GPU in one GL context (`context`, else a new one of
     `context_kind`) and explain where the rasteriser and the ray tracer (samples, pattern,
-    max_depth (default the ray tracer's), seed as RayTracer takes them) differ."""
+    max_depth (default the ray tracer's), seed, adaptive_threshold as RayTracer takes them)
+    differ."""
     from renderer.gpu.context import make_context, release_context
     from renderer.gpu.pipeline import GpuRenderer
     from renderer.gpu.raytracer import DEFAULT_MAX_DEPTH, RayTracer
@@ -199,10 +201,13 @@ def compare_methods(scene: Scene, width: int, height: int, *, context=None, cont
                  "shadows": (samples, pattern, 0, True), "raytrace": (samples, pattern, max_depth, True)}
         renders, last = 1 + (frames["phong"] is not frames["raster"]), None
         for name, (n, kind, depth, shadows) in steps.items():
-            key = (sample_pattern(kind, n, seed).tobytes(), depth if bounces else 0, shadows and lit)
+            centre = n == 1 and kind == "regular"          # one ray through the pixel centre
+            sampling = "centre" if centre else (n, kind, seed, adaptive_threshold)
+            key = (sampling, depth if bounces else 0, shadows and lit)
             if key != last:
                 with RayTracer(scene, width, height, context=ctx, samples=n, pattern=kind,
-                               max_depth=depth, seed=seed, shadows=shadows) as tracer:
+                               max_depth=depth, seed=seed, shadows=shadows,
+                               adaptive_threshold=None if centre else adaptive_threshold) as tracer:
                     frame = tracer.render()
                 renders += 1
             frames[name], last = frame, key
@@ -213,7 +218,8 @@ def compare_methods(scene: Scene, width: int, height: int, *, context=None, cont
     raster, raytrace = frames["raster"], frames["raytrace"]
     comparison = compare_frames(raster.rgba8, raytrace.rgba8, raster.depth, raytrace.depth,
                                 threshold=threshold, deviation=deviation)
-    settings = {"samples": samples, "pattern": pattern, "max_depth": max_depth, "seed": seed}
+    settings = {"samples": samples, "pattern": pattern, "max_depth": max_depth, "seed": seed,
+                "adaptive_threshold": adaptive_threshold}
     result = MethodComparison(scene.name, raster, raytrace, causes, comparison, settings, renders, [])
     result.notes = notes(scene, result.counts())
     return result

@@ -174,6 +174,41 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) ->
     return Bvh(flat, triangles, depth_seen)
 
 
+def refit(bvh: Bvh, vertices) -> Bvh:
+    """`bvh`'s tree over the same triangles moved to `vertices` (T, 3, 3), in their original
+    order (a translation relative to another eye, say): the tree, leaf order and depth kept,
+    every box recomputed from the new float32 vertices, the leaves' from their triangles and
+    then the interior nodes' from their children's, level by level from the deepest. Min and
+    max are exact, so the boxes are the very ones build_bvh gives the same tree over `vertices`
+    (bytes, but for the sign of a zero)."""
+    vertices = np.asarray(vertices, dtype=np.float32)
+    if vertices.shape != (len(bvh.triangles), 3, 3):
+        raise ValueError(f"refit needs the BVH's {len(bvh.triangles)} triangles as "
+                         f"({len(bvh.triangles)}, 3, 3), not {vertices.shape}")
+    if not np.isfinite(vertices).all():
+        raise ValueError("triangle vertices must be finite")
+    placed = vertices[bvh.original_index]                   # leaf order
+    nodes = bvh.nodes.copy()
+    leaf = bvh.is_leaf
+    first = nodes[leaf, 0, 3].astype(np.int64)              # increasing: leaves tile 0..T-1
+    nodes[leaf, 0, :3] = np.minimum.reduceat(placed.min(1), first)
+    nodes[leaf, 1, :3] = np.maximum.reduceat(placed.max(1), first)
+    inner = np.flatnonzero(~leaf)
+    left, right = inner + 1, nodes[inner, 0, 3].astype(np.int64)
+    depth = np.zeros(len(nodes), np.int64)                  # pre-order: a parent precedes
+    for _ in range(bvh.depth):                              # its children, so one pass per
+        depth[left] = depth[inner] + 1                      # level settles every depth
+        depth[right] = depth[inner] + 1
+    for level in range(bvh.depth - 1, -1, -1):
+        at = depth[inner] == level
+        i, l, r = inner[at], left[at], right[at]
+        nodes[i, 0, :3] = np.minimum(nodes[l, 0, :3], nodes[r, 0, :3])
+        nodes[i, 1, :3] = np.maximum(nodes[l, 1, :3], nodes[r, 1, :3])
+    triangles = bvh.triangles.copy()
+    triangles[:, :, :3] = placed
+    return Bvh(nodes, triangles, bvh.depth)
+
+
 def mesh_vertices(positions, faces) -> np.ndarray:
     """(F, 3, 3) float32 triangle vertices of a mesh (positions (V, 3), faces (F, 3))."""
     return np.asarray(positions, np.float32)[np.asarray(faces)]

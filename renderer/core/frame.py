@@ -12,6 +12,14 @@ import numpy as np
 BACKGROUNDS = ("opaque", "transparent")
 
 
+def image_size(width, height) -> tuple[int, int]:
+    """(width, height) as ints, each at least 1 pixel, or a ValueError: the size a renderer
+    is made or resized at."""
+    if int(width) < 1 or int(height) < 1:
+        raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+    return int(width), int(height)
+
+
 @dataclass
 class Frame:
     """One rendered image. Row 0 is the top row in every array (docs/conventions.md).
@@ -29,6 +37,8 @@ class Frame:
     gl_info: for a GPU frame, the GL implementation that drew it (GpuRenderer.gl_info:
             GL_VENDOR, GL_RENDERER, GL_VERSION, context, depth_format); None from the
             reference. Golden tests record it beside each golden.
+    samples: from the ray tracer (either twin), (H, W) int32 camera rays traced per pixel:
+            N everywhere but with the adaptive pattern; None from the rasteriser.
     """
     rgba8: np.ndarray
     linear: np.ndarray | None = None
@@ -36,6 +46,7 @@ class Frame:
     milliseconds: float = 0.0
     rgba8_tie: np.ndarray | None = None
     gl_info: dict | None = None
+    samples: np.ndarray | None = None
 
     def image(self, background: str = "opaque") -> np.ndarray:
         """The pixels an image file of this frame holds: (H, W, 3) for an opaque background,

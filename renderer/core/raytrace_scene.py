@@ -6,6 +6,10 @@ renderer/gpu/raytracer.py, reference/raytrace/trace.py): made once per scene, ca
 - every other object's triangles in world space relative to the eye, one list for the whole
   scene, with their unit world-space vertex normals (the normal matrix, then normalised, as the
   rasteriser's vertex stage) and object indices, and one BVH over them (renderer/core/bvh.py);
+  the BVH's tree does not depend on the eye: it is built over the world-space triangles
+  relative to their bounds' centre, then its boxes fitted to the camera-relative triangles
+  (`refit`), so that a new eye needs only a refit (`ray_scene(scene, tree=...)`: the bytes a
+  build for that eye gives);
 - the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided.
 """
 
@@ -15,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from renderer.core.bvh import Bvh, build_bvh
+from renderer.core.bvh import Bvh, build_bvh, refit
 from renderer.core.scene import Scene, WorldPlane, WorldSphere
 
 
@@ -55,25 +59,34 @@ def _normalize_or_zero(v):
     return v / np.where(length > 0, length, 1.0)
 
 
-def ray_scene(scene: Scene) -> RayScene:
-    """The scene's surfaces and materials for the ray tracer."""
+def ray_scene(scene: Scene, tree: Bvh | None = None) -> RayScene:
+    """The scene's surfaces and materials for the ray tracer. `tree`: the BVH of an earlier
+    ray_scene of this scene's very triangles (another camera, other materials or lights),
+    refitted instead of built again."""
     shapes = scene.world_shapes()
     matrices = scene.matrices(1, 1)
+    world_matrices = scene.world_matrices()
     spheres = [(k, s) for k, s in enumerate(shapes) if isinstance(s, WorldSphere)]
     planes = [(k, s) for k, s in enumerate(shapes) if isinstance(s, WorldPlane)]
-    tris, normals, owner = [], [], []
+    tris, world_tris, normals, owner = [], [], [], []
     for k, (obj, shape) in enumerate(zip(scene.objects, shapes)):
         if shape is not None or len(obj.mesh.faces) == 0:
             continue
         m = matrices.objects[k]
         positions = np.asarray(obj.mesh.positions, np.float64)
-        world = positions @ m.model[:3, :3].T + m.model[:3, 3]
+        world = positions @ m.model[:3, :3].T + m.model[:3, 3]          # camera-relative
+        absolute = positions @ world_matrices[k][:3, :3].T + world_matrices[k][:3, 3]
         vertex_normals = _normalize_or_zero(np.asarray(obj.mesh.normals, np.float64) @ m.normal.T)
         faces = np.asarray(obj.mesh.faces, np.int64)
         tris.append(world[faces])
+        world_tris.append(absolute[faces])
         normals.append(vertex_normals[faces])
         owner.append(np.full(len(faces), k, np.int64))
     triangles = np.concatenate(tris) if tris else np.zeros((0, 3, 3))
+    if len(triangles) and tree is None:
+        absolute = np.concatenate(world_tris)
+        centre = (absolute.min((0, 1)) + absolute.max((0, 1))) / 2
+        tree = build_bvh(absolute - centre)
     mats = [obj.material for obj in scene.objects]
 
     def rows(name, width=3):
@@ -90,7 +103,7 @@ def ray_scene(scene: Scene) -> RayScene:
         triangles=triangles,
         triangle_normals=np.concatenate(normals) if normals else np.zeros((0, 3, 3)),
         triangle_object=np.concatenate(owner) if owner else np.zeros(0, np.int64),
-        bvh=build_bvh(triangles) if len(triangles) else None,
+        bvh=refit(tree, triangles) if len(triangles) else None,
         ka=rows("ka"), kd=rows("kd"), ks=rows("ks"), n=rows("n", 1), kr=rows("kr"), kt=rows("kt"),
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
     )

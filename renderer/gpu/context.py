@@ -322,6 +322,14 @@ def adopt_context(ctx: moderngl.Context, make_current, release, get_proc_address
     _current_window = binding
 
 
+def before_window_context() -> None:
+    """Call before a window library makes a context (renderer/viewer/window.py; glfw makes it
+    current as it creates it): no EGL context may be current on the thread then (see _WindowBinding), or GLX refuses
+    (BadAccess, which Xlib's default handler turns into the end of the process)."""
+    _release_window()
+    _release_egl()
+
+
 def context_kind(ctx: moderngl.Context) -> str:
     """"egl" or "osmesa" for a context from make_context(), "window" for one adopted from a
     window library (adopt_context), "external" for any other."""

@@ -53,7 +53,7 @@ import numpy as np
 
 from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
 from renderer.errors import ContextError, SystemFault
-from renderer.core.frame import Frame
+from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
@@ -144,11 +144,10 @@ class GpuRenderer:
     def __init__(self, scene: Scene, width: int, height: int,
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  specialise: bool = True):
-        if int(width) < 1 or int(height) < 1:
-            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        width, height = image_size(width, height)
         check_light_count(scene)         # before a program fails to link (renderer/core/gl_rules.py)
         self.scene = scene
-        self.width, self.height = int(width), int(height)
+        self.width, self.height = width, height
         self.specialise = bool(specialise)
         self.wireframe = False           # draw() draws edges only (a viewer's toggle)
         self._owns_context = context is None
@@ -294,9 +293,7 @@ class GpuRenderer:
         """Render at another size from now on (a viewer's window was resized): the framebuffers
         are made again at that size and update() recomputes the projection for the new aspect.
         Programs, meshes and vertex arrays are kept."""
-        width, height = int(width), int(height)
-        if width < 1 or height < 1:
-            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
+        width, height = image_size(width, height)
         if (width, height) == (self.width, self.height):
             return
         activate(self.ctx)

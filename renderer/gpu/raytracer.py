@@ -1,15 +1,21 @@
 """The GPU ray tracer (glsl/raytrace/raytrace.frag and trace.glsl; twin: reference/raytrace/
 pipeline.py): one full-screen pass that traces every sample of every pixel (the samples looped
-in the shader), into a float colour target (average linear colour, coverage) and a float depth
-target (the view depth of the nearest first hit), read back row 0 at the top; rgba8 is
-gl_rules.to_unorm8 of the clamped linear colour, alpha 255 where a camera ray hit.
+in the shader, placed by glsl/raytrace/sampling.glsl), into a float colour target (average
+linear colour, coverage), a float depth target (the view depth of the nearest first hit) and,
+for the adaptive pattern, a float target of the samples traced per pixel, read back row 0 at
+the top; rgba8 is gl_rules.to_unorm8 of the clamped linear colour, alpha 255 where a camera ray
+hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, no recompile).
 
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
-MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, NUM_SAMPLES);
-the uniforms (camera rays from renderer/core/camera_rays.py, lights from renderer/core/
-uniforms.py, shapes, sample offsets); the materials, the BVH (renderer/gpu/bvh.py) and the
-triangles' vertices and normals as float textures.
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, and the sample
+pattern's constants from renderer/core/ray_sampling.py); the uniforms (camera rays from
+renderer/core/camera_rays.py, lights from renderer/core/uniforms.py, shapes, the pattern's); the
+materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
+renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
+the camera calls update() (and resize()), which keeps all of them and writes new contents: the
+same image as a RayTracer made afresh, without the BVH build or (unless the light counts
+changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
@@ -27,19 +33,18 @@ import numpy as np
 
 from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
-from renderer.core.frame import Frame
+from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
+from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
-from renderer.core.sampling import DEFAULT_SEED, pattern as sample_pattern
+from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import light_uniforms
-from renderer.gpu.bvh import bvh_textures
 from renderer.gpu.context import activate, context_kind, make_context, release_context
 from renderer.gpu.shaders import shader_source
 
 DEFAULT_MAX_DEPTH = 4
-MAX_SAMPLES = 256
 
 
 def _texture(ctx, array):
@@ -56,17 +61,15 @@ class RayTracer:
     def __init__(self, scene: Scene, width: int, height: int, *,
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
-                 seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True):
-        if int(width) < 1 or int(height) < 1:
-            raise ValueError(f"image size must be at least 1x1 pixels, got {width}x{height}")
-        if not 1 <= int(samples) <= MAX_SAMPLES:
-            raise ValueError(f"samples must be between 1 and {MAX_SAMPLES}, got {samples}")
+                 seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True,
+                 adaptive_threshold: float | None = None):
+        width, height = image_size(width, height)
         if not 0 <= int(max_depth) <= 16:
             raise ValueError(f"max_depth must be between 0 and 16, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
-        self.width, self.height = int(width), int(height)
-        self.offsets = np.asarray(sample_pattern(pattern, int(samples), seed), np.float32)
+        self.width, self.height = width, height
+        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
         self.max_depth = int(max_depth)
         self.shadows = bool(shadows)
         self.specialise = bool(specialise)
@@ -82,10 +85,26 @@ class RayTracer:
             raise
 
     def _build(self) -> None:
-        ctx, scene = self.ctx, self.scene
-        rs = self.ray_scene = ray_scene(scene)
-        every = not self.specialise
-        self.defines = {
+        ctx = self.ctx
+        rs = self.ray_scene = ray_scene(self.scene)
+        self._surfaces = self._surfaces_now()
+        self.defines = self._defines(rs)
+        self._compile()
+        self._textures, self._units = [], {}          # (unit, texture); sampler -> unit
+        for unit, (name, array) in enumerate(self._texture_arrays(rs).items()):
+            texture = _texture(ctx, array)
+            self._resources.append(texture)
+            self._textures.append((unit, texture))
+            self._units[name] = unit
+        self._write_uniforms(rs)
+        self._build_targets()
+        self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
+                         "GL_VERSION": ctx.info["GL_VERSION"],
+                         "context": context_kind(ctx)}
+
+    def _defines(self, rs) -> dict:
+        scene, every = self.scene, not self.specialise
+        return {
             "NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
             "NUM_POINT_LIGHTS": len(scene.point_lights),
             "SPECULAR": rs.specular or every,
@@ -96,13 +115,26 @@ class RayTracer:
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
-            "NUM_SAMPLES": len(self.offsets),
+            **self.sampling.defines(),
         }
-        self.program = ctx.program(
+
+    def _compile(self) -> None:
+        """The program for self.defines and its vertex array (those of before released)."""
+        for name in ("_vao", "program"):
+            old = getattr(self, name, None)
+            if old is not None:
+                self._resources.remove(old)
+                old.release()
+        self.program = self.ctx.program(
             vertex_shader=shader_source("raytrace/fullscreen.vert").text,
             fragment_shader=shader_source("raytrace/raytrace.frag", self.defines).text)
         self._resources.append(self.program)
-        program = self.program
+        self._vao = self.ctx.vertex_array(self.program, [])
+        self._resources.append(self._vao)
+
+    def _write_uniforms(self, rs) -> None:
+        """Camera rays, lights, shapes and the sample pattern; the textures' units."""
+        scene, program = self.scene, self.program
         matrices = scene.matrices(self.width, self.height)
         rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
         values = {name: to_glsl(value) for name, value in rays.items()}
@@ -112,7 +144,7 @@ class RayTracer:
         values["u_background"] = np.asarray(scene.background, np.float32).tobytes()
         values["u_near"] = np.float32(scene.camera.near).tobytes()
         values["u_far"] = np.float32(scene.camera.far).tobytes()
-        values["u_sample_offsets"] = self.offsets.tobytes()
+        values.update({name: value.tobytes() for name, value in self.sampling.uniforms().items()})
         if len(rs.sphere_radius):
             values["u_spheres"] = np.concatenate([rs.sphere_centre, rs.sphere_radius[:, None]], 1).astype(np.float32).tobytes()
             values["u_sphere_object"] = rs.sphere_object.astype(np.int32).tobytes()
@@ -122,49 +154,102 @@ class RayTracer:
         for name, value in values.items():
             if name in program:
                 program[name].write(value)
+        for name, unit in self._units.items():
+            if name in program:
+                program[name].value = unit
+
+    def _texture_arrays(self, rs) -> dict:
+        """The float textures' contents by sampler name (`texels` lays them out)."""
         zero = np.zeros((len(rs.n), 1))
         materials = np.stack([np.concatenate(part, 1) for part in (
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
             (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
-        textures = {"u_materials": _texture(ctx, materials)}
+        arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object
             bvh = rs.bvh
             if bvh is None:                           # all features, no triangles: a placeholder
                 triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
                 bvh = build_bvh(triangles)
-            textures["u_nodes"], textures["u_triangles"] = bvh_textures(ctx, bvh)
+            arrays["u_nodes"], arrays["u_triangles"] = bvh.nodes, bvh.triangles
             data = np.zeros((len(triangles), 6, 4))
             data[:, :3, :3] = triangles
             data[:, 3:, :3] = normals
             data[:, 3, 3] = owner
-            textures["u_triangle_data"] = _texture(ctx, data)
-        self._textures = []
-        for unit, (name, texture) in enumerate(textures.items()):
-            self._resources.append(texture)
-            self._textures.append((unit, texture))
-            if name in program:
-                program[name].value = unit
+            arrays["u_triangle_data"] = data
+        return arrays
+
+    def _build_targets(self) -> None:
+        """The framebuffer at the image size and its float targets (self._targets)."""
+        ctx = self.ctx
         self._colour = ctx.texture((self.width, self.height), 4, dtype="f4")
         self._depth = ctx.texture((self.width, self.height), 1, dtype="f4")
-        self._fbo = ctx.framebuffer([self._colour, self._depth])
-        self._vao = ctx.vertex_array(program, [])
-        self._resources += [self._colour, self._depth, self._fbo, self._vao]
-        self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
-                         "GL_VERSION": ctx.info["GL_VERSION"],
-                         "context": context_kind(ctx)}
+        self._targets = [self._colour, self._depth]
+        if self.sampling.adaptive:                    # the samples traced per pixel
+            self._targets.append(ctx.texture((self.width, self.height), 1, dtype="f4"))
+        self._fbo = ctx.framebuffer(self._targets)
+        self._resources += [*self._targets, self._fbo]
+
+    # -- a viewer's changes ------------------------------------------------------------------
+    def update(self) -> None:
+        """Take the scene again after its camera, lights or materials changed in place (a
+        viewer's orbit and keys; its objects, meshes and shapes must be the ones this tracer
+        was made with): the image is then, bit for bit, that of a RayTracer made afresh for
+        the scene. Cheaper: the BVH's tree is kept and only refitted to the triangles relative
+        to the new eye (renderer/core/raytrace_scene.py), the textures are written again in
+        place, and the program is compiled again only when its #defines changed (a light
+        switched on or off)."""
+        if self._released:
+            raise RuntimeError("this RayTracer was released")
+        now = self._surfaces_now()
+        if len(now) != len(self._surfaces) or any(
+                a is not b for old, new in zip(self._surfaces, now) for a, b in zip(old, new)):
+            raise ValueError("the scene's objects changed since this RayTracer was made; "
+                             "make a new one")
+        check_light_count(self.scene)
+        activate(self.ctx)
+        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh)
+        defines = self._defines(rs)
+        if defines != self.defines:
+            self.defines = defines
+            self._compile()
+        for (_, texture), array in zip(self._textures, self._texture_arrays(rs).values()):
+            texture.write(texels(array).tobytes())
+        self._write_uniforms(rs)
+
+    def _surfaces_now(self) -> list[tuple]:
+        """What update() must find unchanged: each object, its mesh and its shape (identity)."""
+        return [(obj, obj.mesh, obj.shape) for obj in self.scene.objects]
+
+    def resize(self, width: int, height: int) -> None:
+        """Trace at another size from now on (a viewer's window was resized): the targets are
+        made again and update() recomputes the camera rays."""
+        width, height = image_size(width, height)
+        if (width, height) == (self.width, self.height):
+            return
+        activate(self.ctx)
+        for thing in (self._fbo, *self._targets):
+            self._resources.remove(thing)
+            thing.release()
+        self.width, self.height = width, height
+        self._build_targets()
+        self.update()
 
     @property
     def gl_info(self) -> dict:
         return dict(self._gl_info)
 
-    def render(self) -> Frame:
-        """Trace the frame: rgba8, linear (average linear colour, alpha the coverage) and
-        depth, row 0 at the top."""
+    def render(self, first_sample: int = 0) -> Frame:
+        """Trace the frame of sample indices first_sample .. first_sample + N - 1: rgba8,
+        linear (average linear colour, alpha the coverage), depth and samples (traced per
+        pixel), row 0 at the top."""
         if self._released:
             raise RuntimeError("this RayTracer was released")
+        first_sample = check_first_sample(first_sample, self.sampling.samples)
         start = time.perf_counter()
         activate(self.ctx)
+        if "u_first_sample" in self.program:
+            self.program["u_first_sample"].value = first_sample
         for unit, texture in self._textures:
             texture.use(unit)
         self._fbo.use()
@@ -175,9 +260,15 @@ class RayTracer:
         depth = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="f4"), np.float32).reshape(h, w)
         linear = np.ascontiguousarray(linear[::-1])
         depth = np.ascontiguousarray(depth[::-1])
+        if self.sampling.adaptive:
+            traced = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), np.float32)
+            samples = np.ascontiguousarray(traced.reshape(h, w)[::-1]).astype(np.int32)
+        else:
+            samples = np.full((h, w), self.sampling.samples, np.int32)
         rgba8 = to_unorm8(linear)
         rgba8[..., 3] = np.where(linear[..., 3] > 0, 255, 0)
-        return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info)
+        return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info,
+                     samples=samples)
 
     def release(self) -> None:
         """Free every GL object; the context too if this tracer made it. Idempotent."""

@@ -6,7 +6,7 @@ same events directly. Controls changes a `ViewState` and an `OrbitCamera` and sa
 did through `on_message`, one short line a key. Each frame the viewer:
 - takes `orbit.camera` and clears `camera_changed` (set by drags, the wheel and R);
 - calls `apply_view` and clears `scene_changed` (set by every key that changes what the
-  picture shows: F G P A T 1-9, and W C H, which the viewer reads from the state itself);
+  picture shows: F G P A T 1-9, and W C H M, which the viewer reads from the state itself);
 - acts on and clears the requests `screenshot` (S) and `quit` (Esc);
 - applies `vsync` and `buffering` when they differ from what it last applied (V and B set
   no change flag: the picture stays the same).
@@ -26,6 +26,8 @@ from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene import Camera, Scene
 
 REFERENCE_MODES = ("off", "side-by-side", "difference")     # C cycles in this order
+METHODS = ("raster", "raytrace")                            # M toggles
+METHOD_NAMES = {"raster": "rasteriser", "raytrace": "ray tracer"}
 ORBIT_DEGREES_PER_PIXEL = 0.4
 SHADING_NAMES = {None: "as authored", "flat": "flat", "gouraud": "Gouraud", "phong": "Phong"}
 LIGHT_KEYS = 9                                              # keys 1 to 9
@@ -42,6 +44,7 @@ class ViewState:
     vsync: bool = True
     buffering: int = 2                  # 2 (double) or 3 (triple)
     help: bool = False
+    method: str = "raster"              # one of METHODS: what draws the picture
     # Requests: the viewer acts on them and clears them.
     screenshot: bool = False
     quit: bool = False
@@ -118,6 +121,7 @@ KEY_BINDINGS = (
     Binding(glfw.KEY_1, "1-9",
             "light 1 to 9 on / off (directional lights first, then point lights)"),
     Binding(glfw.KEY_C, "C", "reference view: off, side by side, difference"),
+    Binding(glfw.KEY_M, "M", "rasteriser / ray tracer (refines while the view is still)"),
     Binding(glfw.KEY_V, "V", "v-sync on / off"),
     Binding(glfw.KEY_B, "B", "double / triple buffering"),
     Binding(glfw.KEY_S, "S", "save a screenshot"),
@@ -161,7 +165,7 @@ def help_lines(state: ViewState | None = None, light_names: list[str] | None = N
                   f"  shading: {SHADING_NAMES[state.shading]}, wireframe: "
                   f"{_on_off(state.wireframe)}, two-sided lighting: {two_sided}",
                   f"  reference view: {state.reference}, v-sync: {_on_off(state.vsync)}, "
-                  f"buffering: {_buffering(state.buffering)}"]
+                  f"buffering: {_buffering(state.buffering)}, method: {METHOD_NAMES[state.method]}"]
     return lines
 
 
@@ -206,6 +210,7 @@ class Controls:
             glfw.KEY_W: self._wireframe,
             glfw.KEY_T: self._two_sided,
             glfw.KEY_C: self._reference,
+            glfw.KEY_M: self._method,
             glfw.KEY_V: self._vsync,
             glfw.KEY_B: self._buffering,
             glfw.KEY_S: self._screenshot,
@@ -309,6 +314,14 @@ class Controls:
         i = REFERENCE_MODES.index(self.state.reference)
         self._set("reference", REFERENCE_MODES[(i + 1) % len(REFERENCE_MODES)])
         self._say(f"reference view: {self.state.reference}")
+
+    def _method(self) -> None:
+        self._set("method", METHODS[1 - METHODS.index(self.state.method)])
+        if self.state.method == "raytrace":
+            self._say("method: ray tracer; it refines while the view is still (the title "
+                      "counts the samples per pixel)")
+        else:
+            self._say("method: rasteriser")
 
     def _vsync(self) -> None:
         self.state.vsync = not self.state.vsync

@@ -9,6 +9,14 @@ overlay beside or over it; then swap. The reference view is the NumPy reference 
 view, made in a background process (renderer/viewer/reference_view.py), side by side with the GPU
 image or as a heat map of their difference with its figures.
 
+With the ray tracer on (the M key, `method="raytrace"`) a frame is one sample per pixel traced
+by a RayTracer made on first use in the window's context (renderer/gpu/raytracer.py) and added
+to the running mean of the view's samples (renderer/viewer/progressive.py); the window shows
+the mean, and the title the samples per pixel so far. A change of the picture (camera, size,
+shading, lights, materials) takes the tracer's update() and starts the mean again; once it
+holds progressive.MAX_SPP samples nothing more is traced and the interactive loop waits for
+events. The reference view compares the rasteriser only: it is off while ray tracing.
+
 `Viewer.run(frames=N, orbit=DEG, screenshot=PATH)` is the scripted mode of the command line:
 N frames, the camera orbiting DEG degrees per frame, then what the window shows saved to PNG
 and the frame-time statistics returned.
@@ -24,18 +32,22 @@ from pathlib import Path
 import numpy as np
 
 from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
+from renderer.gpu.context import activate
 from renderer.gpu.pipeline import GpuRenderer
+from renderer.gpu.raytracer import RayTracer
 from renderer.core.imageio import write_image
 from renderer.core.paths import output_stem
 from renderer.viewer.orbit import OrbitCamera
 from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
+from renderer.viewer.progressive import PATTERN, SAMPLES_PER_FRAME, Accumulator
 from renderer.viewer.reference_view import BackgroundReference, difference_view, figures_line
 from renderer.core.scene import Scene
 from renderer.viewer.window import Window
 
 SCREEN_CLEAR = (0.12, 0.12, 0.14)          # the window around a letterboxed image
 TITLE_EVERY_S = 0.25                       # how often the title's figures are refreshed
+IDLE_WAIT_S = 0.1                          # the longest an idle loop waits for events
 
 
 @dataclass
@@ -78,13 +90,14 @@ class Viewer:
 
     def __init__(self, scene: Scene, width: int, height: int, *, vsync: bool = True,
                  buffering: int = 2, reference: str = "off", screenshot: Path | None = None,
-                 on_message=print):
+                 on_message=print, method: str = "raster"):
         self.authored = scene
         self.shown = working_copy(scene)
         self.say = on_message
         self.screenshot_path = screenshot
         self._screenshots = 0
-        self.state = ViewState(vsync=vsync, buffering=buffering, reference=reference)
+        self.state = ViewState(vsync=vsync, buffering=buffering, reference=reference,
+                               method=method)
         self.orbit = OrbitCamera(scene.camera)
         self.controls = Controls(self.state, self.orbit, light_names_of(scene), on_message=on_message,
                                  scene=scene)
@@ -102,6 +115,10 @@ class Viewer:
             self._difference_image = CpuImage(self.ctx)  # the heat map
             self._overlay = CpuImage(self.ctx)
             self._overlay_lines: tuple = ()
+            self._tracer = None                # the RayTracer, made on first use
+            self._traced_version = -1          # the version it and the mean were made for
+            self.accumulator = Accumulator()
+            self._traced = CpuImage(self.ctx)  # the mean so far
             self._version = 0                 # bumped whenever the shaded image would change
             self._view: tuple | None = None   # what the version stands for
             self._requested = -1              # the version the reference was asked for
@@ -145,7 +162,7 @@ class Viewer:
         """Ask for the reference of the current view when it is wanted and not asked for yet,
         and take a finished one (`wait`: wait for it): its heat map against a GPU image of
         the same view."""
-        if self.state.reference == "off":
+        if self.state.reference == "off" or self.state.method == "raytrace":
             return
         if self._requested != self._version:
             self.background.request(working_copy(self.shown), self.gpu.width, self.gpu.height,
@@ -172,7 +189,7 @@ class Viewer:
         width, height = self.window.framebuffer_size
         screen.use()
         blit = self.presenter.blitter.copy
-        mode = self.state.reference
+        mode = "off" if self.state.method == "raytrace" else self.state.reference
         have_reference = self._reference_version >= 0
         whole = (0, 0, width, height)
         if mode != "off" or fit(shown.size, whole) != whole:
@@ -202,9 +219,12 @@ class Viewer:
 
     def _overlay_text(self) -> tuple:
         lines = []
-        if self.state.reference == "side-by-side":
+        if self.state.method == "raytrace":
+            if self.state.reference != "off":
+                lines.append("reference view: off while ray tracing (it compares the rasteriser)")
+        elif self.state.reference == "side-by-side":
             lines.append("left: GPU (GLSL)    right: NumPy reference")
-        if self.state.reference != "off":
+        if self.state.reference != "off" and self.state.method == "raster":
             current = self._reference_version == self._version
             if self._figures is not None and self._reference_version >= 0:
                 lines.append(figures_line(self._figures) + ("" if current else " (updating)"))
@@ -220,7 +240,7 @@ class Viewer:
         self._follow_changes()
         self._follow_reference()
         started = time.perf_counter()
-        drawn = self.gpu.draw()
+        drawn = self._trace() if self.state.method == "raytrace" else self.gpu.draw()
         self.ctx.finish()                     # so that draw_ms is the drawing, not queued work
         self.stats.draw_ms.append((time.perf_counter() - started) * 1000.0)
         self.presenter.submit(drawn, started)
@@ -239,10 +259,51 @@ class Viewer:
             self.window.set_title(self.title())
             self._last_title = now
 
+    def _trace(self):
+        """The ray tracer's frame: the tracer brought to the current view (made, or updated
+        and the mean restarted, when the version moved on), one more frame added to the mean
+        unless it is complete, and the mean uploaded; its framebuffer."""
+        size = (self.gpu.width, self.gpu.height)
+        if self._tracer is None:
+            started = time.perf_counter()
+            self._tracer = RayTracer(self.shown, *size, context=self.ctx,
+                                     samples=SAMPLES_PER_FRAME, pattern=PATTERN)
+            rs = self._tracer.ray_scene
+            self.say(f"ray tracer ready in {time.perf_counter() - started:.1f} s "
+                     f"({len(rs.triangles):,} triangles, {len(rs.sphere_radius)} spheres, "
+                     f"{len(rs.plane_offset)} planes)")
+        elif self._traced_version != self._version:
+            if size != (self._tracer.width, self._tracer.height):
+                self._tracer.resize(*size)                       # (and update)
+            else:
+                self._tracer.update()
+        if self._traced_version != self._version:
+            self._traced_version = self._version
+            self.accumulator.restart()
+        if not self.accumulator.done:
+            self.accumulator.trace(self._tracer)
+            self._traced.upload(self.accumulator.rgba8)
+        return self._traced.framebuffer
+
+    @property
+    def idle(self) -> bool:
+        """Nothing new to draw until an event comes: the ray tracer's mean of the current view
+        is complete (the reference view is off while ray tracing)."""
+        return (self.state.method == "raytrace" and self._traced_version == self._version
+                and self.accumulator.done)
+
+    @property
+    def samples(self) -> int | None:
+        """The samples per pixel in the picture on the screen: the ray tracer's so far, None
+        while rasterising."""
+        return self.accumulator.samples if self.state.method == "raytrace" else None
+
     @property
     def figures(self) -> dict | None:
         """The reference view's figures (renderer/viewer/reference_view.py) for the view on the
         screen, or None when there are none for it (not asked for, or not ready)."""
+        if self.state.method == "raytrace":
+            return None
         return self._figures if self._reference_version == self._version else None
 
     def title(self) -> str:
@@ -253,8 +314,13 @@ class Viewer:
             timing = f" | {1000.0 / ms if ms > 0 else 0:.0f} fps, {ms:.1f} ms/frame"
         latency = self.presenter.latency_ms
         latency_text = "" if latency is None else f", latency {latency:.1f} ms"
-        return (f"renderer view: {self.authored.name}{timing} | {self.presenter.name} buffering"
-                f"{latency_text} | v-sync {'on' if self.state.vsync else 'off'} | H for help")
+        tracing = ""
+        if self.state.method == "raytrace":
+            tracing = f" | ray tracing: {self.accumulator.samples} spp" + (
+                " (done)" if self.accumulator.done else "")
+        return (f"renderer view: {self.authored.name}{tracing}{timing} | {self.presenter.name} "
+                f"buffering{latency_text} | v-sync {'on' if self.state.vsync else 'off'} | "
+                f"H for help")
 
     # -- screenshots -------------------------------------------------------------------------
     def window_image(self) -> np.ndarray:
@@ -266,7 +332,8 @@ class Viewer:
     def shown_image(self) -> np.ndarray:
         """What the window shows now, (H, W, 3) uint8: the image just swapped in is the front
         buffer; it is drawn again (the same frame, no orbit step) to read it from the back
-        buffer."""
+        buffer (in the window's context: a headless render may have bound another since)."""
+        activate(self.ctx)
         self._compose(self.presenter.shown)
         return self.window_image()
 
@@ -294,10 +361,12 @@ class Viewer:
             if frames is not None and count >= frames:
                 break
             last = frames is not None and count == frames - 1
+            if frames is None and self.idle:
+                self.window.wait(IDLE_WAIT_S)     # nothing to draw: no busy loop
             if orbit:
                 self.orbit.orbit(orbit, 0.0)
                 self.state.camera_changed = True
-            if last and self.state.reference != "off":
+            if last and self.state.reference != "off" and self.state.method == "raster":
                 self._follow_changes()        # the last frame's view, orbit step included
                 self._follow_reference(wait=True)
                 self._last_swap = None        # the wait is not a frame time
@@ -310,7 +379,7 @@ class Viewer:
 
     def close(self) -> None:
         for name in ("background", "_reference_image", "_difference_image", "_overlay",
-                     "presenter", "gpu"):
+                     "_traced", "_tracer", "presenter", "gpu"):
             item = getattr(self, name, None)
             if item is not None:
                 (item.close if hasattr(item, "close") else item.release)()

@@ -19,7 +19,8 @@ import os
 import glfw
 import moderngl
 
-from renderer.gpu.context import REQUIRED_GL, activate, adopt_context, release_context
+from renderer.gpu.context import (REQUIRED_GL, activate, adopt_context, before_window_context,
+                                  release_context)
 from renderer.errors import ContextError
 
 
@@ -50,6 +51,7 @@ class Window:
             glfw.window_hint(glfw.OPENGL_FORWARD_COMPAT, True)
             glfw.window_hint(glfw.DOUBLEBUFFER, True)
             glfw.window_hint(glfw.SAMPLES, 0)       # the renderer does its own MSAA, offscreen
+            before_window_context()     # glfw binds the new context at once; EGL must let go
             self._handle = glfw.create_window(int(width), int(height), title, None, None)
             if not self._handle:
                 raise _no_display(f"glfw could not open an OpenGL {REQUIRED_GL / 100:.1f} window: "
@@ -110,6 +112,10 @@ class Window:
 
     def poll(self) -> None:
         glfw.poll_events()
+
+    def wait(self, timeout: float) -> None:
+        """Sleep until an event comes or `timeout` seconds pass (an idle viewer)."""
+        glfw.wait_events_timeout(timeout)
 
     def swap(self) -> None:
         activate(self.ctx)                 # a headless context may have been bound meanwhile

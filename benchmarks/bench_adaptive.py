@@ -1,0 +1,114 @@
+"""What adaptive supersampling saves, in samples and in time, against every pixel at N samples.
+
+    .venv/bin/python benchmarks/bench_adaptive.py [--size 640x480] [--frames 5] [--quick]
+                     [--thresholds 1,2,4] [--context egl]
+
+Scenes: the classic scene (assets/scenes/classic.toml, or assets/raytrace/classic.toml where
+it has not moved yet) and the built-in `sphere` (3,968 triangles). Per scene, N = 16:
+- jittered 4 (the first set alone), jittered 16 (the full N), and adaptive 16 at each
+  threshold of --thresholds (in 8-bit steps, 1/255 each; 1 is the default);
+- samples per pixel: the mean of Frame.samples, and the share of pixels refined;
+- GPU ms (renderer/gpu/raytracer.py): the median of --frames frames after a warm-up, the
+  patterns' frames interleaved so that the machine's load falls on all alike;
+- reference ms (reference/raytrace/pipeline.py): one frame (the ray scene made before, not
+  timed); --quick leaves the reference out;
+- error against a 64-spp jittered GPU frame (another seed): the RMS and largest difference of
+  the clamped linear colour, in 8-bit steps (x 255), over all pixels.
+Not a test: this machine is shared and noisy; the load average is printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+from pathlib import Path
+
+import numpy as np
+
+from reference.raytrace.pipeline import render as reference_render
+from renderer.cli import parse_size
+from renderer.core.raytrace_scene import ray_scene
+from renderer.core.scene_file import load_scene
+from renderer.gpu.context import make_context
+from renderer.gpu.raytracer import RayTracer
+
+ASSETS = Path(__file__).resolve().parent.parent / "assets"
+N, TRUTH_SPP, TRUTH_SEED = 16, 64, 64
+
+
+def classic_path() -> Path:
+    moved = ASSETS / "scenes" / "classic.toml"
+    return moved if moved.is_file() else ASSETS / "raytrace" / "classic.toml"
+
+
+def machine() -> str:
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
+    return f"{platform.node()}: {os.cpu_count()} CPUs, load average {load}"
+
+
+def error_steps(frame, truth) -> tuple[float, float]:
+    """(RMS, largest) difference of the clamped linear colours, in 8-bit steps."""
+    difference = (np.clip(frame.linear[..., :3], 0, 1).astype(np.float64)
+                  - np.clip(truth.linear[..., :3], 0, 1)) * 255.0
+    return float(np.sqrt(np.mean(difference ** 2))), float(np.abs(difference).max())
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--size", type=parse_size, default=(640, 480))
+    parser.add_argument("--frames", type=int, default=5)
+    parser.add_argument("--quick", action="store_true", help="no reference frames")
+    parser.add_argument("--thresholds", default="1,2,4", help="adaptive thresholds in 8-bit steps")
+    parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
+    args = parser.parse_args()
+    W, H = args.size
+    steps = [float(t) for t in args.thresholds.split(",")]
+    ctx = make_context(args.context)
+    print(f"{machine()}; {ctx.info['GL_RENDERER']}; {time.strftime('%Y-%m-%d %H:%M')}")
+    print(f"{W}x{H}, max depth 4, N = {N}; GPU: median of {args.frames} interleaved frames after a "
+          f"warm-up ({args.context}); reference: 1 frame; error against {TRUTH_SPP} spp jittered, "
+          f"in 8-bit steps")
+    scenes = {"classic": load_scene(classic_path()), "sphere (3,968 tri)": load_scene("sphere")}
+    runs = {"jittered 4": dict(samples=4, pattern="jittered"),
+            f"jittered {N}": dict(samples=N, pattern="jittered"),
+            **{f"adaptive {N} T={t:g}/255": dict(samples=N, pattern="adaptive", adaptive_threshold=t / 255)
+               for t in steps}}
+    header = (f"{'scene':20} {'pattern':22} {'spp':>6} {'refined':>8} {'GPU ms':>8} {'ref ms':>8} "
+              f"{'RMS err':>8} {'max err':>8}")
+    print(header)
+    print("-" * len(header))
+    for name, scene in scenes.items():
+        with RayTracer(scene, W, H, context=ctx, samples=TRUTH_SPP, pattern="jittered", seed=TRUTH_SEED) as tracer:
+            truth = tracer.render()
+        tracers = {label: RayTracer(scene, W, H, context=ctx, **options) for label, options in runs.items()}
+        try:
+            frames = {label: tracer.render() for label, tracer in tracers.items()}     # warm-up
+            times = {label: [] for label in tracers}
+            for _ in range(args.frames):
+                for label, tracer in tracers.items():
+                    start = time.perf_counter()
+                    tracer.render()
+                    times[label].append((time.perf_counter() - start) * 1000.0)
+        finally:
+            for tracer in tracers.values():
+                tracer.release()
+        rs = ray_scene(scene)
+        for label, options in runs.items():
+            frame = frames[label]
+            ref = "-"
+            if not args.quick:
+                start = time.perf_counter()
+                reference_render(scene, W, H, rs=rs, **options)
+                ref = f"{(time.perf_counter() - start) * 1000.0:.0f}"
+            rms, worst = error_steps(frame, truth)
+            print(f"{name:20} {label:22} {frame.samples.mean():6.2f} {np.mean(frame.samples > 4):8.1%} "
+                  f"{statistics.median(times[label]):8.1f} {ref:>8} {rms:8.3f} {worst:8.1f}", flush=True)
+    print(f"\n{machine()}")
+    ctx.release()
+
+
+if __name__ == "__main__":
+    main()

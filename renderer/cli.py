@@ -25,6 +25,7 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
 
@@ -116,7 +117,8 @@ def build_parser() -> argparse.ArgumentParser:
                        help="ray tracer, --pattern adaptive: refine a pixel whose first 4 samples' "
                             "clamped colours differ by more than T in some channel (default 1/255)")
         p.add_argument("--max-depth", type=int, default=4, metavar="D",
-                       help="ray tracer: bounces of reflection and refraction, 0 to 16 (default 4)")
+                       help="ray tracer: bounces of reflection and refraction, 0 to "
+                            f"{MAX_DEPTH_LIMIT} (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
                        help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
 
@@ -215,6 +217,9 @@ def build_parser() -> argparse.ArgumentParser:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
+    extremes.add_argument("--method", choices=("both", "raster", "raytrace"), default="both",
+                          help="which cases: rasterised, ray traced (scene files named rt_*), or "
+                               "both (default)")
     for name in ("render", "view", "compare", "shaders", "report", "extremes"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
@@ -263,8 +268,8 @@ def check_raytrace_options(args) -> None:
         also = " or --methods" if hasattr(args, "methods") else ""
         args.parser.error("--spp, --pattern, --max-depth, --seed and --adaptive-threshold are for "
                           f"--method raytrace{also}")
-    if not 0 <= args.max_depth <= 16:
-        args.parser.error(f"--max-depth must be between 0 and 16, got {args.max_depth}")
+    if not 0 <= args.max_depth <= MAX_DEPTH_LIMIT:
+        args.parser.error(f"--max-depth must be between 0 and {MAX_DEPTH_LIMIT}, got {args.max_depth}")
     if args.adaptive_threshold is not None and args.pattern != "adaptive":
         args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
     if traced:
@@ -445,7 +450,7 @@ def cmd_compare_methods(args) -> int:
 
 def cmd_compare(args) -> int:
     import reference
-    from renderer.checks.compare import compare_frames, depth_tie_pixels, heat_map
+    from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision, heat_map
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.paths import output_stem
     from renderer.core.jsonio import finite_or_none, to_json
@@ -463,30 +468,38 @@ def cmd_compare(args) -> int:
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
+    tie, tie_depth, grazing = None, None, 0
     if args.method == "raytrace":
         from reference.raytrace.pipeline import render as reference_raytrace
         gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
                                                    _raytrace_options(args), frames=3)
         start = time.perf_counter()
         ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args))
+        reference_ms = (time.perf_counter() - start) * 1000.0
+        # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
+        # elsewhere the adaptive pattern's other decision, rgba8_tie).
+        truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64")
+        tie, tie_depth, grazing = either_precision(ref_frame, truth)
     else:
         gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
         start = time.perf_counter()
         ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
-    reference_ms = (time.perf_counter() - start) * 1000.0
+        reference_ms = (time.perf_counter() - start) * 1000.0
+        tie = ref_frame.rgba8_tie
     warn_if_nothing_drawn(scene, gpu_frame)
     tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
     result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
                             threshold=tolerance.threshold, deviation=tolerance.deviation,
-                            reference_tie=ref_frame.rgba8_tie)
+                            reference_tie=tie, reference_tie_depth=tie_depth)
     with outputs(*names) as written:             # all three or none
         written.png(names[0], gpu_frame.rgba8)
         written.png(names[1], ref_frame.rgba8)
         written.png(names[2], heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
-                                       tolerance.deviation, reference_tie=ref_frame.rgba8_tie))
+                                       tolerance.deviation, reference_tie=tie))
     figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
+               "grazing_ray_pixels": grazing,
                "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
     if args.method == "raytrace":        # adaptive: the samples traced, and where the twins chose differently
@@ -569,7 +582,8 @@ def cmd_extremes(args) -> int:
     try:
         for kind in kinds:
             contexts[kind] = make_context(kind)
-        cases = measure_extremes(extreme_scenes(extra), args.size, contexts)
+        methods = ("raster", "raytrace") if args.method == "both" else (args.method,)
+        cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods)
     finally:
         for ctx in contexts.values():
             release_context(ctx)

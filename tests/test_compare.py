@@ -4,8 +4,10 @@ import math
 
 import numpy as np
 
-from renderer.checks.compare import (compare_frames, depth_max_rel, heat_map,
-                              position_deviation_mismatch, raw_mismatch)
+from renderer.checks.compare import (compare_frames, depth_max_rel, either_precision,
+                                     grazing_ray_pixels, heat_map, position_deviation_mismatch,
+                                     raw_mismatch)
+from renderer.core.frame import Frame
 
 
 def blank(h=8, w=8, value=0):
@@ -93,3 +95,31 @@ def test_a_depth_tie_accepts_either_surface_and_nothing_else():
     result[1, 1] = (200, 10, 10, 255)                    # the tie's colour where there is no tie
     assert compare_frames(result, reference, reference_tie=tie).mismatched_pixels == 1
     assert not heat_map(reference, reference, reference_tie=tie).any()
+
+
+def test_grazing_rays_accept_either_precision_there_and_nothing_else():
+    """Where the float32 and float64 references' ray trees differ (a grazing ray hit in one
+    precision and missed in the other), the GPU may show either one's colour and depth; a
+    third colour there fails, and so does the float64 colour anywhere else."""
+    trees32, trees64 = np.zeros((8, 8), np.uint64), np.zeros((8, 8), np.uint64)
+    trees64[4, 4] = 7                                    # one pixel's tree differs
+    depth = np.full((8, 8), 5.0, np.float32)
+    ref32 = Frame(blank(value=40), depth=depth, ray_tree=trees32)
+    ref64 = Frame(blank(value=40), depth=depth.copy(), ray_tree=trees64)
+    ref64.rgba8[4, 4] = (200, 10, 10, 255)
+    ref64.depth[4, 4] = 9.0                              # another surface behind
+    assert grazing_ray_pixels(ref32, ref64).sum() == 1
+    tie, tie_depth, pixels = either_precision(ref32, ref64)
+    assert pixels == 1 and tuple(tie[4, 4]) == (200, 10, 10, 255) and tie_depth[4, 4] == 9.0
+    assert either_precision(ref32, ref32) == (None, None, 0)
+    result, result_depth = ref64.rgba8.copy(), ref64.depth.copy()    # the GPU took float64's side
+    figures = compare_frames(result, ref32.rgba8, result_depth, ref32.depth,
+                             reference_tie=tie, reference_tie_depth=tie_depth)
+    assert figures.mismatched_pixels == 0 and figures.raw_mismatched_pixels == 0
+    assert figures.depth_max_rel == 0.0
+    assert compare_frames(result, ref32.rgba8, result_depth, ref32.depth).mismatched_pixels == 1
+    assert depth_max_rel(result_depth, ref32.depth) > 0.5
+    result[4, 4] = (10, 200, 10, 255)                    # neither precision's colour
+    assert compare_frames(result, ref32.rgba8, reference_tie=tie).mismatched_pixels == 1
+    result[4, 4], result[1, 1] = ref32.rgba8[4, 4], (200, 10, 10, 255)   # float64's, elsewhere
+    assert compare_frames(result, ref32.rgba8, reference_tie=tie).mismatched_pixels == 1

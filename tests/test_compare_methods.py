@@ -215,7 +215,7 @@ def test_command_line_end_to_end(tmp_path, capsys):
         assert f"{cause.name:<13} {row['pixels']:>8,}" in table
     assert figures["causes"]["shadows"]["pixels"] > 20 and figures["causes"]["sampling"]["pixels"] > 0
     assert sum(row["pixels"] for row in figures["causes"].values()) == figures["differing_pixels"]
-    for bad in (["--method", "raster"], ["--method", "raytrace"], ["--spp", "2"], ["--max-depth", "17"]):
+    for bad in (["--method", "raster"], ["--method", "raytrace"], ["--spp", "2"], ["--max-depth", "65"]):
         assert main(["compare", str(path), "--methods", "--size", "8x8", "--out", str(tmp_path / "no"), *bad]) == 2
         assert "usage: renderer compare" in capsys.readouterr().err
     path.write_text(SHADOW_TOML.replace("radius = 0.5", "radius = -0.5"))

@@ -1,6 +1,8 @@
 """Stiff and extreme cases (docs/conventions.md): a hand-checked case per rule, then every
 scene of assets/extreme/ through the GPU on EGL and OSMesa and through the reference:
-finite everywhere, and within the pipeline tolerance of tests/test_gpu_vs_reference.py."""
+finite everywhere, and within the pipeline tolerance of tests/test_gpu_vs_reference.py.
+The ray-traced ones (rt_*) against the float64 reference ray tracer, grazing rays accepted
+either way (tests/test_raytrace_precision.py has the rules by hand)."""
 
 import ctypes
 import functools
@@ -19,7 +21,8 @@ from renderer.core import transforms as tf
 from renderer.checks.compare import compare_frames, depth_tie_pixels
 from renderer.gpu.context import activate, gl_function
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.study.extremes import STABILITY, extreme_scenes, is_finite_frame
+from renderer.study.extremes import (RAYTRACE_DEPTHS, STABILITY, extreme_scenes, is_finite_frame,
+                                     is_ray_traced, measure_ray_traced)
 from renderer.core.gl_rules import GL_NEGATIVE_ONE_TO_ONE
 from renderer.gpu import GpuRenderer
 from renderer.core.primitives import plane
@@ -28,7 +31,8 @@ from renderer.core.scene_file import load_scene
 
 SIZE = (160, 120)
 REFUSED = ("nan_mesh",)
-RENDERED = sorted(name for name in extreme_scenes() if name not in REFUSED)
+RENDERED = sorted(name for name in extreme_scenes() if name not in REFUSED and not is_ray_traced(name))
+RAY_TRACED = sorted(name for name in extreme_scenes() if is_ray_traced(name))
 GL_CLIP_DEPTH_MODE = 0x935D
 
 
@@ -213,6 +217,41 @@ def test_every_case_is_documented_and_there_are_at_least_14():
     assert set(extreme_scenes()) == set(STABILITY)
 
 
+def test_the_ray_tracers_extreme_cases_are_the_issues():
+    """Issue 14's list: a ray grazing a sphere; spheres of radius 1e-4 and 1e4; a scene 1e6
+    from the origin; a light on a surface; a camera inside a glass sphere; total internal
+    reflection; a coplanar plane and triangle; max depth 0 and 64."""
+    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_grazing_sphere", "rt_huge_sphere",
+                          "rt_inside_glass", "rt_light_on_surface", "rt_mirrors", "rt_tiny_sphere",
+                          "rt_total_internal_reflection"]
+    radii = {name: [s.radius for s in extreme_scene(name).world_shapes() if hasattr(s, "radius")]
+             for name in ("rt_tiny_sphere", "rt_huge_sphere")}
+    assert min(radii["rt_tiny_sphere"]) == pytest.approx(1e-4) and max(radii["rt_huge_sphere"]) == pytest.approx(1e4)
+    assert RAYTRACE_DEPTHS == {"rt_mirrors": (0, 64)}
+
+
+def ray_traced_cases() -> list:
+    """(name, max depth) of every ray-traced case; the default run keeps one."""
+    cases = []
+    for name in RAY_TRACED:
+        for depth in RAYTRACE_DEPTHS.get(name, (4,)):
+            marks = () if name == "rt_grazing_sphere" else (pytest.mark.slow,)
+            cases.append(pytest.param(name, depth, marks=marks, id=f"{name}-{depth}"))
+    return cases
+
+
+@pytest.mark.parametrize("name, max_depth", ray_traced_cases())
+def test_ray_traced_extreme_case_is_finite_and_within_tolerance_of_float64(name, max_depth, gl_contexts):
+    size = (64, 48) if name == "rt_grazing_sphere" else SIZE
+    case = measure_ray_traced(extreme_scene(name), size, gl_contexts, max_depth)
+    assert set(case["finite"]) == {"egl", "osmesa", "reference"} and all(case["finite"].values())
+    for kind, figures in case["contexts"].items():
+        assert PIPELINE_TOLERANCE.passes(figures), (kind, PIPELINE_TOLERANCE.failures(figures))
+    assert case["passes"]
+    if name == "rt_grazing_sphere":                      # the float64 edge is columns away
+        assert case["grazing_pixels"] >= 24 and case["worst_truth"]["mismatched_pixels"] > 0
+
+
 @pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
 @pytest.mark.parametrize("name", RENDERED)
 def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts,
@@ -260,13 +299,15 @@ def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli):
 
 
 def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
-    result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa")
+    result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa",
+                 "--method", "raster")
     assert result.returncode == 0, result.stdout + result.stderr
     document = json.loads((tmp_path / "extremes.json").read_text())
     table = (tmp_path / "extremes.md").read_text()
     cases = {case["case"]: case for case in document["cases"]}
     reversed_scenes = [n for n in RENDERED if extreme_scene(n).camera.reversed_z]
-    assert set(cases) == set(extreme_scenes()) | {f"{n} (reversed_z off)" for n in reversed_scenes}
+    assert set(cases) == (set(extreme_scenes()) - set(RAY_TRACED)) | {f"{n} (reversed_z off)"
+                                                                      for n in reversed_scenes}
     for name, case in cases.items():
         assert f"| {name} |" in table
         if name in REFUSED:
@@ -275,3 +316,16 @@ def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
             assert all(case["finite"].values()) and set(case["finite"]) == {"osmesa", "reference"}
             assert case["passes"] or case.get("before")
     assert document["size"] == [64, 48] and math.isfinite(cases["far_from_origin"]["worst"]["rmse"])
+
+
+@pytest.mark.slow
+def test_renderer_extremes_ray_traces_the_rt_scenes(tmp_path, cli):
+    result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--method", "raytrace")
+    assert result.returncode == 0, result.stdout + result.stderr
+    cases = {case["case"]: case for case in json.loads((tmp_path / "extremes.json").read_text())["cases"]}
+    assert set(cases) == (set(RAY_TRACED) - {"rt_mirrors"}) | {"rt_mirrors (max depth 0)",
+                                                               "rt_mirrors (max depth 64)"}
+    for name, case in cases.items():
+        assert case["method"] == "raytrace" and case["passes"] and all(case["finite"].values()), name
+        assert f"| {name} | raytrace |" in (tmp_path / "extremes.md").read_text()
+    assert cases["rt_grazing_sphere"]["grazing_pixels"] > 0 and cases["rt_tiny_sphere"]["grazing_pixels"] == 0

@@ -285,3 +285,44 @@ def test_lights_up_to_the_limit_compile_and_render(gl_contexts, work, shading, d
     for ctx in gl_contexts.values():
         with GpuRenderer(scene, 16, 12, context=ctx) as gpu:
             assert gpu.render().rgba8[..., 3].any()
+
+
+# -- the ray tracer's inputs (issue 14, "Bad input") -------------------------------------------
+
+RAYTRACE = ["--method", "raytrace"]
+ENERGY_RULE = ("the energy rule is kr + kt <= 1 in each channel (the reflected and refracted "
+               "rays together carry at most the light that arrives)")
+
+
+@pytest.mark.parametrize("shape, material, key, reason", [
+    ('{ type = "sphere", radius = -1.0 }', "{}", "objects[0].shape.radius", "must be > 0, got -1"),
+    ('{ type = "plane", normal = [0, 0, 0] }', "{}", "objects[0].shape.normal",
+     "must not be zero length: the plane is P·N + d = 0"),
+    ('{ type = "sphere" }', "{ kt = 0.5, ior = 0 }", "objects[0].material.ior", "must be > 0, got 0"),
+    ('{ type = "sphere" }', "{ kt = 0.5, ior = -1.33 }", "objects[0].material.ior", "must be > 0, got -1.33"),
+    ('{ type = "sphere" }', "{ kr = 0.6, kt = [0.3, 0.5, 0.3] }", "objects[0].material.kt",
+     f"kr + kt is 1.1 in channel g; {ENERGY_RULE}"),
+], ids=["negative radius", "zero normal", "ior 0", "ior negative", "kr + kt > 1"])
+def test_a_bad_ray_traced_scene_is_one_line_naming_file_key_and_reason(capsys, work, shape, material,
+                                                                      key, reason):
+    (work / "rt.toml").write_text(f"[[objects]]\nshape = {shape}\nmaterial = {material}\n")
+    assert refused(capsys, render("rt.toml", *RAYTRACE), work) == f"renderer: rt.toml: {key}: {reason}"
+
+
+@pytest.mark.parametrize("command", ["render", "compare"])
+@pytest.mark.parametrize("option, reason", [
+    (["--spp", "0"], "argument --spp: expected a whole number of at least 1, got '0'"),
+    (["--max-depth", "-1"], "--max-depth must be between 0 and 64, got -1"),
+    (["--max-depth", "65"], "--max-depth must be between 0 and 64, got 65"),
+    (["--pattern", "hexagonal"], "argument --pattern: invalid choice: 'hexagonal' (choose from"),
+], ids=["spp 0", "max depth -1", "max depth 65", "unknown pattern"])
+def test_a_bad_ray_tracer_option_is_its_reason_then_the_usage(capsys, work, command, option, reason):
+    """Argument errors print the reason on one line (the option named), then the usage line
+    (tests/test_cli.py); status 2, nothing written. 65 is absurd: renderer/core/ray_depth.py's
+    MAX_DEPTH_LIMIT is 64."""
+    args = [command, "sphere", "--method", "raytrace", "--size", "16x12", *option]
+    before = sorted(p.name for p in work.iterdir())
+    assert main(args) == 2
+    first, usage = capsys.readouterr().err.splitlines()
+    assert first.startswith(f"renderer {command}: {reason}") and usage.startswith(f"usage: renderer {command}")
+    assert sorted(p.name for p in work.iterdir()) == before

@@ -58,6 +58,26 @@ bool ray_sphere(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max, out f
     return false;
 }
 
+// A ray that starts on the sphere (a secondary or shadow ray leaving a point of it, with no
+// offset): its origin is the root c / q (c = 0 on the surface, up to the rounding of
+// f.f - r^2, which cancels there), so the one other point of the sphere it can meet is the
+// root s1 = q / a, ahead (s1 > 0) when the ray goes inwards (b < 0) and behind when it leaves
+// outwards (q <= 0): a sphere is convex. c is not used.
+bool ray_sphere_from_surface(vec3 O, vec3 D, vec3 C, float r, float s_min, float s_max,
+                             out float s) {
+    vec3 f = O - C;
+    float a = dot(D, D);
+    float b = dot(f, D);
+    vec3 l = f - (b / a) * D;
+    float delta = r * r - dot(l, l);
+    s = s_max;
+    if (delta < 0.0) return false;
+    float far = -(b + (b >= 0.0 ? 1.0 : -1.0) * sqrt(a * delta)) / a;
+    if (!(far > s_min && far < s_max)) return false;
+    s = far;
+    return true;
+}
+
 // The outward unit normal at a point P on the sphere.
 vec3 sphere_normal(vec3 P, vec3 C, float r) {
     return (P - C) / r;

@@ -2,8 +2,9 @@
 // The ray tracer proper (docs/conventions.md, "Rays"): the closest hit among the analytic
 // spheres, then planes, then the scene's triangles through its BVH; Phong shading through
 // lighting.glsl (MATERIAL_VARIABLES: the hit's material; SHADOWS: a shadow ray per light); then
-// reflected (k_r + k_t F) and transmitted (k_t (1 - F)) rays, F Schlick's, to MAX_DEPTH bounces,
-// depth first through a fixed-size stack in a loop of fixed length (no recursion in GLSL).
+// reflected (k_r + k_t F) and transmitted (k_t (1 - F)) rays, F Schlick's, to MAX_DEPTH bounces
+// and down to a weight cut-off, depth first through a fixed-size stack in a loop of bounded
+// length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
 // SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR.
 
@@ -43,6 +44,14 @@ const int TRACE_SPHERE = 1;
 const int TRACE_PLANE = 2;
 const int TRACE_TRIANGLE = 3;
 const float TRACE_INF = uintBitsToFloat(0x7f800000u);
+// Hits closer than this, relative, are a tie: the surface found first keeps it (scene_hit);
+// a secondary or shadow ray (unit direction) from O starts at s_min = TRACE_HIT_TIE |O|, so a
+// surface met closer than that ties with the one it leaves (trace_s_min).
+const float TRACE_HIT_TIE = 1.0 / 262144.0;
+
+float trace_s_min(vec3 O) {
+    return TRACE_HIT_TIE * sqrt(dot(O, O));
+}
 
 vec4 trace_texel(sampler2D texture_, int k) {
     int width = textureSize(texture_, 0).x;
@@ -51,30 +60,41 @@ vec4 trace_texel(sampler2D texture_, int k) {
 
 // The nearest hit with s_min < s < s_max: its kind (TRACE_MISS on a miss), the sphere's,
 // plane's or original triangle's index, s (s_max on a miss) and the triangle's (u, v).
-int scene_hit(vec3 O, vec3 D, float s_min, float s_max, out int index, out float s, out vec2 uv) {
+// `from_shape`: the analytic shape the ray starts on (a sphere k, a plane NUM_SPHERES + k; -1
+// for none), which it meets again only at a sphere's far side (convexity; no offset needed).
+// Ties: a surface replaces the nearest found so far only when nearer by more than
+// TRACE_HIT_TIE relative, so of surfaces closer than float32 can order (a triangle lying in a
+// plane) the first found shows: spheres, then planes, then triangles (docs/conventions.md).
+int scene_hit(vec3 O, vec3 D, float s_min, float s_max, int from_shape,
+              out int index, out float s, out vec2 uv) {
     s = s_max;
+    float s_limit = s_max;
     index = -1;
     uv = vec2(0.0);
     int kind = TRACE_MISS;
     float s_k;
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        if (ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, s_min, s, s_k)) {
-            s = s_k; kind = TRACE_SPHERE; index = k;
+        vec3 C = u_spheres[k].xyz;
+        float r = u_spheres[k].w;
+        if (k == from_shape ? ray_sphere_from_surface(O, D, C, r, s_min, s_limit, s_k)
+                            : ray_sphere(O, D, C, r, s_min, s_limit, s_k)) {
+            s = s_k; s_limit = s_k * (1.0 - TRACE_HIT_TIE); kind = TRACE_SPHERE; index = k;
         }
     }
 #endif
 #if NUM_PLANES > 0
     for (int k = 0; k < NUM_PLANES; ++k) {
-        if (ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s, s_k)) {
-            s = s_k; kind = TRACE_PLANE; index = k;
+        if (NUM_SPHERES + k != from_shape
+                && ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s_limit, s_k)) {
+            s = s_k; s_limit = s_k * (1.0 - TRACE_HIT_TIE); kind = TRACE_PLANE; index = k;
         }
     }
 #endif
 #ifdef MESHES
     vec2 uv_t;
     int triangle;
-    if (bvh_closest_hit(u_nodes, u_triangles, O, D, s_min, s, s_k, uv_t, triangle)) {
+    if (bvh_closest_hit(u_nodes, u_triangles, O, D, s_min, s_limit, s_k, uv_t, triangle)) {
         s = s_k; kind = TRACE_TRIANGLE; index = triangle; uv = uv_t;
     }
 #endif
@@ -117,50 +137,75 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
 #endif
 }
 
-// Whether anything is hit with 0 < s < s_max (a shadow ray): the first hit found answers (any
-// hit, not the nearest: the analytic shapes first, the BVH only if none of them is hit).
-bool occluded(vec3 O, vec3 D, float s_max) {
+// Whether anything is hit with trace_s_min(O) < s < s_max (a shadow ray from a point of
+// `from_shape`, as scene_hit): the first hit found answers (any hit, not the nearest: the
+// analytic shapes first, the BVH only if none of them is hit).
+bool occluded(vec3 O, vec3 D, float s_max, int from_shape) {
     float s_k;
+    float s_min = trace_s_min(O);
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        if (ray_sphere(O, D, u_spheres[k].xyz, u_spheres[k].w, 0.0, s_max, s_k)) return true;
+        vec3 C = u_spheres[k].xyz;
+        float r = u_spheres[k].w;
+        if (k == from_shape ? ray_sphere_from_surface(O, D, C, r, s_min, s_max, s_k)
+                            : ray_sphere(O, D, C, r, s_min, s_max, s_k)) return true;
     }
 #endif
 #if NUM_PLANES > 0
     for (int k = 0; k < NUM_PLANES; ++k) {
-        if (ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, 0.0, s_max, s_k)) return true;
+        if (NUM_SPHERES + k != from_shape
+                && ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s_max, s_k)) return true;
     }
 #endif
 #ifdef MESHES
     vec2 uv_t;
     int triangle;
-    if (bvh_closest_hit(u_nodes, u_triangles, O, D, 0.0, s_max, s_k, uv_t, triangle)) return true;
+    if (bvh_closest_hit(u_nodes, u_triangles, O, D, s_min, s_max, s_k, uv_t, triangle)) return true;
 #endif
     return false;
 }
 
 vec3 g_geometric_normal;             // the outward Ng of the point being lit
+int g_shape;                         // its analytic shape (scene_hit's from_shape), or -1
+
+// Where a secondary or shadow ray leaving P on the side of n starts: P itself on an analytic
+// shape (scene_hit and occluded never meet it there again), else Waechter and Binder's offset.
+vec3 ray_origin(vec3 P, vec3 n, int shape) {
+    return shape >= 0 ? P : offset_ray_origin(P, n);
+}
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
 float light_visibility_directional(int i, vec3 P, vec3 N) {
     vec3 L = normalize(-u_directional_direction[i]);
     vec3 n = dot(g_geometric_normal, L) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
-    return occluded(offset_ray_origin(P, n), L, TRACE_INF) ? 0.0 : 1.0;
+    return occluded(ray_origin(P, n, g_shape), L, TRACE_INF, g_shape) ? 0.0 : 1.0;
 }
 #endif
 #if NUM_POINT_LIGHTS > 0
 float light_visibility_point(int i, vec3 P, vec3 N) {
     vec3 Q = u_point_position[i];
     vec3 n = dot(g_geometric_normal, Q - P) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
-    vec3 O = offset_ray_origin(P, n);
+    vec3 O = ray_origin(P, n, g_shape);
     vec3 to_light = Q - O;
     float d = sqrt(dot(to_light, to_light));
-    return (d > 0.0 && occluded(O, to_light / d, d)) ? 0.0 : 1.0;
+    return (d > 0.0 && occluded(O, to_light / d, d, g_shape)) ? 0.0 : 1.0;
 }
 #endif
 
+// Hall and Greenberg's adaptive tree depth (1983): a secondary ray whose weight is below
+// TRACE_WEIGHT_CUTOFF in every channel is not spawned (renderer/core/ray_depth.py: the rule,
+// its RAY_WEIGHT_CUTOFF and max_rays, which these mirror). The energy rule kr + kt <= 1 makes
+// the children's weights sum to at most their parent's in each channel, so at most
+// 3 / cutoff = 1536 rays of one depth reach the cut-off: depth d has at most min(2^d, 1536)
+// rays (2^d up to d = 10), which bounds the loop for any MAX_DEPTH.
+const float TRACE_WEIGHT_CUTOFF = 1.0 / 512.0;
+#define TRACE_RAYS_PER_DEPTH 1536
 #define TRACE_STACK (MAX_DEPTH + 2)
+#if MAX_DEPTH <= 10
 #define TRACE_MAX_RAYS ((2 << MAX_DEPTH) - 1)
+#else
+#define TRACE_MAX_RAYS (2047 + (MAX_DEPTH - 10) * TRACE_RAYS_PER_DEPTH)
+#endif
 
 // The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
 // from 0 to infinity); hit and s: the first ray's hit.
@@ -170,10 +215,12 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
     vec3 stack_D[TRACE_STACK];
     vec3 stack_w[TRACE_STACK];
     int stack_depth[TRACE_STACK];
+    int stack_from[TRACE_STACK];        // the analytic shape a ray starts on, or -1
     stack_O[0] = O0;
     stack_D[0] = D0;
     stack_w[0] = vec3(1.0);
     stack_depth[0] = 0;
+    stack_from[0] = -1;
     int top = 1;
     hit = false;
     s_hit = s_max;
@@ -189,8 +236,8 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
         int index;
         float s;
         vec2 uv;
-        int kind = scene_hit(O, D, depth == 0 ? s_min : 0.0, depth == 0 ? s_max : TRACE_INF,
-                             index, s, uv);
+        int kind = scene_hit(O, D, depth == 0 ? s_min : trace_s_min(O),
+                             depth == 0 ? s_max : TRACE_INF, stack_from[top], index, s, uv);
         if (depth == 0) {
             hit = kind != TRACE_MISS;
             s_hit = s;
@@ -215,6 +262,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
 #endif
             vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
             g_geometric_normal = Ng;
+            g_shape = kind == TRACE_SPHERE ? index : kind == TRACE_PLANE ? NUM_SPHERES + index : -1;
             colour += w * lighting(P, N);
 #ifdef SECONDARY
             if (depth < MAX_DEPTH) {
@@ -228,18 +276,20 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 vec3 w_t = w * (kt * (1.0 - F));
                 vec3 T;
                 bool refracted = ray_refract(Du, N_in, eta, T);
-                if (any(greaterThan(w_t, vec3(0.0))) && refracted) {
-                    stack_O[top] = offset_ray_origin(P, -Ng_in);
+                if (any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted) {
+                    stack_O[top] = ray_origin(P, -Ng_in, g_shape);
                     stack_D[top] = T;
                     stack_w[top] = w_t;
                     stack_depth[top] = depth + 1;
+                    stack_from[top] = g_shape;
                     ++top;
                 }
-                if (any(greaterThan(w_r, vec3(0.0)))) {
-                    stack_O[top] = offset_ray_origin(P, Ng_in);
+                if (any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)))) {
+                    stack_O[top] = ray_origin(P, Ng_in, g_shape);
                     stack_D[top] = ray_reflect(Du, N_in);
                     stack_w[top] = w_r;
                     stack_depth[top] = depth + 1;
+                    stack_from[top] = g_shape;
                     ++top;
                 }
             }

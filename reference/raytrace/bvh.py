@@ -1,12 +1,12 @@
 """# Twin: glsl/raytrace/bvh.glsl
 
 The closest hit of rays against the triangles of a BVH (renderer/core/bvh.py: the layout), in
-float32, vectorised over rays: a wavefront of (ray, node) pairs, one level of the tree per step
-(no Python loop over rays or nodes). The ray-box test and the triangle test are the GLSL's
-(`ray_box` below; `ray_triangle` of intersect.py), so each pair decides as the GLSL does;
-the order differs (the GLSL goes depth first, nearer child first), which changes the answer
-only where two triangles are hit at the same s (an edge or vertex they share): either is the
-closest hit then.
+float32 as the GLSL (or float64, the ground truth), vectorised over rays: a wavefront of
+(ray, node) pairs, one level of the tree per step (no Python loop over rays or nodes). The
+ray-box test and the triangle test are the GLSL's (`ray_box` below; `ray_triangle` of
+intersect.py), so each pair decides as the GLSL does; the order differs (the GLSL goes depth
+first, nearer child first), which changes the answer only where two triangles are hit at the
+same s (an edge or vertex they share): either is the closest hit then.
 
 Ray-box (slab) test with 1/D precomputed, IEEE: 1/(+-0) = +-inf. An axis whose 1/D is
 infinite (D's component 0, or so small that 1/D overflows) is parallel to its slab: it admits
@@ -17,6 +17,11 @@ axes), far = min(s_max, BOX_FAR_SCALE * max-side), and the box is hit when near 
 far end is widened by BOX_FAR_SCALE = 1 + 3 * 2^-23 (about 1 + 2 gamma_3, Ize, "Robust BVH Ray
 Traversal", JCGT 2(2) 2013) so that rounding in the slabs (and a 1/D that llvmpipe computes an
 ulp off) does not lose a triangle lying on a box's face.
+
+In float64 (rays O, D of that dtype) the same walk runs on the same float32 boxes with the
+scene's float64 triangles (`vertices`): those lie within half a float32 ulp of the float32
+vertices the boxes were built from, so each box is widened by one float32 ulp on every side
+(nextafter) to hold them, and the far end by 1 + 3 eps64.
 """
 
 from __future__ import annotations
@@ -29,48 +34,70 @@ F32 = np.float32
 BOX_FAR_SCALE = F32(1 + 3 * 2.0 ** -23)
 
 
+def _dtype(O) -> np.dtype:
+    """float64 for float64 rays (the ground truth), else float32 (the GLSL's)."""
+    return np.dtype(np.float64) if np.asarray(O).dtype == np.float64 else np.dtype(F32)
+
+
+def _far_scale(dtype):
+    return BOX_FAR_SCALE if dtype == F32 else dtype.type(1 + 3 * np.finfo(dtype).eps)
+
+
 def inverse_direction(D):
+    dtype = _dtype(D)
     with np.errstate(divide="ignore", over="ignore"):
-        return (F32(1) / np.asarray(D, F32)).astype(F32)
+        return (dtype.type(1) / np.asarray(D, dtype)).astype(dtype)
 
 
 def ray_box(O, inv_D, bmin, bmax, s_min, s_max):
-    """(hit, near) for rays (..., 3) against boxes (..., 3), all float32, as the GLSL's
-    bvh_ray_box."""
-    O, inv_D, bmin, bmax = (np.asarray(a, F32) for a in (O, inv_D, bmin, bmax))
+    """(hit, near) for rays (..., 3) against boxes (..., 3), in the dtype of O (float32 or
+    float64), as the GLSL's bvh_ray_box."""
+    dtype = _dtype(O)
+    O, inv_D, bmin, bmax = (np.asarray(a, dtype) for a in (O, inv_D, bmin, bmax))
+    inf = dtype.type(np.inf)
     with np.errstate(invalid="ignore", over="ignore"):
         lo = (bmin - O) * inv_D
         hi = (bmax - O) * inv_D
         tn, tf = np.minimum(lo, hi), np.maximum(lo, hi)
     parallel = np.isinf(inv_D)
     inside = (O >= bmin) & (O <= bmax)
-    tn = np.where(parallel, np.where(inside, F32(-np.inf), F32(np.inf)), tn)
-    tf = np.where(parallel, np.where(inside, F32(np.inf), F32(-np.inf)), tf)
-    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]), np.maximum(tn[..., 2], np.asarray(s_min, F32)))
+    tn = np.where(parallel, np.where(inside, -inf, inf), tn)
+    tf = np.where(parallel, np.where(inside, inf, -inf), tf)
+    near = np.maximum(np.maximum(tn[..., 0], tn[..., 1]),
+                      np.maximum(tn[..., 2], np.asarray(s_min, dtype)))
     with np.errstate(over="ignore"):
-        far = np.minimum(np.minimum(tf[..., 0], tf[..., 1]), tf[..., 2]) * BOX_FAR_SCALE
-    far = np.minimum(far, np.asarray(s_max, F32))
+        far = np.minimum(np.minimum(tf[..., 0], tf[..., 1]), tf[..., 2]) * _far_scale(dtype)
+    far = np.minimum(far, np.asarray(s_max, dtype))
     return near <= far, near
 
 
-def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
+def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
-    s_min < s < s_max, the nearest such s (s_max on a miss), its (u, v), and the triangle's
-    original index (-1 on a miss). Everything float32 as the GLSL."""
-    O = np.asarray(O, F32).reshape(-1, 3)
-    D = np.asarray(D, F32).reshape(-1, 3)
+    s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v),
+    and the triangle's original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
+    `vertices` (T, 3, 3), by original index, replace the BVH's float32 triangles (the float64
+    twin passes the scene's float64 ones; the boxes are widened to hold them)."""
+    dtype = _dtype(O)
+    O = np.asarray(O, dtype).reshape(-1, 3)
+    D = np.asarray(D, dtype).reshape(-1, 3)
     R = len(O)
     inv_D = inverse_direction(D)
-    s_min = F32(s_min)
-    best_s = np.full(R, F32(s_max), F32)
-    best_uv = np.zeros((R, 2), F32)
+    s_min = np.broadcast_to(np.asarray(s_min, dtype), (R,))
+    best_s = np.full(R, dtype.type(s_max), dtype)
+    best_uv = np.zeros((R, 2), dtype)
     best_tri = np.full(R, -1, np.int64)
-    nodes, tris = bvh.nodes, bvh.triangles
+    nodes, tris = bvh.nodes, bvh.triangles[..., :3]
+    if vertices is not None:
+        lo = np.nextafter(nodes[:, 0, :3], F32(-np.inf))
+        hi = np.nextafter(nodes[:, 1, :3], F32(np.inf))
+        nodes = np.stack([np.concatenate([lo, nodes[:, 0, 3:]], -1),
+                          np.concatenate([hi, nodes[:, 1, 3:]], -1)], 1)
+        tris = np.asarray(vertices, dtype)[bvh.original_index]
     ray = np.arange(R)
     node = np.zeros(R, np.int64)
     while ray.size:
         n0, n1 = nodes[node, 0], nodes[node, 1]
-        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min, best_s[ray])
+        hit, _ = ray_box(O[ray], inv_D[ray], n0[:, :3], n1[:, :3], s_min[ray], best_s[ray])
         ray, node, n0, n1 = ray[hit], node[hit], n0[hit], n1[hit]
         leaf = n1[:, 3] > 0
         # leaves: every (ray, triangle) pair, then the nearest hit per ray
@@ -81,7 +108,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
             t = (np.repeat(n0[leaf, 3].astype(np.int64) - starts, count)
                  + np.arange(count.sum()))
             v = tris[t]
-            h, s, uv = ray_triangle(O[r], D[r], v[:, 0, :3], v[:, 1, :3], v[:, 2, :3], s_min, best_s[r])
+            h, s, uv = ray_triangle(O[r], D[r], v[:, 0], v[:, 1], v[:, 2], s_min[r], best_s[r])
             r, s, uv, t = r[h], s[h], uv[h], t[h]
             if r.size:
                 order = np.lexsort((t, s, r))           # per ray: nearest s, then leaf order
@@ -96,7 +123,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf):
         ray = np.repeat(ray[inner], 2)
         node = np.stack([node[inner] + 1, n0[inner, 3].astype(np.int64)], axis=1).reshape(-1)
     hit = best_tri >= 0
-    original = np.where(hit, tris[np.maximum(best_tri, 0), 0, 3].astype(np.int64), -1)
+    original = np.where(hit, bvh.original_index[np.maximum(best_tri, 0)], -1)
     return hit, best_s, best_uv, original
 
 

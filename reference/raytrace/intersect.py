@@ -60,18 +60,28 @@ def plane_normal(N):
     return _normalize(np.asarray(N))
 
 
+def _sphere_terms(O, D, C, r):
+    """(f, a, delta, q) of Ray Tracing Gems ch. 7 (Haines, Guenther, Akenine-Moeller 2019) for
+    rays O, D and a sphere C, r of one float dtype: f = O - C, a = D.D, b = f.D,
+    delta = r^2 - |f - (b/a) D|^2 (eq. 7.6: the discriminant b^2 - a c over a, without its
+    cancellation), q = -(b + sign(b) sqrt(a delta)) with sign(0) = +1 (eq. 7.7)."""
+    dtype = O.dtype
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        f = O - C
+        a = _dot(D, D)
+        b = _dot(f, D)
+        l = f - (b / a)[..., None] * D
+        delta = r * r - _dot(l, l)
+        sign = np.where(b >= 0, dtype.type(1), dtype.type(-1))
+        q = -(b + sign * np.sqrt(np.maximum(a * delta, 0)))
+    return f, a, delta, q
+
+
 def sphere_discriminant(O, D, C, r):
     """r^2 - |f - (b/a) D|^2 with f = O - C, a = D.D, b = f.D: the discriminant b^2 - a c over a,
-    in the robust form of Ray Tracing Gems ch. 7 (Haines, Guenther, Akenine-Moeller 2019,
-    eq. 7.6)."""
+    in the robust form of Ray Tracing Gems ch. 7 (eq. 7.6)."""
     dtype = _float_dtype(O, D)
-    O, D, C, r = _as(dtype, O, D, C, r)
-    f = O - C
-    a = _dot(D, D)
-    b = _dot(f, D)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        l = f - (b / a)[..., None] * D
-    return r * r - _dot(l, l)
+    return _sphere_terms(*_as(dtype, O, D, C, r))[2]
 
 
 def ray_sphere(O, D, C, r, s_min, s_max):
@@ -81,15 +91,9 @@ def ray_sphere(O, D, C, r, s_min, s_max):
     far root."""
     dtype = _float_dtype(O, D)
     O, D, C, r, s_min, s_max = _as(dtype, O, D, C, r, s_min, s_max)
+    f, a, delta, q = _sphere_terms(O, D, C, r)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        f = O - C
-        a = _dot(D, D)
-        b = _dot(f, D)
         c = _dot(f, f) - r * r
-        l = f - (b / a)[..., None] * D
-        delta = r * r - _dot(l, l)
-        sign = np.where(b >= 0, dtype.type(1), dtype.type(-1))
-        q = -(b + sign * np.sqrt(np.maximum(a * delta, 0)))
         s0 = c / q
         s1 = q / a
         near = np.minimum(s0, s1)
@@ -99,6 +103,19 @@ def ray_sphere(O, D, C, r, s_min, s_max):
         hit = (delta >= 0) & (near_hit | far_hit)
         s = np.where(near_hit, near, far)
     return _select(hit, s, s_max)
+
+
+def ray_sphere_from_surface(O, D, C, r, s_min, s_max):
+    """A ray that starts on the sphere (no offset): its origin is the root c / q, so the one
+    other point it can meet is s1 = q / a (ahead when it goes inwards, b < 0; behind when it
+    leaves outwards: a sphere is convex). c = f.f - r^2, which cancels there, is not used."""
+    dtype = _float_dtype(O, D)
+    O, D, C, r, s_min, s_max = _as(dtype, O, D, C, r, s_min, s_max)
+    _, a, delta, q = _sphere_terms(O, D, C, r)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        far = q / a
+        hit = (delta >= 0) & (far > s_min) & (far < s_max)
+    return _select(hit, far, s_max)
 
 
 def sphere_normal(P, C, r):

@@ -3,8 +3,9 @@
 Reflection, refraction, Schlick's Fresnel approximation and the self-intersection offset
 (docs/conventions.md, "Rays"), vectorised over rays, with the GLSL's formulas in the GLSL's order.
 D is the incoming direction (towards the surface), N the unit normal on the incoming side
-(D.N <= 0), eta = n1 / n2. Computed in the float dtype of D (float64 for integer input); the
-offset is float32 only (it works on float32 bits), as in the GLSL.
+(D.N <= 0), eta = n1 / n2. Computed in the float dtype of D (float64 for integer input). The
+offset works on the bits of float32 (the GLSL's) or float64 points (the float64 twin, the
+ground truth): the same rule in units of the last place of either, its constants below.
 """
 
 from __future__ import annotations
@@ -14,6 +15,15 @@ import numpy as np
 RAY_OFFSET_ORIGIN = np.float32(1.0 / 32.0)
 RAY_OFFSET_FLOAT_SCALE = np.float32(1.0 / 65536.0)
 RAY_OFFSET_INT_SCALE = np.float32(256.0)
+# float64: the same number of ulps (int_scale) and origin; near 0 the additive step shrinks
+# with the epsilon, 2^-16 eps64 / eps32 = 2^-45, so that it stays the same multiple of the
+# ulps of the points near 1/32 (float64 points need not move as far as float32 ones).
+_EPS_RATIO = np.finfo(np.float64).eps / np.finfo(np.float32).eps          # 2^-29
+_OFFSET = {  # dtype: (its integer view, origin, float_scale, int_scale)
+    np.dtype(np.float32): (np.int32, RAY_OFFSET_ORIGIN, RAY_OFFSET_FLOAT_SCALE, RAY_OFFSET_INT_SCALE),
+    np.dtype(np.float64): (np.int64, np.float64(RAY_OFFSET_ORIGIN),
+                           np.float64(RAY_OFFSET_FLOAT_SCALE) * _EPS_RATIO, np.float64(RAY_OFFSET_INT_SCALE)),
+}
 
 
 def _float_dtype(*arrays) -> np.dtype:
@@ -72,13 +82,16 @@ def fresnel_schlick(D, N, eta):
 
 def offset_ray_origin(p, n):
     """Waechter and Binder, Ray Tracing Gems ch. 6: p moved along the unit geometric normal n (on
-    the side the new ray leaves to) by int(256 n) ulps per coordinate (float32 bits as int32),
-    or by n / 65536 where |p| < 1/32. float32 in and out, bit for bit the GLSL."""
-    p = np.asarray(p, dtype=np.float32)
-    n = np.asarray(n, dtype=np.float32)
-    of_i = (RAY_OFFSET_INT_SCALE * n).astype(np.int32)          # truncation towards zero
+    the side the new ray leaves to) by int(256 n) ulps per coordinate (the float bits as
+    integers), or by n / 65536 where |p| < 1/32 (n 2^-45 in float64). float32 in and out, bit
+    for bit the GLSL; float64 points stay float64."""
+    dtype = np.dtype(np.float64) if np.asarray(p).dtype == np.float64 else np.dtype(np.float32)
+    integer, origin, float_scale, int_scale = _OFFSET[dtype]
+    p = np.asarray(p, dtype=dtype)
+    n = np.asarray(n, dtype=dtype)
+    of_i = (int_scale * n).astype(integer)                      # truncation towards zero
     with np.errstate(over="ignore"):
-        bits = p.view(np.int32) + np.where(p < 0, -of_i, of_i)
-    p_i = bits.astype(np.int32).view(np.float32)
-    p_f = p + RAY_OFFSET_FLOAT_SCALE * n
-    return np.where(np.abs(p) < RAY_OFFSET_ORIGIN, p_f, p_i)
+        bits = p.view(integer) + np.where(p < 0, -of_i, of_i)
+    p_i = bits.astype(integer).view(dtype)
+    p_f = p + float_scale * n
+    return np.where(np.abs(p) < origin, p_f, p_i)

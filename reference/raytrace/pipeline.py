@@ -15,6 +15,10 @@ more than the threshold, masks rather than a loop. The GPU decides on its own fl
 which may differ from these in the last bits: a pixel whose spread lies within DECISION_MARGIN
 of the threshold is traced both ways, and the frame's rgba8_tie holds the other decision's
 colour there (comparisons accept either, as at a depth tie).
+
+In float32 as the GPU, or in float64 (dtype=np.float64: the uniforms, offsets and lights in
+float64 too), the ground truth; the frame's ray_tree holds each pixel's hash of its samples'
+ray trees (trace.py), which tells where the two precisions disagree on a grazing ray.
 """
 
 from __future__ import annotations
@@ -27,7 +31,7 @@ from reference.lighting import Lights
 from reference.output import flip_rows
 from reference.raytrace.camera import camera_ray
 from reference.raytrace.sampling import sample_offset
-from reference.raytrace.trace import trace
+from reference.raytrace.trace import mix64, trace
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
@@ -45,52 +49,61 @@ DECISION_MARGIN = 2.0 ** -12
 
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
            max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
-           rs=None, first_sample: int = 0, adaptive_threshold: float | None = None) -> Frame:
+           rs=None, first_sample: int = 0, adaptive_threshold: float | None = None,
+           dtype=F32) -> Frame:
     """The frame (module docstring) of sample indices first_sample .. first_sample + N - 1;
-    `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays."""
+    `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays; `dtype`
+    float32 (the GPU's twin) or float64."""
     start = time.perf_counter()
+    t = np.dtype(dtype).type
     rs = rs if rs is not None else ray_scene(scene)
     sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
     first_sample = check_first_sample(first_sample, sampling.samples)
     matrices = scene.matrices(width, height)
     uniforms = camera_ray_uniforms(matrices.view, matrices.projection, width, height)
-    uniforms = {k: v.astype(F32) for k, v in uniforms.items()}
-    lights = Lights.from_scene(scene, F32, origin=matrices.origin)
+    uniforms = {k: v.astype(t) for k, v in uniforms.items()}
+    lights = Lights.from_scene(scene, t, origin=matrices.origin)
     cam = scene.camera
     y, x = np.divmod(np.arange(width * height, dtype=np.uint32), np.uint32(width))  # row 0 at the bottom
 
     def traced(pixels, ks):
         """Each sample k of `ks` at each pixel of `pixels` (flat indices): colour (S, P, 3),
-        hit (S, P), s (S, P)."""
+        hit (S, P), s (S, P), and the hash of each ray tree mixed with its k (S, P)."""
         if len(pixels) == 0:
-            return np.zeros((len(ks), 0, 3), F32), np.zeros((len(ks), 0), bool), np.zeros((len(ks), 0), F32)
+            return (np.zeros((len(ks), 0, 3), t), np.zeros((len(ks), 0), bool),
+                    np.zeros((len(ks), 0), t), np.zeros((len(ks), 0), np.uint64))
         px, py = x[pixels], y[pixels]
-        centres = np.stack([px, py], -1).astype(F32) + F32(0.5)
-        windows = np.stack([centres + sample_offset(px, py, k, first_sample, sampling) for k in ks])
+        centres = np.stack([px, py], -1).astype(t) + t(0.5)
+        windows = np.stack([centres + sample_offset(px, py, k, first_sample, sampling).astype(t) for k in ks])
         O, D = camera_ray(windows.reshape(-1, 2), uniforms)
+        trees = np.zeros(len(O), np.uint64)
         parts = [trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near, cam.far,
-                       scene.background, max_depth, shadows) for i in range(0, len(O), CHUNK_RAYS)]
+                       scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS])
+                 for i in range(0, len(O), CHUNK_RAYS)]
         colour, hit, s = (np.concatenate(part) for part in zip(*parts))
-        return colour.reshape(len(ks), len(pixels), 3), hit.reshape(len(ks), -1), s.reshape(len(ks), -1)
+        trees = mix64(trees.reshape(len(ks), -1) + np.asarray(ks, np.uint64)[:, None])
+        return (colour.reshape(len(ks), len(pixels), 3), hit.reshape(len(ks), -1),
+                s.reshape(len(ks), -1), trees)
 
-    def accumulate(state, colour, hit, s):
-        """(total, covered, depth) with the samples added, in sample order as the GLSL."""
-        total, covered, depth = (a.copy() for a in state)
+    def accumulate(state, colour, hit, s, trees):
+        """(total, covered, depth, trees) with the samples added, in sample order as the GLSL."""
+        total, covered, depth, tree = (a.copy() for a in state)
         for k in range(len(colour)):
             total += colour[k]
-        return total, covered | hit.any(0), np.minimum(depth, np.where(hit, s, F32(np.inf)).min(0))
+        return (total, covered | hit.any(0), np.minimum(depth, np.where(hit, s, t(np.inf)).min(0)),
+                tree + trees.sum(0, dtype=np.uint64))
 
     everywhere = np.arange(width * height)
-    colour, hit, s = traced(everywhere, range(sampling.first_set))
-    empty = (np.zeros((width * height, 3), F32), np.zeros(width * height, bool),
-             np.full(width * height, F32(np.inf)))
-    first = accumulate(empty, colour, hit, s)
+    colour, hit, s, trees = traced(everywhere, range(sampling.first_set))
+    empty = (np.zeros((width * height, 3), t), np.zeros(width * height, bool),
+             np.full(width * height, t(np.inf)), np.zeros(width * height, np.uint64))
+    first = accumulate(empty, colour, hit, s, trees)
     count = np.full(width * height, sampling.first_set, np.int32)
     decided, other = (first, count), None
     if sampling.adaptive and sampling.samples > sampling.first_set:
-        clamped = np.clip(colour, F32(0), F32(1))
+        clamped = np.clip(colour, t(0), t(1))
         spread = (clamped.max(0) - clamped.min(0)).max(-1)
-        threshold = F32(sampling.threshold)
+        threshold = t(F32(sampling.threshold))
         refine = spread > threshold
         near = np.abs(spread.astype(np.float64) - float(threshold)) <= DECISION_MARGIN
         more = np.flatnonzero(refine | near)
@@ -106,19 +119,21 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
         decided = taking(np.flatnonzero(refine))
         if near.any():
             other = taking(np.flatnonzero(refine ^ near))
-    frame = _frame(*decided, width, height)
-    frame.rgba8_tie = None if other is None else _frame(*other, width, height).rgba8
+    frame = _frame(*decided, width, height, t)
+    frame.rgba8_tie = None if other is None else _frame(*other, width, height, t).rgba8
     frame.milliseconds = (time.perf_counter() - start) * 1000.0
     return frame
 
 
-def _frame(state, count, width: int, height: int) -> Frame:
-    """The Frame of per-pixel (total, covered, depth) and samples traced (flat, row 0 at the
-    bottom): the average colour total / count in float32, as the GLSL."""
-    total, covered, depth = state
-    average = total / count[:, None].astype(F32)
-    linear = np.concatenate([average, covered[:, None].astype(F32)], -1).reshape(height, width, 4)
+def _frame(state, count, width: int, height: int, t=F32) -> Frame:
+    """The Frame of per-pixel (total, covered, depth, trees) and samples traced (flat, row 0
+    at the bottom): the average colour total / count in float32 as the GLSL (or float64)."""
+    total, covered, depth, trees = state
+    average = total / count[:, None].astype(t)
+    linear = np.concatenate([average, covered[:, None].astype(t)], -1).reshape(height, width, 4)
     rgba8 = to_unorm8(linear)
     rgba8[..., 3] = np.where(covered.reshape(height, width), 255, 0)
-    return Frame(flip_rows(rgba8), flip_rows(linear.astype(F32)), flip_rows(depth.reshape(height, width)),
-                 samples=flip_rows(count.reshape(height, width)))
+    return Frame(flip_rows(rgba8), flip_rows(linear.astype(F32)),
+                 flip_rows(depth.reshape(height, width).astype(F32)),
+                 samples=flip_rows(count.reshape(height, width)),
+                 ray_tree=flip_rows(trees.reshape(height, width)))

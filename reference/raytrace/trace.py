@@ -1,8 +1,8 @@
 """# Twin: glsl/raytrace/trace.glsl
 
-The ray tracer proper (docs/conventions.md, "Rays", "Tracing"), in float32 as the GLSL,
-vectorised over rays: a wavefront per bounce (every ray of one depth at once), no Python loop
-over pixels or rays.
+The ray tracer proper (docs/conventions.md, "Rays", "Tracing"), in float32 as the GLSL (or in
+float64, the ground truth: the dtype of the rays given), vectorised over rays: a wavefront per
+bounce (every ray of one depth at once), no Python loop over pixels or rays.
 
 - closest hit: the analytic spheres, then the planes (intersect.py), then the scene's triangles
   through its BVH (bvh.py) with s_max the nearest hit so far;
@@ -30,154 +30,254 @@ import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import closest_hit as bvh_closest_hit
-from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, sphere_normal,
-                                          triangle_normal)
+from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere,
+                                          ray_sphere_from_surface, sphere_normal, triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
+from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
 F32 = np.float32
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
+# Hits closer than this, relative, are a tie, kept by the surface found first (scene_hit; the
+# GLSL's TRACE_HIT_TIE): 64 eps32, above the few ulps by which the rounding of a triangle's
+# vertices and of the two intersection formulas moves a triangle lying in a plane off it.
+HIT_TIE = 2.0 ** -18
 
 
 def _dot(a, b):
     return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
-def scene_hit(rs, O, D, s_min, s_max):
+def leaving_s_min(O):
+    """s_min of a secondary or shadow ray (unit direction) from O: HIT_TIE |O|. A surface met
+    closer than that to the point the ray leaves ties with the surface it leaves (positions
+    are camera-relative, so |O| is the scale of their rounding), which keeps it."""
+    return O.dtype.type(HIT_TIE) * np.sqrt(_dot(O, O))
+
+
+def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
     """(kind, index, s, uv) of the nearest hit with s_min < s < s_max of rays O, D (R, 3):
     kind MISS/SPHERE/PLANE/TRIANGLE, index the sphere's, plane's or original triangle's, s the
-    hit (s_max on a miss)."""
-    R = len(O)
-    s = np.broadcast_to(np.asarray(s_max, F32), (R,)).astype(F32)
+    hit (s_max on a miss). In the dtype of O: float32, or float64 with the scene's float64
+    surfaces. `from_shape` (R,): the analytic shape each ray starts on (shape_id; -1 for none),
+    met again only at a sphere's far side (ray_sphere_from_surface). Ties (HIT_TIE): a surface
+    replaces the nearest found so far only when nearer by more than HIT_TIE relative."""
+    R, t = len(O), O.dtype.type
+    s = np.broadcast_to(np.asarray(s_max, t), (R,)).astype(t)
+    s_min = np.broadcast_to(np.asarray(s_min, t), (R,))
+    limit = s.copy()
+    keep = t(1) - t(HIT_TIE)
+    from_shape = np.full(R, -1) if from_shape is None else from_shape
     kind = np.zeros(R, np.int64)
     index = np.full(R, -1, np.int64)
-    uv = np.zeros((R, 2), F32)
+    uv = np.zeros((R, 2), t)
+
+    def found(hit, s_k, what, k):
+        nonlocal s, limit
+        s = np.where(hit, s_k, s)
+        limit = np.where(hit, s_k * keep, limit)
+        kind[hit], index[hit] = what, k
+
     for k in range(len(rs.sphere_radius)):
-        hit, s_k = ray_sphere(O, D, rs.sphere_centre[k].astype(F32), F32(rs.sphere_radius[k]), F32(s_min), s)
-        s = np.where(hit, s_k, s)
-        kind[hit], index[hit] = SPHERE, k
+        C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
+        hit, s_k = ray_sphere(O, D, C, r, s_min, limit)
+        on = from_shape == k
+        if on.any():
+            hit_on, s_on = ray_sphere_from_surface(O[on], D[on], C, r, s_min[on], limit[on])
+            hit[on], s_k[on] = hit_on, s_on
+        found(hit, s_k, SPHERE, k)
     for k in range(len(rs.plane_offset)):
-        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(F32), F32(rs.plane_offset[k]), F32(s_min), s)
-        s = np.where(hit, s_k, s)
-        kind[hit], index[hit] = PLANE, k
+        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, limit)
+        found(hit & (from_shape != len(rs.sphere_radius) + k), s_k, PLANE, k)
     if rs.bvh is not None:
-        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, s)
+        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, limit,
+                                              vertices=None if t is F32 else rs.triangles)
         s = np.where(hit, s_t, s)
         kind[hit], index[hit], uv[hit] = TRIANGLE, tri[hit], uv_t[hit]
     return kind, index, s, uv
 
 
-def occluded(rs, O, D, s_max):
-    """Whether anything is hit with 0 < s < s_max (a shadow ray)."""
-    return scene_hit(rs, O, D, 0.0, s_max)[0] != MISS
+def shape_id(rs, kind, index):
+    """The analytic shape of hits (kind, index), as from_shape: sphere k is k, plane k is
+    (number of spheres) + k; -1 for a triangle or a miss (the GLSL's g_shape)."""
+    return np.where(kind == SPHERE, index, np.where(kind == PLANE, len(rs.sphere_radius) + index, -1))
+
+
+def ray_origin(P, n, shape):
+    """Where a secondary or shadow ray leaving P on the side of n starts: P itself on an
+    analytic shape (scene_hit never meets it there again), else Waechter and Binder's offset."""
+    return np.where((shape >= 0)[:, None], P, offset_ray_origin(P, n))
+
+
+def occluded(rs, O, D, s_max, from_shape=None):
+    """Whether anything is hit with leaving_s_min(O) < s < s_max (a shadow ray from a point of
+    from_shape)."""
+    return scene_hit(rs, O, D, leaving_s_min(O), s_max, from_shape)[0] != MISS
 
 
 def surface(rs, O, D, kind, index, s, uv):
     """(P, Ng, Ns, obj) at hits (no misses): the hit point, the outward geometric and shading
     unit normals, the object index."""
     P = O + s[:, None] * D
+    t = P.dtype.type
     Ng = np.zeros_like(P)
     Ns = np.zeros_like(P)
     obj = np.zeros(len(P), np.int64)
     m = kind == SPHERE
     if m.any():
         k = index[m]
-        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(F32), rs.sphere_radius[k].astype(F32)[:, None])
+        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(t),
+                              rs.sphere_radius[k].astype(t)[:, None])
         Ns[m] = Ng[m]
         obj[m] = rs.sphere_object[k]
     m = kind == PLANE
     if m.any():
         k = index[m]
-        Ng[m] = plane_normal(rs.plane_normal[k].astype(F32))
+        Ng[m] = plane_normal(rs.plane_normal[k].astype(t))
         Ns[m] = Ng[m]
         obj[m] = rs.plane_object[k]
     m = kind == TRIANGLE
     if m.any():
         k = index[m]
-        V = rs.triangles[k].astype(F32)
+        V = rs.triangles[k].astype(t)
         Ng[m] = triangle_normal(V[:, 0], V[:, 1], V[:, 2])
-        n = rs.triangle_normals[k].astype(F32)
+        n = rs.triangle_normals[k].astype(t)
         u, v = uv[m, 0:1], uv[m, 1:2]
-        Ns[m] = normalize_or_zero((F32(1) - u - v) * n[:, 0] + u * n[:, 1] + v * n[:, 2])
+        Ns[m] = normalize_or_zero((t(1) - u - v) * n[:, 0] + u * n[:, 1] + v * n[:, 2])
         obj[m] = rs.triangle_object[k]
     return P, Ng, Ns, obj
 
 
-def materials(rs, obj, specular: bool) -> MaterialUniforms:
-    return MaterialUniforms(rs.ka[obj].astype(F32), rs.kd[obj].astype(F32), rs.ks[obj].astype(F32),
-                            rs.n[obj].astype(F32)[:, None], specular=specular)
+def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
+    return MaterialUniforms(rs.ka[obj].astype(dtype), rs.kd[obj].astype(dtype), rs.ks[obj].astype(dtype),
+                            rs.n[obj].astype(dtype)[:, None], specular=specular)
 
 
-def shadow_visibility(rs, lights: Lights, Ng):
-    """The visibility callable of lighting.py for hits with outward geometric normals Ng: one
-    shadow ray per point and light (the GLSL's light_visibility_directional / _point)."""
+def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
+    """The visibility callable of lighting.py for hits with outward geometric normals Ng on
+    analytic shapes `shape` (shape_id): one shadow ray per point and light (the GLSL's
+    light_visibility_directional / _point). `record(needed, event)`, if given, hears each
+    shadow ray's outcome (ray_tree_event)."""
+    t = Ng.dtype.type
+
     def visibility(kind, i, P, N, needed):
         blocked = np.zeros(len(P), bool)
-        P, n = P[needed], Ng[needed]
+        P, n, on = P[needed], Ng[needed], shape[needed]
         if kind == "directional":
             L = normalize(-lights.u_directional_direction[i])
             n = np.where((_dot(n, L) >= 0)[:, None], n, -n)
-            O = offset_ray_origin(P, n)
-            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(F32), F32(np.inf))
+            O = ray_origin(P, n, on)
+            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on)
         else:
             Q = lights.u_point_position[i]
             n = np.where((_dot(n, Q - P) >= 0)[:, None], n, -n)
-            O = offset_ray_origin(P, n)
+            O = ray_origin(P, n, on)
             to_light = Q - O
             d = np.sqrt(_dot(to_light, to_light))
             with np.errstate(divide="ignore", invalid="ignore"):
                 L = to_light / d[:, None]
-            blocked[needed] = occluded(rs, O, L, d) & (d > 0)
-        return np.where(blocked, F32(0), F32(1))[:, None]
+            blocked[needed] = occluded(rs, O, L, d, on) & (d > 0)
+        if record is not None:
+            light = i if kind == "directional" else len(lights.u_directional_direction) + i
+            record(blocked, ray_tree_event(SHADOW, light))
+        return np.where(blocked, t(0), t(1))[:, None]
     return visibility
 
 
-def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True):
-    """Trace rays O, D (R, 3) float32: (colour (R, 3), hit (R,), s (R,)) with hit and s of
-    each ray's first hit (primary rays between s_min and s_max; secondary rays from 0 to inf).
-    shadows=False lights every point by every light (no shadow rays; the GLSL without SHADOWS)."""
-    O = np.asarray(O, F32)
-    D = np.asarray(D, F32)
+# -- the ray tree's hash ------------------------------------------------------------------------
+# Which surface each ray of a camera ray's tree hit (or none), and which shadow rays were
+# blocked, hashed into one uint64 per camera ray: two precisions that disagree on a grazing ray
+# (a hit in one and a miss or another surface in the other; a shadow ray blocked in one only;
+# one child spawned in one only) give different hashes (docs/conventions.md, "Grazing rays").
+# A shadow ray not cast (its light adds nothing at the point) counts as not blocked: whether a
+# term of 1e-50 underflows to 0 (float32) or not (float64) changes nothing one can see.
+# Every ray has a path id (the root's ROOT_PATH; a child's the mix of its parent's and of
+# which child it is); each event adds mix(path + event) to the sum, modulo 2^64, so that the
+# order in which the rays are traced (the GLSL's depth first, the twin's wavefronts) does not
+# matter. mix is splitmix64's finaliser (Steele, Lea and Flood 2014).
+SHADOW = 4                    # event kinds: MISS, SPHERE, PLANE, TRIANGLE; SHADOW + blocked
+ROOT_PATH = np.uint64(0x9E3779B97F4A7C15)
+
+
+def mix64(z):
+    z = np.asarray(z, np.uint64)
+    with np.errstate(over="ignore"):                 # products modulo 2^64, as meant
+        z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+        z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+def ray_tree_event(kind, index):
+    """The uint64 event of a ray that hit surface (kind, index), or of a shadow ray."""
+    kind = np.asarray(kind, np.uint64)
+    return (kind << np.uint64(32)) | (np.asarray(index, np.int64) & 0xFFFFFFFF).astype(np.uint64)
+
+
+def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
+          ray_trees=None):
+    """Trace rays O, D (R, 3): (colour (R, 3), hit (R,), s (R,)) with hit and s of each ray's
+    first hit (primary rays between s_min and s_max; secondary rays from 0 to inf). float32 as
+    the GLSL, or float64 for float64 rays (and then `lights` in float64). shadows=False lights
+    every point by every light (no shadow rays; the GLSL without SHADOWS). `ray_trees`, an
+    (R,) uint64 array, has each ray tree's hash added to it (the comment above).
+    A secondary ray is spawned only when some channel of its weight is at least
+    RAY_WEIGHT_CUTOFF (renderer/core/ray_depth.py)."""
+    t = np.asarray(O).dtype.type if np.asarray(O).dtype == np.float64 else F32
+    O = np.asarray(O, t)
+    D = np.asarray(D, t)
     R = len(O)
-    colour = np.zeros((R, 3), F32)
-    background = np.asarray(background, F32)
+    colour = np.zeros((R, 3), t)
+    background = np.asarray(background, t)
     specular = rs.specular
     owner = np.arange(R)
-    weight = np.ones((R, 3), F32)
+    from_shape = np.full(R, -1)
+    path = np.full(R, ROOT_PATH, np.uint64)
+    weight = np.ones((R, 3), t)
     first_hit, first_s = None, None
-    lo, hi = F32(s_min), F32(s_max)
+    lo, hi = t(s_min), t(s_max)
+    trees = np.zeros(R, np.uint64) if ray_trees is None else ray_trees
+
+    def record(rays, event):
+        np.add.at(trees, owner[rays], mix64(path[rays] + mix64(event)))
+
     for depth in range(max_depth + 1):
         if not len(O):
             break
-        kind, index, s, uv = scene_hit(rs, O, D, lo, hi)
+        kind, index, s, uv = scene_hit(rs, O, D, lo, hi, from_shape)
+        record(slice(None), ray_tree_event(kind, index))
         hit = kind != MISS
         if depth == 0:
             first_hit, first_s = hit.copy(), s.copy()
         np.add.at(colour, owner[~hit], weight[~hit] * background)
-        O, D, kind, index, s, uv, owner, weight = (a[hit] for a in (O, D, kind, index, s, uv, owner, weight))
+        O, D, kind, index, s, uv, owner, path, weight = (
+            a[hit] for a in (O, D, kind, index, s, uv, owner, path, weight))
         P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv)
+        shape = shape_id(rs, kind, index)
         Du = normalize(D)
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
-        local = lighting(P, N, O, materials(rs, obj, specular), lights,
-                         shadow_visibility(rs, lights, Ng) if shadows else None)
+        local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
+                         shadow_visibility(rs, lights, Ng, shape, record) if shadows else None)
         np.add.at(colour, owner, weight * local)
         if depth == max_depth:
             break
-        # secondary rays
+        # secondary rays, down to the weight cut-off
         N_in = np.where(back[:, None], -Ns, Ns)
         Ng_in = np.where(back[:, None], -Ng, Ng)
-        ior = rs.ior[obj].astype(F32)
-        eta = np.where(back, ior, F32(1) / ior)
+        ior = rs.ior[obj].astype(t)
+        eta = np.where(back, ior, t(1) / ior)
         F = fresnel_schlick(Du, N_in, eta)[:, None]
-        kr, kt = rs.kr[obj].astype(F32), rs.kt[obj].astype(F32)
+        kr, kt = rs.kr[obj].astype(t), rs.kt[obj].astype(t)
         w_r = weight * (kr + kt * F)
-        w_t = weight * (kt * (F32(1) - F))
+        w_t = weight * (kt * (t(1) - F))
         refracted, T = ray_refract(Du, N_in, eta)
-        go_r = (w_r > 0).any(-1)
-        go_t = (w_t > 0).any(-1) & refracted
-        O = np.concatenate([offset_ray_origin(P[go_r], Ng_in[go_r]), offset_ray_origin(P[go_t], -Ng_in[go_t])])
-        D = np.concatenate([ray_reflect(Du[go_r], N_in[go_r]), T[go_t]]).astype(F32)
+        go_r = w_r.max(-1) >= RAY_WEIGHT_CUTOFF
+        go_t = (w_t.max(-1) >= RAY_WEIGHT_CUTOFF) & refracted
+        O = np.concatenate([ray_origin(P[go_r], Ng_in[go_r], shape[go_r]),
+                            ray_origin(P[go_t], -Ng_in[go_t], shape[go_t])])
+        D = np.concatenate([ray_reflect(Du[go_r], N_in[go_r]), T[go_t]]).astype(t)
         owner = np.concatenate([owner[go_r], owner[go_t]])
+        from_shape = np.concatenate([shape[go_r], shape[go_t]])
+        path = np.concatenate([mix64(path[go_r] ^ np.uint64(1)), mix64(path[go_t] ^ np.uint64(2))])
         weight = np.concatenate([w_r[go_r], w_t[go_t]])
-        lo, hi = F32(0), F32(np.inf)
+        lo, hi = leaving_s_min(O), t(np.inf)
     return colour, first_hit, first_s

@@ -5,6 +5,12 @@ intThresholdPositionDeviationCompare): a pixel passes when some pixel within ±N
 the other image matches within the threshold on every channel, checked both ways
 (GPU → reference and reference → GPU). That forgives an edge that moved by one pixel, which
 sub-pixel rounding may do, and nothing else.
+
+A second acceptable reference (`reference_tie`, and for depth `reference_tie_depth`) is
+accepted wherever it differs from the first: the rasteriser reference's rgba8_tie at depth
+ties, and for the ray tracer the float64 reference's colour and depth at grazing pixels, where
+the float32 and float64 references' ray trees differ (`grazing_ray_pixels`,
+`either_precision`; docs/conventions.md, "Grazing rays").
 """
 
 from __future__ import annotations
@@ -92,25 +98,49 @@ def _depth_rel_nearby(a: np.ndarray, b: np.ndarray, deviation: int) -> np.ndarra
     return best
 
 
-def depth_max_rel(result: np.ndarray, reference: np.ndarray, deviation: int = DEFAULT_DEVIATION) -> float:
+def depth_max_rel(result: np.ndarray, reference: np.ndarray, deviation: int = DEFAULT_DEVIATION,
+                  reference_tie: np.ndarray | None = None) -> float:
     """Largest relative depth difference where both drew, with the same ±deviation as colour.
 
     At a silhouette one image may see the object and the other the one behind it, exactly as
     with colour, so each pixel is held against the nearest-matching depth within ±deviation,
-    both ways.
+    both ways. `reference_tie`, a second acceptable reference depth (the other precision's at
+    grazing rays, `either_precision`), counts wherever it is nearer.
     """
-    both = np.isfinite(result) & np.isfinite(reference)
+    references = [reference] if reference_tie is None else [reference, reference_tie]
+    both = np.isfinite(result) & np.logical_or.reduce([np.isfinite(r) for r in references])
     if not both.any():
         return 0.0
-    worst = max(_depth_rel_nearby(result, reference, deviation)[both].max(),
-                _depth_rel_nearby(reference, result, deviation)[both].max())
-    return float(worst)
+    forward = np.fmin.reduce([_depth_rel_nearby(result, r, deviation) for r in references])
+    backward = np.fmin.reduce([_depth_rel_nearby(r, result, deviation) for r in references])
+    return float(max(forward[both].max(), backward[both].max()))
 
 
 def depth_tie_pixels(reference_frame) -> int:
     """Pixels where the reference accepts another colour because of a depth tie."""
     tie = reference_frame.rgba8_tie
     return 0 if tie is None else int((tie != reference_frame.rgba8).any(axis=-1).sum())
+
+
+def grazing_ray_pixels(reference32, reference64) -> np.ndarray:
+    """(H, W) bool: where the reference ray tracer in float32 and in float64 disagree on a
+    grazing ray: some sample's ray tree (Frame.ray_tree: which surface each camera, secondary
+    and shadow ray hit) differs (docs/conventions.md, "Grazing rays")."""
+    return reference32.ray_tree != reference64.ray_tree
+
+
+def either_precision(frame, other) -> tuple[np.ndarray | None, np.ndarray | None, int]:
+    """(rgba8, depth, pixels) for two reference ray-traced frames, float32 and float64 either
+    way round: the second acceptable reference that compare_frames takes as reference_tie and
+    reference_tie_depth, and how many pixels graze. At grazing pixels `other`'s colour and
+    depth; elsewhere `frame`'s own alternative (rgba8_tie: the adaptive pattern's other
+    decision) or its image. (frame.rgba8_tie, None, 0) where no pixel grazes."""
+    grazing = grazing_ray_pixels(frame, other)
+    if not grazing.any():
+        return frame.rgba8_tie, None, 0
+    base = frame.rgba8 if frame.rgba8_tie is None else frame.rgba8_tie
+    return (np.where(grazing[..., None], other.rgba8, base),
+            np.where(grazing, other.depth, frame.depth), int(grazing.sum()))
 
 
 @dataclass
@@ -134,10 +164,12 @@ class Comparison:
 def compare_frames(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
                    result_depth: np.ndarray | None = None, reference_depth: np.ndarray | None = None,
                    threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION,
-                   reference_tie: np.ndarray | None = None) -> Comparison:
+                   reference_tie: np.ndarray | None = None,
+                   reference_tie_depth: np.ndarray | None = None) -> Comparison:
     """The figures of `renderer compare`. `reference_tie`: the reference frame's rgba8_tie,
-    accepted wherever it differs (pixels at a depth tie); max_abs and the like measure
-    against the nearer of the two there."""
+    accepted wherever it differs (pixels at a depth tie), or the other precision's colour at
+    grazing rays (`either_precision`, with its depth as `reference_tie_depth`); max_abs and
+    the like measure against the nearer of the two there."""
     if result_rgba8.shape != reference_rgba8.shape:
         raise ValueError(f"image sizes differ: {result_rgba8.shape} and {reference_rgba8.shape}")
     difference = channel_difference(result_rgba8, reference_rgba8, reference_tie)
@@ -149,7 +181,7 @@ def compare_frames(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
                                           reference_tie).sum())
     depth = None
     if result_depth is not None and reference_depth is not None:
-        depth = depth_max_rel(result_depth, reference_depth, deviation)
+        depth = depth_max_rel(result_depth, reference_depth, deviation, reference_tie_depth)
     return Comparison(
         max_abs=int(diff.max()), mean_abs=float(diff.mean()), rmse=rmse,
         psnr=math.inf if rmse == 0 else 20 * math.log10(255.0 / rmse),

@@ -39,6 +39,10 @@ class Frame:
             reference. Golden tests record it beside each golden.
     samples: from the ray tracer (either twin), (H, W) int32 camera rays traced per pixel:
             N everywhere but with the adaptive pattern; None from the rasteriser.
+    ray_tree: from the reference ray tracer only, (H, W) uint64: per pixel a hash of which
+            surface each ray of its samples' ray trees hit and which shadow rays were
+            blocked (reference/raytrace/trace.py). Where the float32 and float64 frames'
+            differ, the two precisions disagree on a grazing ray (docs/conventions.md).
     """
     rgba8: np.ndarray
     linear: np.ndarray | None = None
@@ -47,6 +51,7 @@ class Frame:
     rgba8_tie: np.ndarray | None = None
     gl_info: dict | None = None
     samples: np.ndarray | None = None
+    ray_tree: np.ndarray | None = None
 
     def image(self, background: str = "opaque") -> np.ndarray:
         """The pixels an image file of this frame holds: (H, W, 3) for an opaque background,

@@ -35,6 +35,7 @@ from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
@@ -64,8 +65,8 @@ class RayTracer:
                  seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True,
                  adaptive_threshold: float | None = None):
         width, height = image_size(width, height)
-        if not 0 <= int(max_depth) <= 16:
-            raise ValueError(f"max_depth must be between 0 and 16, got {max_depth}")
+        if not 0 <= int(max_depth) <= MAX_DEPTH_LIMIT:
+            raise ValueError(f"max_depth must be between 0 and {MAX_DEPTH_LIMIT}, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
         self.width, self.height = width, height

@@ -10,6 +10,14 @@ numerical stability, not aliasing. Each case passes when no pixel is NaN or Inf 
 pipeline tolerance against it (renderer/checks/tolerance.py). A scene authored with
 reversed-Z is measured a second time with it off, to show the depth error it removes. A
 scene whose file is refused (a NaN vertex) is listed with the one-line error a user sees.
+
+A scene file whose name starts with `rt_` is ray traced instead (RayTracer on each context
+against reference/raytrace in float64, 1 sample per pixel, at each of its RAYTRACE_DEPTHS,
+the default depth otherwise): where the float32 and float64 references disagree on a grazing
+ray (renderer/checks/compare.py, grazing_ray_pixels) either one's colour and depth is
+accepted, as at the rasteriser's depth ties. Ray-traced cases are not rasterised: the
+rasteriser draws their spheres and planes as tessellations, whose extremes are the rasteriser
+cases' own.
 """
 
 from __future__ import annotations
@@ -21,11 +29,14 @@ from pathlib import Path
 import numpy as np
 
 import reference
+from reference.raytrace.pipeline import render as reference_raytrace
 from renderer.core.builtin import assets_dir, scene_description
-from renderer.checks.compare import compare_frames, depth_tie_pixels
+from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision
 from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
+from renderer.core.ray_depth import DEFAULT_MAX_DEPTH
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import GpuRenderer
+from renderer.gpu.raytracer import RayTracer
 from renderer.core.imageio import outputs
 from renderer.core.jsonio import json_text
 from renderer.core.scene_file import load_scene
@@ -62,7 +73,42 @@ STABILITY = {
                       "zeroes lights as ambient (normalize_or_zero)",
     "subpixel_triangles": "vertices snapped to 1/256 px and the fill rule decide coverage "
                           "identically in both pipelines",
+    # ray traced (docs/conventions.md, "Rays")
+    "rt_coplanar": "hit ties: a surface replaces the nearest hit only when nearer by more than "
+                   "2^-18 relative, so the plane, found first, shows wherever the triangle lies "
+                   "in it; rays leaving it start at s > 2^-18 |O| and skip it",
+    "rt_far_from_origin": "camera-relative coordinates: the shapes and lights relative to the "
+                          "eye in float64 before the float32 upload",
+    "rt_grazing_sphere": "the robust discriminant (Ray Tracing Gems ch. 7); where float32 "
+                         "cannot tell a tangent ray from a miss the float64 reference decides "
+                         "otherwise, and those grazing pixels accept either",
+    "rt_huge_sphere": "rays leaving a sphere never meet it again but at the far root q/a "
+                      "(convexity), so the cancellation of f.f - r^2 at radius 1e4 casts no "
+                      "false shadow; camera rays' depth keeps it within 5e-4",
+    "rt_inside_glass": "from inside, the near root is behind and the far one is the hit; "
+                       "leaving the glass flips the normal and eta = ior; Snell's k < 0 is "
+                       "total internal reflection, weighted F = 1",
+    "rt_light_on_surface": "a shadow ray of length 0 (d = 0) casts nothing and the light is "
+                           "fully incident (L = N); rays along the plane graze the sphere "
+                           "resting on it, accepted either way",
+    "rt_mirrors": "Hall and Greenberg's weight cut-off (2^-9) and the energy rule bound the "
+                  "ray tree, so the GLSL loop is finite at depth 64; perfect mirrors keep "
+                  "weight 1 and reach it",
+    "rt_tiny_sphere": "rays leaving a shape start on it, with no offset to swamp a radius of "
+                      "1e-4 (Waechter and Binder's 2^-16 near the eye is for triangles only)",
+    "rt_total_internal_reflection": "ray_refract reports k < 0 and the transmitted weight "
+                                    "goes to the reflection (F = 1); triangles' rays leave "
+                                    "from Waechter and Binder's offset",
 }
+
+# Ray-traced cases measured at other maximum depths than the default.
+RAYTRACE_DEPTHS = {"rt_mirrors": (0, 64)}
+RAY_TRACED_PREFIX = "rt_"
+
+
+def is_ray_traced(name: str) -> bool:
+    """Whether the extreme scene file `name` (its stem) is ray traced (module docstring)."""
+    return name.startswith(RAY_TRACED_PREFIX)
 
 
 def extreme_scenes(extra=()) -> dict[str, Path]:
@@ -107,22 +153,62 @@ def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
             "passes": all(finite.values()) and all(TOLERANCE.passes(c) for c in per_context.values())}
 
 
+def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
+                       max_depth: int = DEFAULT_MAX_DEPTH) -> dict:
+    """Figures of one ray-traced scene, as measure_scene: each GPU frame against the float64
+    reference, which accepts the float32 reference's colour and depth at grazing pixels
+    (`grazing_pixels`: where the two references' ray trees differ); `truth` without that."""
+    width, height = size
+    gpu_frames = {}
+    for kind, ctx in contexts.items():
+        with RayTracer(scene, width, height, context=ctx, max_depth=max_depth) as tracer:
+            gpu_frames[kind] = tracer.render()
+    truth = reference_raytrace(scene, width, height, max_depth=max_depth, dtype=np.float64)
+    twin = reference_raytrace(scene, width, height, max_depth=max_depth)
+    tie, tie_depth, grazing = either_precision(truth, twin)
+    finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
+    finite["reference"] = is_finite_frame(truth) and is_finite_frame(twin)
+    per_context = {kind: compare_frames(frame.rgba8, truth.rgba8, frame.depth, truth.depth,
+                                        reference_tie=tie, reference_tie_depth=tie_depth).as_dict()
+                   for kind, frame in gpu_frames.items()}
+    against_truth = {kind: compare_frames(frame.rgba8, truth.rgba8).as_dict()
+                     for kind, frame in gpu_frames.items()}
+    return {"finite": finite, "grazing_pixels": grazing,
+            "contexts": per_context, "worst": _worst(per_context),
+            "truth": against_truth, "worst_truth": _worst(against_truth),
+            "passes": all(finite.values()) and all(TOLERANCE.passes(c) for c in per_context.values())}
+
+
 def _worst(comparisons: dict) -> dict:
     return max(comparisons.values(), key=lambda c: (c["mismatched_pixels"],
                                                     c["raw_mismatched_fraction"], c["rmse"]))
 
 
-def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: dict) -> list[dict]:
-    """One case per scene (two for a reversed-Z scene: as authored, and with it off)."""
+def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: dict,
+                     methods=("raster", "raytrace")) -> list[dict]:
+    """One case per scene (two for a reversed-Z scene: as authored, and with it off; one per
+    depth of RAYTRACE_DEPTHS for a ray-traced one), of the scenes whose method is in
+    `methods`."""
     cases = []
     for name, path in scenes.items():
-        base = {"case": name, "file": str(path), "stability": STABILITY.get(name, "")}
+        method = "raytrace" if is_ray_traced(name) else "raster"
+        if method not in methods:
+            continue
+        base = {"case": name, "file": str(path), "method": method,
+                "stability": STABILITY.get(name, "")}
         try:
             scene = load_scene(path)
         except SceneError as error:
             cases.append(base | {"refused": error.line(), "passes": True})
             continue
         description = scene_description(path)
+        if method == "raytrace":
+            depths = RAYTRACE_DEPTHS.get(name, (DEFAULT_MAX_DEPTH,))
+            for depth in depths:
+                case = name if len(depths) == 1 else f"{name} (max depth {depth})"
+                cases.append(base | {"case": case, "tests": description, "max_depth": depth}
+                             | measure_ray_traced(scene, size, contexts, depth))
+            continue
         cases.append(base | {"tests": description, "reversed_z": scene.camera.reversed_z}
                      | measure_scene(scene, size, contexts))
         if scene.camera.reversed_z:
@@ -154,31 +240,35 @@ def _yes_no(flag: bool) -> str:
 def markdown_table(cases: list[dict], size: tuple[int, int]) -> str:
     lines = [f"# Extreme cases ({size[0]}x{size[1]})", "",
              "GPU against the float64 reference (the ground truth here: the same pipeline in "
-             "float64 at the same size). Mismatched: pixels failing the threshold-2 compare "
+             "float64 at the same size; for `raytrace` cases the ray tracer, 1 sample per "
+             "pixel). Mismatched: pixels failing the threshold-2 compare "
              "with ±1 px allowed, both ways; raw: fraction off by more than 2 in place; both "
              "accept either surface at the reference's depth ties (tie px: pixels where two "
-             "surfaces are closer than GL's float32 depth can order, that is z-fighting). "
+             "surfaces are closer than GL's float32 depth can order, that is z-fighting) and, "
+             "ray traced, either precision's result where the float32 and float64 references "
+             "disagree on a grazing ray (grazing px). "
              "Against truth: rmse / max_abs on the 0-255 scale against the reference image "
              "alone, ties not forgiven. Depth: largest relative error of the camera-space "
              "depth. Figures are the worst of the GPU contexts. Pass: the pipeline tolerance "
              f"({TOLERANCE.max_mismatched_pixels} mismatched, raw <= {TOLERANCE.raw_mismatch_limit}, "
              f"depth <= {TOLERANCE.depth_rel_limit:g}).", "",
-             "| case | what it tests | finite (" + " / ".join(_backends(cases)) + ") | mismatched px "
-             "| raw mismatch | tie px | against truth: rmse / max_abs | depth max rel | pass "
-             "| what makes it stable |",
-             "| --- | --- | --- | ---: | ---: | ---: | --- | ---: | --- | --- |"]
+             "| case | method | what it tests | finite (" + " / ".join(_backends(cases)) + ") "
+             "| mismatched px | raw mismatch | tie / grazing px | against truth: rmse / max_abs "
+             "| depth max rel | pass | what makes it stable |",
+             "| --- | --- | --- | --- | ---: | ---: | ---: | --- | ---: | --- | --- |"]
     for case in cases:
         if "refused" in case:
-            lines.append(f"| {case['case']} | refused: `{case['refused']}` | - | - | - | - | - "
-                         f"| - | yes (refused) | {case['stability']} |")
+            lines.append(f"| {case['case']} | {case['method']} | refused: `{case['refused']}` | - "
+                         f"| - | - | - | - | - | yes (refused) | {case['stability']} |")
             continue
         worst, truth = case["worst"], case["worst_truth"]
         finite = " / ".join(_yes_no(v) for v in case["finite"].values())
         verdict = _yes_no(case["passes"]) if not case.get("before") else \
             ("yes" if case["passes"] else "no (expected)")
+        ties = case["grazing_pixels"] if case["method"] == "raytrace" else case["tie_pixels"]
         lines.append(
-            f"| {case['case']} | {case['tests']} | {finite} | {worst['mismatched_pixels']} "
-            f"| {worst['raw_mismatched_fraction']:.4f} | {case['tie_pixels']} "
+            f"| {case['case']} | {case['method']} | {case['tests']} | {finite} "
+            f"| {worst['mismatched_pixels']} | {worst['raw_mismatched_fraction']:.4f} | {ties} "
             f"| {truth['rmse']:.3f} / {truth['max_abs']} "
             f"| {worst['depth_max_rel']:.2e} | {verdict} | {case['stability']} |")
     return "\n".join(lines) + "\n"

@@ -19,6 +19,10 @@ rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 
 mismatched_fraction (pixels whose 8-bit value differs from the truth's by more than 2/255 in
 some channel). report.md, results.csv and plots/SCENE-KNOB.png are written when the sweep
 has finished, each atomically.
+
+run_report drives a study: RasterStudy, this sweep, or (method="raytrace") renderer/study/
+ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, with the same
+metrics, plots and tables.
 """
 
 from __future__ import annotations

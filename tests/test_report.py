@@ -111,9 +111,9 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     (("sphere", "--method", "raytrace", "--size", "400x300"),
      "--size: 400x300 is too large for the ray tracer's ground truth"),
 ])
-def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli):
+def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_here):
     out = tmp_path / "report"
-    result = cli("report", *args, "--out", str(out), "--cache", str(tmp_path / "cache"))
+    result = cli_here("report", *args, "--out", str(out), "--cache", str(tmp_path / "cache"))
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [result.stderr.strip()]
     assert reason in result.stderr and "Traceback" not in result.stderr

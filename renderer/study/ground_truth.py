@@ -8,7 +8,7 @@ curved primitive at the finest tessellation (renderer/study/tessellation.py FINE
 256th of the passes' cost.
 
 The ray tracer's truth is the reference ray tracer (reference/raytrace/pipeline.py) in float64
-at RAY_TRUTH_DEPTH bounces, RAY_TRUTH_PASSES frames of RAY_TRUTH_SAMPLES jittered samples per
+at up to RAY_TRUTH_DEPTH bounces, RAY_TRUTH_PASSES frames of RAY_TRUTH_SAMPLES jittered samples per
 pixel (1024 in all), the frames' sample indices following one another (first_sample), so each
 frame draws new, independent strata; its seed is not the sweep's. The frames' average linear
 colour, clamped to [0, 1], is the truth: what the tracer shows of a pixel, as the frames it is
@@ -16,7 +16,7 @@ compared with. A frame at a time bounds the memory (the reference holds a frame'
 
     truth_scene(scene)                              the scene as the rasteriser's truth draws it
     ground_truth(scene, 160, 120, cache_dir)        ((120, 160, 3) float64 in [0, 1], cache hit?)
-    ray_ground_truth(scene, 160, 120, cache_dir)    the same, the ray tracer's
+    ground_truth(scene, 160, 120, cache_dir, method="raytrace")     the ray tracer's
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ import numpy as np
 import reference
 from renderer.core.imageio import write_npy
 from renderer.core.paths import output_stem
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
@@ -40,7 +41,8 @@ TRUTH_VERSION = 1                      # bump when the truth's recipe changes: o
 MAX_TRUTH_PIXELS = 5120 * 3840         # the 16x image of 320x240; rendered in one piece
 RAY_TRUTH_SAMPLES = 64                 # jittered samples per pixel in one frame (8 x 8 strata)
 RAY_TRUTH_PASSES = 16                  # frames averaged: 1024 samples per pixel
-RAY_TRUTH_DEPTH = 16                   # bounces (the max_depth knob shows whether deeper matters)
+RAY_TRUTH_DEPTH = MAX_DEPTH_LIMIT      # as deep as the tracer goes (its weight cut-off ends
+                                       # a ray tree before that: renderer/core/ray_depth.py)
 RAY_TRUTH_SEED = DEFAULT_SEED + 1      # not the seed of the swept patterns' samples
 RAY_TRUTH_VERSION = 1                  # bump when the ray truth's recipe changes
 

@@ -56,7 +56,7 @@ class RaySweep:
     """Which settings a ray-tracing report traces."""
     sample_counts: tuple = (1, 4, 16, 64)            # per pattern; regular keeps the squares
     thresholds: tuple = (1, 4, 16)                   # adaptive, in levels of 255: a series each
-    depths: tuple = (0, 1, 2, 3, 4, 8, RAY_TRUTH_DEPTH)
+    depths: tuple = (0, 1, 2, 3, 4, 8, 16, RAY_TRUTH_DEPTH)
     patterns: tuple = tuple(PATTERNS)
     runs: int = 3
 

@@ -66,23 +66,24 @@ def ray_report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "samples 5 to N, jittered; `samples` in `results.csv` is the mean traced per pixel, the "
         "x of the adaptive series in N. Unlike the rasteriser's adaptive supersampling (a "
         "full-frame pass per sample), only the refined pixels trace the extra rays, so it can "
-        "save time as well as samples: in the reference fully, on the GPU as far as the "
-        "fragment shader's lockstep groups let it (a group waits for its slowest pixel).",
+        "save time as well as samples: in the reference as far as its rays outweigh its fixed "
+        "cost per bounce, on the GPU as far as the fragment shader's lockstep groups let it "
+        "(a group waits for its slowest pixel).",
         f"- **max_depth** (depths {', '.join(str(d) for d in sweep.depths)}: bounces of "
         f"reflection and refraction) and **precision** (the reference in float32 and float64, "
         f"at the truth's depth) are sampled with {RAY_BASE_SAMPLES} jittered samples, the same "
         "for every setting of a knob, so the differences between settings are the knob's; at "
-        f"depth {RAY_TRUTH_DEPTH} only that sampling error is left, and where depth 8 is as "
-        "close, deeper bounces carry nothing visible.",
+        f"depth {RAY_TRUTH_DEPTH} (the truth's) only that sampling error is left, so a depth "
+        "as close to it adds nothing visible by going deeper.",
         "",
         "## Convergence of the sampling patterns",
         "",
         "Least-squares slope of log RMSE against log N (samples per pixel; for adaptive, the "
         "mean traced) and against log time (the median ms of a frame), over all scenes, each "
         "scene with its own intercept. The slope in time is what a user pays for: -0.5 means "
-        "four times the time halves the error. Where a frame's fixed cost (the GPU's launch "
-        "and read-back) outweighs its rays, time grows slower than N and the slope in time is "
-        "the steeper. Each N is one realisation of its pattern (fixed seeds).",
+        "four times the time halves the error. Where a frame's fixed cost (a GPU frame's "
+        "launch and read-back, the reference's set-up of each bounce) outweighs its rays, time "
+        "grows slower than N and the slope in time is the steeper. Each N is one realisation of its pattern (fixed seeds).",
         "",
         *_slope_lines(rows),
     ]

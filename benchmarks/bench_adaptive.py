@@ -3,10 +3,9 @@
     .venv/bin/python benchmarks/bench_adaptive.py [--size 640x480] [--frames 5] [--quick]
                      [--thresholds 1,2,4] [--context egl]
 
-Scenes: the classic scene (assets/scenes/classic.toml, or assets/raytrace/classic.toml where
-it has not moved yet) and the built-in `sphere` (3,968 triangles). Per scene, N = 16:
+Scenes: the built-in `classic` and the built-in `sphere` (3,968 triangles). Per scene, N = 16:
 - jittered 4 (the first set alone), jittered 16 (the full N), and adaptive 16 at each
-  threshold of --thresholds (in 8-bit steps, 1/255 each; 1 is the default);
+  threshold of --thresholds (in 8-bit steps, 1/255 each; 2 is the default);
 - samples per pixel: the mean of Frame.samples, and the share of pixels refined;
 - GPU ms (renderer/gpu/raytracer.py): the median of --frames frames after a warm-up, the
   patterns' frames interleaved so that the machine's load falls on all alike;
@@ -24,7 +23,6 @@ import os
 import platform
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -35,13 +33,7 @@ from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.gpu.raytracer import RayTracer
 
-ASSETS = Path(__file__).resolve().parent.parent / "assets"
 N, TRUTH_SPP, TRUTH_SEED = 16, 64, 64
-
-
-def classic_path() -> Path:
-    moved = ASSETS / "scenes" / "classic.toml"
-    return moved if moved.is_file() else ASSETS / "raytrace" / "classic.toml"
 
 
 def machine() -> str:
@@ -71,7 +63,7 @@ def main() -> None:
     print(f"{W}x{H}, max depth 4, N = {N}; GPU: median of {args.frames} interleaved frames after a "
           f"warm-up ({args.context}); reference: 1 frame; error against {TRUTH_SPP} spp jittered, "
           f"in 8-bit steps")
-    scenes = {"classic": load_scene(classic_path()), "sphere (3,968 tri)": load_scene("sphere")}
+    scenes = {"classic": load_scene("classic"), "sphere (3,968 tri)": load_scene("sphere")}
     runs = {"jittered 4": dict(samples=4, pattern="jittered"),
             f"jittered {N}": dict(samples=N, pattern="jittered"),
             **{f"adaptive {N} T={t:g}/255": dict(samples=N, pattern="adaptive", adaptive_threshold=t / 255)

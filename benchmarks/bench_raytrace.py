@@ -1,22 +1,26 @@
 """The ray tracer's speed per scene, GPU and reference, printed (issue 14's benchmark).
 
-    .venv/bin/python benchmarks/bench_raytrace.py [--size 640x480] [--frames 5] [--quick] [--context egl]
+    .venv/bin/python benchmarks/bench_raytrace.py [--size 640x480] [--frames 5] [--quick]
+        [--spp 1,16] [--scenes classic,cornell_box,...] [--context egl]
 
-Scenes: the classic scene (assets/raytrace/classic.toml: a floor plane, a diffuse, a mirror and
-a glass sphere, two lights, hard shadows), the built-in `sphere` (3,968 triangles) and a
-20,480-triangle icosphere (subdivisions 5) lit as `sphere`, built here. For each at 1 and 16
-samples per pixel (regular pattern, max depth 4):
+Scenes: the built-in scenes made for the ray tracer (classic: a floor plane, a diffuse, a
+mirror and a glass sphere, two lights; cornell_box: five planes, a mirror and a glass sphere,
+a point light; mesh_shadow: the 5,040-triangle torus knot over a plane; tir_bubble: a glass
+sphere and an air bubble before a 256-triangle checkerboard), the built-in `sphere` (3,968
+triangles) and a 20,480-triangle icosphere (subdivisions 5) lit as `sphere`, built here.
+For each at 1 and 16 samples per pixel (--spp; regular pattern, max depth 4):
 - GPU (renderer/gpu/raytracer.py): the median of --frames frames after a warm-up frame,
   RayTracer.render() (the draw and the read-back);
 - reference (reference/raytrace/pipeline.py): one frame (the ray scene and BVH made before,
-  not timed); --quick leaves out the 16-spp reference frames;
+  not timed); --quick leaves out the reference frames of more than 1 sample;
 - rays per frame, counted in the reference (every ray it intersects with the scene: camera
   rays, reflected and refracted rays, shadow rays), the same for the GPU (same algorithm);
-  where --quick skips the 16-spp reference, estimated as 16 times the 1-spp count (marked ~);
+  where --quick skips a reference frame, estimated as spp times the 1-spp count (marked ~);
 - rays per second = rays per frame / time per frame; ref/GPU = the ratio of the times.
 Then, at 1 spp, the GPU specialised (the default: only what the scene uses compiled in) against
 all features compiled in (RayTracer(..., specialise=False)), frames alternating; the images
-must be identical. The BVH's speed-up over brute force: benchmarks/bench_bvh.py.
+must be identical; and the rasteriser (renderer.gpu.GpuRenderer) against the ray tracer at
+1 spp, frames alternating. The BVH's speed-up over brute force: benchmarks/bench_bvh.py.
 Not a test: this machine is shared and noisy; the load average is printed.
 """
 
@@ -27,7 +31,6 @@ import os
 import platform
 import statistics
 import time
-from pathlib import Path
 
 import numpy as np
 
@@ -37,9 +40,11 @@ from renderer.cli import parse_size
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.gpu.context import make_context
+from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.raytracer import RayTracer
 
-CLASSIC = Path(__file__).resolve().parent.parent / "assets" / "raytrace" / "classic.toml"
+RAYTRACE_SCENES = ("classic", "cornell_box", "mesh_shadow", "tir_bubble")
+ICOSPHERE = "icosphere (20,480 tri)"
 
 
 def icosphere_scene():
@@ -88,6 +93,17 @@ def gpu_ms(tracer, frames: int):
     return statistics.median(times)
 
 
+def alternating_ms(calls, frames: int) -> list[float]:
+    """The median ms of each callable, called in turn `frames` times (so all see the same load)."""
+    times = [[] for _ in calls]
+    for _ in range(frames):
+        for call, spent in zip(calls, times):
+            start = time.perf_counter()
+            call()
+            spent.append((time.perf_counter() - start) * 1000.0)
+    return [statistics.median(spent) for spent in times]
+
+
 def machine() -> str:
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     return f"{platform.node()}: {os.cpu_count()} CPUs, load average {load}"
@@ -97,14 +113,21 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", type=parse_size, default=(640, 480))
     parser.add_argument("--frames", type=int, default=5)
-    parser.add_argument("--quick", action="store_true", help="no 16-spp reference frames")
+    parser.add_argument("--quick", action="store_true", help="no reference frames of more than 1 sample")
+    parser.add_argument("--spp", type=lambda text: [int(n) for n in text.split(",")], default=[1, 16],
+                        help="sample counts, comma-separated (each a perfect square)")
+    parser.add_argument("--scenes", type=lambda text: text.split(","), default=None,
+                        help=f"comma-separated names among {', '.join(RAYTRACE_SCENES)}, sphere, icosphere")
     parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
     args = parser.parse_args()
     W, H = args.size
     ctx = make_context(args.context)
     print(f"{machine()}; {ctx.info['GL_RENDERER']}; {time.strftime('%Y-%m-%d %H:%M')}")
-    scenes = {"classic": load_scene(CLASSIC), "sphere (3,968 tri)": load_scene("sphere"),
-              "icosphere (20,480 tri)": icosphere_scene()}
+    scenes = {name: load_scene(name) for name in RAYTRACE_SCENES}
+    scenes["sphere (3,968 tri)"] = load_scene("sphere")
+    scenes[ICOSPHERE] = icosphere_scene()
+    if args.scenes:
+        scenes = {name: scene for name, scene in scenes.items() if name.split()[0] in args.scenes}
     print(f"{W}x{H}, max depth 4, regular samples; GPU: median of {args.frames} frames after a "
           f"warm-up ({args.context}); reference: 1 frame")
     header = (f"{'scene':24} {'spp':>3} {'rays/frame':>12} {'GPU ms':>9} {'GPU Mrays/s':>11} "
@@ -114,18 +137,19 @@ def main() -> None:
     counts = {}
     for name, scene in scenes.items():
         rs = ray_scene(scene)
-        for spp in (1, 16):
+        for spp in args.spp:
             with RayTracer(scene, W, H, context=ctx, samples=spp) as tracer:
                 g = gpu_ms(tracer, args.frames)
-            if spp == 16 and args.quick:
-                rays, r, mark = 16 * counts[name], None, "~"
+            if spp > 1 and args.quick and name in counts:
+                rays, r, mark = spp * counts[name], None, "~"
             else:
                 with RayCount() as count:
                     start = time.perf_counter()
                     reference_render(scene, W, H, samples=spp, rs=rs)
                     r = (time.perf_counter() - start) * 1000.0
                 rays, mark = count.total, " "
-                counts.setdefault(name, rays)
+                if spp == 1:
+                    counts[name] = rays
             ref = (f"{r:10.0f} {rays / r / 1000:11.2f} {r / g:7.1f}x" if r is not None
                    else f"{'-':>10} {'-':>11} {'-':>8}")
             print(f"{name:24} {spp:3d} {mark}{rays:11,d} {g:9.1f} {rays / g / 1000:11.2f} {ref}",
@@ -136,16 +160,18 @@ def main() -> None:
                 RayTracer(scene, W, H, context=ctx, specialise=False) as every:
             a, b = fast.render(), every.render()
             same = np.array_equal(a.rgba8, b.rgba8) and np.array_equal(a.linear, b.linear)
-            t_fast, t_every = [], []
-            for _ in range(args.frames):
-                for tracer, times in ((fast, t_fast), (every, t_every)):
-                    start = time.perf_counter()
-                    tracer.render()
-                    times.append((time.perf_counter() - start) * 1000.0)
-            f, e = statistics.median(t_fast), statistics.median(t_every)
+            f, e = alternating_ms((fast.render, every.render), args.frames)
             left_out = [k for k in ("SPECULAR", "SHADOWS", "MESHES", "SECONDARY") if every.defines[k] and not fast.defines[k]]
             print(f"  {name:24} specialised {f:7.1f} ms, all features {e:7.1f} ms: {e / f:.2f}x "
                   f"(left out: {', '.join(left_out) or 'nothing'}; identical images: {same})")
+    print(f"\nthe rasteriser against the ray tracer, GPU, 1 spp (frames alternate after a warm-up; "
+          f"median of {args.frames}; colour and depth read back):")
+    for name, scene in scenes.items():
+        with GpuRenderer(scene, W, H, context=ctx) as raster, RayTracer(scene, W, H, context=ctx) as tracer:
+            raster.render()                                       # warm-up
+            tracer.render()
+            r, t = alternating_ms((raster.render, tracer.render), args.frames)
+            print(f"  {name:24} rasteriser {r:7.1f} ms, ray tracer {t:7.1f} ms: {t / r:.0f}x")
     print(f"\n{machine()}")
     ctx.release()
 

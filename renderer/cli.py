@@ -115,7 +115,7 @@ def build_parser() -> argparse.ArgumentParser:
                             "\"Sample positions\")")
         p.add_argument("--adaptive-threshold", type=float, default=None, metavar="T",
                        help="ray tracer, --pattern adaptive: refine a pixel whose first 4 samples' "
-                            "clamped colours differ by more than T in some channel (default 1/255)")
+                            "clamped colours differ by more than T in some channel (default 2/255)")
         p.add_argument("--max-depth", type=int, default=4, metavar="D",
                        help="ray tracer: bounces of reflection and refraction, 0 to "
                             f"{MAX_DEPTH_LIMIT} (default 4)")

@@ -9,10 +9,14 @@ Why an option rather than `-m "not slow and not window"` in addopts: undoing an 
 `-m` takes another `-m` with an expression that selects everything, which nobody guesses,
 and a user's own `-m` would silently replace ours; `--all` says what it does.
 
+The built-in scenes made for the ray tracer (RAYTRACE_SCENES) are rasterised by the tests
+that take every built-in scene only in the full run: `raster_scene_params(names)` marks them.
+
 Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
 `on_x_display` (Xvfb), `cli` (the command line in a new process), `gpu_stand_in` (the command
-line's GPU frames replaced, in this process) and `reference_frames` (NumPy reference frames,
-each rendered once per test run).
+line's GPU frames replaced, in this process), `reference_frames` (NumPy reference frames,
+each rendered once per test run) and `traced_references` (the NumPy ray tracer's frames of the
+built-in scenes, likewise).
 """
 
 import os
@@ -79,6 +83,29 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
         tests = "test" if left_out == 1 else "tests"
         terminalreporter.write_line(f"left out {left_out} {tests} marked slow or window; "
                                     f"pytest --all runs every test")
+
+
+# -- the built-in scenes -----------------------------------------------------------------------
+
+# The built-in scenes made for `--method raytrace` (their descriptions say so; tests/
+# test_scene_shapes.py holds this set to the scene files). They rasterise too, and the
+# rasteriser's tests over every built-in scene (GPU against reference, goldens, determinism,
+# specialisation) hold them in the full run: in the default run they would add about 6 s
+# (measured at load average 3, 2026-12-01) for no rasteriser feature the other scenes lack.
+# Their ray-tracing tests are tests/test_raytrace_scenes.py.
+RAYTRACE_SCENES = frozenset({"classic", "cornell_box", "mesh_shadow", "tir_bubble"})
+
+
+def raster_scene_params(names, ids=None):
+    """pytest.param for each case of a rasteriser test over built-in scenes: `names` are scene
+    names, or tuples whose first item is one; a ray-tracing scene's case is marked slow."""
+    params = []
+    for index, case in enumerate(names):
+        name = case[0] if isinstance(case, tuple) else case
+        marks = [pytest.mark.slow] if name in RAYTRACE_SCENES else []
+        params.append(pytest.param(*(case if isinstance(case, tuple) else (case,)), marks=marks,
+                                   id=None if ids is None else ids[index]))
+    return params
 
 
 # -- GL contexts and the virtual display --------------------------------------------------------
@@ -199,12 +226,52 @@ def reference_frames():
             loaded = load_scene(path)
             if shading is not None:
                 loaded = loaded.with_shading(shading)
-            rendered = reference.render(loaded, width, height, **options)
-            for field in fields(rendered):
-                value = getattr(rendered, field.name)
-                if isinstance(value, np.ndarray):
-                    value.flags.writeable = False
-            frames[key] = rendered
+            frames[key] = read_only(reference.render(loaded, width, height, **options))
         return frames[key]
 
     return frame
+
+
+def read_only(frame):
+    """The frame, its arrays made read-only (a frame shared by tests is not changed by one)."""
+    for field in fields(frame):
+        value = getattr(frame, field.name)
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    return frame
+
+
+class TracedReferences:
+    """The NumPy ray tracer's view of the built-in scenes, each piece made once per test run:
+    scene(name) the loaded Scene, ray_scene(name) its packed ray scene (the BVH built once:
+    about a second for mesh_shadow's 5,040 triangles), frame(name, width, height, **options)
+    reference.raytrace.pipeline.render's Frame, its arrays read-only."""
+
+    def __init__(self):
+        self._scenes, self._ray_scenes, self._frames = {}, {}, {}
+
+    def scene(self, name: str):
+        from renderer.core.scene_file import load_scene
+        if name not in self._scenes:
+            self._scenes[name] = load_scene(name)
+        return self._scenes[name]
+
+    def ray_scene(self, name: str):
+        from renderer.core.raytrace_scene import ray_scene
+        if name not in self._ray_scenes:
+            self._ray_scenes[name] = ray_scene(self.scene(name))
+        return self._ray_scenes[name]
+
+    def frame(self, name: str, width: int, height: int, **options):
+        from reference.raytrace.pipeline import render
+        key = (name, width, height, tuple(sorted(options.items())))
+        if key not in self._frames:
+            self._frames[key] = read_only(render(self.scene(name), width, height,
+                                                 rs=self.ray_scene(name), **options))
+        return self._frames[key]
+
+
+@pytest.fixture(scope="session")
+def traced_references():
+    """A TracedReferences: the NumPy ray tracer's scenes and frames, made once per test run."""
+    return TracedReferences()

@@ -22,6 +22,8 @@ from renderer.gpu.context import make_context
 from renderer.gpu import GpuRenderer
 from renderer.core.scene_file import load_scene
 
+from conftest import raster_scene_params
+
 SIZE = (256, 256)
 CONTEXT_KINDS = ("egl", "osmesa")
 SCENE_NAMES = sorted(builtin_scenes())
@@ -88,7 +90,7 @@ def in_process_digest(name, kind, ctx):
 # -- one process ----------------------------------------------------------------------------
 
 @pytest.mark.parametrize("context_kind", CONTEXT_KINDS)
-@pytest.mark.parametrize("name", SCENE_NAMES)
+@pytest.mark.parametrize("name", raster_scene_params(SCENE_NAMES))
 def test_every_frame_of_a_scene_is_byte_identical(name, context_kind, gl_contexts):
     frames = render_repeatedly(name, gl_contexts[context_kind])
     (_, first), later = frames[0], frames[1:]
@@ -136,7 +138,7 @@ def test_other_processes_render_every_case(worker_digests):
 
 
 @pytest.mark.parametrize("context_kind", CONTEXT_KINDS)
-@pytest.mark.parametrize("name", SCENE_NAMES)
+@pytest.mark.parametrize("name", raster_scene_params(SCENE_NAMES))
 def test_other_processes_render_the_same_bytes(name, context_kind, worker_digests, gl_contexts):
     key = case_key(name, context_kind)
     here = in_process_digest(name, context_kind, gl_contexts[context_kind])

@@ -818,3 +818,34 @@ def test_check_scene_records_the_real_gl_implementation(spec):
     result = spec.run()
     result.assert_outcomes(passed=1)
     assert "GoldenWarning" not in result.stdout.str()
+
+
+def test_check_scene_ray_traces_with_the_tracer_options(spec):
+    """method="raytrace": the frame is RayTracer's, with the options given (4 samples here);
+    tracer options without it, and an unknown method, fail with one line."""
+    spec.write("""
+        from renderer.core.scene_file import load_scene
+        from renderer.gpu.raytracer import RayTracer
+
+        def test_traced(golden):
+            frame = golden.check_scene("classic", size=(32, 24), context="egl", method="raytrace",
+                                       samples=4)
+            with RayTracer(load_scene("classic"), 32, 24, context_kind="egl", samples=4) as tracer:
+                assert np.array_equal(frame.rgba8, tracer.render().rgba8)
+            with RayTracer(load_scene("classic"), 32, 24, context_kind="egl") as tracer:
+                assert not np.array_equal(frame.rgba8, tracer.render().rgba8)   # 1 sample differs
+
+        def test_raster_with_samples(golden):
+            golden.check_scene("sphere", size=(8, 8), samples=4)
+
+        def test_unknown_method(golden):
+            golden.check_scene("sphere", size=(8, 8), method="pathtrace")
+    """)
+    result = spec.run("--update-goldens")
+    assert outcomes(result) == {"test_traced": "passed", "test_raster_with_samples": "failed",
+                                "test_unknown_method": "failed"}
+    assert json.loads((spec.goldens / "test_traced.json").read_text())["scene"] == "classic"
+    assert failure(result, "test_raster_with_samples").strip() == 'samples: options of method="raytrace"'
+    assert failure(result, "test_unknown_method").strip() == \
+        "method must be one of raster, raytrace, got 'pathtrace'"
+    assert outcomes(spec.run("-k", "traced")) == {"test_traced": "passed"}

@@ -1,4 +1,5 @@
-"""This project's golden images: every built-in scene in each shading mode, at 256x256.
+"""This project's golden images: every built-in scene in each shading mode, at 256x256, and
+each scene made for the ray tracer ray traced, at 160x120.
 
 Each golden is held two ways. The GPU's frame is held against it on EGL and on OSMesa (the
 `golden` fixture from renderer/checks/pytest_plugin.py, default policy "threshold"). The golden is
@@ -7,7 +8,9 @@ golden can never drift from the reference unnoticed, not even by `--update-golde
 
 Goldens are tests/goldens/SCENE-MODE.png (+ .json): MODE is flat, gouraud or phong (every
 material drawn that way) and, for scenes whose materials mix modes, "as-authored" (the scene
-as its file has it).
+as its file has it); "raytrace" for the GPU ray tracer (renderer/gpu/raytracer.py, 1 sample
+per pixel, max depth 4), held the same two ways, against the NumPy ray tracer
+(reference/raytrace/).
 """
 
 import functools
@@ -23,9 +26,13 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import load_scene
 
+from conftest import RAYTRACE_SCENES, raster_scene_params
+
 SIZE = (256, 256)
+RAYTRACE_SIZE = (160, 120)
 GOLDENS = Path(__file__).parent / "goldens"
 AS_AUTHORED = "as-authored"
+RAYTRACE = "raytrace"
 
 
 @functools.lru_cache(maxsize=None)
@@ -47,57 +54,94 @@ def variants():
 
 VARIANTS = variants()
 IDS = [f"{name}-{mode}" for name, mode in VARIANTS]
+RENDERED = raster_scene_params(VARIANTS, IDS)       # the ray-tracing scenes' in the full run
+TRACED = sorted(RAYTRACE_SCENES)
+TRACED_IDS = [f"{name}-{RAYTRACE}" for name in TRACED]
 
 
-# Defined first so that under --update-goldens the goldens are written before the reference
-# checks below read them.
-@pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
-@pytest.mark.parametrize("name, mode", VARIANTS, ids=IDS)
-def test_gpu_matches_golden(name, mode, context_kind, gl_contexts, golden):
-    frame = golden.check_scene(scene_variant(name, mode), f"{name}-{mode}", size=SIZE,
-                               context=gl_contexts[context_kind])
-    # Something was drawn: a golden of background only would hold nothing.
-    assert (frame.rgba8[..., 3] == 255).mean() > 0.02
-    # On the GL implementation that made the golden (this machine's llvmpipe; EGL and OSMesa
-    # draw the same bits), the golden is exact: a change of even one level in one pixel is
-    # caught when it is introduced, not left to pile up under the policy's tolerance.
-    sidecar = json.loads((GOLDENS / f"{name}-{mode}.json").read_text())
+def assert_exact_where_made(name, frame):
+    """On the GL implementation that made the golden (this machine's llvmpipe; EGL and OSMesa
+    draw the same bits), the golden is exact: a change of even one level in one pixel is
+    caught when it is introduced, not left to pile up under the policy's tolerance."""
+    sidecar = json.loads((GOLDENS / f"{name}.json").read_text())
     made_here = (sidecar["gl_renderer"], sidecar["gl_version"]) == \
         (frame.gl_info.get("GL_RENDERER"), frame.gl_info.get("GL_VERSION"))
     if made_here:
-        expected = read_golden(GOLDENS / f"{name}-{mode}.png")
+        expected = read_golden(GOLDENS / f"{name}.png")
         differing = int((expected != frame.rgba8).any(axis=2).sum())
-        assert differing == 0, (f"{name}-{mode}: {differing} pixels differ from the golden on the "
-                                f"GL implementation that made it; if intended: pytest "
+        assert differing == 0, (f"{name}: {differing} pixels differ from the golden on the GL "
+                                f"implementation that made it; if intended: pytest "
                                 f"--update-goldens=all, review, commit")
 
 
-@pytest.mark.parametrize("name, mode", VARIANTS, ids=IDS)
-def test_golden_matches_reference(name, mode, reference_frames):
-    png = GOLDENS / f"{name}-{mode}.png"
-    if not png.exists():
-        pytest.fail(f"{png} is missing; make it with pytest --update-goldens", pytrace=False)
-    expected = reference_frames(name, *SIZE, shading=None if mode == AS_AUTHORED else mode,
-                                depth=False)
-    result = compare_frames(read_golden(png), expected.rgba8, reference_tie=expected.rgba8_tie)
+def assert_matches_reference(png, expected_rgba8, reference_tie=None):
+    result = compare_frames(read_golden(png), expected_rgba8, reference_tie=reference_tie)
     failures = PIPELINE_TOLERANCE.failures(result)
     if failures:
         pytest.fail(f"{png.name} drifted from the NumPy reference: {'; '.join(failures)}; largest "
                     f"channel difference {result.max_abs}", pytrace=False)
 
 
+def golden_png(name):
+    png = GOLDENS / f"{name}.png"
+    if not png.exists():
+        pytest.fail(f"{png} is missing; make it with pytest --update-goldens", pytrace=False)
+    return png
+
+
+# Defined first so that under --update-goldens the goldens are written before the reference
+# checks below read them.
+@pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
+@pytest.mark.parametrize("name, mode", RENDERED)
+def test_gpu_matches_golden(name, mode, context_kind, gl_contexts, golden):
+    frame = golden.check_scene(scene_variant(name, mode), f"{name}-{mode}", size=SIZE,
+                               context=gl_contexts[context_kind])
+    # Something was drawn: a golden of background only would hold nothing.
+    assert (frame.rgba8[..., 3] == 255).mean() > 0.02
+    assert_exact_where_made(f"{name}-{mode}", frame)
+
+
+@pytest.mark.parametrize("name, mode", RENDERED)
+def test_golden_matches_reference(name, mode, reference_frames):
+    png = golden_png(f"{name}-{mode}")
+    expected = reference_frames(name, *SIZE, shading=None if mode == AS_AUTHORED else mode,
+                                depth=False)
+    assert_matches_reference(png, expected.rgba8, expected.rgba8_tie)
+
+
+# OSMesa in the full run: the same llvmpipe as EGL (the same bits), and each tracer costs the
+# scene's BVH again (mesh_shadow's: about 0.4 s).
+@pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
+@pytest.mark.parametrize("name", TRACED, ids=TRACED_IDS)
+def test_ray_tracer_matches_golden(name, context_kind, gl_contexts, golden):
+    frame = golden.check_scene(scene_variant(name, AS_AUTHORED), f"{name}-{RAYTRACE}",
+                               size=RAYTRACE_SIZE, context=gl_contexts[context_kind],
+                               method=RAYTRACE)
+    assert (frame.rgba8[..., 3] == 255).mean() > 0.5
+    assert_exact_where_made(f"{name}-{RAYTRACE}", frame)
+
+
+@pytest.mark.parametrize("name", TRACED, ids=TRACED_IDS)
+def test_ray_traced_golden_matches_reference(name, traced_references):
+    png = golden_png(f"{name}-{RAYTRACE}")
+    assert_matches_reference(png, traced_references.frame(name, *RAYTRACE_SIZE).rgba8)
+
+
 def test_every_golden_belongs_to_a_scene_and_mode():
     """No golden is left behind by a removed scene, and each has its sidecar."""
     on_disk = {path.stem for path in GOLDENS.glob("*.png")}
-    assert on_disk == set(IDS)
+    assert on_disk == set(IDS) | set(TRACED_IDS)
     assert {path.stem for path in GOLDENS.glob("*.json")} == on_disk
 
 
-@pytest.mark.parametrize("name, mode", VARIANTS, ids=IDS)
-def test_sidecar_describes_its_golden(name, mode):
+@pytest.mark.parametrize("name, mode, size",
+                         [(name, mode, SIZE) for name, mode in VARIANTS]
+                         + [(name, RAYTRACE, RAYTRACE_SIZE) for name in TRACED],
+                         ids=IDS + TRACED_IDS)
+def test_sidecar_describes_its_golden(name, mode, size):
     sidecar = json.loads((GOLDENS / f"{name}-{mode}.json").read_text())
     assert sidecar["name"] == f"{name}-{mode}"
     assert sidecar["scene"] == name
-    assert sidecar["size"] == list(SIZE)
+    assert sidecar["size"] == list(size)
     assert sidecar["policy"] == {"name": "threshold", "threshold": 2, "deviation": 1, "max_failing_pixels": 0}
     assert sidecar["gl_renderer"] and sidecar["gl_version"] and sidecar["renderer_version"]

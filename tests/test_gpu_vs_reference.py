@@ -15,6 +15,8 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.gpu import GpuRenderer
 from renderer.core.scene_file import load_scene
 
+from conftest import raster_scene_params
+
 SIZES = ((320, 240), (640, 480))
 
 
@@ -24,15 +26,15 @@ def scene_named(name):
 
 
 # The default run holds every scene at 320x240 on both contexts (EGL and OSMesa are the same
-# llvmpipe and draw the same bits); the full run (--all) adds 640x480 on both, to keep the
-# default run short.
+# llvmpipe and draw the same bits); the full run (--all) adds 640x480 on both, and the scenes
+# made for the ray tracer (conftest.RAYTRACE_SCENES), to keep the default run short.
 CASES = [pytest.param(size, kind, id=f"{size[0]}x{size[1]}-{kind}",
                       marks=[pytest.mark.slow] if size == (640, 480) else [])
          for size in SIZES for kind in ("egl", "osmesa")]
 
 
 @pytest.mark.parametrize("size, context_kind", CASES)
-@pytest.mark.parametrize("name", sorted(builtin_scenes()))
+@pytest.mark.parametrize("name", raster_scene_params(sorted(builtin_scenes())))
 def test_gpu_matches_reference(name, size, context_kind, gl_contexts, reference_frames):
     with GpuRenderer(scene_named(name), *size, context=gl_contexts[context_kind]) as gpu:
         frame = gpu.render(depth=True)

@@ -201,25 +201,3 @@ def test_memory_estimates_of_the_ray_tracer():
     assert memory.raytrace_reference_bytes(640, 480, 0, samples=16) > memory.raytrace_reference_bytes(640, 480, 0)
     assert memory.raytrace_reference_bytes(10, 10, 1000) > memory.raytrace_reference_bytes(10, 10, 0)
 
-
-def test_the_classic_scene_loads_and_the_twins_agree_on_it(gl_contexts):
-    """assets/raytrace/classic.toml (benchmarks/bench_raytrace.py's scene): a floor plane, a
-    diffuse, a mirror and a glass sphere, two lights; GPU (EGL) and reference within
-    PIPELINE_TOLERANCE at 64 x 48, 1 spp."""
-    from pathlib import Path
-
-    from renderer.core.scene_file import load_scene
-    from renderer.gpu.raytracer import RayTracer
-    s = load_scene(Path(__file__).resolve().parent.parent / "assets" / "raytrace" / "classic.toml")
-    rs = ray_scene(s)
-    assert len(rs.sphere_radius) == 3 and len(rs.plane_offset) == 1 and rs.bvh is None
-    assert (rs.kr > 0.8).any() and (rs.kt > 0.8).any() and s.directional_lights and s.point_lights
-    reference = reference_raytrace(s, 64, 48, rs=rs)
-    assert (reference.rgba8[..., 3] > 0).mean() > 0.3
-    with RayTracer(s, 64, 48, context=gl_contexts["egl"]) as tracer:
-        frame = tracer.render()
-        assert tracer.defines["SECONDARY"] and not tracer.defines["MESHES"]
-    assert_within_tolerance(frame, reference)
-    with RayTracer(s, 64, 48, context=gl_contexts["egl"], specialise=False) as every:
-        assert every.defines["MESHES"]                  # a placeholder BVH no ray hits
-        assert np.array_equal(every.render().linear, frame.linear)

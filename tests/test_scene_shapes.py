@@ -8,11 +8,13 @@ import numpy as np
 import pytest
 
 from renderer.core import memory, shapes
-from renderer.core.builtin import builtin_scenes
+from renderer.core.builtin import builtin_scenes, scene_descriptions
 from renderer.core.scene import (Material, Plane, Scene, SceneObject, Sphere, Transform,
                                  WorldPlane, WorldSphere, world_shape)
 from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.errors import SceneError
+
+from conftest import RAYTRACE_SCENES
 
 
 def one_object(**obj) -> dict:
@@ -68,13 +70,22 @@ def test_material_ray_tracer_keys():
     load(one_object(mesh={"primitive": "cube"}, material={"kr": 0.7, "kt": 0.3}))
 
 
-def test_builtin_scenes_have_no_shapes_and_no_ray_tracer_terms():
+def test_only_the_ray_tracing_builtin_scenes_use_shapes_and_ray_tracer_terms():
+    """conftest.RAYTRACE_SCENES is the set of built-in scenes made for the ray tracer: each uses
+    an analytic shape or k_r, k_t, ior and says `--method raytrace` in its description; every
+    other built-in scene uses none of them (the rasteriser's scenes stay as they were)."""
+    descriptions = scene_descriptions()
     for name, path in builtin_scenes().items():
-        for obj in load_scene(path).objects:
-            assert obj.shape is None, name
-            m = obj.material
-            assert (m.kr, m.kt, m.ior) == ((0.0,) * 3, (0.0,) * 3, 1.5), name
-        assert all(s is None for s in load_scene(path).world_shapes())
+        scene = load_scene(path)
+        terms = {(m.kr, m.kt, m.ior) for m in (obj.material for obj in scene.objects)}
+        uses_ray_tracing = (any(obj.shape is not None for obj in scene.objects)
+                            or terms != {((0.0,) * 3, (0.0,) * 3, 1.5)})
+        made_for_it = name in RAYTRACE_SCENES
+        assert uses_ray_tracing == made_for_it, name
+        assert ("--method raytrace" in descriptions[name]) == made_for_it, name
+        if not made_for_it:
+            assert all(s is None for s in scene.world_shapes())
+    assert RAYTRACE_SCENES <= set(builtin_scenes())
 
 
 # --------------------------------------------------------------------------- refusals

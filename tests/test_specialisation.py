@@ -24,6 +24,8 @@ from renderer.core.scene_file import load_scene
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant, program_sources
 from renderer.core.visibility import outside_view_volume, visible_objects
 
+from conftest import raster_scene_params
+
 SIZE = (96, 72)
 
 
@@ -113,7 +115,7 @@ def test_material_specular_is_any_nonzero_ks():
 
 # --- the all-features build draws the same pixels -----------------------------------------
 
-@pytest.mark.parametrize("name", sorted(builtin_scenes()))
+@pytest.mark.parametrize("name", raster_scene_params(sorted(builtin_scenes())))
 def test_all_features_build_gives_identical_images(name, gl_contexts):
     scene = scene_named(name)
     ctx = gl_contexts["egl"]

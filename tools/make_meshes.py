@@ -6,6 +6,9 @@ torus_knot.obj   a (2, 3) torus knot tube with analytic vertex normals (scene me
 bowl.obj         an open hemisphere, normals pointing out of the sphere (scene open_mesh_inside)
 octahedron.ply   ASCII PLY with per-vertex normals (tests, scene mesh_file)
 tetrahedron.stl  ASCII STL, three vertices per facet as STL has it (tests, scene mesh_file)
+checker_dark.obj, checker_light.obj
+                 the dark and the light squares of an 8 x 8 checkerboard (scene tir_bubble:
+                 there are no textures, so the pattern is geometry, one mesh per colour)
 
 Every face is counter-clockwise seen from the side its normals point to; main() checks it.
 """
@@ -88,6 +91,29 @@ def tetrahedron():
     return positions, faces
 
 
+def checker(squares: int = 8, side: float = 1.0):
+    """The two colours of a squares x squares board of `side`-long squares in the xz plane,
+    facing +y, centred on the origin: [(positions, normals, faces) of the squares whose
+    column + row is even, ... odd]. Each square has its own four corners (two triangles), so
+    the two meshes share no vertex; the corner square at -x, -z is of the first colour."""
+    boards = []
+    for parity in (0, 1):
+        corners, faces = [], []
+        for row in range(squares):
+            for col in range(squares):
+                if (row + col) % 2 != parity:
+                    continue
+                x0, z0 = (col - squares / 2) * side, (row - squares / 2) * side
+                a = len(corners)
+                corners += [(x0, 0.0, z0), (x0, 0.0, z0 + side), (x0 + side, 0.0, z0 + side),
+                            (x0 + side, 0.0, z0)]
+                faces += [[a, a + 1, a + 2], [a, a + 2, a + 3]]    # CCW seen from +y
+        positions = np.array(corners, dtype=float)
+        normals = np.tile([0.0, 1.0, 0.0], (len(positions), 1))
+        boards.append((positions, normals, np.array(faces, dtype=np.int64)))
+    return boards
+
+
 def check_outward(positions, normals, faces, name):
     """Each face's winding normal agrees with its vertices' normals (CCW seen from outside)."""
     tri = positions[faces]
@@ -144,6 +170,10 @@ def main() -> None:
     tetra_positions, tetra_faces = tetrahedron()
     check_outward(tetra_positions, tetra_positions, tetra_faces, "tetrahedron")
     write_stl(MESHES / "tetrahedron.stl", tetra_positions, tetra_faces)
+    for colour, board in zip(("dark", "light"), checker()):
+        check_outward(*board, f"checker_{colour}")
+        write_obj(MESHES / f"checker_{colour}.obj", *board,
+                  f"the {colour} squares of an 8 x 8 checkerboard of unit squares in y = 0, facing +y")
     for path in sorted(MESHES.iterdir()):
         print(f"{path.relative_to(MESHES.parent.parent)}  {path.stat().st_size} bytes")
 

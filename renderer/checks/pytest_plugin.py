@@ -2,6 +2,7 @@
 
     def test_my_scene(golden):
         golden.check_scene("my_scene.toml")      # GPU, 256x256, against goldens/test_my_scene.png
+        golden.check_scene("classic", "classic-rt", method="raytrace", samples=4)   # ray traced
 
     pytest                       # compare; failures go to golden-results/index.html
     pytest --update-goldens      # create missing goldens, rewrite those that fail (the only writer)
@@ -25,6 +26,8 @@ from pathlib import Path
 import pytest
 
 RESULTS_DEFAULT = "golden-results"
+
+METHODS = ("raster", "raytrace")          # check_scene's: the rasteriser, the ray tracer
 
 
 class GoldenWarning(UserWarning):
@@ -190,25 +193,35 @@ class GoldenChecker:
         pytest.fail("\n".join(lines), pytrace=False)
 
     def check_scene(self, scene, name: str | None = None, *, size=(256, 256), context="auto",
-                    shading: str | None = None, policy=None):
+                    shading: str | None = None, policy=None, method: str = "raster", **trace):
         """Render `scene` on the GPU and check it; returns the Frame.
 
         `scene`: a renderer.core.scene.Scene, a built-in scene's name, or a scene file (relative
         paths are taken from the test file's folder). `context`: "auto", "egl", "osmesa" or
         a moderngl context to reuse. `shading`: render every material flat, gouraud or phong.
+        `method`: "raster" (renderer.gpu.GpuRenderer) or "raytrace" (renderer.gpu.raytracer.
+        RayTracer); `trace`, for "raytrace" only: the RayTracer's options (samples, pattern,
+        max_depth, seed, shadows).
         """
         from renderer.errors import UserError
-        from renderer.gpu.pipeline import GpuRenderer
         from renderer.core.scene import Scene
 
+        if method not in METHODS:
+            pytest.fail(f"method must be one of {', '.join(METHODS)}, got {method!r}", pytrace=False)
+        if trace and method != "raytrace":
+            pytest.fail(f"{', '.join(sorted(trace))}: options of method=\"raytrace\"", pytrace=False)
+        if method == "raster":
+            from renderer.gpu.pipeline import GpuRenderer as Renderer
+        else:
+            from renderer.gpu.raytracer import RayTracer as Renderer
         try:
             if not isinstance(scene, Scene):
                 scene = self._load(scene)
             if shading is not None:
                 scene = scene.with_shading(shading)
             where = {"context_kind": context} if isinstance(context, str) else {"context": context}
-            with GpuRenderer(scene, *size, **where) as gpu:
-                frame = gpu.render(depth=False)
+            with Renderer(scene, *size, **where, **trace) as renderer:
+                frame = renderer.render(depth=False) if method == "raster" else renderer.render()
         except UserError as error:
             _fail_plainly(error)
         self.check(frame, name, policy=policy, scene=scene.name)

@@ -31,9 +31,11 @@ TABLE_PATTERNS = ("regular", "poisson")
 MAX_SAMPLES = 256            # also keeps a stratum's fixed-point numerator in 32 bits (sampling.glsl)
 UINT32_LIMIT = 1 << 32       # seeds and sample indices are uint32 (the PCG counter)
 FIRST_SET = 4                # adaptive: the samples every pixel gets, a 2 x 2 grid
-# Adaptive: refine where the first samples' clamped linear colours differ by more than one
-# 8-bit step in some channel (their average could then be a level off the pixel's).
-DEFAULT_ADAPTIVE_THRESHOLD = 1.0 / 255.0
+# Adaptive: refine where the first samples' clamped linear colours spread over more than two
+# 8-bit steps in some channel, i.e. where some sample lies more than a step from the middle of
+# their range. One step refines 1.7 to 2.5 times as many pixels (smooth shading's gradients)
+# for an RMS error 1 to 3 % lower (benchmarks/bench_adaptive.py, docs/conventions.md).
+DEFAULT_ADAPTIVE_THRESHOLD = 2.0 / 255.0
 
 
 @dataclass(frozen=True)

@@ -558,9 +558,11 @@ def cmd_report(args) -> int:
     check_outputs(check_folder(args.out) / "report.md", args.out / "results.csv")
     traced = args.method == "raytrace"
     if args.scenes or args.quick:
-        scenes = [_load(name) for name in args.scenes or (RAY_QUICK_SCENES if traced else QUICK_SCENES)]
+        names = args.scenes or (RAY_QUICK_SCENES if traced else QUICK_SCENES)
+        scenes = [_load(name) for name in names]
     else:                  # the built-in scenes made for the method: shapes, k_r, k_t or none
-        scenes = [scene for scene in map(_load, builtin_scenes()) if made_for_raytracing(scene) == traced]
+        scenes = [scene for scene in map(_load, builtin_scenes())
+                  if made_for_raytracing(scene) == traced]
         if not scenes:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")

@@ -4,10 +4,11 @@
 import csv
 import math
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 import pytest
+
+from conftest import RAYTRACE_SCENES
 
 from renderer.core.builtin import builtin_scenes
 from renderer.study.ground_truth import RAY_TRUTH_DEPTH, ground_truth
@@ -122,7 +123,6 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_he
 
 # -- the ray tracer's report (renderer/study/ray_report.py) ------------------------------------
 
-CLASSIC = Path(__file__).parent.parent / "assets" / "raytrace" / "classic.toml"
 MIRROR_SCENE = """
 background = [0.3, 0.4, 0.6]
 [camera]
@@ -148,7 +148,7 @@ material = "mirror"
 
 
 def test_ray_truth_is_the_background_where_no_ray_hits_and_is_cached(tmp_path):
-    scene = load_scene(CLASSIC)
+    scene = load_scene(builtin_scenes()["classic"])
     # Looking up and away from the spheres: the floor is below the lowest ray (7.5 degrees up).
     sky = replace(scene, camera=replace(scene.camera, look=(0.0, 10.0, 20.0)))
     truth, hit = ground_truth(sky, 4, 3, tmp_path, method="raytrace")
@@ -191,10 +191,11 @@ def test_adaptive_thresholds_are_series_of_their_own_fitted_in_samples_and_in_ti
     assert in_time[("adaptive @16/255", "gpu")].samples == (4, 36)
 
 
-def test_the_scenes_made_for_the_ray_tracer(tmp_path):
-    assert made_for_raytracing(load_scene(CLASSIC))                    # spheres and a plane
-    sphere = load_scene(builtin_scenes()["sphere"])
-    assert not made_for_raytracing(sphere)                             # a mesh, no k_r or k_t
+def test_the_scenes_made_for_the_ray_tracer():
+    """What `renderer report` reports by default with each --method."""
+    scenes = {name: load_scene(path) for name, path in builtin_scenes().items()}
+    assert {name for name, scene in scenes.items() if made_for_raytracing(scene)} == RAYTRACE_SCENES
+    sphere = scenes["sphere"]                                          # a mesh, no k_r or k_t
     mirror = replace(sphere.objects[0].material, kr=(0.5, 0.5, 0.5))
     assert made_for_raytracing(replace(sphere, objects=[replace(sphere.objects[0], material=mirror)]))
 
@@ -214,7 +215,8 @@ def test_a_tiny_ray_sweep_gpu_and_reference(tmp_path, gl_contexts):
             ("antialiasing", "jittered 16", "gpu", "jittered", 16, RAY_TRUTH_DEPTH, None),
             ("antialiasing", "adaptive", "reference", "adaptive", 16, RAY_TRUTH_DEPTH, 1 / 255),
             ("max_depth", "depth 0", "reference", "jittered", 16, 0, None)):
-        image, spent[name], ms = run.timed(RaySetting(knob, name, backend, pattern, n, depth, threshold), 1)
+        setting = RaySetting(knob, name, backend, pattern, n, depth, threshold)
+        image, spent[name], ms = run.timed(setting, 1)
         error[(name, backend)] = metrics(image, truth)["rmse"]
         assert ms > 0
     assert error[("jittered 16", "reference")] < error[("jittered 1", "reference")]
@@ -240,7 +242,7 @@ def test_ray_report_markdown_has_the_slopes_in_samples_and_in_time():
 @pytest.mark.slow                       # the quick ray-tracing sweep, through the command line
 def test_ray_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     out = tmp_path / "report"
-    result = cli("report", CLASSIC, "--method", "raytrace", "--quick", "--size", "16x12",
+    result = cli("report", "--method", "raytrace", "--quick", "--size", "16x12",      # classic
                  "--out", out, "--cache", tmp_path / "cache", "--context", "osmesa", timeout=900)
     assert result.returncode == 0, result.stderr
     with open(out / "results.csv", newline="") as handle:

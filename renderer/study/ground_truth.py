@@ -77,7 +77,8 @@ def cache_path(scene: Scene, width: int, height: int, cache_dir, method: str = "
     """Where the truth of `method` ("raster" or "raytrace") is cached: named after the scene
     and size, keyed by the content of the scene it draws and the truth's recipe."""
     if method == "raster":
-        drawn, recipe, stem = truth_scene(scene), f"grid={TRUTH_GRID} v{TRUTH_VERSION}", output_stem(scene)
+        drawn, stem = truth_scene(scene), output_stem(scene)
+        recipe = f"grid={TRUTH_GRID} v{TRUTH_VERSION}"
     else:
         drawn, stem = scene, f"{output_stem(scene)}-raytrace"
         recipe = (f"jittered={RAY_TRUTH_SAMPLES}x{RAY_TRUTH_PASSES} depth={RAY_TRUTH_DEPTH} "

@@ -83,7 +83,8 @@ def ray_report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "scene with its own intercept. The slope in time is what a user pays for: -0.5 means "
         "four times the time halves the error. Where a frame's fixed cost (a GPU frame's "
         "launch and read-back, the reference's set-up of each bounce) outweighs its rays, time "
-        "grows slower than N and the slope in time is the steeper. Each N is one realisation of its pattern (fixed seeds).",
+        "grows slower than N and the slope in time is the steeper. Each N is one realisation "
+        "of its pattern (fixed seeds).",
         "",
         *_slope_lines(rows),
     ]

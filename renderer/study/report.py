@@ -43,7 +43,8 @@ from renderer.core.imageio import outputs
 from renderer.checks.perceptual import flip_error
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
-from renderer.study.report_settings import BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS, QUICK_SIZE
+from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS,
+                                            QUICK_SIZE)
 from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
 from renderer.study.timing import median_timed
 

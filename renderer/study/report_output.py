@@ -80,7 +80,8 @@ def plot_png(rows: list[dict], title: str) -> bytes:
             series[series_key(row)].append(row)
     names = list(dict.fromkeys(series_name(row) for row in rows))
     for index, (name, members) in enumerate(series.items()):
-        members.sort(key=lambda r: (r["samples"], r["median_ms"]))
+        # Along the knob: samples per pixel, else the depth (the ray tracer's), else time.
+        members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         first = members[0]
         marker, line = STYLES[first["backend"]]
         colour = (_colour(series_name(first), names) if first["knob"] == "antialiasing"
@@ -142,7 +143,8 @@ def convergence_slopes(rows: list[dict], series=tuple(sampling.PATTERNS), x: str
             for points in by_scene.values():
                 along, log_rmse, n = np.array(points).T
                 if np.ptp(along) > 0:
-                    centred.append((np.log(along) - np.log(along).mean(), log_rmse - log_rmse.mean(), n))
+                    centred.append((np.log(along) - np.log(along).mean(),
+                                    log_rmse - log_rmse.mean(), n))
             if centred:
                 cx, cy, n = (np.concatenate(parts) for parts in zip(*centred))
                 slopes[(name, backend)] = Slope(_fit(cx, cy), len(cx), (n.min(), n.max()),
@@ -167,7 +169,8 @@ def cheapest_sections(rows: list[dict], scenes: list[str], antialiasing: str) ->
             for line in _cheapest_section(rows, scenes, target, antialiasing)]
 
 
-def _cheapest_section(rows: list[dict], scenes: list[str], target: float, antialiasing: str) -> list[str]:
+def _cheapest_section(rows: list[dict], scenes: list[str], target: float,
+                      antialiasing: str) -> list[str]:
     lines = [
         "",
         f"## Cheapest setting reaching RMSE <= {target:g} (about {target * 255:.1f}/255)",
@@ -253,8 +256,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         f"segment counts), {TRUTH_GRID}x{TRUTH_GRID} regular-grid supersampling per pixel "
         "(rendered once at 16W x 16H and box-filtered), clamped linear colour in [0, 1]. It is "
         "cached on disk by a hash of the scene's content, the size and these parameters.",
-        errors_bullet() + " MSAA resolves into an 8-bit buffer, so its error has a 1/255 quantisation floor "
-        "(RMSE about 0.001) that the float accumulation does not.",
+        errors_bullet() + " MSAA resolves into an 8-bit buffer, so its error has a 1/255 "
+        "quantisation floor (RMSE about 0.001) that the float accumulation does not.",
         "- **antialiasing** draws the truth's scene (Phong, finest tessellation), so its error is "
         "the sampling error alone. Supersampling accumulates one full-frame pass per sample, "
         "each pass the projection moved by the sample's offset (every pixel uses the same "

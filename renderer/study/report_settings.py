@@ -29,7 +29,7 @@ RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", 
                    "threshold", "runs", "median_ms", "rmse", "max_abs", "psnr", "flip_mean",
                    "mismatched_fraction")
 RAY_TEXTBOOK_SLOPES = TEXTBOOK_SLOPES | {
-    "adaptive": ("faster than jittered in N", "N is the mean traced: the rest of the samples "
-                 "only where the first 4 disagree (edges, shadow boundaries); smooth pixels stop "
-                 "at 4, so the error falls with fewer samples, until missed edges set a floor"),
+    "adaptive": ("none", "N is the mean traced: samples 5..N only where the first 4 disagree "
+                 "(edges, shadow boundaries), so the error falls faster in N than jittered's, "
+                 "until what the first 4 miss sets a floor"),
 }

@@ -58,7 +58,7 @@ class RaySweep:
     thresholds: tuple = (1, 4, 16)                   # adaptive, in levels of 255: a series each
     depths: tuple = (0, 1, 2, 3, 4, 8, 16, RAY_TRUTH_DEPTH)
     patterns: tuple = tuple(PATTERNS)
-    runs: int = 3
+    runs: int = 5                                    # as the rasteriser's: GPU times are noisy
 
 
 RAY_FULL = RaySweep()

@@ -10,14 +10,15 @@ RAY_TRUTH_DEPTH) make one row of results.csv, with report.py's metrics.
     antialiasing    regular / random / jittered / poisson at N          the truth's depth: the
                     samples per pixel; adaptive 4->N @T, a series       error is the sampling
                     per threshold T (in levels of 255)                  error alone
-    max_depth       0 .. RAY_TRUTH_DEPTH bounces                        jittered, BASE_SAMPLES
-    precision       float32, float64 (reference only)                   jittered, BASE_SAMPLES,
+    max_depth       0 .. RAY_TRUTH_DEPTH bounces                        jittered, RAY_BASE_SAMPLES
+    precision       float32, float64 (reference only)                   jittered, RAY_BASE_SAMPLES,
                                                                         the truth's depth
 
 A setting is one frame of the tracer: its N samples per pixel are looped in the shader (in the
 reference, traced as one wavefront), so its time grows with the rays it traces, and the
 adaptive pattern, which traces samples 5..N only where a pixel's first 4 disagree by more than
-T, saves time as well as samples (renderer/core/ray_sampling.py). `samples` in results.csv is
+T (renderer/core/ray_sampling.py), can save time as well as samples; the report measures how
+much. `samples` in results.csv is
 the mean traced per pixel. Every setting builds its own RayTracer (the setting is compiled into
 its shader); building it, and the scene's BVH, is not timed.
 """

@@ -194,8 +194,9 @@ def build_parser() -> argparse.ArgumentParser:
     report = sub.add_parser("report", help="error against run time over quality settings "
                                            "(results.csv, plots, report.md)")
     report.add_argument("scenes", nargs="*", metavar="SCENE",
-                        help="scene files or built-in names (default: every built-in scene; "
-                             "with --quick, two small ones)")
+                        help="scene files or built-in names (default: the built-in scenes made "
+                             "for --method: for raytrace those with spheres, planes, k_r or k_t, "
+                             "for raster the others; with --quick, two small ones, or classic)")
     report.add_argument("--out", type=output_path, required=True, help="folder for the report")
     report.add_argument("--quick", action="store_true",
                         help="a reduced sweep at 64x48 that takes about a minute (for CI)")
@@ -205,6 +206,10 @@ def build_parser() -> argparse.ArgumentParser:
                         help="ground-truth cache (default ~/.cache/checked-renderer/truth)")
     report.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
                         help="headless GL context (default: EGL, then OSMesa)")
+    report.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+                        help="raster (default): the rasteriser's knobs; raytrace: the ray "
+                             "tracer's (samples per pixel by pattern, adaptive thresholds, max "
+                             "depth), against a ray-traced ground truth")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -548,12 +553,21 @@ def cmd_report(args) -> int:
     from renderer.core.builtin import builtin_scenes
     from renderer.study.report import run_report
     from renderer.core.imageio import check_folder, check_outputs
-    from renderer.study.report_settings import QUICK_SCENES
+    from renderer.study.ray_report import made_for_raytracing
+    from renderer.study.report_settings import QUICK_SCENES, RAY_QUICK_SCENES
     check_outputs(check_folder(args.out) / "report.md", args.out / "results.csv")
-    names = args.scenes or (list(QUICK_SCENES) if args.quick else list(builtin_scenes()))
-    scenes = [_load(name) for name in names]
-    result = run_report(scenes, args.out, quick=args.quick, size=args.size, cache_dir=args.cache,
-                        context_kind=args.context)
+    traced = args.method == "raytrace"
+    if args.scenes or args.quick:
+        names = args.scenes or (RAY_QUICK_SCENES if traced else QUICK_SCENES)
+        scenes = [_load(name) for name in names]
+    else:                  # the built-in scenes made for the method: shapes, k_r, k_t or none
+        scenes = [scene for scene in map(_load, builtin_scenes())
+                  if made_for_raytracing(scene) == traced]
+        if not scenes:
+            raise UserError(f"no built-in scene is made for --method {args.method}; name the "
+                            "scenes to report", key="SCENE")
+    result = run_report(scenes, args.out, method=args.method, quick=args.quick, size=args.size,
+                        cache_dir=args.cache, context_kind=args.context)
     print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "
           f"{len(result.files) - 2} plots in {result.seconds:.0f} s")
     return 0

@@ -8,11 +8,15 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from conftest import RAYTRACE_SCENES
+
 from renderer.core.builtin import builtin_scenes
-from renderer.study.ground_truth import ground_truth
-from renderer.study.report import QUICK, metrics, settings
-from renderer.study.report_settings import CSV_COLUMNS
-from renderer.study.report_output import convergence_slopes, pareto_front
+from renderer.study.ground_truth import RAY_TRUTH_DEPTH, ground_truth
+from renderer.study.ray_report import (RAY_QUICK, RayStudy, RaySceneRun, RaySetting,
+                                       made_for_raytracing, ray_settings)
+from renderer.study.report import QUICK, ReportResult, metrics, settings
+from renderer.study.report_settings import CSV_COLUMNS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS
+from renderer.study.report_output import convergence_slopes, pareto_front, series_name
 from renderer.core.scene_file import load_scene
 
 
@@ -105,11 +109,161 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
 @pytest.mark.parametrize("args, reason", [
     (("no_such_scene",), "no_such_scene: no such scene file or built-in scene"),
     (("sphere", "--size", "400x300"), "--size: 400x300 is too large for the ground truth"),
+    (("sphere", "--method", "raytrace", "--size", "400x300"),
+     "--size: 400x300 is too large for the ray tracer's ground truth"),
 ])
-def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli):
+def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_here):
     out = tmp_path / "report"
-    result = cli("report", *args, "--out", str(out), "--cache", str(tmp_path / "cache"))
+    result = cli_here("report", *args, "--out", str(out), "--cache", str(tmp_path / "cache"))
     assert result.returncode == 2
     assert result.stderr.strip().splitlines() == [result.stderr.strip()]
     assert reason in result.stderr and "Traceback" not in result.stderr
     assert not out.exists() and not (tmp_path / "cache").exists()
+
+
+# -- the ray tracer's report (renderer/study/ray_report.py) ------------------------------------
+
+MIRROR_SCENE = """
+background = [0.3, 0.4, 0.6]
+[camera]
+eye = [0.0, 1.0, 4.0]
+look = [0.0, 0.5, 0.0]
+[materials.floor]
+kd = [0.7, 0.7, 0.6]
+[materials.mirror]
+kd = [0.1, 0.1, 0.1]
+kr = [0.8, 0.8, 0.8]
+[[lights]]
+type = "directional"
+direction = [0.5, -1.0, -0.3]
+[[objects]]
+name = "floor"
+shape = { type = "plane", normal = [0.0, 1.0, 0.0], offset = 0.0 }
+material = "floor"
+[[objects]]
+name = "ball"
+shape = { type = "sphere", centre = [0.0, 0.7, 0.0], radius = 0.7 }
+material = "mirror"
+"""
+
+
+def test_ray_truth_is_the_background_where_no_ray_hits_and_is_cached(tmp_path):
+    scene = load_scene(builtin_scenes()["classic"])
+    # Looking up and away from the spheres: the floor is below the lowest ray (7.5 degrees up).
+    sky = replace(scene, camera=replace(scene.camera, look=(0.0, 10.0, 20.0)))
+    truth, hit = ground_truth(sky, 4, 3, tmp_path, method="raytrace")
+    assert hit is False and truth.shape == (3, 4, 3)
+    assert np.array_equal(truth, np.broadcast_to(np.float32(scene.background), (3, 4, 3)))
+    assert ground_truth(sky, 4, 3, tmp_path, method="raytrace")[1] is True
+    assert [path.name.split("-")[:2] for path in tmp_path.glob("*.npy")] == [["classic", "raytrace"]]
+
+
+def test_ray_settings_cover_each_knob_on_its_backends():
+    plan = ray_settings(RAY_QUICK)
+    assert {(s.knob, s.backend) for s in plan} == {
+        ("antialiasing", "gpu"), ("antialiasing", "reference"), ("max_depth", "gpu"),
+        ("max_depth", "reference"), ("precision", "reference")}
+    sampled = [s for s in plan if s.knob == "antialiasing"]
+    assert {s.max_depth for s in sampled} == {RAY_TRUTH_DEPTH}      # the sampling error alone
+    assert {s.setting for s in sampled if s.pattern == "regular"} == {"regular 1", "regular 4",
+                                                                      "regular 16"}
+    adaptive = {(s.setting, s.samples, s.threshold) for s in sampled if s.pattern == "adaptive"}
+    assert adaptive == {("adaptive 4->4 @4/255", 4, 4 / 255), ("adaptive 4->16 @4/255", 16, 4 / 255)}
+    depths = [s for s in plan if s.knob == "max_depth" and s.backend == "gpu"]
+    assert [s.max_depth for s in depths] == list(RAY_QUICK.depths)
+    assert {(s.pattern, s.samples) for s in depths} == {("jittered", RAY_BASE_SAMPLES)}
+    assert [s.dtype for s in plan if s.knob == "precision"] == ["float32", "float64"]
+
+
+def test_adaptive_thresholds_are_series_of_their_own_fitted_in_samples_and_in_time():
+    rows = [{"scene": "a", "knob": "antialiasing", "pattern": "adaptive", "backend": "gpu",
+             "threshold": levels / 255, "samples": n, "median_ms": 3.0 * n ** 0.5,
+             "rmse": 0.1 * n ** -1.0}
+            for levels in (1, 16) for n in (4, 9, 36)]
+    rows += [{**rows[0], "pattern": "jittered", "threshold": None}]        # one point: no fit
+    assert [series_name(r) for r in rows[::3]] == ["adaptive @1/255", "adaptive @16/255", "jittered"]
+    names = ["adaptive @1/255", "adaptive @16/255", "jittered"]
+    in_samples = convergence_slopes(rows, names)
+    in_time = convergence_slopes(rows, names, x="median_ms")
+    assert set(in_samples) == {("adaptive @1/255", "gpu"), ("adaptive @16/255", "gpu")}
+    assert in_samples[("adaptive @1/255", "gpu")].slope == pytest.approx(-1.0)
+    assert in_time[("adaptive @1/255", "gpu")].slope == pytest.approx(-2.0)     # t ~ N^0.5
+    assert in_time[("adaptive @16/255", "gpu")].samples == (4, 36)
+
+
+def test_the_scenes_made_for_the_ray_tracer():
+    """What `renderer report` reports by default with each --method."""
+    scenes = {name: load_scene(path) for name, path in builtin_scenes().items()}
+    assert {name for name, scene in scenes.items() if made_for_raytracing(scene)} == RAYTRACE_SCENES
+    sphere = scenes["sphere"]                                          # a mesh, no k_r or k_t
+    mirror = replace(sphere.objects[0].material, kr=(0.5, 0.5, 0.5))
+    assert made_for_raytracing(replace(sphere, objects=[replace(sphere.objects[0], material=mirror)]))
+
+
+def test_a_tiny_ray_sweep_gpu_and_reference(tmp_path, gl_contexts):
+    """One scene at 8x6 (a mirror ball on a floor): more samples, less error; no bounce, a
+    blank mirror; the GPU's error that of the reference, which traces the same rays."""
+    path = tmp_path / "mirror.toml"
+    path.write_text(MIRROR_SCENE)
+    scene = load_scene(path)
+    truth, _ = ground_truth(scene, 8, 6, tmp_path, method="raytrace")
+    run = RaySceneRun(scene, 8, 6, gl_contexts["egl"])
+    error, spent = {}, {}
+    for knob, name, backend, pattern, n, depth, threshold in (
+            ("antialiasing", "jittered 1", "reference", "jittered", 1, RAY_TRUTH_DEPTH, None),
+            ("antialiasing", "jittered 16", "reference", "jittered", 16, RAY_TRUTH_DEPTH, None),
+            ("antialiasing", "jittered 16", "gpu", "jittered", 16, RAY_TRUTH_DEPTH, None),
+            ("antialiasing", "adaptive", "reference", "adaptive", 16, RAY_TRUTH_DEPTH, 1 / 255),
+            ("max_depth", "depth 0", "reference", "jittered", 16, 0, None)):
+        setting = RaySetting(knob, name, backend, pattern, n, depth, threshold)
+        image, spent[name], ms = run.timed(setting, 1)
+        error[(name, backend)] = metrics(image, truth)["rmse"]
+        assert ms > 0
+    assert error[("jittered 16", "reference")] < error[("jittered 1", "reference")]
+    assert error[("depth 0", "reference")] > 5 * error[("jittered 16", "reference")]
+    assert error[("jittered 16", "gpu")] == pytest.approx(error[("jittered 16", "reference")], abs=1e-5)
+    assert spent["jittered 1"] == 1 and spent["depth 0"] == 16
+    assert 4 < spent["adaptive"] < 16    # the first 4 everywhere, 16 where they disagree
+
+
+def test_ray_report_markdown_has_the_slopes_in_samples_and_in_time():
+    rows = [{"scene": "s", "knob": "antialiasing", "setting": f"{p} {n}", "pattern": p,
+             "backend": b, "threshold": None, "samples": n, "median_ms": float(n), "rmse": n ** -0.5}
+            for p in ("random", "jittered") for b in ("gpu", "reference") for n in (1, 4, 16)]
+    result = ReportResult(rows=rows, scenes={"s": (3, 1, 0, "yes")}, gl_renderer="llvmpipe")
+    text = RayStudy().markdown(result, {("s", "antialiasing"): "plots/s-antialiasing.png"},
+                               (64, 48), RAY_QUICK, quick=True)
+    assert "renderer report --method raytrace --quick" in text
+    assert "| s | 3 | 1 | 0 | yes |" in text
+    assert "| random | gpu | -0.50 | -0.50 (-0.50 to -0.50) | -0.50 |" in text
+    assert "![s: antialiasing](plots/s-antialiasing.png)" in text
+
+
+@pytest.mark.slow                       # the quick ray-tracing sweep, through the command line
+def test_ray_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
+    out = tmp_path / "report"
+    result = cli("report", "--method", "raytrace", "--quick", "--size", "16x12",      # classic
+                 "--out", out, "--cache", tmp_path / "cache", "--context", "osmesa", timeout=900)
+    assert result.returncode == 0, result.stderr
+    with open(out / "results.csv", newline="") as handle:
+        reader = csv.DictReader(handle)
+        assert tuple(reader.fieldnames) == RAY_CSV_COLUMNS
+        rows = list(reader)
+    assert len(rows) == len(ray_settings(RAY_QUICK))
+    error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in rows}
+    samples = {(row["setting"], row["backend"]): float(row["samples"]) for row in rows}
+    for backend in ("gpu", "reference"):
+        assert error[("jittered 16", backend)] < error[("jittered 1", backend)]
+        assert error[("depth 0", backend)] > error[(f"depth {RAY_TRUTH_DEPTH}", backend)]
+        assert 4 < samples[("adaptive 4->16 @4/255", backend)] < 16
+    for setting, backend in error:            # the same rays: the same error
+        if backend == "gpu":
+            assert error[(setting, "gpu")] == pytest.approx(error[(setting, "reference")], abs=1e-5)
+    plots = sorted(path.name for path in (out / "plots").iterdir())
+    assert plots == [f"classic-{knob}.png" for knob in ("antialiasing", "max_depth", "precision")]
+    report = (out / "report.md").read_text()
+    for heading in ("# Error against run time: the ray tracer", "## Method",
+                    "## Convergence of the sampling patterns", "slope in time",
+                    "| adaptive @4/255 | reference |", "## Cheapest setting reaching RMSE <= 0.01 "):
+        assert heading in report
+    assert "wrote" in result.stdout

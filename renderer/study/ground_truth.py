@@ -1,14 +1,22 @@
-"""The ground truth the report measures every setting against, cached on disk by content.
+"""The ground truths the report measures every setting against, cached on disk by content.
 
-The truth is the NumPy reference in float64, Phong shading on every object, every curved
-primitive at the finest tessellation (renderer/study/tessellation.py FINEST), and 16 x 16
-supersampling per pixel. Rendering the reference once at 16W x 16H and averaging each
+The rasteriser's truth is the NumPy reference in float64, Phong shading on every object, every
+curved primitive at the finest tessellation (renderer/study/tessellation.py FINEST), and
+16 x 16 supersampling per pixel. Rendering the reference once at 16W x 16H and averaging each
 16 x 16 block of clamped linear colour is exactly the 16 x 16 regular grid of sample offsets
 ((a + 0.5) / 16 - 0.5, (b + 0.5) / 16 - 0.5) (renderer/core/sampling.py regular_grid(256)) at a
 256th of the passes' cost.
 
-    truth_scene(scene)                              the scene as the truth draws it
+The ray tracer's truth is the reference ray tracer (reference/raytrace/pipeline.py) in float64
+at up to RAY_TRUTH_DEPTH bounces, RAY_TRUTH_PASSES frames of RAY_TRUTH_SAMPLES jittered samples per
+pixel (1024 in all), the frames' sample indices following one another (first_sample), so each
+frame draws new, independent strata; its seed is not the sweep's. The frames' average linear
+colour, clamped to [0, 1], is the truth: what the tracer shows of a pixel, as the frames it is
+compared with. A frame at a time bounds the memory (the reference holds a frame's rays at once).
+
+    truth_scene(scene)                              the scene as the rasteriser's truth draws it
     ground_truth(scene, 160, 120, cache_dir)        ((120, 160, 3) float64 in [0, 1], cache hit?)
+    ground_truth(scene, 160, 120, cache_dir, method="raytrace")     the ray tracer's
 """
 
 from __future__ import annotations
@@ -21,6 +29,9 @@ import numpy as np
 import reference
 from renderer.core.imageio import write_npy
 from renderer.core.paths import output_stem
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
+from renderer.core.raytrace_scene import ray_scene
+from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.study.supersample import clamped
 from renderer.study.tessellation import FINEST, scene_at_level
@@ -28,6 +39,12 @@ from renderer.study.tessellation import FINEST, scene_at_level
 TRUTH_GRID = 16                        # samples per pixel along x and along y
 TRUTH_VERSION = 1                      # bump when the truth's recipe changes: old entries miss
 MAX_TRUTH_PIXELS = 5120 * 3840         # the 16x image of 320x240; rendered in one piece
+RAY_TRUTH_SAMPLES = 64                 # jittered samples per pixel in one frame (8 x 8 strata)
+RAY_TRUTH_PASSES = 16                  # frames averaged: 1024 samples per pixel
+RAY_TRUTH_DEPTH = MAX_DEPTH_LIMIT      # as deep as the tracer goes (its weight cut-off ends
+                                       # a ray tree before that: renderer/core/ray_depth.py)
+RAY_TRUTH_SEED = DEFAULT_SEED + 1      # not the seed of the swept patterns' samples
+RAY_TRUTH_VERSION = 1                  # bump when the ray truth's recipe changes
 
 
 def default_cache_dir() -> Path:
@@ -48,16 +65,26 @@ def scene_digest(scene: Scene) -> str:
         digest.update(repr(part).encode())
     for obj in scene.objects:
         digest.update(repr((obj.name, obj.material, obj.transform, obj.parent, obj.cull)).encode())
+        if obj.shape is not None:             # what the ray tracer intersects instead of the mesh
+            digest.update(repr(obj.shape).encode())
         for array, dtype in ((obj.mesh.positions, np.float64), (obj.mesh.normals, np.float64),
                              (obj.mesh.faces, np.int64)):
             digest.update(np.ascontiguousarray(array, dtype=dtype).tobytes())
     return digest.hexdigest()
 
 
-def cache_path(scene: Scene, width: int, height: int, cache_dir) -> Path:
-    key = hashlib.sha256(f"{scene_digest(truth_scene(scene))} {width}x{height} "
-                         f"grid={TRUTH_GRID} v{TRUTH_VERSION}".encode()).hexdigest()[:24]
-    return Path(cache_dir) / f"{output_stem(scene)}-{width}x{height}-{key}.npy"
+def cache_path(scene: Scene, width: int, height: int, cache_dir, method: str = "raster") -> Path:
+    """Where the truth of `method` ("raster" or "raytrace") is cached: named after the scene
+    and size, keyed by the content of the scene it draws and the truth's recipe."""
+    if method == "raster":
+        drawn, stem = truth_scene(scene), output_stem(scene)
+        recipe = f"grid={TRUTH_GRID} v{TRUTH_VERSION}"
+    else:
+        drawn, stem = scene, f"{output_stem(scene)}-raytrace"
+        recipe = (f"jittered={RAY_TRUTH_SAMPLES}x{RAY_TRUTH_PASSES} depth={RAY_TRUTH_DEPTH} "
+                  f"seed={RAY_TRUTH_SEED} v{RAY_TRUTH_VERSION}")
+    key = hashlib.sha256(f"{scene_digest(drawn)} {width}x{height} {recipe}".encode()).hexdigest()[:24]
+    return Path(cache_dir) / f"{stem}-{width}x{height}-{key}.npy"
 
 
 def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:
@@ -72,12 +99,26 @@ def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     return blocks.mean(axis=(1, 3))
 
 
-def ground_truth(scene: Scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
-    """(truth (H, W, 3) float64, whether it came from the cache). A miss renders it and
-    stores it atomically under `cache_dir`, named after the scene, size and content hash."""
-    path = cache_path(scene, width, height, cache_dir)
+def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
+    """(H, W, 3) float64: the ray tracer's truth rendered now (see the module docstring)."""
+    from reference.raytrace.pipeline import render
+    rs = ray_scene(scene)
+    total = np.zeros((height, width, 3))
+    for frame in range(RAY_TRUTH_PASSES):
+        total += render(scene, width, height, samples=RAY_TRUTH_SAMPLES, pattern="jittered",
+                        max_depth=RAY_TRUTH_DEPTH, seed=RAY_TRUTH_SEED, rs=rs, dtype=np.float64,
+                        first_sample=frame * RAY_TRUTH_SAMPLES).linear[..., :3]
+    return clamped(total / RAY_TRUTH_PASSES)
+
+
+def ground_truth(scene: Scene, width: int, height: int, cache_dir,
+                 method: str = "raster") -> tuple[np.ndarray, bool]:
+    """(truth (H, W, 3) float64, whether it came from the cache) of `method` ("raster" or
+    "raytrace"). A miss renders it and stores it atomically under `cache_dir`, named after
+    the scene, size and content hash."""
+    path = cache_path(scene, width, height, cache_dir, method)
     if path.is_file():
         return np.load(path), True
-    truth = render_truth(scene, width, height)
+    truth = (render_truth if method == "raster" else render_ray_truth)(scene, width, height)
     write_npy(path, truth)
     return truth, False

@@ -19,12 +19,15 @@ rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 
 mismatched_fraction (pixels whose 8-bit value differs from the truth's by more than 2/255 in
 some channel). report.md, results.csv and plots/SCENE-KNOB.png are written when the sweep
 has finished, each atomically.
+
+run_report drives a study: RasterStudy, this sweep, or (method="raytrace") renderer/study/
+ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, with the same
+metrics, plots and tables.
 """
 
 from __future__ import annotations
 
 import math
-import statistics
 import sys
 import time
 from dataclasses import dataclass, field
@@ -40,8 +43,10 @@ from renderer.core.imageio import outputs
 from renderer.checks.perceptual import flip_error
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
-from renderer.study.report_settings import BASE_SAMPLES, DEFAULT_SIZE, MISMATCH_LEVELS, QUICK_SIZE
+from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS,
+                                            QUICK_SIZE)
 from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
+from renderer.study.timing import median_timed
 
 @dataclass(frozen=True)
 class Sweep:
@@ -66,6 +71,11 @@ class Setting:
     variant: tuple                   # ("truth",) | ("level", L) | ("shading", mode)
     sampling: tuple                  # ("pattern", name, N) | ("adaptive", first, total, t) | ("msaa", N)
     dtype: str = "float64"
+
+    def columns(self) -> dict:
+        """The columns of results.csv that name this setting."""
+        return {"knob": self.knob, "setting": self.setting, "backend": self.backend,
+                "pattern": self.pattern}
 
 
 def settings(sweep: Sweep, msaa_counts: list[int]) -> list[Setting]:
@@ -148,16 +158,10 @@ class SceneRun:
         return supersample(pass_, sampling.pattern(name, n)), float(n)
 
     def timed(self, setting: Setting, runs: int) -> tuple[np.ndarray, float, float]:
-        """(image, samples per pixel, median ms of `runs` runs of the whole setting). The GPU
-        gets one untimed run first (shader compilation, first use of a target)."""
-        if setting.backend == "gpu":
-            self.render(setting)
-        times = []
-        for _ in range(runs):
-            start = time.perf_counter()
-            image, samples = self.render(setting)
-            times.append((time.perf_counter() - start) * 1000.0)
-        return image, samples, statistics.median(times)
+        """(image, samples per pixel, median ms of `runs` runs of the whole setting; timing.py)."""
+        (image, samples), ms = median_timed(lambda: self.render(setting), runs,
+                                            warm_up=setting.backend == "gpu")
+        return image, samples, ms
 
     def release(self) -> None:
         for gpu in self._gpus.values():
@@ -165,86 +169,119 @@ class SceneRun:
         self._gpus.clear()
 
 
+class RasterStudy:
+    """The rasteriser's sweep (module docstring), as run_report drives it; renderer/study/
+    ray_report.py's RayStudy is the ray tracer's, with the same methods."""
+    method = "raster"
+    columns = CSV_COLUMNS
+
+    def sweep(self, quick: bool) -> Sweep:
+        return QUICK if quick else FULL
+
+    def size(self, quick: bool) -> tuple[int, int]:
+        return QUICK_SIZE if quick else DEFAULT_SIZE
+
+    def check(self, scenes: list, width: int, height: int) -> None:
+        """A UserError, before any work, for what the sweep cannot do."""
+        from renderer.errors import UserError
+        if width * height * TRUTH_GRID ** 2 > MAX_TRUTH_PIXELS:
+            raise UserError(f"{width}x{height} is too large for the ground truth ({TRUTH_GRID}x"
+                            f"{TRUTH_GRID} samples per pixel, at most 320x240 pixels)", key="--size")
+
+    def settings(self, sweep: Sweep, ctx) -> list[Setting]:
+        from renderer.gpu.pipeline import multisample_counts
+        return settings(sweep, multisample_counts(ctx))
+
+    def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
+        return ground_truth(scene, width, height, cache_dir)
+
+    def describe(self, scene) -> tuple:
+        """The Scenes table's cells: triangles as authored, at the finest tessellation."""
+        return tuple(sum(obj.mesh.triangle_count for obj in drawn.objects)
+                     for drawn in (scene, truth_scene(scene)))
+
+    def scene_run(self, scene, width: int, height: int, ctx) -> SceneRun:
+        return SceneRun(scene, width, height, ctx)
+
+    def markdown(self, result, plots: dict, size, sweep: Sweep, quick: bool) -> str:
+        return report_markdown(result, plots, size, sweep, quick)
+
+
+def study(method: str):
+    """The sweep of `method`: "raster" or "raytrace"."""
+    if method == "raytrace":
+        from renderer.study.ray_report import RayStudy
+        return RayStudy()
+    if method == "raster":
+        return RasterStudy()
+    raise ValueError(f"method must be raster or raytrace, got {method!r}")
+
+
 @dataclass
 class ReportResult:
     rows: list = field(default_factory=list)
     seconds: float = 0.0
     truth_hits: int = 0
-    triangles: dict = field(default_factory=dict)     # scene -> (authored, at the finest level)
+    scenes: dict = field(default_factory=dict)        # scene -> the study's describe(scene)
     gl_renderer: str = ""
     files: list = field(default_factory=list)
 
 
-def check_size(width: int, height: int) -> None:
-    from renderer.errors import UserError
-    if width * height * TRUTH_GRID ** 2 > MAX_TRUTH_PIXELS:
-        raise UserError(f"{width}x{height} is too large for the ground truth ({TRUTH_GRID}x"
-                        f"{TRUTH_GRID} samples per pixel, at most 320x240 pixels)", key="--size")
-
-
-def run_report(scenes: list, out: Path, *, quick: bool = False, size=None, cache_dir=None,
-               context_kind: str = "auto", sweep: Sweep | None = None) -> ReportResult:
-    """Sweep `scenes` (Scene objects), write results.csv, plots/ and report.md under `out`."""
+def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool = False,
+               size=None, cache_dir=None, context_kind: str = "auto", sweep=None) -> ReportResult:
+    """Sweep `scenes` (Scene objects) with `method`'s study (study()), write results.csv,
+    plots/ and report.md under `out`."""
     from tqdm import tqdm
 
     from renderer.gpu.context import make_context, release_context
-    from renderer.gpu.pipeline import multisample_counts
-    width, height = size or (QUICK_SIZE if quick else DEFAULT_SIZE)
-    check_size(width, height)
-    sweep = sweep or (QUICK if quick else FULL)
+    runner = study(method)
+    width, height = size or runner.size(quick)
+    runner.check(scenes, width, height)
+    sweep = sweep or runner.sweep(quick)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
     result = ReportResult()
     start = time.perf_counter()
     ctx = make_context(context_kind)
     try:
         result.gl_renderer = ctx.info["GL_RENDERER"]
-        plan = settings(sweep, multisample_counts(ctx))
+        plan = runner.settings(sweep, ctx)
         with tqdm(total=len(scenes) * (len(plan) + 1), unit="setting", file=sys.stderr,
                   mininterval=0.5, dynamic_ncols=True) as bar:
             for scene in scenes:
                 bar.set_description(f"{scene.name}: ground truth")
-                truth, hit = ground_truth(scene, width, height, cache_dir)
+                truth, hit = runner.truth(scene, width, height, cache_dir)
                 result.truth_hits += hit
-                result.triangles[scene.name] = tuple(
-                    sum(obj.mesh.triangle_count for obj in drawn.objects)
-                    for drawn in (scene, truth_scene(scene)))
+                result.scenes[scene.name] = runner.describe(scene)
                 bar.update()
-                run = SceneRun(scene, width, height, ctx)
+                run = runner.scene_run(scene, width, height, ctx)
                 try:
                     for setting in plan:
                         bar.set_description(f"{scene.name}: {setting.knob} {setting.setting} "
                                             f"({setting.backend})")
                         image, samples, ms = run.timed(setting, sweep.runs)
                         result.rows.append({
-                            "scene": scene.name, "knob": setting.knob, "setting": setting.setting,
-                            "backend": setting.backend, "pattern": setting.pattern,
-                            "samples": samples, "runs": sweep.runs, "median_ms": ms,
-                            **metrics(image, truth)})
+                            "scene": scene.name, **setting.columns(), "samples": samples,
+                            "runs": sweep.runs, "median_ms": ms, **metrics(image, truth)})
                         bar.update()
                 finally:
                     run.release()
     finally:
         release_context(ctx)
     result.seconds = time.perf_counter() - start
-    write_outputs(result, Path(out), (width, height), sweep, quick)
+    write_outputs(result, Path(out), runner, (width, height), sweep, quick)
     return result
 
 
 # ------------------------------------------------------------------------------- outputs
 
-def write_outputs(result: ReportResult, out: Path, size, sweep: Sweep, quick: bool) -> None:
+def write_outputs(result: ReportResult, out: Path, runner, size, sweep, quick: bool) -> None:
     plots = {}
     with outputs() as written:               # the whole report or none of it
-        _write_outputs(written, result, out, size, sweep, quick, plots)
+        for scene in dict.fromkeys(row["scene"] for row in result.rows):
+            for knob in dict.fromkeys(row["knob"] for row in result.rows if row["scene"] == scene):
+                rows = [row for row in result.rows if row["scene"] == scene and row["knob"] == knob]
+                plots[(scene, knob)] = f"plots/{scene}-{knob}.png"
+                written.bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}"))
+        written.text(out / "results.csv", csv_text(result.rows, runner.columns))
+        written.text(out / "report.md", runner.markdown(result, plots, size, sweep, quick))
     result.files = ["report.md", "results.csv", *plots.values()]
-
-
-def _write_outputs(written, result: ReportResult, out: Path, size, sweep: Sweep, quick: bool,
-                   plots: dict) -> None:
-    for scene in dict.fromkeys(row["scene"] for row in result.rows):
-        for knob in dict.fromkeys(row["knob"] for row in result.rows if row["scene"] == scene):
-            rows = [row for row in result.rows if row["scene"] == scene and row["knob"] == knob]
-            plots[(scene, knob)] = f"plots/{scene}-{knob}.png"
-            written.bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}"))
-    written.text(out / "results.csv", csv_text(result.rows))
-    written.text(out / "report.md", report_markdown(result, plots, size, sweep, quick))

@@ -25,9 +25,9 @@ COLOURS = {name: f"C{i}" for i, name in
            enumerate(("regular", "random", "jittered", "poisson", "adaptive", "msaa"))}
 
 
-def csv_text(rows: list[dict]) -> str:
+def csv_text(rows: list[dict], columns=CSV_COLUMNS) -> str:
     buffer = io.StringIO()
-    writer = csv.DictWriter(buffer, CSV_COLUMNS, lineterminator="\n")
+    writer = csv.DictWriter(buffer, columns, lineterminator="\n")
     writer.writeheader()
     for row in rows:
         writer.writerow({key: (f"{value:.6g}" if isinstance(value, float) else value)
@@ -47,9 +47,22 @@ def pareto_front(points: list[tuple[float, float]]) -> list[int]:
     return front
 
 
+def series_name(row: dict) -> str:
+    """An anti-aliasing row's series: its pattern, an adaptive one's with its threshold when the
+    row has a `threshold` column (the ray tracer's: a series per threshold)."""
+    threshold = row.get("threshold")
+    return row["pattern"] if threshold in (None, "") else f"{row['pattern']} @{threshold * 255:g}/255"
+
+
 def series_key(row: dict) -> str:
-    """The plot series a row belongs to: pattern and backend for anti-aliasing, else backend."""
-    return f"{row['pattern']} ({row['backend']})" if row["knob"] == "antialiasing" else row["backend"]
+    """The plot series a row belongs to: series_name and backend for anti-aliasing, else backend."""
+    return f"{series_name(row)} ({row['backend']})" if row["knob"] == "antialiasing" else row["backend"]
+
+
+def _colour(name: str, names: list[str]) -> str:
+    """A series' colour: the pattern's own (COLOURS), else the next after them in `names`' order."""
+    extra = [other for other in names if other not in COLOURS]
+    return COLOURS.get(name) or f"C{len(COLOURS) + extra.index(name)}"
 
 
 def plot_png(rows: list[dict], title: str) -> bytes:
@@ -65,11 +78,14 @@ def plot_png(rows: list[dict], title: str) -> bytes:
     for row in rows:
         if row["rmse"] > 0:
             series[series_key(row)].append(row)
+    names = list(dict.fromkeys(series_name(row) for row in rows))
     for index, (name, members) in enumerate(series.items()):
-        members.sort(key=lambda r: (r["samples"], r["median_ms"]))
+        # Along the knob: samples per pixel, else the depth (the ray tracer's), else time.
+        members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         first = members[0]
         marker, line = STYLES[first["backend"]]
-        colour = COLOURS[first["pattern"]] if first["knob"] == "antialiasing" else f"C{index}"
+        colour = (_colour(series_name(first), names) if first["knob"] == "antialiasing"
+                  else f"C{index}")
         axes.plot([r["median_ms"] for r in members], [r["rmse"] for r in members], marker=marker,
                   linestyle=line, markersize=4, linewidth=1, color=colour, label=name)
         if first["knob"] != "antialiasing":              # few points: name each one
@@ -100,10 +116,10 @@ def plot_png(rows: list[dict], title: str) -> bytes:
 
 @dataclass
 class Slope:
-    """A pattern's convergence on one backend: log RMSE against log N."""
+    """A series' convergence on one backend: log RMSE against log N or log time."""
     slope: float                     # least squares over all scenes, each its own intercept
     points: int
-    samples: tuple                   # (smallest N, largest N)
+    samples: tuple                   # (smallest N, largest N), samples per pixel spent
     per_scene: list                  # each scene's own least-squares slope
 
 
@@ -112,25 +128,27 @@ def _fit(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.sum(x * y) / np.sum(x * x))
 
 
-def convergence_slopes(rows: list[dict]) -> dict:
-    """(pattern, backend) -> Slope, for the anti-aliasing rows of each sampling pattern."""
+def convergence_slopes(rows: list[dict], series=tuple(sampling.PATTERNS), x: str = "samples") -> dict:
+    """(series, backend) -> Slope of log RMSE against log `x` ("samples" or "median_ms"), for
+    the anti-aliasing rows of each of `series` (series_name)."""
     slopes = {}
-    for pattern in sampling.PATTERNS:
+    for name in series:
         for backend in BACKENDS:
             by_scene = defaultdict(list)
             for row in rows:
-                if (row["knob"], row["pattern"], row["backend"]) == ("antialiasing", pattern, backend) \
-                        and row["rmse"] > 0:
-                    by_scene[row["scene"]].append((row["samples"], math.log(row["rmse"])))
+                if row["knob"] == "antialiasing" and series_name(row) == name \
+                        and row["backend"] == backend and row["rmse"] > 0:
+                    by_scene[row["scene"]].append((row[x], math.log(row["rmse"]), row["samples"]))
             centred = []
             for points in by_scene.values():
-                n, log_rmse = np.array(points).T
-                if np.ptp(n) > 0:
-                    centred.append((np.log(n) - np.log(n).mean(), log_rmse - log_rmse.mean(), n))
+                along, log_rmse, n = np.array(points).T
+                if np.ptp(along) > 0:
+                    centred.append((np.log(along) - np.log(along).mean(),
+                                    log_rmse - log_rmse.mean(), n))
             if centred:
-                x, y, n = (np.concatenate(parts) for parts in zip(*centred))
-                slopes[(pattern, backend)] = Slope(_fit(x, y), len(x), (int(n.min()), int(n.max())),
-                                                   [_fit(cx, cy) for cx, cy, _ in centred])
+                cx, cy, n = (np.concatenate(parts) for parts in zip(*centred))
+                slopes[(name, backend)] = Slope(_fit(cx, cy), len(cx), (n.min(), n.max()),
+                                                [_fit(px, py) for px, py, _ in centred])
     return slopes
 
 
@@ -144,15 +162,22 @@ def _ms(value: float) -> str:
     return f"{value:.3g}"
 
 
-def _cheapest_section(rows: list[dict], scenes: list[str], target: float) -> list[str]:
-    """The markdown lines naming, per scene and backend, the cheapest setting reaching `target`."""
+def cheapest_sections(rows: list[dict], scenes: list[str], antialiasing: str) -> list[str]:
+    """The markdown lines naming, per scene and backend, the cheapest setting reaching each of
+    TARGETS_RMSE; `antialiasing` says in parentheses what the anti-aliasing settings draw."""
+    return [line for target in TARGETS_RMSE
+            for line in _cheapest_section(rows, scenes, target, antialiasing)]
+
+
+def _cheapest_section(rows: list[dict], scenes: list[str], target: float,
+                      antialiasing: str) -> list[str]:
     lines = [
         "",
         f"## Cheapest setting reaching RMSE <= {target:g} (about {target * 255:.1f}/255)",
         "",
         "The fastest setting (median time per image) whose RMSE against the ground truth is at "
         "most the target, first over every knob's settings, then among the anti-aliasing "
-        "settings alone (which draw the truth's geometry and shading).",
+        f"settings alone ({antialiasing}).",
         "",
     ]
     for title, knob in (("Any knob", None), ("Anti-aliasing only", "antialiasing")):
@@ -171,25 +196,58 @@ def _cheapest_section(rows: list[dict], scenes: list[str], target: float) -> lis
     return lines
 
 
+def generated_line(result, size, runs: int, command: str) -> str:
+    """The paragraph saying how, when and where the report was made."""
+    width, height = size
+    scenes = len(dict.fromkeys(r["scene"] for r in result.rows))
+    return (f"Generated by `{command}` on {time.strftime('%Y-%m-%d', time.gmtime())} at "
+            f"{width}x{height} pixels on {platform.machine()} with {os.cpu_count()} CPUs, GL "
+            f"renderer `{result.gl_renderer}`; {scenes} scene(s), {len(result.rows)} rows, "
+            f"{result.seconds / 60:.1f} minutes ({result.truth_hits} ground truth(s) from the "
+            f"cache). Every time is the median of {runs} runs of the whole setting (all its "
+            "passes); `results.csv` has every figure.")
+
+
+def errors_bullet() -> str:
+    """The Method section's line on what the errors are."""
+    return ("- **Errors** are on the float image in [0, 1]: `rmse`, `max_abs`, `psnr` (dB, peak "
+            "1), `flip_mean` (ꟻLIP, LDR, both images quantised to 8 bits) and "
+            f"`mismatched_fraction` (pixels more than {MISMATCH_LEVELS}/255 off in some channel "
+            "after 8-bit quantisation).")
+
+
+def spread(fit: Slope) -> str:
+    """A fit's per-scene slopes: median (range)."""
+    return (f"{np.median(fit.per_scene):.2f} ({min(fit.per_scene):.2f} to "
+            f"{max(fit.per_scene):.2f})")
+
+
+def plots_section(scenes: list[str], plots: dict) -> list[str]:
+    lines = ["## Plots", "",
+             "RMSE against the median time per image, log-log; circled points joined by the "
+             "dashed staircase are the Pareto front (no other setting is both faster and more "
+             "accurate).", ""]
+    for scene in scenes:
+        lines += [f"### {scene}", ""]
+        for (plot_scene, knob), path in plots.items():
+            if plot_scene == scene:
+                lines += [f"![{scene}: {knob}]({path})", ""]
+    return lines
+
+
 def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     rows = result.rows
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
-    width, height = size
     lines = [
         "# Error against run time",
         "",
-        f"Generated by `renderer report{' --quick' if quick else ''}` on "
-        f"{time.strftime('%Y-%m-%d', time.gmtime())} at {width}x{height} pixels "
-        f"on {platform.machine()} with {os.cpu_count()} CPUs, GL renderer `{result.gl_renderer}`; "
-        f"{len(scenes)} scene(s), {len(rows)} rows, {result.seconds / 60:.1f} minutes "
-        f"({result.truth_hits} ground truth(s) from the cache). Every time is the median of "
-        f"{sweep.runs} runs of the whole setting (all its passes); `results.csv` has every figure.",
+        generated_line(result, size, sweep.runs, f"renderer report{' --quick' if quick else ''}"),
         "",
         "## Scenes",
         "",
         "| scene | triangles as authored | at the finest tessellation (ground truth, anti-aliasing) |",
         "| --- | ---: | ---: |",
-        *(f"| {name} | {authored} | {finest} |" for name, (authored, finest) in result.triangles.items()),
+        *(f"| {name} | {authored} | {finest} |" for name, (authored, finest) in result.scenes.items()),
         "",
         "## Method",
         "",
@@ -198,11 +256,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         f"segment counts), {TRUTH_GRID}x{TRUTH_GRID} regular-grid supersampling per pixel "
         "(rendered once at 16W x 16H and box-filtered), clamped linear colour in [0, 1]. It is "
         "cached on disk by a hash of the scene's content, the size and these parameters.",
-        "- **Errors** are on the float image in [0, 1]: `rmse`, `max_abs`, `psnr` (dB, peak 1), "
-        "`flip_mean` (ꟻLIP, LDR, both images quantised to 8 bits) and `mismatched_fraction` "
-        f"(pixels more than {MISMATCH_LEVELS}/255 off in some channel after 8-bit quantisation). "
-        "MSAA resolves into an 8-bit buffer, so its error has a 1/255 quantisation floor "
-        "(RMSE about 0.001) that the float accumulation does not.",
+        errors_bullet() + " MSAA resolves into an 8-bit buffer, so its error has a 1/255 "
+        "quantisation floor (RMSE about 0.001) that the float accumulation does not.",
         "- **antialiasing** draws the truth's scene (Phong, finest tessellation), so its error is "
         "the sampling error alone. Supersampling accumulates one full-frame pass per sample, "
         "each pass the projection moved by the sample's offset (every pixel uses the same "
@@ -237,19 +292,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     ]
     for (pattern, backend), fit in convergence_slopes(rows).items():
         rate, why = TEXTBOOK_SLOPES[pattern]
-        spread = (f"{np.median(fit.per_scene):.2f} ({min(fit.per_scene):.2f} to "
-                  f"{max(fit.per_scene):.2f})")
-        lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread} | {fit.points} | "
-                     f"{fit.samples[0]}-{fit.samples[1]} | {rate} | {why} |")
-    for target in TARGETS_RMSE:
-        lines += _cheapest_section(rows, scenes, target)
-    lines += ["## Plots", "",
-              "RMSE against the median time per image, log-log; circled points joined by the "
-              "dashed staircase are the Pareto front (no other setting is both faster and more "
-              "accurate).", ""]
-    for scene in scenes:
-        lines += [f"### {scene}", ""]
-        for (plot_scene, knob), path in plots.items():
-            if plot_scene == scene:
-                lines += [f"![{scene}: {knob}]({path})", ""]
+        lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread(fit)} | {fit.points} | "
+                     f"{fit.samples[0]:g}-{fit.samples[1]:g} | {rate} | {why} |")
+    lines += cheapest_sections(rows, scenes, "which draw the truth's geometry and shading")
+    lines += plots_section(scenes, plots)
     return "\n".join(lines)

@@ -18,3 +18,18 @@ TEXTBOOK_SLOPES = {                  # RMSE against N (Mitchell 1996; docs/repor
     "jittered": ("N^-0.75 at edges", "one sample per stratum"),
     "poisson": ("about N^-0.75", "between random and jittered, close to jittered"),
 }
+
+# The ray tracer's report (renderer/study/ray_report.py, ray_report_output.py).
+RAY_DEFAULT_SIZE = (160, 120)
+RAY_QUICK_SIZE = (64, 48)
+RAY_QUICK_SCENES = ("classic",)
+RAY_MAX_SIZE = (320, 240)            # its ground truth traces 1024 rays per pixel in float64
+RAY_BASE_SAMPLES = 16                # jittered, for the knobs other than antialiasing
+RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "max_depth",
+                   "threshold", "runs", "median_ms", "rmse", "max_abs", "psnr", "flip_mean",
+                   "mismatched_fraction")
+RAY_TEXTBOOK_SLOPES = TEXTBOOK_SLOPES | {
+    "adaptive": ("none", "N is the mean traced: samples 5..N only where the first 4 disagree "
+                 "(edges, shadow boundaries), so the error falls faster in N than jittered's, "
+                 "until what the first 4 miss sets a floor"),
+}

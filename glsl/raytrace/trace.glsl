@@ -3,8 +3,8 @@
 // spheres, then planes, then the scene's triangles through its BVH; Phong shading through
 // lighting.glsl (MATERIAL_VARIABLES: the hit's material; SHADOWS: a shadow ray per light); then
 // reflected (k_r + k_t F) and transmitted (k_t (1 - F)) rays, F Schlick's, to MAX_DEPTH bounces
-// and down to a weight cut-off, depth first through a fixed-size stack in a loop of bounded
-// length (no recursion in GLSL).
+// and down to a weight cut-off, depth first (the reflected ray first, the transmitted one
+// waiting on a fixed-size stack) in a loop of bounded length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
 // SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR.
 
@@ -198,48 +198,94 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
 // rays (2^d up to d = 10), which bounds the loop for any MAX_DEPTH.
 const float TRACE_WEIGHT_CUTOFF = 1.0 / 512.0;
 #define TRACE_RAYS_PER_DEPTH 1536
-#define TRACE_STACK (MAX_DEPTH + 2)
 #if MAX_DEPTH <= 10
 #define TRACE_MAX_RAYS ((2 << MAX_DEPTH) - 1)
 #else
 #define TRACE_MAX_RAYS (2047 + (MAX_DEPTH - 10) * TRACE_RAYS_PER_DEPTH)
 #endif
 
+#ifdef SECONDARY
+// The rays waiting to be traced: a ray that spawns both a reflected and a transmitted ray goes
+// on with the reflected one and leaves the transmitted one here, so at most one waits per depth
+// (MAX_DEPTH in all). llvmpipe reads and writes an array at a per-lane index lane by lane (a
+// store is a branch per lane and component), so a short stack compares the index with each
+// slot instead (TRACE_STACK_SELECT: up to 12 slots that is fewer instructions).
+#define TRACE_STACK MAX_DEPTH
+#if TRACE_STACK <= 12
+#define TRACE_STACK_SELECT
+#endif
+vec3 stack_O[TRACE_STACK];
+vec3 stack_D[TRACE_STACK];
+vec3 stack_w[TRACE_STACK];
+int stack_depth[TRACE_STACK];
+int stack_from[TRACE_STACK];            // the analytic shape a ray starts on, or -1
+
+void trace_store(int i, vec3 O, vec3 D, vec3 w, int depth, int from_shape) {
+    stack_O[i] = O;
+    stack_D[i] = D;
+    stack_w[i] = w;
+    stack_depth[i] = depth;
+    stack_from[i] = from_shape;
+}
+
+void trace_load(int i, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape) {
+    O = stack_O[i];
+    D = stack_D[i];
+    w = stack_w[i];
+    depth = stack_depth[i];
+    from_shape = stack_from[i];
+}
+
+void trace_push(int top, vec3 O, vec3 D, vec3 w, int depth, int from_shape) {
+#ifdef TRACE_STACK_SELECT
+    for (int i = 0; i < TRACE_STACK; ++i) {
+        if (i == top) trace_store(i, O, D, w, depth, from_shape);
+    }
+#else
+    trace_store(top, O, D, w, depth, from_shape);
+#endif
+}
+
+void trace_pop(int top, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape) {
+#ifdef TRACE_STACK_SELECT
+    trace_load(0, O, D, w, depth, from_shape);
+    for (int i = 1; i < TRACE_STACK; ++i) {
+        if (i == top) trace_load(i, O, D, w, depth, from_shape);
+    }
+#else
+    trace_load(top, O, D, w, depth, from_shape);
+#endif
+}
+#endif
+
 // The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
 // from 0 to infinity); hit and s: the first ray's hit.
 vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s_hit) {
     vec3 colour = vec3(0.0);
-    vec3 stack_O[TRACE_STACK];
-    vec3 stack_D[TRACE_STACK];
-    vec3 stack_w[TRACE_STACK];
-    int stack_depth[TRACE_STACK];
-    int stack_from[TRACE_STACK];        // the analytic shape a ray starts on, or -1
-    stack_O[0] = O0;
-    stack_D[0] = D0;
-    stack_w[0] = vec3(1.0);
-    stack_depth[0] = 0;
-    stack_from[0] = -1;
-    int top = 1;
+    vec3 O = O0;
+    vec3 D = D0;
+    vec3 w = vec3(1.0);
+    int depth = 0;
+    int from_shape = -1;
+#ifdef SECONDARY
+    int top = 0;
+#endif
     hit = false;
     s_hit = s_max;
-    // The stack's emptiness is tested at the end of the body, not at the top, and no
-    // `continue`: llvmpipe runs a loop's body with lanes masked off until every lane of its
-    // SIMD group has left, so a test at the top costs one more whole body, masked, per group.
+    // Whether to go on is tested at the end of the body, not at the top, and no `continue`:
+    // llvmpipe runs a loop's body with lanes masked off until every lane of its SIMD group has
+    // left, so a test at the top costs one more whole body, masked, per group.
     for (int k = 0; k < TRACE_MAX_RAYS; ++k) {
-        --top;
-        vec3 O = stack_O[top];
-        vec3 D = stack_D[top];
-        vec3 w = stack_w[top];
-        int depth = stack_depth[top];
         int index;
         float s;
         vec2 uv;
         int kind = scene_hit(O, D, depth == 0 ? s_min : trace_s_min(O),
-                             depth == 0 ? s_max : TRACE_INF, stack_from[top], index, s, uv);
+                             depth == 0 ? s_max : TRACE_INF, from_shape, index, s, uv);
         if (depth == 0) {
             hit = kind != TRACE_MISS;
             s_hit = s;
         }
+        bool next = false;                  // a child of this ray is traced next
         if (kind == TRACE_MISS) {
             colour += w * u_background;
         } else {
@@ -274,26 +320,37 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 vec3 w_t = w * (kt * (1.0 - F));
                 vec3 T;
                 bool refracted = ray_refract(Du, N_in, eta, T);
-                if (any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted) {
-                    stack_O[top] = ray_origin(P, -Ng_in, g_shape);
-                    stack_D[top] = T;
-                    stack_w[top] = w_t;
-                    stack_depth[top] = depth + 1;
-                    stack_from[top] = g_shape;
+                bool transmit = any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted;
+                bool reflect = any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)));
+                vec3 O_t = ray_origin(P, -Ng_in, g_shape);
+                if (transmit && reflect) {      // the reflected ray first, then this one
+                    trace_push(top, O_t, T, w_t, depth + 1, g_shape);
                     ++top;
                 }
-                if (any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)))) {
-                    stack_O[top] = ray_origin(P, Ng_in, g_shape);
-                    stack_D[top] = ray_reflect(Du, N_in);
-                    stack_w[top] = w_r;
-                    stack_depth[top] = depth + 1;
-                    stack_from[top] = g_shape;
-                    ++top;
+                if (reflect) {
+                    O = ray_origin(P, Ng_in, g_shape);
+                    D = ray_reflect(Du, N_in);
+                    w = w_r;
+                } else if (transmit) {
+                    O = O_t;
+                    D = T;
+                    w = w_t;
                 }
+                depth += 1;
+                from_shape = g_shape;
+                next = transmit || reflect;
             }
 #endif
         }
-        if (top == 0) break;
+#ifdef SECONDARY
+        if (!next && top == 0) break;
+        if (!next) {
+            --top;
+            trace_pop(top, O, D, w, depth, from_shape);
+        }
+#else
+        break;
+#endif
     }
     return colour;
 }

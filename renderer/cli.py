@@ -478,12 +478,14 @@ def cmd_compare(args) -> int:
         from reference.raytrace.pipeline import render as reference_raytrace
         gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
                                                    _raytrace_options(args), frames=3)
+        from renderer.core.raytrace_scene import ray_scene
         start = time.perf_counter()
-        ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args))
+        rs = ray_scene(scene)                    # the BVH built once, for both precisions
+        ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args), rs=rs)
         reference_ms = (time.perf_counter() - start) * 1000.0
         # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
         # elsewhere the adaptive pattern's other decision, rgba8_tie).
-        truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64")
+        truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64", rs=rs)
         tie, tie_depth, grazing = either_precision(ref_frame, truth)
     else:
         gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)

@@ -1,6 +1,6 @@
-"""A BVH (renderer/core/bvh.py) as the two RGBA32F textures glsl/raytrace/bvh.glsl reads:
-nodes and triangles, texel k at (k % width, k // width), the width a power of two
-(`renderer.core.bvh.texels`)."""
+"""Arrays as the RGBA32F textures the ray tracer's GLSL reads (`texel_texture`: texel k at
+(k % width, k // width), the width a power of two, `renderer.core.bvh.texels`); a BVH
+(renderer/core/bvh.py) as its two, nodes and triangles, as glsl/raytrace/bvh.glsl reads them."""
 
 from __future__ import annotations
 
@@ -9,7 +9,8 @@ import moderngl
 from renderer.core.bvh import Bvh, texels
 
 
-def _texture(ctx: moderngl.Context, array) -> moderngl.Texture:
+def texel_texture(ctx: moderngl.Context, array) -> moderngl.Texture:
+    """`array`'s rows of 4 floats (texels) as a nearest-filtered, unrepeated RGBA32F texture."""
     data = texels(array)
     texture = ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(), dtype="f4")
     texture.filter = (ctx.NEAREST, ctx.NEAREST)
@@ -19,4 +20,4 @@ def _texture(ctx: moderngl.Context, array) -> moderngl.Texture:
 
 def bvh_textures(ctx: moderngl.Context, bvh: Bvh) -> tuple[moderngl.Texture, moderngl.Texture]:
     """(nodes, triangles) textures; the caller releases them."""
-    return _texture(ctx, bvh.nodes), _texture(ctx, bvh.triangles)
+    return texel_texture(ctx, bvh.nodes), texel_texture(ctx, bvh.triangles)

@@ -42,18 +42,11 @@ from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import light_uniforms
+from renderer.gpu.bvh import texel_texture
 from renderer.gpu.context import activate, context_kind, make_context, release_context
 from renderer.gpu.shaders import shader_source
 
 DEFAULT_MAX_DEPTH = 4
-
-
-def _texture(ctx, array):
-    data = texels(array)
-    texture = ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(), dtype="f4")
-    texture.filter = (ctx.NEAREST, ctx.NEAREST)
-    texture.repeat_x = texture.repeat_y = False
-    return texture
 
 
 class RayTracer:
@@ -93,7 +86,7 @@ class RayTracer:
         self._compile()
         self._textures, self._units = [], {}          # (unit, texture); sampler -> unit
         for unit, (name, array) in enumerate(self._texture_arrays(rs).items()):
-            texture = _texture(ctx, array)
+            texture = texel_texture(ctx, array)
             self._resources.append(texture)
             self._textures.append((unit, texture))
             self._units[name] = unit

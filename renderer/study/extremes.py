@@ -34,6 +34,7 @@ from renderer.core.builtin import assets_dir, scene_description
 from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision
 from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
 from renderer.core.ray_depth import DEFAULT_MAX_DEPTH
+from renderer.core.raytrace_scene import ray_scene
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.raytracer import RayTracer
@@ -163,8 +164,9 @@ def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
     for kind, ctx in contexts.items():
         with RayTracer(scene, width, height, context=ctx, max_depth=max_depth) as tracer:
             gpu_frames[kind] = tracer.render()
-    truth = reference_raytrace(scene, width, height, max_depth=max_depth, dtype=np.float64)
-    twin = reference_raytrace(scene, width, height, max_depth=max_depth)
+    rs = ray_scene(scene)                        # the BVH built once, for both precisions
+    truth = reference_raytrace(scene, width, height, max_depth=max_depth, dtype=np.float64, rs=rs)
+    twin = reference_raytrace(scene, width, height, max_depth=max_depth, rs=rs)
     tie, tie_depth, grazing = either_precision(truth, twin)
     finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
     finite["reference"] = is_finite_frame(truth) and is_finite_frame(twin)

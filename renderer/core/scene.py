@@ -17,6 +17,7 @@ from typing import Literal
 import numpy as np
 
 from renderer.core import transforms
+from renderer.core.shadows import Shadow
 
 Projection = Literal["perspective", "parallel"]
 ShadingMode = Literal["flat", "gouraud", "phong"]
@@ -202,6 +203,8 @@ class SceneObject:
     parent: str | None = None    # name of another object; its world matrix applies after ours
     cull: Cull = "none"          # which faces GL culls (window-space winding; CCW is front)
     shape: Shape | None = None   # an analytic shape the ray tracer intersects; None: triangles
+    casts_shadows: bool = True   # drawn into the lights' shadow maps (renderer/core/shadows.py)
+    receives_shadows: bool = True  # looks itself up in them: lit only where a light reaches it
 
 
 @dataclass
@@ -209,6 +212,7 @@ class DirectionalLight:
     """An infinitely distant light; `direction` is the way its light travels."""
     direction: tuple = (0.0, 0.0, -1.0)
     intensity: tuple = (1.0, 1.0, 1.0)
+    shadow: Shadow = field(default_factory=Shadow)   # its shadow map (renderer/core/shadows.py)
 
 
 @dataclass
@@ -217,6 +221,7 @@ class PointLight:
     position: tuple = (0.0, 0.0, 5.0)
     intensity: tuple = (1.0, 1.0, 1.0)
     attenuation: tuple = (1.0, 0.0, 0.0)
+    shadow: Shadow = field(default_factory=Shadow)   # its shadow map: six cube faces
 
 
 @dataclass

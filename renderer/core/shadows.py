@@ -1,0 +1,506 @@
+"""Shadow maps: the rules both twins read, written once (docs/conventions.md, "Shadows").
+
+The rasteriser decides per fragment and per light whether the light reaches the fragment by
+looking the fragment up in a shadow map: the depth of the nearest caster seen from the
+light, drawn by a depth-only pass (glsl/shadow/depth.vert, reference/shadow/depth.py) and
+compared by GL's depth-compare sampler (glsl/shadow/lookup.glsl, reference/shadow/lookup.py).
+This module holds what the GPU path and the reference share and neither computes on its own:
+
+- the settings of a light's map (`Shadow`: on/off, resolution, filter, bias) and their
+  defaults; objects carry `casts_shadows` / `receives_shadows` (renderer/core/scene.py);
+- the atlas: every map of a scene is a square tile in one DEPTH_COMPONENT32F texture whose
+  side is a power of two (`ShadowLayout`, packed by `pack_tiles`); a directional light has
+  one tile, a point light six (the faces of a cube around it, each a 90-degree perspective
+  view widened by a guard band, so that no filter tap ever leaves its tile: no seams);
+- each frame's light views (`plan_shadows`): an orthographic view for a directional light
+  fitted to the receivers the camera can see and the casters that can shadow them, six
+  perspective views for a point light, the passes worth drawing (none for a light that
+  nothing can shadow, none for a cube face that sees no caster), and the uniform values;
+- the filters (`FILTERS`, `tap_offsets`) and the bias rule (`BiasRule`, `auto_bias`).
+
+Coordinates are camera-relative, as everything else the pipelines get (FrameMatrices). Tile
+texel (i, j) of a tile at atlas texel (x0, y0) is atlas texel (x0 + i, y0 + j); rows count up
+from the bottom as GL's window rows do (the depth pass draws with the viewport on the tile).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from renderer.core import transforms
+
+# --- settings --------------------------------------------------------------------------------
+
+# filter name -> kernel k: "hard" is one nearest-texel comparison (k = 1); "pcfKxK" is the mean
+# of (K-1)^2 bilinear comparisons (GL's LINEAR depth compare) on a unit grid centred on the
+# point, so that together they read a K x K block of texels (`tap_offsets`).
+FILTERS = {"hard": 1, "pcf2x2": 2, "pcf3x3": 3, "pcf5x5": 5}
+DEFAULT_FILTER = "pcf2x2"
+
+RESOLUTIONS = (256, 512, 1024, 2048, 4096)     # texels on a side of one tile; powers of two
+MAX_ATLAS_SIDE = 8192                          # 256 MiB of float depth; GL guarantees 16384
+
+
+@dataclass(frozen=True)
+class BiasRule:
+    """How far a receiver's lookup point moves before it is compared, in texels of its map
+    (t, the world size of one texel at the point): along the surface normal N by
+    normal * (|N.X| + |N.Y|) (X, Y the map's axes: the normal offset), and towards the light
+    by constant + slope * min(tan(theta), MAX_SLOPE) (a depth bias; theta is the angle
+    between N and the light). `auto_bias(filter)` is the rule that needs no tuning."""
+    normal: float = 0.0
+    constant: float = 0.0
+    slope: float = 0.0
+
+    def as_vec4(self) -> np.ndarray:
+        return np.array([self.normal, self.constant, self.slope, 0.0])
+
+
+MAX_SLOPE = 16.0                       # tan(theta) is capped here in the slope term (86.4 deg)
+CONSTANT_BIAS_TEXELS = 0.25            # towards the light: rounding of depth and position
+
+
+def footprint_radius(kernel: int) -> float:
+    """How far (texels, along each map axis) from the lookup point the centres of the texels a
+    filter reads may lie: 1/2 for the nearest texel, K/2 for K x K PCF (bilinear taps reach
+    1 texel past their own position; the taps lie within (K-2)/2 of the point)."""
+    return 0.5 if kernel == 1 else kernel / 2.0
+
+
+def auto_bias(filter_name: str) -> BiasRule:
+    """The automatic bias: a normal offset of the filter's footprint radius.
+
+    For a planar receiver, moving the lookup point o texels along N lifts it o cos(theta)
+    towards the light and moves it o sin(theta) across the map, where the plane lies
+    o sin(theta) tan(theta) further away: a margin of o / cos(theta) in depth. A texel centre
+    the filter reads lies at most r = radius (|n_x| + |n_y|) / sin(theta) across the map in
+    the plane's downhill direction (n_x, n_y: N on the map's axes; the bound is exact for the
+    square of centres), where the plane is r tan(theta) nearer. No texel of the receiver itself
+    then shadows the point when o / cos(theta) >= r tan(theta), i.e. o >= radius (|n_x| + |n_y|):
+    finite at every angle, unlike a slope-scaled depth bias (tan(theta) is unbounded at grazing
+    light). CONSTANT_BIAS_TEXELS more towards the light covers rounding (depth stored in
+    float32, positions interpolated in float32)."""
+    return BiasRule(normal=footprint_radius(FILTERS[filter_name]), constant=CONSTANT_BIAS_TEXELS)
+
+
+BIAS_RULES = ("auto", "slope", "constant", "none")   # the report's knob (renderer/study)
+
+
+def named_bias(rule: str, filter_name: str) -> BiasRule:
+    """The report's bias rules: "auto" (above), "slope" (the classic slope-scaled depth bias
+    with the same footprint: no normal offset), "constant" (a fixed depth bias of one texel),
+    "none" (nothing: acne everywhere a surface faces the light)."""
+    radius = footprint_radius(FILTERS[filter_name])
+    if rule == "auto":
+        return auto_bias(filter_name)
+    if rule == "slope":
+        return BiasRule(constant=CONSTANT_BIAS_TEXELS, slope=radius * math.sqrt(2.0))
+    if rule == "constant":
+        return BiasRule(constant=1.0)
+    if rule == "none":
+        return BiasRule()
+    raise ValueError(f"bias rule must be one of {', '.join(BIAS_RULES)}, got {rule!r}")
+
+
+@dataclass(frozen=True)
+class Shadow:
+    """A light's shadow-map settings (scene file: the light's `shadows`, `shadow_resolution`,
+    `shadow_filter`, `shadow_bias` keys). resolution None: `auto_resolution`; bias None:
+    `auto_bias(filter)`."""
+    enabled: bool = True
+    resolution: int | None = None
+    filter: str = DEFAULT_FILTER
+    bias: BiasRule | None = None
+
+    @property
+    def kernel(self) -> int:
+        return FILTERS[self.filter]
+
+    def bias_rule(self) -> BiasRule:
+        return self.bias if self.bias is not None else auto_bias(self.filter)
+
+
+def auto_resolution(width: int, height: int, point: bool) -> int:
+    """The default tile side: the power of two at or above twice the image's longer side, so
+    that a map spread over the view has about two texels per pixel on a side (a point light's
+    face, a quarter of the directions around it, the power of two at or above the longer
+    side); within RESOLUTIONS."""
+    target = max(width, height) * (1 if point else 2)
+    side = 1 << max(0, math.ceil(math.log2(max(target, 1))))
+    return min(max(side, RESOLUTIONS[0]), RESOLUTIONS[-1])
+
+
+def tap_offsets(kernel: int) -> np.ndarray:
+    """(T, 2) tap positions in texels from the lookup point, in the order both twins sum them:
+    the nearest texel's comparison at 0 for "hard"; for K x K, every (i - (K-2)/2, j - (K-2)/2)
+    with i, j = 0..K-2, j (the map's y) outer."""
+    if kernel == 1:
+        return np.zeros((1, 2))
+    steps = np.arange(kernel - 1) - (kernel - 2) / 2.0
+    ys, xs = np.meshgrid(steps, steps, indexing="ij")
+    return np.stack([xs.ravel(), ys.ravel()], axis=1)
+
+
+def guard_texels(kernel: int, bias: BiasRule) -> int:
+    """Texels at each edge of a tile that the region it answers for leaves free: the filter's
+    footprint plus the normal offset's move across the map (at most normal * sqrt(2) texels),
+    rounded up, plus one for rounding. No tap of a lookup inside the region leaves the tile."""
+    return math.ceil(footprint_radius(kernel) + bias.normal * math.sqrt(2.0)) + 1
+
+
+# --- cube faces ------------------------------------------------------------------------------
+
+# Face f of a point light's cube looks along CUBE_FACE_AXES[f] (+x, -x, +y, -y, +z, -z); its view
+# rotation's rows are (right, up, back) = CUBE_FACE_ROTATIONS[f], a proper rotation, so that a
+# direction d from the light has eye coordinates R d with -z_eye = d . axis. The face for d is
+# its major axis: the largest |d_i|, ties going to the earlier axis (x before y before z); the
+# sign picks + or - (+ for a zero component). glsl/shadow/lookup.glsl writes the same table.
+CUBE_FACE_AXES = np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]],
+                          dtype=np.float64)
+CUBE_FACE_ROTATIONS = np.array([
+    [[0, 0, -1], [0, 1, 0], [-1, 0, 0]],     # +x: right -z, up +y
+    [[0, 0, 1], [0, 1, 0], [1, 0, 0]],       # -x: right +z, up +y
+    [[1, 0, 0], [0, 0, -1], [0, -1, 0]],     # +y: right +x, up -z
+    [[1, 0, 0], [0, 0, 1], [0, 1, 0]],       # -y: right +x, up +z
+    [[1, 0, 0], [0, 1, 0], [0, 0, -1]],      # +z: right +x, up +y
+    [[-1, 0, 0], [0, 1, 0], [0, 0, 1]],      # -z: right -x, up +y
+], dtype=np.float64)
+
+
+def cube_face(direction: np.ndarray) -> np.ndarray:
+    """(...,) int face index for directions (..., 3) from the light (the rule above)."""
+    d = np.asarray(direction)
+    a = np.abs(d)
+    axis = np.where((a[..., 0] >= a[..., 1]) & (a[..., 0] >= a[..., 2]), 0,
+                    np.where(a[..., 1] >= a[..., 2], 1, 2))
+    negative = np.take_along_axis(d, axis[..., None], axis=-1)[..., 0] < 0
+    return 2 * axis + negative.astype(axis.dtype)
+
+
+# --- the atlas -------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Tile:
+    """A square of `size` texels at atlas texel (x, y) (GL rows: y counts up from the bottom)."""
+    x: int
+    y: int
+    size: int
+
+    def rect(self, atlas_side: int) -> np.ndarray:
+        """(x0, y0, size, 0) in atlas texture coordinates (what the lookup adds and scales)."""
+        return np.array([self.x, self.y, self.size, 0.0]) / np.array([atlas_side] * 3 + [1.0])
+
+
+def _morton_decode(index: int) -> tuple[int, int]:
+    x = y = 0
+    for bit in range(32):
+        x |= ((index >> (2 * bit)) & 1) << bit
+        y |= ((index >> (2 * bit + 1)) & 1) << bit
+    return x, y
+
+
+def pack_tiles(sizes: list[int]) -> tuple[int, list[Tile]]:
+    """Square power-of-two tiles into the smallest square power-of-two atlas: (side, tiles in
+    the order given). Sorted largest first and laid in Morton (Z) order, each tile starts at a
+    multiple of its own area, so the tiles never overlap and fill the atlas without gaps."""
+    if not sizes:
+        return 0, []
+    order = sorted(range(len(sizes)), key=lambda i: -sizes[i])
+    total = sum(s * s for s in sizes)
+    side = 1 << math.ceil(math.log2(math.isqrt(total - 1) + 1)) if total > 1 else 1
+    side = max(side, max(sizes))
+    tiles: list[Tile | None] = [None] * len(sizes)
+    start = 0                                        # in texels of area, Morton order
+    for i in order:
+        s = sizes[i]
+        x, y = _morton_decode(start // (s * s))
+        tiles[i] = Tile(x * s, y * s, s)
+        start += s * s
+    return side, tiles
+
+
+@dataclass(frozen=True)
+class LightMap:
+    """One light's shadow map in the atlas."""
+    kind: str                  # "directional" or "point"
+    index: int                 # the light's index among lights of its kind
+    shadow: Shadow
+    resolution: int
+    tiles: tuple[Tile, ...]    # 1 for a directional light, 6 (CUBE_FACE_AXES order) for a point one
+
+    @property
+    def guard(self) -> int:
+        return guard_texels(self.shadow.kernel, self.shadow.bias_rule())
+
+
+@dataclass(frozen=True)
+class ShadowLayout:
+    """Which lights have a map and where: fixed for a scene at an image size (the programs'
+    uniform arrays and the atlas texture are made from it once)."""
+    atlas_side: int
+    maps: tuple[LightMap, ...]
+
+    def get(self, kind: str, index: int) -> LightMap | None:
+        for m in self.maps:
+            if m.kind == kind and m.index == index:
+                return m
+        return None
+
+    @property
+    def any(self) -> bool:
+        return bool(self.maps)
+
+
+def scene_has_shadows(scene) -> bool:
+    """Whether any object casts and any receives: otherwise no light needs a map."""
+    return (any(o.casts_shadows and o.mesh.triangle_count for o in scene.objects)
+            and any(o.receives_shadows for o in scene.objects))
+
+
+def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
+    """The atlas for `scene` rendered at width x height: a tile per light with shadows on
+    (six for a point light), none at all when nothing casts or nothing receives. A
+    ValueError when the tiles need an atlas over MAX_ATLAS_SIDE."""
+    if not scene_has_shadows(scene):
+        return ShadowLayout(0, ())
+    wanted = []
+    for kind, lights in (("directional", scene.directional_lights), ("point", scene.point_lights)):
+        for i, light in enumerate(lights):
+            if light.shadow.enabled:
+                resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
+                wanted.append((kind, i, light.shadow, resolution))
+    sizes = [r for kind, _, _, r in wanted for _ in range(6 if kind == "point" else 1)]
+    side, tiles = pack_tiles(sizes)
+    if side > MAX_ATLAS_SIDE:
+        raise ValueError(f"the shadow maps need a {side}x{side} atlas, more than "
+                         f"{MAX_ATLAS_SIDE}x{MAX_ATLAS_SIDE}: lower shadow_resolution or turn "
+                         f"shadows off for some lights")
+    maps, at = [], 0
+    for kind, i, shadow, resolution in wanted:
+        count = 6 if kind == "point" else 1
+        maps.append(LightMap(kind, i, shadow, resolution, tuple(tiles[at:at + count])))
+        at += count
+    return ShadowLayout(side, tuple(maps))
+
+
+# --- each frame's light views ----------------------------------------------------------------
+
+# A point light's near plane: half the distance to the nearest caster's bounding box, and at
+# least NEAR_FRACTION of the far distance (geometry nearer than that to the light casts no
+# shadow; depth precision near the far plane stays ~1e-7 * far^2 / near = ~1e-4 far).
+NEAR_FRACTION = 2.0 ** -10
+DEPTH_MARGIN = 2.0 ** -8               # of the depth span, added at both ends of a light view
+
+
+@dataclass(frozen=True)
+class ShadowPass:
+    """One tile drawn by the depth pass: `casters` (object indices) seen through
+    `clip_from_world` (light clip coordinates from camera-relative world, float64) into
+    `tile` of the atlas, standard depth mapping (z_w = (z_ndc + 1) / 2, cleared to 1, GL_LESS)."""
+    kind: str
+    light: int
+    face: int
+    tile: Tile
+    clip_from_world: np.ndarray
+    casters: tuple[int, ...]
+
+
+@dataclass
+class ShadowPlan:
+    """A frame's shadow work: the passes to draw and the uniforms of the lookup (float64,
+    named as in glsl/shadow/lookup.glsl; a light without a map reads as lit)."""
+    layout: ShadowLayout
+    passes: list[ShadowPass]
+    uniforms: dict[str, np.ndarray]
+    texel_size: dict = field(default_factory=dict)   # (kind, light) -> world size of a texel (directional)
+
+    @property
+    def atlas_side(self) -> int:
+        return self.layout.atlas_side
+
+
+def world_points(scene, matrices) -> list[np.ndarray]:
+    """Each object's vertices in camera-relative world coordinates (float64, (V, 3))."""
+    out = []
+    for obj, m in zip(scene.objects, matrices.objects):
+        model = np.asarray(m.model, dtype=np.float64)
+        out.append(np.asarray(obj.mesh.positions, dtype=np.float64) @ model[:3, :3].T + model[:3, 3])
+    return out
+
+
+def _camera_frustum_corners(matrices, reversed_z: bool) -> np.ndarray:
+    """(8, 3) corners of the camera's view volume, camera-relative world."""
+    from renderer.core.gl_rules import depth_mapping
+    mapping = depth_mapping(reversed_z)
+    inverse = np.linalg.inv(matrices.projection @ matrices.view)
+    corners = np.array([[x, y, z, 1.0] for x in (-1.0, 1.0) for y in (-1.0, 1.0)
+                        for z in (mapping.ndc_near, mapping.ndc_far)])
+    world = corners @ inverse.T
+    return world[:, :3] / world[:, 3:4]
+
+
+def _ortho_rows(centre_x, centre_y, half, near, far) -> np.ndarray:
+    return np.array([[1.0 / half, 0.0, 0.0, -centre_x / half],
+                     [0.0, 1.0 / half, 0.0, -centre_y / half],
+                     transforms.depth_row(near, far, perspective=False, reversed_z=False),
+                     [0.0, 0.0, 0.0, 1.0]])
+
+
+def _atlas_from_clip(tile: Tile, atlas_side: int) -> np.ndarray:
+    """(4, 4) taking light clip coordinates (w = 1) to (u, v) in the atlas and z_w."""
+    scale = 0.5 * tile.size / atlas_side
+    m = np.diag([scale, scale, 0.5, 1.0])
+    m[0, 3] = scale + tile.x / atlas_side
+    m[1, 3] = scale + tile.y / atlas_side
+    m[2, 3] = 0.5
+    return m
+
+
+def _plan_directional(index, light, light_map, layout, scene, points, receivers, casters,
+                      frustum) -> tuple[ShadowPass | None, np.ndarray, np.ndarray, float]:
+    rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light.direction, (0.0, 1.0, 0.0))
+    to_light = lambda p: p @ rotation[:3, :3].T            # noqa: E731  light-space x, y, -depth
+    seen = [to_light(points[i]) for i in receivers]
+    params = np.zeros(4)
+    if not seen:
+        return None, np.eye(4), params, 0.0
+    box = np.vstack(seen)
+    lo, hi = box[:, :2].min(axis=0), box[:, :2].max(axis=0)
+    f_light = to_light(frustum)
+    lo = np.maximum(lo, f_light[:, :2].min(axis=0))
+    hi = np.minimum(hi, f_light[:, :2].max(axis=0))
+    if np.any(lo > hi):
+        return None, np.eye(4), params, 0.0
+    resolution, guard = light_map.resolution, light_map.guard
+    half_inner = max(float((hi - lo).max()) / 2.0, 1e-9 * (1.0 + float(np.abs(box).max())))
+    texel = 2.0 * half_inner / (resolution - 2 * guard)
+    centre = np.round((lo + hi) / 2.0 / texel) * texel       # snapped: steady as the camera moves
+    half = resolution * texel / 2.0
+    region_lo, region_hi = centre - half, centre + half
+    depth = -box[:, 2]
+    near_depth, far_depth = float(depth.min()), float(depth.max())
+    drawn = []
+    for i in casters:
+        p = to_light(points[i])
+        if np.any(p[:, :2].max(axis=0) < region_lo) or np.any(p[:, :2].min(axis=0) > region_hi):
+            continue
+        d = -p[:, 2]
+        if d.min() > far_depth:
+            continue
+        drawn.append(i)
+        near_depth = min(near_depth, float(d.min()))
+    margin = max(DEPTH_MARGIN * (far_depth - near_depth), 2.0 * texel)
+    near_depth, far_depth = near_depth - margin, far_depth + margin
+    clip = _ortho_rows(centre[0], centre[1], half, near_depth, far_depth) @ rotation
+    lookup = _atlas_from_clip(light_map.tiles[0], layout.atlas_side) @ clip
+    if not drawn:
+        return None, lookup, params, texel
+    params[:] = (1.0, texel, light_map.shadow.kernel, 0.0)
+    return (ShadowPass("directional", index, 0, light_map.tiles[0], clip, tuple(drawn)),
+            lookup, params, texel)
+
+
+def _box_distance(points: np.ndarray, position: np.ndarray) -> float:
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return float(np.linalg.norm(np.maximum(np.maximum(lo - position, position - hi), 0.0)))
+
+
+def _outside_frustum(clip_from_world: np.ndarray, points: np.ndarray) -> bool:
+    """True when the points' bounding box lies wholly outside one clip plane (as
+    renderer/core/visibility.py tests objects against the camera's)."""
+    from renderer.core.visibility import CLIP_PLANES
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    corners = np.array([[(hi if (k >> a) & 1 else lo)[a] for a in range(3)] + [1.0] for k in range(8)])
+    clip = corners @ clip_from_world.T
+    return any(bool(np.all(clip[:, 3] + sign * clip[:, axis] < 0.0)) for axis, sign in CLIP_PLANES)
+
+
+def point_face_projection(resolution: int, guard: int, near: float, far: float) -> tuple[np.ndarray, float]:
+    """A cube face's perspective projection, widened so that the 90-degree face fills all but
+    `guard` texels at each edge: tan(half angle) = R / (R - 2 guard). Returns (P, tan)."""
+    tan_half = resolution / (resolution - 2.0 * guard)
+    projection = transforms.perspective(2.0 * math.atan(tan_half), 1.0, near, far)
+    return projection, tan_half
+
+
+def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters):
+    position = matrices.relative(light.position)
+    passes = []
+    rects = np.zeros((6, 4))
+    params = np.zeros(4)
+    depth = np.zeros(4)
+    seen = [points[i] for i in receivers]
+    if not seen or not casters:
+        return passes, rects, params, depth
+    far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
+    far = max(far, 1e-30)
+    near = max(0.5 * min(_box_distance(points[i], position) for i in casters), NEAR_FRACTION * far)
+    near = min(near, 0.5 * far)
+    projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
+    for face in range(6):
+        view = np.eye(4)
+        view[:3, :3] = CUBE_FACE_ROTATIONS[face]
+        view[:3, 3] = -CUBE_FACE_ROTATIONS[face] @ position
+        clip = projection @ view
+        tile = light_map.tiles[face]
+        rects[face] = tile.rect(layout.atlas_side)
+        drawn = tuple(i for i in casters if not _outside_frustum(clip, points[i]))
+        if not drawn or all(_outside_frustum(clip, points[i]) for i in receivers):
+            continue
+        rects[face, 3] = 1.0                      # drawn: the lookup reads this face
+        passes.append(ShadowPass("point", index, face, tile, clip, drawn))
+    if passes:
+        params[:] = (1.0, tan_half, light_map.shadow.kernel, light_map.resolution)
+        depth[:] = (0.5 - 0.5 * projection[2, 2], 0.5 * projection[2, 3], near, far)
+    return passes, rects, params, depth
+
+
+def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | None = None) -> ShadowPlan:
+    """The frame's shadow passes and lookup uniforms (module docstring). `visible`: which
+    objects the camera can see (renderer/core/visibility.visible_objects; all if None); only
+    those count as receivers to fit a map to."""
+    n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
+    uniforms = {
+        "u_shadow_atlas_size": np.array(float(layout.atlas_side)),
+        "u_directional_shadow_matrix": np.tile(np.eye(4), (n_dir, 1, 1)),
+        "u_directional_shadow": np.zeros((n_dir, 4)),
+        "u_directional_shadow_bias": np.zeros((n_dir, 4)),
+        "u_point_shadow": np.zeros((n_point, 4)),
+        "u_point_shadow_depth": np.zeros((n_point, 4)),
+        "u_point_shadow_bias": np.zeros((n_point, 4)),
+        "u_point_shadow_tiles": np.zeros((6 * n_point, 4)),
+    }
+    plan = ShadowPlan(layout, [], uniforms)
+    if not layout.any:
+        return plan
+    visible = [True] * len(scene.objects) if visible is None else visible
+    points = world_points(scene, matrices)
+    receivers = [i for i, o in enumerate(scene.objects)
+                 if o.receives_shadows and visible[i] and o.mesh.triangle_count]
+    casters = [i for i, o in enumerate(scene.objects) if o.casts_shadows and o.mesh.triangle_count]
+    frustum = _camera_frustum_corners(matrices, scene.camera.reversed_z)
+    for light_map in layout.maps:
+        i = light_map.index
+        bias = light_map.shadow.bias_rule().as_vec4()
+        if light_map.kind == "directional":
+            shadow_pass, lookup, params, texel = _plan_directional(
+                i, scene.directional_lights[i], light_map, layout, scene, points, receivers,
+                casters, frustum)
+            uniforms["u_directional_shadow_matrix"][i] = lookup
+            uniforms["u_directional_shadow"][i] = params
+            uniforms["u_directional_shadow_bias"][i] = bias
+            plan.texel_size[("directional", i)] = texel
+            if shadow_pass is not None:
+                plan.passes.append(shadow_pass)
+        else:
+            passes, rects, params, depth = _plan_point(
+                i, scene.point_lights[i], light_map, layout, matrices, points, receivers, casters)
+            uniforms["u_point_shadow"][i] = params
+            uniforms["u_point_shadow_depth"][i] = depth
+            uniforms["u_point_shadow_bias"][i] = bias
+            uniforms["u_point_shadow_tiles"][6 * i:6 * i + 6] = rects
+            plan.passes.extend(passes)
+    return plan

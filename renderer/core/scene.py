@@ -17,7 +17,7 @@ from typing import Literal
 import numpy as np
 
 from renderer.core import transforms
-from renderer.core.shadows import Shadow
+from renderer.core.shadow_settings import Shadow
 
 Projection = Literal["perspective", "parallel"]
 ShadingMode = Literal["flat", "gouraud", "phong"]

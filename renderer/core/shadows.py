@@ -6,8 +6,8 @@ light, drawn by a depth-only pass (glsl/shadow/depth.vert, reference/shadow/dept
 compared by GL's depth-compare sampler (glsl/shadow/lookup.glsl, reference/shadow/lookup.py).
 This module holds what the GPU path and the reference share and neither computes on its own:
 
-- the settings of a light's map (`Shadow`: on/off, resolution, filter, bias) and their
-  defaults; objects carry `casts_shadows` / `receives_shadows` (renderer/core/scene.py);
+- (the settings of a light's map, `Shadow`: on/off, resolution, filter, bias, are in
+  renderer/core/shadow_settings.py; objects carry `casts_shadows` / `receives_shadows`);
 - the atlas: every map of a scene is a square tile in one DEPTH_COMPONENT32F texture whose
   side is a power of two (`ShadowLayout`, packed by `pack_tiles`); a directional light has
   one tile, a point light six (the faces of a cube around it, each a 90-degree perspective
@@ -16,7 +16,6 @@ This module holds what the GPU path and the reference share and neither computes
   fitted to the receivers the camera can see and the casters that can shadow them, six
   perspective views for a point light, the passes worth drawing (none for a light that
   nothing can shadow, none for a cube face that sees no caster), and the uniform values;
-- the filters (`FILTERS`, `tap_offsets`) and the bias rule (`BiasRule`, `auto_bias`).
 
 Coordinates are camera-relative, as everything else the pipelines get (FrameMatrices). Tile
 texel (i, j) of a tile at atlas texel (x0, y0) is atlas texel (x0 + i, y0 + j); rows count up
@@ -31,125 +30,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from renderer.core import transforms
-
-# --- settings --------------------------------------------------------------------------------
-
-# filter name -> kernel k: "hard" is one nearest-texel comparison (k = 1); "pcfKxK" is the mean
-# of (K-1)^2 bilinear comparisons (GL's LINEAR depth compare) on a unit grid centred on the
-# point, so that together they read a K x K block of texels (`tap_offsets`).
-FILTERS = {"hard": 1, "pcf2x2": 2, "pcf3x3": 3, "pcf5x5": 5}
-DEFAULT_FILTER = "pcf2x2"
-
-RESOLUTIONS = (256, 512, 1024, 2048, 4096)     # texels on a side of one tile; powers of two
-MAX_ATLAS_SIDE = 8192                          # 256 MiB of float depth; GL guarantees 16384
-
-
-@dataclass(frozen=True)
-class BiasRule:
-    """How far a receiver's lookup point moves before it is compared, in texels of its map
-    (t, the world size of one texel at the point): along the surface normal N by
-    normal * (|N.X| + |N.Y|) (X, Y the map's axes: the normal offset), and towards the light
-    by constant + slope * min(tan(theta), MAX_SLOPE) (a depth bias; theta is the angle
-    between N and the light). `auto_bias(filter)` is the rule that needs no tuning."""
-    normal: float = 0.0
-    constant: float = 0.0
-    slope: float = 0.0
-
-    def as_vec4(self) -> np.ndarray:
-        return np.array([self.normal, self.constant, self.slope, 0.0])
-
-
-MAX_SLOPE = 16.0                       # tan(theta) is capped here in the slope term (86.4 deg)
-CONSTANT_BIAS_TEXELS = 0.25            # towards the light: rounding of depth and position
-
-
-def footprint_radius(kernel: int) -> float:
-    """How far (texels, along each map axis) from the lookup point the centres of the texels a
-    filter reads may lie: 1/2 for the nearest texel, K/2 for K x K PCF (bilinear taps reach
-    1 texel past their own position; the taps lie within (K-2)/2 of the point)."""
-    return 0.5 if kernel == 1 else kernel / 2.0
-
-
-def auto_bias(filter_name: str) -> BiasRule:
-    """The automatic bias: a normal offset of the filter's footprint radius.
-
-    For a planar receiver, moving the lookup point o texels along N lifts it o cos(theta)
-    towards the light and moves it o sin(theta) across the map, where the plane lies
-    o sin(theta) tan(theta) further away: a margin of o / cos(theta) in depth. A texel centre
-    the filter reads lies at most r = radius (|n_x| + |n_y|) / sin(theta) across the map in
-    the plane's downhill direction (n_x, n_y: N on the map's axes; the bound is exact for the
-    square of centres), where the plane is r tan(theta) nearer. No texel of the receiver itself
-    then shadows the point when o / cos(theta) >= r tan(theta), i.e. o >= radius (|n_x| + |n_y|):
-    finite at every angle, unlike a slope-scaled depth bias (tan(theta) is unbounded at grazing
-    light). CONSTANT_BIAS_TEXELS more towards the light covers rounding (depth stored in
-    float32, positions interpolated in float32)."""
-    return BiasRule(normal=footprint_radius(FILTERS[filter_name]), constant=CONSTANT_BIAS_TEXELS)
-
-
-BIAS_RULES = ("auto", "slope", "constant", "none")   # the report's knob (renderer/study)
-
-
-def named_bias(rule: str, filter_name: str) -> BiasRule:
-    """The report's bias rules: "auto" (above), "slope" (the classic slope-scaled depth bias
-    with the same footprint: no normal offset), "constant" (a fixed depth bias of one texel),
-    "none" (nothing: acne everywhere a surface faces the light)."""
-    radius = footprint_radius(FILTERS[filter_name])
-    if rule == "auto":
-        return auto_bias(filter_name)
-    if rule == "slope":
-        return BiasRule(constant=CONSTANT_BIAS_TEXELS, slope=radius * math.sqrt(2.0))
-    if rule == "constant":
-        return BiasRule(constant=1.0)
-    if rule == "none":
-        return BiasRule()
-    raise ValueError(f"bias rule must be one of {', '.join(BIAS_RULES)}, got {rule!r}")
-
-
-@dataclass(frozen=True)
-class Shadow:
-    """A light's shadow-map settings (scene file: the light's `shadows`, `shadow_resolution`,
-    `shadow_filter`, `shadow_bias` keys). resolution None: `auto_resolution`; bias None:
-    `auto_bias(filter)`."""
-    enabled: bool = True
-    resolution: int | None = None
-    filter: str = DEFAULT_FILTER
-    bias: BiasRule | None = None
-
-    @property
-    def kernel(self) -> int:
-        return FILTERS[self.filter]
-
-    def bias_rule(self) -> BiasRule:
-        return self.bias if self.bias is not None else auto_bias(self.filter)
-
-
-def auto_resolution(width: int, height: int, point: bool) -> int:
-    """The default tile side: the power of two at or above twice the image's longer side, so
-    that a map spread over the view has about two texels per pixel on a side (a point light's
-    face, a quarter of the directions around it, the power of two at or above the longer
-    side); within RESOLUTIONS."""
-    target = max(width, height) * (1 if point else 2)
-    side = 1 << max(0, math.ceil(math.log2(max(target, 1))))
-    return min(max(side, RESOLUTIONS[0]), RESOLUTIONS[-1])
-
-
-def tap_offsets(kernel: int) -> np.ndarray:
-    """(T, 2) tap positions in texels from the lookup point, in the order both twins sum them:
-    the nearest texel's comparison at 0 for "hard"; for K x K, every (i - (K-2)/2, j - (K-2)/2)
-    with i, j = 0..K-2, j (the map's y) outer."""
-    if kernel == 1:
-        return np.zeros((1, 2))
-    steps = np.arange(kernel - 1) - (kernel - 2) / 2.0
-    ys, xs = np.meshgrid(steps, steps, indexing="ij")
-    return np.stack([xs.ravel(), ys.ravel()], axis=1)
-
-
-def guard_texels(kernel: int, bias: BiasRule) -> int:
-    """Texels at each edge of a tile that the region it answers for leaves free: the filter's
-    footprint plus the normal offset's move across the map (at most normal * sqrt(2) texels),
-    rounded up, plus one for rounding. No tap of a lookup inside the region leaves the tile."""
-    return math.ceil(footprint_radius(kernel) + bias.normal * math.sqrt(2.0)) + 1
-
+from renderer.core.gl_rules import depth_mapping
+from renderer.core.shadow_settings import MAX_ATLAS_SIDE, Shadow, auto_resolution, guard_texels
+from renderer.core.visibility import CLIP_PLANES
 
 # --- cube faces ------------------------------------------------------------------------------
 
@@ -333,7 +216,6 @@ def world_points(scene, matrices) -> list[np.ndarray]:
 
 def _camera_frustum_corners(matrices, reversed_z: bool) -> np.ndarray:
     """(8, 3) corners of the camera's view volume, camera-relative world."""
-    from renderer.core.gl_rules import depth_mapping
     mapping = depth_mapping(reversed_z)
     inverse = np.linalg.inv(matrices.projection @ matrices.view)
     corners = np.array([[x, y, z, 1.0] for x in (-1.0, 1.0) for y in (-1.0, 1.0)
@@ -411,7 +293,6 @@ def _box_distance(points: np.ndarray, position: np.ndarray) -> float:
 def _outside_frustum(clip_from_world: np.ndarray, points: np.ndarray) -> bool:
     """True when the points' bounding box lies wholly outside one clip plane (as
     renderer/core/visibility.py tests objects against the camera's)."""
-    from renderer.core.visibility import CLIP_PLANES
     lo, hi = points.min(axis=0), points.max(axis=0)
     corners = np.array([[(hi if (k >> a) & 1 else lo)[a] for a in range(3)] + [1.0] for k in range(8)])
     clip = corners @ clip_from_world.T

@@ -1,0 +1,131 @@
+// Twin: reference/shadow/lookup.py
+// The shadow-map lookup (docs/conventions.md, "Shadows"; the rules: renderer/core/shadows.py and
+// renderer/core/shadow_settings.py): whether light i reaches the surface point P with unit normal N
+// (the normal that is lit), as lighting.glsl's SHADOWS hook asks: 1 lit, 0 in shadow, a fraction
+// where a filter straddles a shadow edge. The point is first moved by the bias rule, then compared
+// with the depth the light's depth pass stored (glsl/shadow/depth.vert) through GL's depth-compare
+// sampler: a tap is lit where its reference depth is <= the stored one (LEQUAL), and LINEAR
+// filtering blends the four nearest texels' comparisons bilinearly (percentage-closer filtering).
+// Every map is a square tile of one atlas (u_shadow_atlas, its side u_shadow_atlas_size a power of
+// two); a point light has six, one per cube face, each widened so that no tap leaves its tile.
+// Coordinates are camera-relative world coordinates, as lighting.glsl's.
+
+#ifndef NUM_DIRECTIONAL_LIGHTS
+#define NUM_DIRECTIONAL_LIGHTS 0
+#endif
+#ifndef NUM_POINT_LIGHTS
+#define NUM_POINT_LIGHTS 0
+#endif
+#define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
+
+uniform sampler2DShadow u_shadow_atlas;
+uniform float u_shadow_atlas_size;   // S, texels on a side
+
+#if NUM_DIRECTIONAL_LIGHTS > 0
+uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];  // P -> (u, v, z_w) in the atlas
+uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];         // (drawn, texel size, kernel, 0)
+uniform vec4 u_directional_shadow_bias[NUM_DIRECTIONAL_LIGHTS];    // (normal, constant, slope) texels
+#endif
+#if NUM_POINT_LIGHTS > 0
+uniform vec4 u_point_shadow[NUM_POINT_LIGHTS];             // (drawn, tan(half angle), kernel, R)
+uniform vec4 u_point_shadow_depth[NUM_POINT_LIGHTS];       // (A, B, near, far): z_w = A + B / m
+uniform vec4 u_point_shadow_bias[NUM_POINT_LIGHTS];        // (normal, constant, slope) texels
+uniform vec4 u_point_shadow_tiles[6 * NUM_POINT_LIGHTS];   // per face (u0, v0, size, drawn)
+#endif
+
+// The receiver point moved before it is compared (shadow_settings.BiasRule): along N by
+// normal * (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by
+// constant + slope * min(tan(theta), SHADOW_MAX_SLOPE) texels; t is the world size of a texel.
+vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bias) {
+    float c = clamp(dot(N, L), 0.0, 1.0);
+    float s = sqrt(1.0 - c * c);
+    float tan_theta = c > 0.0 ? min(s / c, SHADOW_MAX_SLOPE) : SHADOW_MAX_SLOPE;
+    float normal = bias.x * (abs(dot(N, X)) + abs(dot(N, Y)));
+    float toward = bias.y + bias.z * tan_theta;
+    return P + t * (normal * N + toward * L);
+}
+
+// The filter (shadow_settings.FILTERS, tap_offsets): kernel 1 is the nearest texel's comparison,
+// read through the LINEAR sampler at that texel's centre (exact: S is a power of two, so the
+// centre's weight is 1); K x K PCF is the mean of (K-1)^2 bilinear comparisons on a unit grid
+// centred on the point, j (the map's y) outer.
+float shadow_filter(vec3 uvz, int kernel) {
+    float S = u_shadow_atlas_size;
+    if (kernel == 1) {
+        return texture(u_shadow_atlas, vec3((floor(uvz.xy * S) + 0.5) / S, uvz.z));
+    }
+    float sum = 0.0;
+    float first = -0.5 * float(kernel - 2);
+    for (int j = 0; j < kernel - 1; ++j) {
+        for (int i = 0; i < kernel - 1; ++i) {
+            vec2 offset = vec2(first + float(i), first + float(j));
+            sum += texture(u_shadow_atlas, vec3(uvz.xy + offset / S, uvz.z));
+        }
+    }
+    return sum / float((kernel - 1) * (kernel - 1));
+}
+
+#if NUM_DIRECTIONAL_LIGHTS > 0
+float light_visibility_directional(int i, vec3 P, vec3 N) {
+    vec4 p = u_directional_shadow[i];
+    if (p.x == 0.0) {
+        return 1.0;                  // no pass this frame: nothing can shadow the receivers
+    }
+    mat4 M = u_directional_shadow_matrix[i];
+    vec3 L = normalize(-u_directional_direction[i]);
+    vec3 X = normalize(vec3(M[0][0], M[1][0], M[2][0]));     // row 0 of M: the map's x axis
+    vec3 Y = normalize(vec3(M[0][1], M[1][1], M[2][1]));     // row 1: its y axis
+    vec3 Q = shadow_bias_point(P, N, L, X, Y, p.y, u_directional_shadow_bias[i]);
+    return shadow_filter((M * vec4(Q, 1.0)).xyz, int(p.z));
+}
+#endif
+
+#if NUM_POINT_LIGHTS > 0
+// The cube (shadows.CUBE_FACE_ROTATIONS): face f's right, up and axis (= -back) vectors.
+const vec3 CUBE_FACE_RIGHT[6] = vec3[6](vec3(0, 0, -1), vec3(0, 0, 1), vec3(1, 0, 0),
+                                        vec3(1, 0, 0), vec3(1, 0, 0), vec3(-1, 0, 0));
+const vec3 CUBE_FACE_UP[6] = vec3[6](vec3(0, 1, 0), vec3(0, 1, 0), vec3(0, 0, -1),
+                                     vec3(0, 0, 1), vec3(0, 1, 0), vec3(0, 1, 0));
+const vec3 CUBE_FACE_AXIS[6] = vec3[6](vec3(1, 0, 0), vec3(-1, 0, 0), vec3(0, 1, 0),
+                                       vec3(0, -1, 0), vec3(0, 0, 1), vec3(0, 0, -1));
+
+// The face a direction d from the light falls on: its major axis, ties to the earlier axis
+// (x, then y, then z); a negative component picks the odd face (+x 0, -x 1, +y 2, ...).
+int cube_face(vec3 d) {
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return d.x < 0.0 ? 1 : 0;
+    }
+    if (a.y >= a.z) {
+        return d.y < 0.0 ? 3 : 2;
+    }
+    return d.z < 0.0 ? 5 : 4;
+}
+
+float light_visibility_point(int i, vec3 P, vec3 N) {
+    vec4 p = u_point_shadow[i];
+    if (p.x == 0.0) {
+        return 1.0;
+    }
+    vec3 light = u_point_position[i];
+    vec3 to_light = light - P;
+    if (dot(to_light, to_light) == 0.0) {
+        return 1.0;                  // a light on the surface: fully incident (lighting.glsl)
+    }
+    vec3 L = normalize(to_light);
+    int f0 = cube_face(-to_light);
+    float t = 2.0 * dot(CUBE_FACE_AXIS[f0], -to_light) * p.y / p.w;   // a texel at P's distance
+    vec3 Q = shadow_bias_point(P, N, L, CUBE_FACE_RIGHT[f0], CUBE_FACE_UP[f0], t,
+                               u_point_shadow_bias[i]);
+    vec3 d = Q - light;
+    int f = cube_face(d);
+    vec4 rect = u_point_shadow_tiles[6 * i + f];
+    if (rect.w == 0.0) {
+        return 1.0;                  // the face sees no caster: it was not drawn
+    }
+    float m = dot(CUBE_FACE_AXIS[f], d);
+    vec2 uv_tile = 0.5 * vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / (m * p.y) + 0.5;
+    vec4 depth = u_point_shadow_depth[i];
+    return shadow_filter(vec3(rect.xy + uv_tile * rect.z, depth.x + depth.y / m), int(p.z));
+}
+#endif

@@ -19,7 +19,7 @@ import numpy as np
 FILTERS = {"hard": 1, "pcf2x2": 2, "pcf3x3": 3, "pcf5x5": 5}
 DEFAULT_FILTER = "pcf2x2"
 
-RESOLUTIONS = (256, 512, 1024, 2048, 4096)     # texels on a side of one tile; powers of two
+RESOLUTIONS = (64, 128, 256, 512, 1024, 2048, 4096)   # texels on a side of a map; powers of two
 MAX_SHADOW_TEXELS = 1 << 26                    # all layers together: 256 MiB of float32 depth
 
 

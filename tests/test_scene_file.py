@@ -659,16 +659,16 @@ BAD_SCENES = [
     ("shadows as a string", LIGHT + 'shadows = "off"\n',
      "lights[0].shadows: expected true or false, got a string ('off')"),
     ("resolution not a power of two", LIGHT + "shadow_resolution = 1000\n",
-     "lights[0].shadow_resolution: expected one of 256, 512, 1024, 2048, 4096 (texels on a side "
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
      "of the map) or \"auto\", got an integer (1000)"),
     ("resolution too large", '[[lights]]\ntype = "point"\nshadow_resolution = 8192\n',
-     "lights[0].shadow_resolution: expected one of 256, 512, 1024, 2048, 4096 (texels on a side "
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
      "of the map) or \"auto\", got an integer (8192)"),
     ("resolution as a float", LIGHT + "shadow_resolution = 1024.0\n",
-     "lights[0].shadow_resolution: expected one of 256, 512, 1024, 2048, 4096 (texels on a side "
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
      "of the map) or \"auto\", got a number (1024)"),
     ("resolution as another string", LIGHT + 'shadow_resolution = "high"\n',
-     "lights[0].shadow_resolution: expected one of 256, 512, 1024, 2048, 4096 (texels on a side "
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
      "of the map) or \"auto\", got a string ('high')"),
     ("unknown shadow filter", LIGHT + 'shadow_filter = "pcf4x4"\n',
      "lights[0].shadow_filter: unknown shadow filter 'pcf4x4'; did you mean 'pcf5x5'? expected "
@@ -682,8 +682,8 @@ BAD_SCENES = [
      "lights[0].shadow_bias.slope_scale: unknown key; did you mean 'slope'?"),
     ("negative shadow bias", LIGHT + "shadow_bias = { normal = -0.5 }\n",
      "lights[0].shadow_bias.normal: must be >= 0, got -0.5"),
-    ("shadow bias too large", '[[lights]]\ntype = "point"\nshadow_bias = { constant = 20 }\n',
-     "lights[0].shadow_bias.constant: must be <= 16 texels, got 20"),
+    ("shadow bias too large", '[[lights]]\ntype = "point"\nshadow_bias = { constant = 8.5 }\n',
+     "lights[0].shadow_bias.constant: must be <= 8 texels, got 8.5"),
     ("nan shadow bias", LIGHT + "shadow_bias = { slope = nan }\n",
      "lights[0].shadow_bias.slope: expected a finite number, got nan"),
     ("shadow bias term as a string", LIGHT + 'shadow_bias = { constant = "auto" }\n',

@@ -552,19 +552,17 @@ def cmd_shaders(args) -> int:
 
 
 def cmd_report(args) -> int:
-    from renderer.core.builtin import builtin_scenes
+    from renderer.core.builtin import builtin_scenes, made_for_raytracing
     from renderer.study.report import run_report
     from renderer.core.imageio import check_folder, check_outputs
-    from renderer.study.ray_report import made_for_raytracing
     from renderer.study.report_settings import QUICK_SCENES, RAY_QUICK_SCENES
     check_outputs(check_folder(args.out) / "report.md", args.out / "results.csv")
     traced = args.method == "raytrace"
     if args.scenes or args.quick:
         names = args.scenes or (RAY_QUICK_SCENES if traced else QUICK_SCENES)
         scenes = [_load(name) for name in names]
-    else:                  # the built-in scenes made for the method: shapes, k_r, k_t or none
-        scenes = [scene for scene in map(_load, builtin_scenes())
-                  if made_for_raytracing(scene) == traced]
+    else:                  # the built-in scenes made for the method (their descriptions say)
+        scenes = [_load(name) for name in builtin_scenes() if made_for_raytracing(name) == traced]
         if not scenes:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")

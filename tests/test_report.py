@@ -10,10 +10,10 @@ import pytest
 
 from conftest import RAYTRACE_SCENES
 
-from renderer.core.builtin import builtin_scenes
+from renderer.core.builtin import builtin_scenes, made_for_raytracing
 from renderer.study.ground_truth import RAY_TRUTH_DEPTH, ground_truth
 from renderer.study.ray_report import (RAY_QUICK, RayStudy, RaySceneRun, RaySetting,
-                                       made_for_raytracing, ray_settings)
+                                       ray_settings)
 from renderer.study.report import QUICK, ReportResult, metrics, settings
 from renderer.study.report_settings import CSV_COLUMNS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS
 from renderer.study.report_output import convergence_slopes, pareto_front, series_name
@@ -191,13 +191,12 @@ def test_adaptive_thresholds_are_series_of_their_own_fitted_in_samples_and_in_ti
     assert in_time[("adaptive @16/255", "gpu")].samples == (4, 36)
 
 
-def test_the_scenes_made_for_the_ray_tracer():
-    """What `renderer report` reports by default with each --method."""
-    scenes = {name: load_scene(path) for name, path in builtin_scenes().items()}
-    assert {name for name, scene in scenes.items() if made_for_raytracing(scene)} == RAYTRACE_SCENES
-    sphere = scenes["sphere"]                                          # a mesh, no k_r or k_t
-    mirror = replace(sphere.objects[0].material, kr=(0.5, 0.5, 0.5))
-    assert made_for_raytracing(replace(sphere, objects=[replace(sphere.objects[0], material=mirror)]))
+def test_the_scenes_made_for_the_ray_tracer(tmp_path):
+    """What `renderer report` reports by default with each --method: the description says."""
+    assert {name for name in builtin_scenes() if made_for_raytracing(name)} == RAYTRACE_SCENES
+    mine = tmp_path / "mine.toml"
+    mine.write_text('description = "Mirrors (--method raytrace)"\n')
+    assert made_for_raytracing(str(mine))
 
 
 def test_a_tiny_ray_sweep_gpu_and_reference(tmp_path, gl_contexts):

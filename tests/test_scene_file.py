@@ -20,14 +20,16 @@ from renderer.core.scene import (Camera, DirectionalLight, Material, Plane, Poin
                             Transform)
 from renderer.core.meshio import load_mesh
 from renderer.core.scene_file import load_scene, scene_from_dict
+from renderer.core.shadow_settings import RESOLUTIONS, BiasRule, Shadow, auto_bias
 
 REPO = Path(__file__).resolve().parent.parent
 BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_plane",
                  "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
-                 "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble"}
-# Scenes whose objects deliberately reach outside the view: through the near plane, or a
-# backdrop (tir_bubble's checkerboard) filling the view.
-PARTLY_OUTSIDE = {"near_plane", "tir_bubble"}
+                 "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble",
+                 "shadow_plane", "shadow_room", "shadow_curved"}
+# Scenes whose objects deliberately reach outside the view: through the near plane (a room
+# around the camera), or a backdrop (tir_bubble's checkerboard) filling the view.
+PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room"}
 IMAGE_SIZES = [(640, 480), (320, 240)]
 
 OBJ_TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
@@ -250,10 +252,17 @@ def summary(scene: Scene) -> dict:
         "background": scene.background, "name": scene.name,
         "directional": [dataclasses.asdict(x) for x in scene.directional_lights],
         "point": [dataclasses.asdict(x) for x in scene.point_lights],
-        "objects": [(o.name, o.parent, o.cull, dataclasses.asdict(o.material),
+        "objects": [(o.name, o.parent, o.cull, o.casts_shadows, o.receives_shadows,
+                     dataclasses.asdict(o.material),
                      dataclasses.asdict(o.transform), o.mesh.positions.tolist(),
                      o.mesh.normals.tolist(), o.mesh.faces.tolist()) for o in scene.objects],
     }
+
+
+# The example's directional light: shadow_bias names normal and slope; constant keeps the
+# automatic rule's value for its filter (0.25 texels).
+EXAMPLE_SHADOW = Shadow(resolution=2048, filter="pcf3x3",
+                        bias=BiasRule(normal=2.0, constant=0.25, slope=0.5))
 
 
 def test_complete_example_loads_with_every_value(tmp_path):
@@ -263,9 +272,13 @@ def test_complete_example_loads_with_every_value(tmp_path):
     assert scene.camera == Camera(eye=(0.0, 2.0, 8.0), look=(0.0, 0.5, 0.0), up=(0.0, 1.0, 0.0),
                                   projection="perspective", fov_y=50.0, height=4.0, near=0.5,
                                   far=60.0)
-    assert scene.directional_lights == [DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8))]
-    assert scene.point_lights == [PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01))]
+    assert scene.directional_lights == [DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8),
+                                                        EXAMPLE_SHADOW)]
+    assert scene.point_lights == [PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01),
+                                             Shadow(enabled=False))]
     floor, ball, box, knot, gem = scene.objects
+    assert [(o.casts_shadows, o.receives_shadows) for o in scene.objects] == [
+        (False, True), (True, True), (True, True), (True, True), (True, False)]
     red = Material((0.3, 0.05, 0.05), (0.8, 0.1, 0.1), (0.6, 0.6, 0.6), 50.0, False, "phong")
     grey = Material((0.4, 0.4, 0.4), (0.5, 0.5, 0.5), (0.0, 0.0, 0.0), 1.0, True, "gouraud")
     assert (floor.name, floor.material, floor.cull, floor.parent) == ("floor", grey, "none", None)
@@ -305,7 +318,8 @@ def test_complete_example_round_trip_file_dict_and_dataclasses(tmp_path):
         camera=Camera((0.0, 2.0, 8.0), (0.0, 0.5, 0.0), (0.0, 1.0, 0.0), "perspective",
                       50.0, 4.0, 0.5, 60.0),
         objects=[
-            SceneObject("floor", plane(10.0, 4), grey, Transform(translate=(0.0, -1.0, 0.0))),
+            SceneObject("floor", plane(10.0, 4), grey, Transform(translate=(0.0, -1.0, 0.0)),
+                        casts_shadows=False),
             SceneObject("ball", uv_sphere(1.0, 24, 12), red,
                         Transform((1.0, 1.5, 1.0), {}, (0.0, 0.0, 10.0), (-2.0, 0.5, 0.0)),
                         cull="back"),
@@ -316,10 +330,12 @@ def test_complete_example_round_trip_file_dict_and_dataclasses(tmp_path):
             from_file.objects[3],
             SceneObject("gem", load_mesh(assets_dir() / "meshes" / "tetrahedron.stl",
                                          crease_angle=120.0),
-                        transform=Transform((0.5, 0.5, 0.5), translate=(0.0, 0.5, -2.0))),
+                        transform=Transform((0.5, 0.5, 0.5), translate=(0.0, 0.5, -2.0)),
+                        receives_shadows=False),
         ],
-        directional_lights=[DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8))],
-        point_lights=[PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01))],
+        directional_lights=[DirectionalLight((-1.0, -1.0, -1.0), (0.8, 0.8, 0.8), EXAMPLE_SHADOW)],
+        point_lights=[PointLight((2.0, 3.0, 2.0), (0.5, 0.4, 0.3), (1.0, 0.1, 0.01),
+                                 Shadow(enabled=False))],
         ambient=(0.2, 0.2, 0.2), background=(0.05, 0.05, 0.1), name="example")
     assert summary(built) == summary(from_file)
     for a, b in zip(built.world_matrices(), from_file.world_matrices()):
@@ -347,7 +363,51 @@ scale = 2
     assert scene.point_lights == [PointLight()] and scene.directional_lights == [DirectionalLight()]
     [obj] = scene.objects
     assert obj.name == "object0" and obj.material == Material() and obj.cull == "none"
+    assert obj.casts_shadows and obj.receives_shadows
+    assert scene.point_lights[0].shadow == Shadow(enabled=True, resolution=None, filter="pcf2x2",
+                                                  bias=None)
     assert obj.transform == Transform(scale=(2.0, 2.0, 2.0))
+
+
+def light_shadow(tmp_path, keys: str, kind: str = "directional") -> Shadow:
+    scene = load_scene(write(tmp_path, "s.toml", f'[[lights]]\ntype = "{kind}"\n{keys}'))
+    return (scene.directional_lights or scene.point_lights)[0].shadow
+
+
+@pytest.mark.parametrize("kind", ["directional", "point"])
+def test_shadow_keys_of_a_light(tmp_path, kind):
+    assert light_shadow(tmp_path, "shadows = false\n", kind) == Shadow(enabled=False)
+    for resolution in RESOLUTIONS:
+        assert light_shadow(tmp_path, f"shadow_resolution = {resolution}\n", kind).resolution \
+            == resolution
+    assert light_shadow(tmp_path, 'shadow_resolution = "auto"\n', kind).resolution is None
+    for name in ("hard", "pcf2x2", "pcf3x3", "pcf5x5"):
+        assert light_shadow(tmp_path, f'shadow_filter = "{name}"\n', kind).filter == name
+
+
+def test_shadow_bias_terms_not_given_keep_the_automatic_rule(tmp_path):
+    """auto_bias: a normal offset of the filter's footprint radius (1/2 texel for hard, K/2
+    for K x K) and 1/4 texel towards the light; a shadow_bias table replaces what it names."""
+    shadow = light_shadow(tmp_path, 'shadow_filter = "pcf5x5"\nshadow_bias = { slope = 2 }\n')
+    assert shadow.bias_rule() == BiasRule(normal=2.5, constant=0.25, slope=2.0)
+    shadow = light_shadow(tmp_path, 'shadow_filter = "hard"\nshadow_bias = { constant = 0 }\n')
+    assert shadow.bias_rule() == BiasRule(normal=0.5, constant=0.0, slope=0.0)
+    shadow = light_shadow(tmp_path, "shadow_bias = { normal = 0, constant = 1, slope = 0.5 }\n")
+    assert shadow.bias_rule() == BiasRule(normal=0.0, constant=1.0, slope=0.5)
+    # an empty table is the automatic rule, written out
+    assert light_shadow(tmp_path, "shadow_bias = {}\n").bias == auto_bias("pcf2x2") \
+        == BiasRule(normal=1.0, constant=0.25)
+    # the filter counts wherever its key stands
+    shadow = light_shadow(tmp_path, 'shadow_bias = { slope = 1 }\nshadow_filter = "pcf3x3"\n')
+    assert shadow.bias_rule() == BiasRule(normal=1.5, constant=0.25, slope=1.0)
+
+
+def test_objects_cast_and_receive_shadows_as_told(tmp_path):
+    scene = load_scene(write(tmp_path, "s.toml", OBJECT + "casts_shadows = false\n"
+                             '[[objects]]\nmesh = { primitive = "cube" }\n'
+                             "receives_shadows = false\ncasts_shadows = true\n"))
+    assert [(o.casts_shadows, o.receives_shadows) for o in scene.objects] == [(False, True),
+                                                                              (True, False)]
 
 
 def test_parallel_camera_allows_a_negative_near(tmp_path):
@@ -399,6 +459,7 @@ def test_scene_from_dict_accepts_tuples_and_names_its_source():
 # --------------------------------------------------------------------------- refusals
 
 OBJECT = '[[objects]]\nname = "ball"\nmesh = { primitive = "uv_sphere" }\n'
+LIGHT = '[[lights]]\ntype = "directional"\n'
 
 # (test id, scene text, expected "KEY.PATH: reason" after "FILE: ")
 BAD_SCENES = [
@@ -411,7 +472,7 @@ BAD_SCENES = [
      "objects[0].material.kdd: unknown key; did you mean 'kd'?"),
     ("unknown light key for its type", '[[lights]]\ntype = "directional"\nposition = [0, 1, 0]\n',
      "lights[0].position: belongs to point lights, not directional ones; keys here: type, "
-     "direction, intensity"),
+     "direction, intensity, shadows, shadow_resolution, shadow_filter, shadow_bias"),
     ("unknown object key", OBJECT + "translation = [0, 1, 0]\n",
      "objects[0].translation: unknown key; did you mean 'translate'?"),
     ("unknown shear factor", OBJECT + "shear = { xx = 1.0 }\n",
@@ -594,6 +655,48 @@ BAD_SCENES = [
      "lights[0].attenuation: must not be all zero: the light is divided by c + l d + q d^2"),
     ("negative intensity", '[[lights]]\ntype = "point"\nintensity = [1, 1, -1]\n',
      "lights[0].intensity: must be >= 0 in every component, item 2 is -1"),
+    # shadows
+    ("shadows as a string", LIGHT + 'shadows = "off"\n',
+     "lights[0].shadows: expected true or false, got a string ('off')"),
+    ("resolution not a power of two", LIGHT + "shadow_resolution = 1000\n",
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
+     "of the map) or \"auto\", got an integer (1000)"),
+    ("resolution too large", '[[lights]]\ntype = "point"\nshadow_resolution = 8192\n',
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
+     "of the map) or \"auto\", got an integer (8192)"),
+    ("resolution as a float", LIGHT + "shadow_resolution = 1024.0\n",
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
+     "of the map) or \"auto\", got a number (1024)"),
+    ("resolution as another string", LIGHT + 'shadow_resolution = "high"\n',
+     "lights[0].shadow_resolution: expected one of 64, 128, 256, 512, 1024, 2048, 4096 (texels on a side "
+     "of the map) or \"auto\", got a string ('high')"),
+    ("unknown shadow filter", LIGHT + 'shadow_filter = "pcf4x4"\n',
+     "lights[0].shadow_filter: unknown shadow filter 'pcf4x4'; did you mean 'pcf5x5'? expected "
+     "one of: hard, pcf2x2, pcf3x3, pcf5x5"),
+    ("shadow filter as a number", LIGHT + "shadow_filter = 3\n",
+     "lights[0].shadow_filter: expected a string, got an integer (3)"),
+    ("shadow bias as a number", LIGHT + "shadow_bias = 0.5\n",
+     "lights[0].shadow_bias: expected a table such as {normal = 1.0, constant = 0.25} (texels), "
+     "got a number (0.5)"),
+    ("unknown shadow bias term", LIGHT + "shadow_bias = { slope_scale = 1 }\n",
+     "lights[0].shadow_bias.slope_scale: unknown key; did you mean 'slope'?"),
+    ("negative shadow bias", LIGHT + "shadow_bias = { normal = -0.5 }\n",
+     "lights[0].shadow_bias.normal: must be >= 0, got -0.5"),
+    ("shadow bias too large", '[[lights]]\ntype = "point"\nshadow_bias = { constant = 8.5 }\n',
+     "lights[0].shadow_bias.constant: must be <= 8 texels, got 8.5"),
+    ("nan shadow bias", LIGHT + "shadow_bias = { slope = nan }\n",
+     "lights[0].shadow_bias.slope: expected a finite number, got nan"),
+    ("shadow bias term as a string", LIGHT + 'shadow_bias = { constant = "auto" }\n',
+     "lights[0].shadow_bias.constant: expected a number, got a string ('auto')"),
+    ("casts_shadows as a number", OBJECT + "casts_shadows = 0\n",
+     "objects[0].casts_shadows: expected true or false, got an integer (0)"),
+    ("receives_shadows as a string", OBJECT + 'receives_shadows = "no"\n',
+     "objects[0].receives_shadows: expected true or false, got a string ('no')"),
+    ("misspelt casts_shadows", OBJECT + "cast_shadows = false\n",
+     "objects[0].cast_shadows: unknown key; did you mean 'casts_shadows'?"),
+    ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
+     "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
+     "two_sided, shading, kr, kt, ior"),
 ]
 
 

@@ -14,7 +14,7 @@ from renderer.core.scene import (Material, Plane, Scene, SceneObject, Sphere, Tr
 from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.errors import SceneError
 
-from conftest import RAYTRACE_SCENES
+from conftest import RAYTRACE_SCENES, SHADOW_SCENES
 
 
 def one_object(**obj) -> dict:
@@ -70,22 +70,24 @@ def test_material_ray_tracer_keys():
     load(one_object(mesh={"primitive": "cube"}, material={"kr": 0.7, "kt": 0.3}))
 
 
-def test_only_the_ray_tracing_builtin_scenes_use_shapes_and_ray_tracer_terms():
+def test_only_the_ray_tracing_and_shadow_builtin_scenes_use_shapes_and_ray_tracer_terms():
     """conftest.RAYTRACE_SCENES is the set of built-in scenes made for the ray tracer: each uses
-    an analytic shape or k_r, k_t, ior and says `--method raytrace` in its description; every
-    other built-in scene uses none of them (the rasteriser's scenes stay as they were)."""
+    an analytic shape or k_r, k_t, ior and says `--method raytrace` in its description. The
+    shadow scenes (conftest.SHADOW_SCENES, made for the rasteriser) use shapes, for the ray
+    tracer's exact shadows, but no k_r, k_t, ior; every other built-in scene uses none of them
+    (the rasteriser's scenes stay as they were)."""
     descriptions = scene_descriptions()
     for name, path in builtin_scenes().items():
         scene = load_scene(path)
         terms = {(m.kr, m.kt, m.ior) for m in (obj.material for obj in scene.objects)}
-        uses_ray_tracing = (any(obj.shape is not None for obj in scene.objects)
-                            or terms != {((0.0,) * 3, (0.0,) * 3, 1.5)})
+        uses_shapes = any(obj.shape is not None for obj in scene.objects)
+        uses_ray_terms = terms != {((0.0,) * 3, (0.0,) * 3, 1.5)}
         made_for_it = name in RAYTRACE_SCENES
-        assert uses_ray_tracing == made_for_it, name
+        assert (uses_shapes or uses_ray_terms) == (made_for_it or name in SHADOW_SCENES), name
+        assert not (uses_ray_terms and name in SHADOW_SCENES), name
         assert ("--method raytrace" in descriptions[name]) == made_for_it, name
-        if not made_for_it:
-            assert all(s is None for s in scene.world_shapes())
-    assert RAYTRACE_SCENES <= set(builtin_scenes())
+    assert RAYTRACE_SCENES | SHADOW_SCENES <= set(builtin_scenes())
+    assert not RAYTRACE_SCENES & SHADOW_SCENES
 
 
 # --------------------------------------------------------------------------- refusals

@@ -6,6 +6,7 @@
     is_scene_name("hierarchy")  True: no folder, no .toml suffix (may name a built-in scene)
     describe("sphere")      its one-line description (for `renderer scenes`)
     scene_descriptions()    {"sphere": "The default: ...", ...}
+    made_for_raytracing("classic")  True: its description says "--method raytrace"
 """
 
 from __future__ import annotations
@@ -19,6 +20,12 @@ from renderer.core.paths import checked_path
 from renderer.errors import SceneError
 
 DEFAULT_SCENE = "sphere"
+
+# What the description of a built-in scene made for the ray tracer says (its author's word:
+# reflection, refraction or shadows that only the ray tracer drew when it was made). Shapes
+# are no mark: the shadow scenes use them so that the ray tracer's shadows, their truth, come
+# from exact spheres and planes, and they are made for the rasteriser.
+RAYTRACE_MARK = "--method raytrace"
 
 
 def assets_dir() -> Path:
@@ -84,3 +91,10 @@ def describe(scene: str) -> str:
 def scene_descriptions() -> dict[str, str]:
     """Name to one-line description of every built-in scene."""
     return {name: scene_description(path) for name, path in builtin_scenes().items()}
+
+
+def made_for_raytracing(scene: str) -> bool:
+    """Whether the built-in scene (by name) or scene file (by path) is made for the ray tracer:
+    its description says RAYTRACE_MARK. `renderer report` with no scenes reports these with
+    --method raytrace, the others with --method raster."""
+    return RAYTRACE_MARK in describe(scene)

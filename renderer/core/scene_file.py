@@ -12,6 +12,7 @@ count list entries from 0: `objects[2].material.kd` is the third [[objects]] tab
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import inspect
 import math
@@ -33,6 +34,8 @@ from renderer.core.paths import checked_path
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core import shapes
+from renderer.core.shadow_settings import (FILTERS, MAX_BIAS_TEXELS, RESOLUTIONS, BiasRule, Shadow,
+                                           auto_bias)
 from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, Plane,
                             PointLight, Scene, SceneObject, Sphere, Transform, energy_excess,
                             world_shape)
@@ -45,12 +48,14 @@ TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials
             "objects")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z")
 MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior")
+SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 LIGHT_KEYS = {
-    "directional": ("type", "direction", "intensity"),
-    "point": ("type", "position", "intensity", "attenuation"),
+    "directional": ("type", "direction", "intensity", *SHADOW_KEYS),
+    "point": ("type", "position", "intensity", "attenuation", *SHADOW_KEYS),
 }
+BIAS_KEYS = tuple(f.name for f in dataclasses.fields(BiasRule))   # normal, constant, slope
 OBJECT_KEYS = ("name", "mesh", "shape", "material", "scale", "shear", "rotate", "translate", "parent",
-               "cull")
+               "cull", "casts_shadows", "receives_shadows")
 MESH_FILE_KEYS = ("file", "crease_angle")
 SHAPE_TYPES = ("sphere", "plane")
 SHAPE_KEYS = {
@@ -491,7 +496,48 @@ class _Reader:
                                                   "by c + l d + q d^2")
         if "intensity" in raw:
             light.intensity = self.colour(raw["intensity"], key("intensity"))
+        light.shadow = self.shadow(raw, path)
         return light
+
+    def shadow(self, raw: dict, path: str) -> Shadow:
+        """A light's shadow-map settings (shadow_settings.Shadow) from its shadow keys. A
+        `shadow_bias` table sets the terms it names; the others keep the automatic rule's
+        value for the light's filter (auto_bias), so that one term can be changed alone."""
+        key = lambda k: _join(path, k)   # noqa: E731
+        shadow = Shadow()
+        if "shadows" in raw:
+            shadow = Shadow(enabled=self.boolean(raw["shadows"], key("shadows")))
+        if "shadow_resolution" in raw:
+            shadow = dataclasses.replace(shadow, resolution=self.shadow_resolution(
+                raw["shadow_resolution"], key("shadow_resolution")))
+        if "shadow_filter" in raw:
+            shadow = dataclasses.replace(shadow, filter=self.choice(
+                raw["shadow_filter"], key("shadow_filter"), "shadow filter", FILTERS))
+        if "shadow_bias" in raw:
+            where = key("shadow_bias")
+            if not isinstance(raw["shadow_bias"], dict):
+                self.fail(where, f"expected a table such as {{normal = 1.0, constant = 0.25}} "
+                                 f"(texels), got {describe_value(raw['shadow_bias'])}")
+            given = self.table(raw["shadow_bias"], where, BIAS_KEYS)
+            terms = {name: self.number(value, _join(where, name), minimum=0.0)
+                     for name, value in given.items()}
+            for name, value in terms.items():
+                if value > MAX_BIAS_TEXELS:
+                    self.fail(_join(where, name), f"must be <= {MAX_BIAS_TEXELS:g} texels, got "
+                                                  f"{value:g}")
+            shadow = dataclasses.replace(
+                shadow, bias=dataclasses.replace(auto_bias(shadow.filter), **terms))
+        return shadow
+
+    def shadow_resolution(self, value: Any, path: str) -> int | None:
+        """A tile side from shadow_settings.RESOLUTIONS, or "auto" (None: auto_resolution)."""
+        if value == "auto" and isinstance(value, str):
+            return None
+        if isinstance(value, bool) or not isinstance(value, numbers.Integral) \
+                or value not in RESOLUTIONS:
+            self.fail(path, f"expected one of {', '.join(map(str, RESOLUTIONS))} (texels on a "
+                            f"side of the map) or \"auto\", got {describe_value(value)}")
+        return int(value)
 
     def scene_object(self, raw: dict, path: str, index: int,
                      materials: dict[str, Material]) -> SceneObject:
@@ -518,6 +564,9 @@ class _Reader:
             obj.parent = self.string(raw["parent"], key("parent"))
         if "cull" in raw:
             obj.cull = self.choice(raw["cull"], key("cull"), "cull mode", CULL_MODES)
+        for flag in ("casts_shadows", "receives_shadows"):
+            if flag in raw:
+                setattr(obj, flag, self.boolean(raw[flag], key(flag)))
         return obj
 
     def object_material(self, raw: Any, path: str, materials: dict[str, Material]) -> Material:

@@ -40,6 +40,11 @@ class BiasRule:
 
 MAX_SLOPE = 16.0                       # tan(theta) is capped here in the slope term (86.4 deg)
 CONSTANT_BIAS_TEXELS = 0.25            # towards the light: rounding of depth and position
+# The most a bias term may be (scene files refuse more): far beyond any useful bias (the
+# automatic one is at most 2.5 texels), and the guard band it asks for (guard_texels: at most
+# ceil(2.5 + 8 sqrt 2) + 1 = 15 texels at each edge) leaves the smallest map (64 texels) more
+# than half its side.
+MAX_BIAS_TEXELS = 8.0
 
 
 def footprint_radius(kernel: int) -> float:

@@ -43,15 +43,6 @@ from renderer.study.timing import median_timed
 BACKENDS = ("gpu", "reference")
 
 
-def made_for_raytracing(scene) -> bool:
-    """Whether a scene is made for the ray tracer: an analytic shape, or a material that
-    reflects or refracts (k_r or k_t > 0), which the rasteriser draws as a mesh or ignores.
-    `renderer report` with no scenes reports these with --method raytrace, the others with
-    --method raster."""
-    return any(obj.shape is not None or max(obj.material.kr + obj.material.kt) > 0
-               for obj in scene.objects)
-
-
 @dataclass(frozen=True)
 class RaySweep:
     """Which settings a ray-tracing report traces."""

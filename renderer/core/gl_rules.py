@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.core.shadow_settings import scene_has_shadows
+
 # --- depth ---------------------------------------------------------------------------------
 
 GL_LOWER_LEFT = 0x8CA1                   # glClipControl origin: GL's default, kept always
@@ -198,7 +200,6 @@ def too_many_lights(directional: int, point: int, directional_shadows: int = 0,
 def scene_light_problem(scene) -> str | None:
     """too_many_lights for `scene`: its lights, and those with shadows on when the scene has
     shadow maps (the programs then declare their lookup uniforms)."""
-    from renderer.core.shadows import scene_has_shadows      # shadows.py imports this module
     directional, point = scene.directional_lights, scene.point_lights
     maps = scene_has_shadows(scene)
     return too_many_lights(len(directional), len(point),

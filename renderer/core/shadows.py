@@ -31,7 +31,8 @@ import numpy as np
 
 from renderer.core import transforms
 from renderer.core.gl_rules import depth_mapping
-from renderer.core.shadow_settings import MAX_ATLAS_SIDE, Shadow, auto_resolution, guard_texels
+from renderer.core.shadow_settings import (MAX_ATLAS_SIDE, Shadow, auto_resolution, guard_texels,
+                                           scene_has_shadows)
 from renderer.core.visibility import CLIP_PLANES
 
 # --- cube faces ------------------------------------------------------------------------------
@@ -135,12 +136,6 @@ class ShadowLayout:
     @property
     def any(self) -> bool:
         return bool(self.maps)
-
-
-def scene_has_shadows(scene) -> bool:
-    """Whether any object casts and any receives: otherwise no light needs a map."""
-    return (any(o.casts_shadows and o.mesh.triangle_count for o in scene.objects)
-            and any(o.receives_shadows for o in scene.objects))
 
 
 def shadow_layout(scene, width: int, height: int) -> ShadowLayout:

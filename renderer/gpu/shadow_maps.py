@@ -28,6 +28,7 @@ import ctypes
 import moderngl
 import numpy as np
 
+from renderer.core.gl_rules import STANDARD_DEPTH
 from renderer.core.shadows import ShadowLayout, ShadowPlan
 from renderer.core.transforms import to_glsl
 from renderer.errors import ContextError
@@ -129,11 +130,11 @@ class ShadowMaps:
         ctx = self.ctx
         self.framebuffer.use()
         ctx.enable_only(moderngl.DEPTH_TEST)                 # no culling: both sides cast
-        ctx.depth_func = "<"
+        ctx.depth_func = STANDARD_DEPTH.depth_func                        # GL_LESS
         ctx.wireframe = False                                # a viewer's wireframe is the camera's
         for viewport, draws in self._passes:
             ctx.viewport = viewport
-            self.framebuffer.clear(depth=1.0, viewport=viewport)    # this tile only (scissor)
+            self.framebuffer.clear(depth=STANDARD_DEPTH.clear_depth, viewport=viewport)   # the tile alone
             for vao, clip_from_model in draws:
                 self._clip_from_model.write(clip_from_model)
                 vao.render(moderngl.TRIANGLES)

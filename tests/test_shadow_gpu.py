@@ -13,6 +13,7 @@ from renderer.core.gl_rules import (COMPONENTS_PER_DIRECTIONAL_SHADOW, COMPONENT
 from renderer.core.primitives import icosphere, plane
 from renderer.core.scene import Camera, DirectionalLight, Material, Scene, SceneObject, Transform
 from renderer.core.shadow_settings import Shadow
+from renderer.core.shadows import has_shadow_maps, shadow_layout
 from renderer.core.uniforms import SHADOW_UNIFORMS
 from renderer.gpu.pipeline import GpuRenderer
 
@@ -103,8 +104,10 @@ def test_without_the_lights_shadow_or_the_floors_the_floor_is_lit_everywhere(ctx
 
 def test_a_scene_without_maps_compiles_no_shadow_code(ctx):
     scene = sphere_over_plane()
+    assert has_shadow_maps(scene)
     for obj in scene.objects:
         obj.receives_shadows = False
+    assert not has_shadow_maps(scene) and not shadow_layout(scene, W, H).any
     for specialise in (True, False):
         with GpuRenderer(scene, W, H, context=ctx, specialise=specialise) as gpu:
             gpu.render(depth=False)

@@ -138,6 +138,13 @@ class ShadowLayout:
         return bool(self.maps)
 
 
+def has_shadow_maps(scene) -> bool:
+    """Whether shadow_layout(scene, ...) has maps, at any image size: something casts,
+    something receives and some light has shadows on."""
+    lights = [*scene.directional_lights, *scene.point_lights]
+    return scene_has_shadows(scene) and any(light.shadow.enabled for light in lights)
+
+
 def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
     """The atlas for `scene` rendered at width x height: a tile per light with shadows on
     (six for a point light), none at all when nothing casts or nothing receives. A

@@ -56,7 +56,7 @@ GPU_ONLY_UNIFORMS = {
     "u_num_point_lights": "all-features build: as u_num_directional_lights",
     "u_two_sided": "all-features build: two-sidedness at run time; the twin reads "
                    "Material.two_sided",
-    "u_shadow_atlas": "the atlas's texture unit; the twin reads its atlas array",
+    "u_shadow_maps": "the maps' texture unit; the twin reads its array of layers",
 }
 
 

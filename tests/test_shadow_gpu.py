@@ -1,4 +1,4 @@
-"""Shadow maps on the GPU (issue 15 step 1): the depth pass fills the atlas with the casters'
+"""Shadow maps on the GPU (issue 15 step 1): the depth pass fills a map with the casters'
 depth seen from the light, and a Phong receiver keeps only its ambient term where a caster
 hides the light. Hand-checked cases on a small scene: a sphere above a plane under a
 directional light, maps of 256 texels (renderer/gpu/shadow_maps.py, glsl/shadow/*)."""
@@ -11,7 +11,8 @@ import pytest
 from renderer.core.gl_rules import (COMPONENTS_PER_DIRECTIONAL_SHADOW, COMPONENTS_PER_POINT_SHADOW,
                                     too_many_lights, to_unorm8)
 from renderer.core.primitives import icosphere, plane
-from renderer.core.scene import Camera, DirectionalLight, Material, Scene, SceneObject, Transform
+from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
+                                 Transform)
 from renderer.core.shadow_settings import Shadow
 from renderer.core.shadows import has_shadow_maps, shadow_layout
 from renderer.core.uniforms import SHADOW_UNIFORMS
@@ -56,12 +57,12 @@ def ctx(gl_contexts):
     return gl_contexts["egl"]
 
 
-def test_the_atlas_holds_the_planes_depth_seen_from_the_light(ctx):
+def test_the_map_holds_the_planes_depth_seen_from_the_light(ctx):
     scene = sphere_over_plane()
     with GpuRenderer(scene, W, H, context=ctx) as gpu:
         gpu.render(depth=False)
-        atlas = gpu.shadow_maps.read_atlas()
         (shadow_pass,) = gpu.shadow_maps.plan.passes
+        layer = gpu.shadow_maps.read_layer(shadow_pass.tile.layer)
     matrices = scene.matrices(W, H)
     C = shadow_pass.clip_from_world
     tile = shadow_pass.tile
@@ -75,7 +76,7 @@ def test_the_atlas_holds_the_planes_depth_seen_from_the_light(ctx):
         a = np.array([C[0, :3], C[1, :3], [0.0, 1.0, 0.0]])
         p = np.linalg.solve(a, [ndc[0] - C[0, 3], ndc[1] - C[1, 3], floor_y])
         expected = np.float32((C[2, :3] @ p + C[2, 3] + 1.0) / 2.0)
-        stored = atlas[tile.y + j, tile.x + i]
+        stored = layer[j, i]
         ulps = abs(int(stored.view(np.int32)) - int(expected.view(np.int32)))
         assert ulps <= 4, (i, j, stored, expected)
 
@@ -87,6 +88,27 @@ def test_the_floor_under_the_sphere_keeps_only_its_ambient_term(ctx, reversed_z)
     scene = sphere_over_plane()
     assert image[pixel_of(scene, UNDER_SPHERE)][:3].tolist() == floor_colour(lit=False).tolist()
     assert image[pixel_of(scene, FAR_FROM_IT)][:3].tolist() == floor_colour(lit=True).tolist()
+
+
+def test_under_a_point_light_too(ctx):
+    """Six cube faces, each a layer of its own; the one looking down holds the sphere. Away
+    from its shadow the floor is as lit as with the light's shadows off."""
+    position = np.array([0.3, 3.0, 0.2])
+    under = position + 1.5 * (SPHERE_CENTRE - position)                 # y = 0 on that ray
+    images = {}
+    for enabled in (True, False):
+        scene = sphere_over_plane()
+        scene.directional_lights = []
+        scene.point_lights = [PointLight(tuple(position), LIGHT.intensity,
+                                         shadow=Shadow(enabled, resolution=256))]
+        with GpuRenderer(scene, W, H, context=ctx) as gpu:
+            images[enabled] = gpu.render(depth=False).rgba8
+            if enabled:
+                assert [p.tile.layer for p in gpu.shadow_maps.plan.passes] == [3]    # -y only
+    assert images[True][pixel_of(scene, under)][:3].tolist() == floor_colour(lit=False).tolist()
+    assert images[False][pixel_of(scene, under)][:3].tolist() != floor_colour(lit=False).tolist()
+    far = pixel_of(scene, FAR_FROM_IT)
+    assert images[True][far].tolist() == images[False][far].tolist()
 
 
 @pytest.mark.parametrize("scene, shadowed_programs", [
@@ -125,16 +147,16 @@ def test_the_all_features_build_looks_the_maps_up_too_and_draws_the_same(ctx):
     assert np.array_equal(images[True], images[False])
 
 
-def test_update_keeps_the_atlas_programs_and_vertex_arrays(ctx):
+def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):
     scene = sphere_over_plane()
     with GpuRenderer(scene, W, H, context=ctx) as gpu:
         gpu.render(depth=False)
-        made = (gpu.shadow_maps, gpu.shadow_maps.atlas, gpu.shadow_maps.program,
+        made = (gpu.shadow_maps, gpu.shadow_maps.texture, gpu.shadow_maps.program,
                 dict(gpu.programs), gpu.shadow_maps.vertex_arrays)
         scene.directional_lights[0] = replace(LIGHT, direction=(-0.3, -1.0, 0.1))
         gpu.update()
         gpu.render(depth=False)
-        again = (gpu.shadow_maps, gpu.shadow_maps.atlas, gpu.shadow_maps.program,
+        again = (gpu.shadow_maps, gpu.shadow_maps.texture, gpu.shadow_maps.program,
                  dict(gpu.programs), gpu.shadow_maps.vertex_arrays)
     assert all(a is b for a, b in zip(made[:3], again[:3]))
     assert made[3] == again[3] and all(made[3][v] is again[3][v] for v in made[3])

@@ -4,7 +4,7 @@
 // it): a caster's vertices straight to the light's clip coordinates. u_clip_from_model is the
 // pass's clip_from_world times the object's camera-relative model matrix, composed in float64
 // on the CPU (renderer/core/shadows.py ShadowPass) so that one float32 product remains here.
-// Standard depth mapping, GL_LESS, no culling; only the depth buffer (the atlas tile) is written.
+// Standard depth mapping, GL_LESS, no culling; only the depth buffer (the map's layer) is written.
 
 uniform mat4 u_clip_from_model;
 

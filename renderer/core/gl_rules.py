@@ -151,7 +151,7 @@ def to_unorm8(c: np.ndarray) -> np.ndarray:
 # vec4 (24), a point light three vec4 and a vec4 per cube face (36). Lighting is computed in
 # one stage (vertex for Gouraud, geometry for flat, fragment for Phong), which also holds at
 # most 100 components of other uniforms (matrices, eye, ambient, material, counts, the
-# atlas's size, padded alike); 128 are kept for them.
+# maps' size, padded alike); 128 are kept for them.
 
 GL_MIN_UNIFORM_COMPONENTS = 1024         # GL 4.5's minimum of GL_MAX_*_UNIFORM_COMPONENTS
 OTHER_UNIFORM_COMPONENTS = 128           # kept for the uniforms that are not lights

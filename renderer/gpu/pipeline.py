@@ -29,11 +29,12 @@ the all-features build instead, for benchmarks/bench_specialisation.py; the imag
 
 Shadows (docs/conventions.md, "Shadows"): when the scene's shadow layout has maps
 (renderer/core/shadows.py: something casts, something receives, a light has shadows on), a
-ShadowMaps (renderer/gpu/shadow_maps.py) holds the atlas and draws each frame's light views
-into it before the camera pass; the programs of objects that receive shadows (Phong, for now)
-are compiled with SHADOW_MAPS and read the atlas on texture unit 0. The layout is recomputed
-by update() (the atlas is made again only when it changes: an automatic map resolution
-follows the image size), the plan (light views, casters, lookup uniforms) every update().
+ShadowMaps (renderer/gpu/shadow_maps.py) holds the maps (layers of one depth array texture)
+and draws each frame's light views into them before the camera pass; the programs of objects
+that receive shadows (Phong, for now) are compiled with SHADOW_MAPS and read the maps on
+texture unit 0. The layout is recomputed by update() (the texture is made again only when it
+changes size: an automatic map resolution follows the image size), the plan (light views,
+casters, lookup uniforms) every update().
 
 The depth mapping (clip control, clear value, compare function) is the camera's, from
 renderer/core/gl_rules.py: reversed-Z draws with glClipControl ZERO_TO_ONE, depth cleared to
@@ -171,7 +172,7 @@ class GpuRenderer:
         self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
         self._multisample: dict[int, moderngl.Framebuffer] = {}   # samples -> MSAA target
         self._jittered: dict[bool, tuple] = {}           # plan -> sample offset its programs hold
-        self._shadow_layout = ShadowLayout(0, ())         # update() sets it (renderer/core/shadows.py)
+        self._shadow_layout = ShadowLayout(0, 0, ())         # update() sets it (renderer/core/shadows.py)
         self._shadow_maps: ShadowMaps | None = None       # made when the layout has maps
         self._shadowed: dict[bool, bool] = {}             # plan -> whether a program looks maps up
         try:
@@ -306,7 +307,7 @@ class GpuRenderer:
         self._jittered.clear()
 
     def _update_shadows(self, matrices, visible: list[bool]) -> dict | None:
-        """The shadow layout (the atlas changes only with it: an automatic resolution follows
+        """The shadow layout (the maps' texture changes only with it: an automatic resolution follows
         the image size), the frame's shadow plan for the depth pass; its lookup uniforms, or
         None when the scene has no maps. The plan is fitted to the objects the camera sees in
         either build, so that the all-features build draws the same shadows."""
@@ -520,7 +521,7 @@ class GpuRenderer:
 
     @property
     def shadow_maps(self) -> ShadowMaps | None:
-        """The atlas and depth pass (None while the scene has no shadow maps)."""
+        """The maps' texture and depth pass (None while the scene has no shadow maps)."""
         return self._shadow_maps
 
     @property

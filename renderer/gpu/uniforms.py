@@ -4,7 +4,7 @@ column-major float32 (transforms.to_glsl, so that GLSL `M * v` is `M @ v`), flag
 int32. A light array of a kind the scene lacks is left out (neither does the shader declare
 it), except in the all-features build, whose arrays have `light_slots` rows, zeros past the
 scene's lights, with the counts as uniforms. The shadow-map lookup's uniforms are the frame's
-ShadowPlan.uniforms (renderer/core/shadows.py), the atlas on texture unit SHADOW_ATLAS_UNIT.
+ShadowPlan.uniforms (renderer/core/shadows.py), the maps on texture unit SHADOW_MAPS_UNIT.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from renderer.core.scene import FrameMatrices, Scene, SceneObject
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms, object_uniforms
 
-SHADOW_ATLAS_UNIT = 0                    # the texture unit the shadow atlas is bound to
+SHADOW_MAPS_UNIT = 0                     # the texture unit the shadow maps are bound to
 
 
 def as_bytes(name: str, value) -> bytes:
@@ -23,7 +23,7 @@ def as_bytes(name: str, value) -> bytes:
     kind = UNIFORM_TYPES[name]
     if kind in ("mat3", "mat4", "mat4[]"):
         return to_glsl(value)
-    if kind in ("int", "bool", "sampler2DShadow"):
+    if kind in ("int", "bool", "sampler2DArrayShadow"):
         return np.asarray(value, dtype=np.int32).tobytes()
     return np.asarray(value, dtype=np.float32).tobytes()
 
@@ -43,7 +43,7 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices, light_slots: int
         values["u_num_point_lights"] = np.asarray(point)
     if shadows is not None:
         values |= shadows
-        values["u_shadow_atlas"] = np.asarray(SHADOW_ATLAS_UNIT)
+        values["u_shadow_maps"] = np.asarray(SHADOW_MAPS_UNIT)
     out = {}
     for name, value in values.items():
         if UNIFORM_TYPES[name].endswith("[]"):

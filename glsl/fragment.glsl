@@ -5,9 +5,18 @@
 // interpolated normal, flips it for a two-sided back face, and lights the fragment.
 // out_color is clamped and converted to unorm8 by GL; LINEAR_OUTPUT adds the unclamped
 // float colour as a second output. Alpha is 1: the background is cleared to alpha 0.
+// SHADOW_MAPS (Phong, an object that receives shadows in a scene with maps): each light's
+// diffuse and specular terms are multiplied by its visibility from the shadow maps
+// (lighting.glsl's SHADOWS hook, answered by shadow/lookup.glsl).
 
 #if defined(SHADING_PHONG)
+#ifdef SHADOW_MAPS
+#define SHADOWS
+#endif
 #include "lighting.glsl"
+#ifdef SHADOW_MAPS
+#include "shadow/lookup.glsl"
+#endif
 in vec3 v_world_position;
 in vec3 v_world_normal;
 #elif defined(SHADING_FLAT)

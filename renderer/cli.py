@@ -529,15 +529,19 @@ def cmd_shaders(args) -> int:
     and a line per variant naming the objects that use it."""
     from renderer.core.imageio import check_folder, outputs
     from renderer.core.paths import output_stem
+    from renderer.core.shadows import has_shadow_maps
     from renderer.gpu.shaders import ShaderVariant, program_sources
     if args.out is not None:
         check_folder(args.out)
     scene = _load(args.scene)
     out = check_folder(args.out or Path(f"shaders-{output_stem(scene)}"))
     users: dict[ShaderVariant, list[str]] = {}
+    maps = has_shadow_maps(scene)
     for obj in scene.objects:
         if obj.mesh.triangle_count:
-            users.setdefault(ShaderVariant.for_material(scene, obj.material), []).append(obj.name)
+            variant = ShaderVariant.for_material(scene, obj.material,
+                                                 shadows=maps and obj.receives_shadows)
+            users.setdefault(variant, []).append(obj.name)
     suffixes = {"vertex_shader": "vert", "geometry_shader": "geom", "fragment_shader": "frag"}
     lines = []
     with outputs() as written:                   # every variant's files or none

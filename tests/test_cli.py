@@ -127,8 +127,9 @@ def test_written_files_get_the_usual_permissions(tmp_path, cli):
 
 
 def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path, gl_contexts, cli):
-    """hierarchy draws with three variants (phong, gouraud, flat with its geometry stage);
-    each file is the text the renderer compiles, and it compiles as it is."""
+    """hierarchy draws with three variants (phong, which looks the shadow maps up, gouraud,
+    flat with its geometry stage); each file is the text the renderer compiles, and it
+    compiles as it is."""
     from renderer.core.builtin import builtin_scenes
     from renderer.gpu.context import activate
     from renderer.gpu.pipeline import GpuRenderer
@@ -138,18 +139,19 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
     result = cli("shaders", "hierarchy", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
     assert result.stdout.splitlines()[0] == \
-        ("phong-specular-1dir-1point: phong-specular-1dir-1point.vert, "
-         "phong-specular-1dir-1point.frag (objects: sun, planet, plinth)")
+        ("phong-specular-1dir-1point-shadows: phong-specular-1dir-1point-shadows.vert, "
+         "phong-specular-1dir-1point-shadows.frag (objects: sun, planet, plinth)")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
         "flat-specular-1dir-1point.frag", "flat-specular-1dir-1point.geom",
         "flat-specular-1dir-1point.vert",
         "gouraud-specular-1dir-1point.frag", "gouraud-specular-1dir-1point.vert",
-        "phong-specular-1dir-1point.frag", "phong-specular-1dir-1point.vert"]
+        "phong-specular-1dir-1point-shadows.frag", "phong-specular-1dir-1point-shadows.vert"]
     ctx = gl_contexts["egl"]
     with GpuRenderer(load_scene(builtin_scenes()["hierarchy"]), 16, 16, context=ctx) as gpu:
         gpu.render()
         assert sorted(variant.name for variant in gpu.programs) == \
-            ["flat-specular-1dir-1point", "gouraud-specular-1dir-1point", "phong-specular-1dir-1point"]
+            ["flat-specular-1dir-1point", "gouraud-specular-1dir-1point",
+             "phong-specular-1dir-1point-shadows"]
     flat = {stage: (tmp_path / f"flat-specular-1dir-1point.{suffix}").read_text()
             for stage, suffix in (("vertex_shader", "vert"), ("geometry_shader", "geom"),
                                   ("fragment_shader", "frag"))}

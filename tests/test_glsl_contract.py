@@ -39,12 +39,14 @@ from renderer.core.builtin import builtin_scenes
 from renderer.core.resources import glsl_dir
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import load_scene
-from renderer.core.uniforms import UNIFORM_TYPES
+from renderer.core.shadows import plan_shadows, shadow_layout
+from renderer.core.uniforms import SHADOW_PASS_UNIFORMS, UNIFORM_TYPES
 from renderer.gpu import GpuRenderer
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS
 
 STAGES = ("vertex.glsl", "geometry.glsl", "fragment.glsl")      # in pipeline order
 LIGHTING = "lighting.glsl"
+SHADOW_FILES = ("shadow/lookup.glsl", "shadow/depth.vert")   # the lookup and the depth pass
 # A scene with both kinds of light, specular materials and all three shading modes.
 EVERY_FEATURE_SCENE = "hierarchy"
 # Uniforms of the GPU path alone, and why the twin has no field for them.
@@ -54,6 +56,7 @@ GPU_ONLY_UNIFORMS = {
     "u_num_point_lights": "all-features build: as u_num_directional_lights",
     "u_two_sided": "all-features build: two-sidedness at run time; the twin reads "
                    "Material.two_sided",
+    "u_shadow_maps": "the maps' texture unit; the twin reads its array of layers",
 }
 
 
@@ -65,8 +68,10 @@ def uploaded_uniform_names() -> set[str]:
     from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
     scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
     matrices = scene.matrices(64, 48)
-    names = set(frame_uniform_values(scene, matrices))
+    shadows = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48)).uniforms
+    names = set(frame_uniform_values(scene, matrices, shadows=shadows))
     names |= set(frame_uniform_values(scene, matrices, light_slots=ALL_FEATURES_LIGHTS))
+    names |= set(SHADOW_PASS_UNIFORMS)          # renderer/gpu/shadow_maps.py, per pass and object
     for obj, object_matrices in zip(scene.objects, matrices.objects):
         names |= set(object_uniform_values(obj, object_matrices))
     return names
@@ -114,7 +119,7 @@ STORAGE = {"in", "out", "uniform"}
 INTERPOLATION = {"smooth", "flat", "noperspective"}
 OTHER_QUALIFIERS = {"centroid", "sample", "invariant", "highp", "mediump", "lowp"}
 _LAYOUT = re.compile(r"^layout\s*\(([^)]*)\)\s*")
-_DECLARATOR = re.compile(r"^(\w+)\s*(?:\[\s*(\w*)\s*\])?$")
+_DECLARATOR = re.compile(r"^(\w+)\s*(?:\[\s*([\w\s*]*?)\s*\])?$")     # [6 * N] too
 
 
 def without_comments_and_directives(text: str) -> str:
@@ -174,7 +179,7 @@ def declarations(file: str, text: str) -> list[Declaration]:
 
 def read_glsl() -> dict[str, str]:
     return {name: (glsl_dir() / name).read_text(encoding="utf-8")
-            for name in (*STAGES, LIGHTING)}
+            for name in (*STAGES, LIGHTING, *SHADOW_FILES)}
 
 
 def parse(sources: dict[str, str]) -> dict[str, list[Declaration]]:
@@ -292,6 +297,12 @@ def uniforms_not_in_the_twin(parsed) -> list[str]:
     problems += names_missing_from(
         of(parsed["fragment.glsl"], "uniform").values(), set(GPU_ONLY_UNIFORMS),
         "GPU_ONLY_UNIFORMS of this test")
+    scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
+    plan = plan_shadows(scene, scene.matrices(64, 48), shadow_layout(scene, 64, 48))
+    problems += names_missing_from(
+        of(parsed["shadow/lookup.glsl"], "uniform").values(),
+        set(plan.uniforms) | set(GPU_ONLY_UNIFORMS), "renderer.core.shadows.ShadowPlan.uniforms "
+        "(what reference/shadow/lookup.py reads) or GPU_ONLY_UNIFORMS")
     return problems
 
 

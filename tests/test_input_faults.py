@@ -250,26 +250,31 @@ def lights_scene(directional: int, point: int, shading: str = "phong") -> str:
             f'material = {{ shading = "{shading}", ks = 0.5 }}\n')
 
 
+# The cube casts and receives, so that each light has a shadow map (24 more components for a
+# directional light, 36 for a point light: renderer/core/gl_rules.py).
 @pytest.mark.parametrize("backend", ["gpu", "reference"])
-@pytest.mark.parametrize("directional, point, used", [(0, 3000, 36000), (113, 0, 904), (0, 75, 900),
-                                                      (56, 38, 904)])
+@pytest.mark.parametrize("directional, point, used", [(0, 3000, 144000), (29, 0, 928), (0, 19, 912),
+                                                      (14, 10, 928)])
 def test_more_lights_than_the_limit_is_one_line(capsys, work, backend, directional, point, used):
     (work / "lights.toml").write_text(lights_scene(directional, point))
     line = refused(capsys, ["render", "lights.toml", "--size", "16x12", "--backend", backend], work)
     assert line == (f"renderer: lights.toml: lights: too many lights: {directional} directional "
                     f"and {point} point lights take {used} uniform components (8 per directional "
-                    f"light, 12 per point light); the limit is 896 (GL's guaranteed 1024 per "
-                    f"shader stage less 128 for the other uniforms), e.g. 112 directional or 74 "
-                    f"point lights")
+                    f"light, 12 per point light, 24 and 36 more for the shadows of each; "
+                    f"{directional} directional and {point} point lights have shadows); the "
+                    f"limit is 896 (GL's guaranteed 1024 per shader stage less 128 for the other "
+                    f"uniforms), e.g. 112 directional or 74 point lights without shadows, 28 or "
+                    f"18 with; set `shadows = false` on some lights")
 
 
 def test_a_scene_made_in_python_is_held_to_the_same_limit(gl_contexts):
     import reference
     from renderer.core.scene import PointLight
+    from renderer.core.shadow_settings import Shadow
     from renderer.errors import SceneError
     from renderer.gpu.pipeline import GpuRenderer
     scene = load_scene("sphere")
-    scene.point_lights = [PointLight()] * 75
+    scene.point_lights = [PointLight(shadow=Shadow(enabled=False))] * 75
     with pytest.raises(SceneError, match="too many lights"):
         reference.render(scene, 8, 6)
     with pytest.raises(SceneError, match="too many lights"):
@@ -279,12 +284,30 @@ def test_a_scene_made_in_python_is_held_to_the_same_limit(gl_contexts):
 @pytest.mark.parametrize("shading", ["flat", "gouraud", "phong"])
 @pytest.mark.parametrize("directional, point", [(112, 0), (0, 74), (56, 37)])
 def test_lights_up_to_the_limit_compile_and_render(gl_contexts, work, shading, directional, point):
+    """The limits without shadows: the lights, made in Python, have them off."""
+    from renderer.core.scene import DirectionalLight, PointLight
+    from renderer.core.shadow_settings import Shadow
     from renderer.gpu.pipeline import GpuRenderer
-    (work / "lights.toml").write_text(lights_scene(directional, point, shading))
+    (work / "lights.toml").write_text(lights_scene(0, 0, shading))
+    scene = load_scene(work / "lights.toml")
+    off, dim = Shadow(enabled=False), (0.01, 0.01, 0.01)
+    scene.directional_lights = [DirectionalLight((0, 0, -1), dim, off)] * directional
+    scene.point_lights = [PointLight((0, 0, 3), dim, shadow=off)] * point
+    for ctx in gl_contexts.values():
+        with GpuRenderer(scene, 16, 12, context=ctx) as gpu:
+            assert gpu.render().rgba8[..., 3].any()
+
+
+@pytest.mark.slow                       # 108 cube faces drawn: about 1 s a case
+@pytest.mark.parametrize("directional, point", [(28, 0), (0, 18), (14, 9)])
+def test_lights_with_shadows_up_to_the_limit_compile_and_render(gl_contexts, work, directional, point):
+    from renderer.gpu.pipeline import GpuRenderer
+    (work / "lights.toml").write_text(lights_scene(directional, point, "phong"))
     scene = load_scene(work / "lights.toml")
     for ctx in gl_contexts.values():
         with GpuRenderer(scene, 16, 12, context=ctx) as gpu:
             assert gpu.render().rgba8[..., 3].any()
+            assert all(variant.shadows for variant in gpu.programs)
 
 
 # -- the ray tracer's inputs (issue 14, "Bad input") -------------------------------------------

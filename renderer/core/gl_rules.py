@@ -20,6 +20,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.core.shadow_settings import scene_has_shadows
+
 # --- depth ---------------------------------------------------------------------------------
 
 GL_LOWER_LEFT = 0x8CA1                   # glClipControl origin: GL's default, kept always
@@ -143,40 +145,72 @@ def to_unorm8(c: np.ndarray) -> np.ndarray:
 # Cost, counted as implementations allocate the default uniform block: each element of a
 # vec3 array takes a whole vec4 slot (4 components). A directional light has two vec3 arrays
 # (direction, intensity): 8 components; a point light three (position, intensity,
-# attenuation): 12. Lighting is computed in one stage (vertex for Gouraud, geometry for flat,
-# fragment for Phong), which also holds at most 96 components of other uniforms (matrices,
-# eye, ambient, material, counts, padded alike); 128 are kept for them.
+# attenuation): 12. A light whose shadows are on, in a scene with shadow maps
+# (renderer/core/shadows.py: something casts and something receives), adds its lookup
+# uniforms (renderer/core/uniforms.py SHADOW_UNIFORMS): a directional light a mat4 and two
+# vec4 (24), a point light three vec4 and a vec4 per cube face (36). Lighting is computed in
+# one stage (vertex for Gouraud, geometry for flat, fragment for Phong), which also holds at
+# most 100 components of other uniforms (matrices, eye, ambient, material, counts, the
+# maps' size, padded alike); 128 are kept for them.
 
 GL_MIN_UNIFORM_COMPONENTS = 1024         # GL 4.5's minimum of GL_MAX_*_UNIFORM_COMPONENTS
 OTHER_UNIFORM_COMPONENTS = 128           # kept for the uniforms that are not lights
 LIGHT_UNIFORM_COMPONENTS = GL_MIN_UNIFORM_COMPONENTS - OTHER_UNIFORM_COMPONENTS   # 896
 COMPONENTS_PER_DIRECTIONAL_LIGHT = 8     # 2 vec3 array elements, a vec4 slot each
 COMPONENTS_PER_POINT_LIGHT = 12          # 3 vec3 array elements
+COMPONENTS_PER_DIRECTIONAL_SHADOW = 24   # mat4 + 2 vec4
+COMPONENTS_PER_POINT_SHADOW = 36         # 3 vec4 + 6 vec4 (one per cube face)
 
 
-def light_components(directional: int, point: int) -> int:
-    """Uniform components the light arrays of a scene take in the lighting stage."""
-    return directional * COMPONENTS_PER_DIRECTIONAL_LIGHT + point * COMPONENTS_PER_POINT_LIGHT
+def light_components(directional: int, point: int, directional_shadows: int = 0,
+                     point_shadows: int = 0) -> int:
+    """Uniform components the light arrays of a scene take in the lighting stage; `*_shadows`
+    lights of each kind (of those) also have shadow maps."""
+    return (directional * COMPONENTS_PER_DIRECTIONAL_LIGHT + point * COMPONENTS_PER_POINT_LIGHT
+            + directional_shadows * COMPONENTS_PER_DIRECTIONAL_SHADOW
+            + point_shadows * COMPONENTS_PER_POINT_SHADOW)
 
 
-def too_many_lights(directional: int, point: int) -> str | None:
-    """Why a scene with these light counts cannot be drawn, or None when it can."""
-    used = light_components(directional, point)
+def too_many_lights(directional: int, point: int, directional_shadows: int = 0,
+                    point_shadows: int = 0) -> str | None:
+    """Why a scene with these light counts cannot be drawn, or None when it can;
+    `*_shadows`: how many lights of each kind have shadow maps."""
+    used = light_components(directional, point, directional_shadows, point_shadows)
     if used <= LIGHT_UNIFORM_COMPONENTS:
         return None
+    limit = LIGHT_UNIFORM_COMPONENTS
+    costs = f"{COMPONENTS_PER_DIRECTIONAL_LIGHT} per directional light, {COMPONENTS_PER_POINT_LIGHT} per point light"
+    examples = (f"e.g. {limit // COMPONENTS_PER_DIRECTIONAL_LIGHT} directional or "
+                f"{limit // COMPONENTS_PER_POINT_LIGHT} point lights")
+    advice = ""
+    if directional_shadows or point_shadows:
+        costs += (f", {COMPONENTS_PER_DIRECTIONAL_SHADOW} and {COMPONENTS_PER_POINT_SHADOW} more for "
+                  f"the shadows of each; {directional_shadows} directional and {point_shadows} "
+                  f"point lights have shadows")
+        examples += (f" without shadows, "
+                     f"{limit // (COMPONENTS_PER_DIRECTIONAL_LIGHT + COMPONENTS_PER_DIRECTIONAL_SHADOW)} or "
+                     f"{limit // (COMPONENTS_PER_POINT_LIGHT + COMPONENTS_PER_POINT_SHADOW)} with")
+        advice = "; set `shadows = false` on some lights"
     return (f"too many lights: {directional} directional and {point} point lights take {used} "
-            f"uniform components ({COMPONENTS_PER_DIRECTIONAL_LIGHT} per directional light, "
-            f"{COMPONENTS_PER_POINT_LIGHT} per point light); the limit is "
-            f"{LIGHT_UNIFORM_COMPONENTS} (GL's guaranteed {GL_MIN_UNIFORM_COMPONENTS} per shader "
-            f"stage less {OTHER_UNIFORM_COMPONENTS} for the other uniforms), e.g. "
-            f"{LIGHT_UNIFORM_COMPONENTS // COMPONENTS_PER_DIRECTIONAL_LIGHT} directional or "
-            f"{LIGHT_UNIFORM_COMPONENTS // COMPONENTS_PER_POINT_LIGHT} point lights")
+            f"uniform components ({costs}); the limit is {limit} (GL's guaranteed "
+            f"{GL_MIN_UNIFORM_COMPONENTS} per shader stage less {OTHER_UNIFORM_COMPONENTS} for "
+            f"the other uniforms), {examples}{advice}")
+
+
+def scene_light_problem(scene) -> str | None:
+    """too_many_lights for `scene`: its lights, and those with shadows on when the scene has
+    shadow maps (the programs then declare their lookup uniforms)."""
+    directional, point = scene.directional_lights, scene.point_lights
+    maps = scene_has_shadows(scene)
+    return too_many_lights(len(directional), len(point),
+                           sum(maps and light.shadow.enabled for light in directional),
+                           sum(maps and light.shadow.enabled for light in point))
 
 
 def check_light_count(scene) -> None:
     """A SceneError (naming the scene's file, if any) when `scene` has more lights than
     too_many_lights allows: what GpuRenderer and the reference check before drawing."""
     from renderer.errors import SceneError
-    problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
+    problem = scene_light_problem(scene)
     if problem:
         raise SceneError(problem, file=getattr(scene, "source", "") or None)

@@ -25,7 +25,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer.core import transforms
-from renderer.core.gl_rules import too_many_lights
+from renderer.core.gl_rules import scene_light_problem
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core import memory
@@ -363,12 +363,12 @@ class _Reader:
                 scene.directional_lights.append(light)
             else:
                 scene.point_lights.append(light)
-        problem = too_many_lights(len(scene.directional_lights), len(scene.point_lights))
-        if problem:
-            self.fail("lights", problem)
         raw_objects = self.list_of_tables(data.get("objects", []), "objects", "objects")
         scene.objects = [self.scene_object(raw, f"objects[{i}]", i, materials)
                          for i, raw in enumerate(raw_objects)]
+        problem = scene_light_problem(scene)     # after the objects: do they cast and receive?
+        if problem:
+            self.fail("lights", problem)
         self.check_names_and_parents(scene.objects, raw_objects)
         self.check_shapes(scene)
         self.check_float32_range(scene)

@@ -107,6 +107,13 @@ class Shadow:
         return self.bias if self.bias is not None else auto_bias(self.filter)
 
 
+def scene_has_shadows(scene) -> bool:
+    """Whether any object casts and any receives: otherwise no light needs a map (and the
+    light budget, renderer/core/gl_rules.py, counts no shadow uniforms)."""
+    return (any(o.casts_shadows and o.mesh.triangle_count for o in scene.objects)
+            and any(o.receives_shadows for o in scene.objects))
+
+
 def auto_resolution(width: int, height: int, point: bool) -> int:
     """The default tile side: the power of two at or above twice the image's longer side, so
     that a map spread over the view has about two texels per pixel on a side (a point light's

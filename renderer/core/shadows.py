@@ -32,7 +32,8 @@ import numpy as np
 
 from renderer.core import transforms
 from renderer.core.gl_rules import depth_mapping
-from renderer.core.shadow_settings import MAX_SHADOW_TEXELS, Shadow, auto_resolution, guard_texels
+from renderer.core.shadow_settings import (MAX_SHADOW_TEXELS, Shadow, auto_resolution, guard_texels,
+                                           scene_has_shadows)
 from renderer.core.visibility import CLIP_PLANES
 
 # --- cube faces ------------------------------------------------------------------------------
@@ -114,10 +115,11 @@ class ShadowLayout:
         return bool(self.maps)
 
 
-def scene_has_shadows(scene) -> bool:
-    """Whether any object casts and any receives: otherwise no light needs a map."""
-    return (any(o.casts_shadows and o.mesh.triangle_count for o in scene.objects)
-            and any(o.receives_shadows for o in scene.objects))
+def has_shadow_maps(scene) -> bool:
+    """Whether shadow_layout(scene, ...) has maps, at any image size: something casts,
+    something receives and some light has shadows on."""
+    lights = [*scene.directional_lights, *scene.point_lights]
+    return scene_has_shadows(scene) and any(light.shadow.enabled for light in lights)
 
 
 def shadow_layout(scene, width: int, height: int) -> ShadowLayout:

@@ -196,5 +196,7 @@ def jitter(dx: float, dy: float, width: int, height: int) -> np.ndarray:
 
 
 def to_glsl(m: np.ndarray) -> bytes:
-    """Bytes for a GLSL matN uniform (column-major float32), so GLSL `M * v` equals `M @ v`."""
-    return np.ascontiguousarray(np.asarray(m, dtype=np.float64).T, dtype=np.float32).tobytes()
+    """Bytes for a GLSL matN uniform (column-major float32), so GLSL `M * v` equals `M @ v`;
+    for an array of matrices (..., N, N) each one is transposed."""
+    return np.ascontiguousarray(np.swapaxes(np.asarray(m, dtype=np.float64), -1, -2),
+                                dtype=np.float32).tobytes()

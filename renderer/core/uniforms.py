@@ -44,7 +44,25 @@ OBJECT_UNIFORMS = {
 }
 # The all-features build (renderer/gpu/shaders.py) reads the light counts at run time.
 LIGHT_COUNT_UNIFORMS = {"u_num_directional_lights": "int", "u_num_point_lights": "int"}
-UNIFORM_TYPES = FRAME_UNIFORMS | OBJECT_UNIFORMS | LIGHT_COUNT_UNIFORMS
+# The shadow-map lookup (glsl/shadow/lookup.glsl), in programs of objects that receive shadows:
+# the values are the frame's renderer/core/shadows.py ShadowPlan.uniforms; the arrays have a
+# row per light of their kind (ROWS_PER_LIGHT rows for the cube's faces).
+SHADOW_UNIFORMS = {
+    "u_shadow_maps": "sampler2DArrayShadow",   # the maps' texture unit (the GPU path's alone)
+    "u_shadow_map_size": "float",           # S, texels on a side of a layer
+    "u_directional_shadow_matrix": "mat4[]",   # camera-relative world -> (u, v, z_w, 1)
+    "u_directional_shadow": "vec4[]",       # (drawn, texel size, kernel, layer)
+    "u_directional_shadow_bias": "vec4[]",  # (normal, constant, slope, 0) in texels
+    "u_point_shadow": "vec4[]",             # (drawn, tan(half angle), kernel, tile side)
+    "u_point_shadow_depth": "vec4[]",       # (A, B, near, far): z_w = A + B / m
+    "u_point_shadow_bias": "vec4[]",
+    "u_point_shadow_tiles": "vec4[]",       # per cube face: (layer, size / S, drawn, 0)
+}
+ROWS_PER_LIGHT = {"u_point_shadow_tiles": 6}   # other light arrays: 1
+# The depth pass (glsl/shadow/depth.vert): light clip from object coordinates, per pass and object.
+SHADOW_PASS_UNIFORMS = {"u_clip_from_model": "mat4"}
+UNIFORM_TYPES = (FRAME_UNIFORMS | OBJECT_UNIFORMS | LIGHT_COUNT_UNIFORMS | SHADOW_UNIFORMS
+                 | SHADOW_PASS_UNIFORMS)
 
 
 def _rows(values) -> np.ndarray:

@@ -27,6 +27,15 @@ only where k_s > 0, back-face code only when two-sided), and an object wholly ou
 view volume is left out of the plan (renderer/core/visibility.py). `specialise=False` draws with
 the all-features build instead, for benchmarks/bench_specialisation.py; the images are the same.
 
+Shadows (docs/conventions.md, "Shadows"): when the scene's shadow layout has maps
+(renderer/core/shadows.py: something casts, something receives, a light has shadows on), a
+ShadowMaps (renderer/gpu/shadow_maps.py) holds the maps (layers of one depth array texture)
+and draws each frame's light views into them before the camera pass; the programs of objects
+that receive shadows (Phong, for now) are compiled with SHADOW_MAPS and read the maps on
+texture unit 0. The layout is recomputed by update() (the texture is made again only when it
+changes size: an automatic map resolution follows the image size), the plan (light views,
+casters, lookup uniforms) every update().
+
 The depth mapping (clip control, clear value, compare function) is the camera's, from
 renderer/core/gl_rules.py: reversed-Z draws with glClipControl ZERO_TO_ONE, depth cleared to
 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
@@ -56,7 +65,9 @@ from renderer.errors import ContextError, SystemFault
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
+from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
+from renderer.gpu.shadow_maps import ShadowMaps
 from renderer.core.transforms import jitter, to_glsl
 from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
 from renderer.core.visibility import visible_objects
@@ -161,6 +172,9 @@ class GpuRenderer:
         self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
         self._multisample: dict[int, moderngl.Framebuffer] = {}   # samples -> MSAA target
         self._jittered: dict[bool, tuple] = {}           # plan -> sample offset its programs hold
+        self._shadow_layout = ShadowLayout(0, 0, ())         # update() sets it (renderer/core/shadows.py)
+        self._shadow_maps: ShadowMaps | None = None       # made when the layout has maps
+        self._shadowed: dict[bool, bool] = {}             # plan -> whether a program looks maps up
         try:
             activate(self.ctx)
             self._check_size()
@@ -248,7 +262,8 @@ class GpuRenderer:
 
     def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
         return ShaderVariant.for_material(self.scene, obj.material, linear,
-                                          all_features=not self.specialise)
+                                          all_features=not self.specialise,
+                                          shadows=obj.receives_shadows and self._shadow_layout.any)
 
     def _vertex_array(self, item: _ObjectBuffers, variant: ShaderVariant) -> moderngl.VertexArray:
         vao = item.vertex_arrays.get(variant)
@@ -276,11 +291,13 @@ class GpuRenderer:
                 self._release_buffers(item)
                 self._upload(item)
         matrices = scene.matrices(self.width, self.height)
+        visible = visible_objects(scene, matrices)
+        shadows = self._update_shadows(matrices, visible)
         self._frame_uniforms = frame_uniform_values(
-            scene, matrices, light_slots=None if self.specialise else ALL_FEATURES_LIGHTS)
+            scene, matrices, light_slots=None if self.specialise else ALL_FEATURES_LIGHTS,
+            shadows=shadows)
         # Objects wholly outside the view volume are left out of the frame's plan.
-        self._visible = (visible_objects(scene, matrices) if self.specialise
-                         else [True] * len(self._objects))
+        self._visible = visible if self.specialise else [True] * len(self._objects)
         for item, object_matrices in zip(self._objects, matrices.objects):
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
         self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width),
@@ -288,6 +305,25 @@ class GpuRenderer:
         self._projection = matrices.projection
         self._plans.clear()
         self._jittered.clear()
+
+    def _update_shadows(self, matrices, visible: list[bool]) -> dict | None:
+        """The shadow layout (the maps' texture changes only with it: an automatic resolution follows
+        the image size), the frame's shadow plan for the depth pass; its lookup uniforms, or
+        None when the scene has no maps. The plan is fitted to the objects the camera sees in
+        either build, so that the all-features build draws the same shadows."""
+        layout = shadow_layout(self.scene, self.width, self.height)
+        if layout != self._shadow_layout and layout.any:
+            if self._shadow_maps is None:
+                self._shadow_maps = ShadowMaps(self.ctx, layout)
+            else:
+                self._shadow_maps.set_layout(layout)
+        self._shadow_layout = layout
+        if not layout.any:
+            return None
+        plan = plan_shadows(self.scene, matrices, layout, visible)
+        self._shadow_maps.set_plan(plan, [(item.vbo, item.ibo) for item in self._objects],
+                                   [m.model for m in matrices.objects])
+        return plan.uniforms
 
     def resize(self, width: int, height: int) -> None:
         """Render at another size from now on (a viewer's window was resized): the framebuffers
@@ -329,6 +365,7 @@ class GpuRenderer:
             cull = CULL_FLAGS[item.obj.cull]
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
             plan.append(_Draw(vao, enable, cull, uploads))
+        self._shadowed[linear] = any(variant.shadows for variant in programs)
         for program in programs.values():          # the same for every object: set once here
             for name, data in self._frame_uniforms.items():
                 uniform = program.get(name, None)
@@ -385,6 +422,11 @@ class GpuRenderer:
         plan = self._plan(linear)
         self._set_sample_offset(linear, tuple(sample_offset))
         target = self._multisample_framebuffer(samples) if samples > 1 else fbo
+        shadowed = self._shadowed[linear]
+        if shadowed:
+            # The light views first, with GL's default clip control (every frame leaves it
+            # behind) whatever the camera's depth mapping.
+            self._shadow_maps.draw()
         target.use()
         red, green, blue = self.scene.background
         mapping = depth_mapping(self.scene.camera.reversed_z)
@@ -392,6 +434,8 @@ class GpuRenderer:
         # leave GL's default behind for whoever draws next.
         self._clip_control(mapping)
         try:
+            if shadowed:
+                self._shadow_maps.bind()
             target.clear(red, green, blue, 0.0, depth=mapping.clear_depth)
             ctx.depth_func = mapping.depth_func
             ctx.front_face = "ccw"
@@ -476,6 +520,11 @@ class GpuRenderer:
         return dict(self._programs.items())
 
     @property
+    def shadow_maps(self) -> ShadowMaps | None:
+        """The maps' texture and depth pass (None while the scene has no shadow maps)."""
+        return self._shadow_maps
+
+    @property
     def drawn_objects(self) -> list[str]:
         """Names of the objects the current frame plan draws, in order: those with triangles
         and, when specialising, not wholly outside the view volume."""
@@ -496,6 +545,9 @@ class GpuRenderer:
         self._plans.clear()
         try:
             activate(self.ctx)
+            if self._shadow_maps is not None:
+                self._shadow_maps.release()
+                self._shadow_maps = None
             for item in self._objects:
                 self._release_buffers(item)
             self._release_targets()

@@ -140,6 +140,11 @@ class ShaderVariant:
     ALL_FEATURES_LIGHTS lights of each kind) and the rest decided by uniforms at run time
     (how many lights, whether the material is two-sided): what a renderer that does not
     specialise runs. benchmarks/bench_specialisation.py compares the two.
+
+    `shadows` (define SHADOW_MAPS) compiles the shadow-map lookup in (glsl/shadow/lookup.glsl):
+    set, in either build, only for an object that receives shadows in a scene whose layout has
+    maps (renderer/core/shadows.py), and for now only for Phong (flat and Gouraud receivers
+    are drawn unshadowed); every other program has no shadow code at all.
     """
     shading: str                     # "flat", "gouraud" or "phong"
     two_sided: bool = False
@@ -148,10 +153,13 @@ class ShaderVariant:
     linear_output: bool = False      # second fragment output: the unclamped float colour
     specular: bool = False           # the k_s term of the lighting equation
     all_features: bool = False
+    shadows: bool = False            # the shadow-map lookup (Phong only, for now)
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
             raise ValueError(f"unknown shading mode {self.shading!r}")
+        if self.shadows and self.shading != "phong":
+            raise ValueError(f"shadow maps are looked up by Phong shading only, not {self.shading!r}")
 
     def defines(self) -> dict[str, object]:
         if self.all_features:
@@ -163,6 +171,7 @@ class ShaderVariant:
                 "NUM_DIRECTIONAL_LIGHTS": ALL_FEATURES_LIGHTS,
                 "NUM_POINT_LIGHTS": ALL_FEATURES_LIGHTS,
                 "LINEAR_OUTPUT": self.linear_output,
+                "SHADOW_MAPS": self.shadows,
             }
         return {
             f"SHADING_{self.shading.upper()}": True,
@@ -171,18 +180,20 @@ class ShaderVariant:
             "NUM_DIRECTIONAL_LIGHTS": self.num_directional_lights,
             "NUM_POINT_LIGHTS": self.num_point_lights,
             "LINEAR_OUTPUT": self.linear_output,
+            "SHADOW_MAPS": self.shadows,
         }
 
     @property
     def name(self) -> str:
-        """A file-name-safe label, e.g. "phong-two-sided-specular-1dir-2point"."""
+        """A file-name-safe label, e.g. "phong-two-sided-specular-1dir-2point-shadows"."""
         linear = "-linear" if self.linear_output else ""
+        shadows = "-shadows" if self.shadows else ""
         if self.all_features:
-            return f"{self.shading}-all-features{linear}"
+            return f"{self.shading}-all-features{linear}{shadows}"
         sides = "-two-sided" if self.two_sided else ""
         specular = "-specular" if self.specular else ""
         return (f"{self.shading}{sides}{specular}-{self.num_directional_lights}dir-"
-                f"{self.num_point_lights}point{linear}")
+                f"{self.num_point_lights}point{linear}{shadows}")
 
     @property
     def uses_geometry_shader(self) -> bool:
@@ -190,13 +201,17 @@ class ShaderVariant:
 
     @classmethod
     def for_material(cls, scene, material, linear_output: bool = False,
-                     all_features: bool = False) -> "ShaderVariant":
+                     all_features: bool = False, shadows: bool = False) -> "ShaderVariant":
         """The variant that draws `material` (a renderer.core.scene.Material) in `scene`:
-        specialised to what they use, or the all-features build."""
+        specialised to what they use, or the all-features build. `shadows`: the object
+        receives shadows and the scene's layout has maps (a Phong material then looks them up)."""
+        shadows = bool(shadows) and material.shading == "phong"
         if all_features:
-            return cls(material.shading, linear_output=bool(linear_output), all_features=True)
+            return cls(material.shading, linear_output=bool(linear_output), all_features=True,
+                       shadows=shadows)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
-                   len(scene.point_lights), bool(linear_output), material.has_specular)
+                   len(scene.point_lights), bool(linear_output), material.has_specular,
+                   shadows=shadows)
 
 
 STAGES = (("vertex_shader", "vertex.glsl"),

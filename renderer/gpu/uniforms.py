@@ -3,7 +3,8 @@ shared with the reference) cast to bytes. Floats and vectors become float32, mat
 column-major float32 (transforms.to_glsl, so that GLSL `M * v` is `M @ v`), flags and counts
 int32. A light array of a kind the scene lacks is left out (neither does the shader declare
 it), except in the all-features build, whose arrays have `light_slots` rows, zeros past the
-scene's lights, with the counts as uniforms.
+scene's lights, with the counts as uniforms. The shadow-map lookup's uniforms are the frame's
+ShadowPlan.uniforms (renderer/core/shadows.py), the maps on texture unit SHADOW_MAPS_UNIT.
 """
 
 from __future__ import annotations
@@ -12,23 +13,26 @@ import numpy as np
 
 from renderer.core.scene import FrameMatrices, Scene, SceneObject
 from renderer.core.transforms import to_glsl
-from renderer.core.uniforms import UNIFORM_TYPES, frame_uniforms, object_uniforms
+from renderer.core.uniforms import ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms, object_uniforms
+
+SHADOW_MAPS_UNIT = 0                     # the texture unit the shadow maps are bound to
 
 
 def as_bytes(name: str, value) -> bytes:
     """The bytes GL takes for uniform `name` (its type from the layout)."""
     kind = UNIFORM_TYPES[name]
-    if kind in ("mat3", "mat4"):
+    if kind in ("mat3", "mat4", "mat4[]"):
         return to_glsl(value)
-    if kind in ("int", "bool"):
+    if kind in ("int", "bool", "sampler2DArrayShadow"):
         return np.asarray(value, dtype=np.int32).tobytes()
     return np.asarray(value, dtype=np.float32).tobytes()
 
 
-def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
-                         light_slots: int | None = None) -> dict[str, bytes]:
-    """Uniforms shared by every object of a frame: camera, eye, ambient and lights.
-    `light_slots` is for the all-features build: arrays of that size and the counts."""
+def frame_uniform_values(scene: Scene, matrices: FrameMatrices, light_slots: int | None = None,
+                         shadows: dict | None = None) -> dict[str, bytes]:
+    """Uniforms shared by every object of a frame: camera, eye, ambient and lights, and the
+    shadow lookup's when `shadows` (ShadowPlan.uniforms) is given. `light_slots` is for the
+    all-features build: arrays of that size and the counts."""
     values = frame_uniforms(scene, matrices)
     if light_slots is not None:
         directional, point = len(scene.directional_lights), len(scene.point_lights)
@@ -37,13 +41,16 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices,
                              f"kind; the scene has {directional} directional and {point} point lights")
         values["u_num_directional_lights"] = np.asarray(directional)
         values["u_num_point_lights"] = np.asarray(point)
+    if shadows is not None:
+        values |= shadows
+        values["u_shadow_maps"] = np.asarray(SHADOW_MAPS_UNIT)
     out = {}
     for name, value in values.items():
-        if UNIFORM_TYPES[name] == "vec3[]":
-            rows = light_slots or len(value)
+        if UNIFORM_TYPES[name].endswith("[]"):
+            rows = light_slots * ROWS_PER_LIGHT.get(name, 1) if light_slots else len(value)
             if rows == 0:
                 continue
-            value = np.concatenate([value, np.zeros((rows - len(value), 3))])
+            value = np.concatenate([value, np.zeros((rows - len(value),) + value.shape[1:])])
         out[name] = as_bytes(name, value)
     return out
 

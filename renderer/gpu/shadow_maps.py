@@ -1,0 +1,224 @@
+"""The shadow maps on the GPU: their array texture and the light-view depth pass that fills it.
+
+    maps = ShadowMaps(ctx, layout)                  # once per GpuRenderer whose layout has maps
+    maps.set_plan(plan, buffers, models)            # each update(): what each pass draws
+    maps.draw()                                     # each frame, before the camera pass
+    maps.bind()                                     # the maps on SHADOW_MAPS_UNIT for lighting
+
+Every map is a layer of one DEPTH_COMPONENT32F 2D array texture (`layout.layers` layers of
+`layout.side` texels on a side; renderer/core/shadows.py), drawn from texel (0, 0): llvmpipe
+evaluates a triangle's depth plane from the window origin in float32, so a map drawn at an
+offset would store other depths. moderngl makes no depth array textures, so the storage is
+re-specified through glTexImage3D (as make_float_depth does for renderbuffers), and each layer
+gets a depth-only framebuffer through glFramebufferTextureLayer. The lighting programs read the
+maps through GL's depth-compare sampler: LINEAR filtering, CLAMP_TO_EDGE, compare LEQUAL (a tap
+is lit when its reference depth <= the stored one).
+
+Each pass (ShadowPass) draws its casters with glsl/shadow/depth.vert and depth.frag into its
+layer: the viewport at (0, 0), R x R (the map's resolution), that square alone (scissored)
+cleared to depth 1, GL_LESS, no culling, filled triangles, depth only, and GL's standard depth
+mapping (z_w = (z_ndc + 1) / 2): draw() expects glClipControl at GL's default, which GpuRenderer
+leaves behind after every frame, and must run before a reversed-Z camera pass sets its own.
+The vertex arrays reuse the renderer's vertex and index buffers (positions only);
+u_clip_from_model is each pass's clip_from_world times the object's camera-relative model
+matrix, composed in float64 once per set_plan(), so that a frame only uploads bytes and draws.
+"""
+
+from __future__ import annotations
+
+import ctypes
+
+import moderngl
+import numpy as np
+
+from renderer.core.gl_rules import STANDARD_DEPTH
+from renderer.core.shadows import ShadowLayout, ShadowPlan
+from renderer.core.transforms import to_glsl
+from renderer.errors import ContextError
+from renderer.gpu.context import gl_function
+from renderer.gpu.shaders import shader_source
+from renderer.gpu.uniforms import SHADOW_MAPS_UNIT
+
+GL_TEXTURE_2D_ARRAY = 0x8C1A
+GL_DEPTH_COMPONENT = 0x1902
+GL_DEPTH_COMPONENT32F = 0x8CAC
+GL_FLOAT = 0x1406
+GL_TEXTURE_INTERNAL_FORMAT = 0x1003
+GL_TEXTURE_PARAMETERS = {               # name -> value, as the lookup needs them
+    0x2801: 0x2601,                     # MIN_FILTER: LINEAR (one level, no mipmaps)
+    0x2800: 0x2601,                     # MAG_FILTER: LINEAR
+    0x2802: 0x812F,                     # WRAP_S: CLAMP_TO_EDGE
+    0x2803: 0x812F,                     # WRAP_T: CLAMP_TO_EDGE
+    0x813D: 0,                          # MAX_LEVEL: 0
+    0x884C: 0x884E,                     # COMPARE_MODE: COMPARE_REF_TO_TEXTURE
+    0x884D: 0x0203,                     # COMPARE_FUNC: LEQUAL
+}
+GL_FRAMEBUFFER = 0x8D40
+GL_FRAMEBUFFER_BINDING = 0x8CA6
+GL_DEPTH_ATTACHMENT = 0x8D00
+GL_FRAMEBUFFER_COMPLETE = 0x8CD5
+GL_NONE = 0
+
+
+class _GL:
+    """The GL entry points moderngl does not wrap for depth array textures."""
+
+    def __init__(self, ctx: moderngl.Context):
+        u, i, p = ctypes.c_uint, ctypes.c_int, ctypes.POINTER
+        signatures = {
+            "glBindTexture": (None, u, u),
+            "glTexImage3D": (None, u, i, i, i, i, i, i, u, u, ctypes.c_void_p),
+            "glTexParameteri": (None, u, u, i),
+            "glGetTexLevelParameteriv": (None, u, i, u, p(i)),
+            "glGetIntegerv": (None, u, p(i)),
+            "glGenFramebuffers": (None, i, p(u)),
+            "glDeleteFramebuffers": (None, i, p(u)),
+            "glBindFramebuffer": (None, u, u),
+            "glFramebufferTextureLayer": (None, u, u, u, i, i),
+            "glCheckFramebufferStatus": (u, u),
+            "glDrawBuffer": (None, u),
+            "glReadBuffer": (None, u),
+        }
+        for name, (restype, *argtypes) in signatures.items():
+            function = gl_function(ctx, name, restype, *argtypes)
+            if function is None:
+                raise ContextError(f"shadow maps need {name}, which this GL does not have")
+            setattr(self, name[2:], function)
+
+
+def make_depth_layers(ctx: moderngl.Context, gl: _GL, side: int, layers: int) -> moderngl.TextureArray:
+    """A side x side x layers array texture re-specified as DEPTH_COMPONENT32F with the
+    lookup's sampling state (a ContextError where GL cannot make it)."""
+    texture = ctx.texture_array((side, side, layers), 1, dtype="f4")
+    value = ctypes.c_int(0)
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, texture.glo)
+    gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, side, side, layers, 0,
+                  GL_DEPTH_COMPONENT, GL_FLOAT, None)
+    ctx.error                                               # clear any error it raised
+    gl.GetTexLevelParameteriv(GL_TEXTURE_2D_ARRAY, 0, GL_TEXTURE_INTERNAL_FORMAT, ctypes.byref(value))
+    for name, setting in GL_TEXTURE_PARAMETERS.items():
+        gl.TexParameteri(GL_TEXTURE_2D_ARRAY, name, setting)
+    gl.BindTexture(GL_TEXTURE_2D_ARRAY, 0)
+    if value.value != GL_DEPTH_COMPONENT32F:
+        texture.release()
+        raise ContextError(f"this GL made the shadow maps {hex(value.value)}, not "
+                           f"DEPTH_COMPONENT32F ({side}x{side}, {layers} layers)")
+    return texture
+
+
+def _layer_framebuffers(ctx: moderngl.Context, gl: _GL, texture, layers: int) -> list:
+    """A depth-only framebuffer on each layer of `texture`: (GL name, moderngl's view of it);
+    GL's framebuffer binding is left as it was."""
+    bound = ctypes.c_int(0)
+    gl.GetIntegerv(GL_FRAMEBUFFER_BINDING, ctypes.byref(bound))
+    names = (ctypes.c_uint * layers)()
+    gl.GenFramebuffers(layers, names)
+    try:
+        for layer, name in enumerate(names):
+            gl.BindFramebuffer(GL_FRAMEBUFFER, name)
+            gl.FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, texture.glo, 0, layer)
+            gl.DrawBuffer(GL_NONE)
+            gl.ReadBuffer(GL_NONE)
+            status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER)
+            if status != GL_FRAMEBUFFER_COMPLETE:
+                gl.DeleteFramebuffers(layers, names)
+                raise ContextError(f"a shadow map's framebuffer is not complete ({hex(status)})")
+        return [(name, ctx.detect_framebuffer(name)) for name in names]
+    finally:
+        gl.BindFramebuffer(GL_FRAMEBUFFER, bound.value)
+
+
+class ShadowMaps:
+    """The maps' array texture, a framebuffer per layer and the depth pass of one GpuRenderer."""
+
+    def __init__(self, ctx: moderngl.Context, layout: ShadowLayout):
+        self.ctx = ctx
+        self._gl = _GL(ctx)
+        self.layout: ShadowLayout | None = None
+        self.texture: moderngl.TextureArray | None = None
+        self._framebuffers: list = []                    # per layer: (GL name, moderngl view)
+        self.program = ctx.program(vertex_shader=shader_source("shadow/depth.vert").text,
+                                   fragment_shader=shader_source("shadow/depth.frag").text)
+        self._clip_from_model = self.program["u_clip_from_model"]
+        self._vertex_arrays: dict[int, tuple[moderngl.Buffer, moderngl.VertexArray]] = {}
+        self._passes: list = []                          # (framebuffer, R, [(vao, bytes)])
+        self.plan: ShadowPlan | None = None
+        self.set_layout(layout)
+
+    def set_layout(self, layout: ShadowLayout) -> None:
+        """Use `layout` from now on; the texture is made again only when its size changes."""
+        if self.texture is None or (layout.side, layout.layers) != (self.layout.side, self.layout.layers):
+            self._release_texture()
+            self.texture = make_depth_layers(self.ctx, self._gl, layout.side, layout.layers)
+            self._framebuffers = _layer_framebuffers(self.ctx, self._gl, self.texture, layout.layers)
+        self.layout = layout
+        self.plan, self._passes = None, []
+
+    def set_plan(self, plan: ShadowPlan, buffers: list, models: list) -> None:
+        """What draw() draws: each pass of `plan` with its casters. `buffers[i]` is object i's
+        (vertex buffer, index buffer) (positions then normals, float32; faces uint32) and
+        `models[i]` its camera-relative model matrix (float64)."""
+        self.plan, self._passes = plan, []
+        for shadow_pass in plan.passes:
+            tile = shadow_pass.tile
+            draws = [(self._vertex_array(i, *buffers[i]),
+                      to_glsl(shadow_pass.clip_from_world @ np.asarray(models[i], dtype=np.float64)))
+                     for i in shadow_pass.casters]
+            self._passes.append((self._framebuffers[tile.layer][1], tile.size, draws))
+
+    def _vertex_array(self, index: int, vbo: moderngl.Buffer, ibo: moderngl.Buffer) -> moderngl.VertexArray:
+        """Object `index`'s vertex array, made again when the renderer uploaded a new mesh."""
+        made = self._vertex_arrays.get(index)
+        if made is not None and made[0] is vbo:
+            return made[1]
+        if made is not None:
+            made[1].release()
+        vao = self.ctx.vertex_array(self.program, [(vbo, "3f 3x4", "in_position")],
+                                    index_buffer=ibo, index_element_size=4)
+        self._vertex_arrays[index] = (vbo, vao)
+        return vao
+
+    @property
+    def vertex_arrays(self) -> dict:
+        """Object index -> its depth-pass vertex array, for those drawn so far."""
+        return {index: vao for index, (_vbo, vao) in self._vertex_arrays.items()}
+
+    def draw(self) -> None:
+        """Draw every pass of the plan into its layer (GL's default clip control expected)."""
+        ctx = self.ctx
+        for framebuffer, size, draws in self._passes:
+            framebuffer.use()
+            ctx.viewport = (0, 0, size, size)               # the map, from texel (0, 0)
+            framebuffer.clear(depth=STANDARD_DEPTH.clear_depth, viewport=(0, 0, size, size))
+            ctx.enable_only(moderngl.DEPTH_TEST)            # no culling: both sides cast
+            ctx.depth_func = STANDARD_DEPTH.depth_func      # GL_LESS
+            ctx.wireframe = False                           # a viewer's wireframe is the camera's
+            for vao, clip_from_model in draws:
+                self._clip_from_model.write(clip_from_model)
+                vao.render(moderngl.TRIANGLES)
+
+    def bind(self) -> None:
+        """The maps on SHADOW_MAPS_UNIT, where the lighting programs' u_shadow_maps reads."""
+        self.texture.use(SHADOW_MAPS_UNIT)
+
+    def read_layer(self, layer: int) -> np.ndarray:
+        """Layer `layer`'s depths, float32 (S, S), GL rows (row 0 at the bottom): for tests."""
+        side = self.layout.side
+        data = self._framebuffers[layer][1].read(viewport=(0, 0, side, side), attachment=-1,
+                                                 components=1, dtype="f4")
+        return np.frombuffer(data, dtype=np.float32).reshape(side, side).copy()
+
+    def _release_texture(self) -> None:
+        if self._framebuffers:
+            names = (ctypes.c_uint * len(self._framebuffers))(*(n for n, _ in self._framebuffers))
+            self._gl.DeleteFramebuffers(len(names), names)
+        if self.texture is not None:
+            self.texture.release()
+        self._framebuffers, self.texture = [], None
+
+    def release(self) -> None:
+        for _vbo, vao in self._vertex_arrays.values():
+            vao.release()
+        self._vertex_arrays, self._passes = {}, []
+        self._release_texture()
+        self.program.release()

@@ -1,0 +1,176 @@
+"""Shadow maps on the GPU (issue 15 step 1): the depth pass fills a map with the casters'
+depth seen from the light, and a Phong receiver keeps only its ambient term where a caster
+hides the light. Hand-checked cases on a small scene: a sphere above a plane under a
+directional light, maps of 256 texels (renderer/gpu/shadow_maps.py, glsl/shadow/*)."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from renderer.core.gl_rules import (COMPONENTS_PER_DIRECTIONAL_SHADOW, COMPONENTS_PER_POINT_SHADOW,
+                                    too_many_lights, to_unorm8)
+from renderer.core.primitives import icosphere, plane
+from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
+                                 Transform)
+from renderer.core.shadow_settings import Shadow
+from renderer.core.shadows import has_shadow_maps, shadow_layout
+from renderer.core.uniforms import SHADOW_UNIFORMS
+from renderer.gpu.pipeline import GpuRenderer
+
+W, H = 64, 48
+LIGHT = DirectionalLight(direction=(0.3, -1.0, 0.2), intensity=(0.9, 0.8, 0.7),
+                         shadow=Shadow(resolution=256))
+FLOOR = Material(ka=(0.2, 0.3, 0.4), kd=(0.6, 0.5, 0.4))
+AMBIENT = (0.25, 0.25, 0.25)
+SPHERE_CENTRE = np.array([0.0, 1.0, 0.0])
+UNDER_SPHERE = SPHERE_CENTRE + 1.0 * np.array(LIGHT.direction)      # where its shadow's centre falls
+FAR_FROM_IT = np.array([-1.4, 0.0, 1.2])
+
+
+def sphere_over_plane(light=LIGHT, floor_receives=True, reversed_z=False) -> Scene:
+    floor = SceneObject("floor", plane(4.0), FLOOR, receives_shadows=floor_receives)
+    ball = SceneObject("ball", icosphere(0.5, 2), Material(), Transform(translate=tuple(SPHERE_CENTRE)))
+    return Scene(Camera(eye=(0.0, 4.0, 4.0), reversed_z=reversed_z), [floor, ball],
+                 directional_lights=[light], ambient=AMBIENT)
+
+
+def pixel_of(scene: Scene, point) -> tuple[int, int]:
+    """(row from the top, column) of the pixel whose centre is nearest `point`'s image."""
+    m = scene.matrices(W, H)
+    clip = m.projection @ m.view @ np.append(m.relative(point), 1.0)
+    x, y = clip[:2] / clip[3]
+    return int((1.0 - y) / 2.0 * H), int((x + 1.0) / 2.0 * W)
+
+
+def floor_colour(lit: bool) -> np.ndarray:
+    """The floor's colour by hand: I_a k_a, plus I_l k_d (N.L) where the light reaches it."""
+    colour = np.multiply(AMBIENT, FLOOR.ka)
+    if lit:
+        L = -np.array(LIGHT.direction) / np.linalg.norm(LIGHT.direction)
+        colour = colour + np.multiply(LIGHT.intensity, FLOOR.kd) * L[1]          # N = +y
+    return to_unorm8(colour)
+
+
+@pytest.fixture(scope="module")
+def ctx(gl_contexts):
+    return gl_contexts["egl"]
+
+
+def test_the_map_holds_the_planes_depth_seen_from_the_light(ctx):
+    scene = sphere_over_plane()
+    with GpuRenderer(scene, W, H, context=ctx) as gpu:
+        gpu.render(depth=False)
+        (shadow_pass,) = gpu.shadow_maps.plan.passes
+        layer = gpu.shadow_maps.read_layer(shadow_pass.tile.layer)
+    matrices = scene.matrices(W, H)
+    C = shadow_pass.clip_from_world
+    tile = shadow_pass.tile
+    # The floor (y = 0, camera-relative y = -origin_y) at texel centres around FAR_FROM_IT:
+    # solve C[0].p = x_ndc, C[1].p = y_ndc, p_y = floor for p; z_w = (C[2].p + 1) / 2.
+    floor_y = -matrices.origin[1]
+    centre = C @ np.append(matrices.relative(FAR_FROM_IT), 1.0)
+    i0, j0 = ((centre[:2] + 1.0) / 2.0 * tile.size).astype(int)
+    for i, j in [(i0 + di, j0 + dj) for di in (-2, 0, 2) for dj in (-2, 0, 2)]:
+        ndc = (np.array([i, j]) + 0.5) / tile.size * 2.0 - 1.0
+        a = np.array([C[0, :3], C[1, :3], [0.0, 1.0, 0.0]])
+        p = np.linalg.solve(a, [ndc[0] - C[0, 3], ndc[1] - C[1, 3], floor_y])
+        expected = np.float32((C[2, :3] @ p + C[2, 3] + 1.0) / 2.0)
+        stored = layer[j, i]
+        ulps = abs(int(stored.view(np.int32)) - int(expected.view(np.int32)))
+        assert ulps <= 4, (i, j, stored, expected)
+
+
+@pytest.mark.parametrize("reversed_z", [False, True])
+def test_the_floor_under_the_sphere_keeps_only_its_ambient_term(ctx, reversed_z):
+    with GpuRenderer(sphere_over_plane(reversed_z=reversed_z), W, H, context=ctx) as gpu:
+        image = gpu.render(depth=False).rgba8
+    scene = sphere_over_plane()
+    assert image[pixel_of(scene, UNDER_SPHERE)][:3].tolist() == floor_colour(lit=False).tolist()
+    assert image[pixel_of(scene, FAR_FROM_IT)][:3].tolist() == floor_colour(lit=True).tolist()
+
+
+def test_under_a_point_light_too(ctx):
+    """Six cube faces, each a layer of its own; the one looking down holds the sphere. Away
+    from its shadow the floor is as lit as with the light's shadows off."""
+    position = np.array([0.3, 3.0, 0.2])
+    under = position + 1.5 * (SPHERE_CENTRE - position)                 # y = 0 on that ray
+    images = {}
+    for enabled in (True, False):
+        scene = sphere_over_plane()
+        scene.directional_lights = []
+        scene.point_lights = [PointLight(tuple(position), LIGHT.intensity,
+                                         shadow=Shadow(enabled, resolution=256))]
+        with GpuRenderer(scene, W, H, context=ctx) as gpu:
+            images[enabled] = gpu.render(depth=False).rgba8
+            if enabled:
+                assert [p.tile.layer for p in gpu.shadow_maps.plan.passes] == [3]    # -y only
+    assert images[True][pixel_of(scene, under)][:3].tolist() == floor_colour(lit=False).tolist()
+    assert images[False][pixel_of(scene, under)][:3].tolist() != floor_colour(lit=False).tolist()
+    far = pixel_of(scene, FAR_FROM_IT)
+    assert images[True][far].tolist() == images[False][far].tolist()
+
+
+@pytest.mark.parametrize("scene, shadowed_programs", [
+    (sphere_over_plane(light=replace(LIGHT, shadow=Shadow(enabled=False))), 0),
+    (sphere_over_plane(floor_receives=False), 1)], ids=["light-shadows-off", "floor-receives-none"])
+def test_without_the_lights_shadow_or_the_floors_the_floor_is_lit_everywhere(ctx, scene,
+                                                                             shadowed_programs):
+    with GpuRenderer(scene, W, H, context=ctx) as gpu:
+        image = gpu.render(depth=False).rgba8
+        # No maps at all, or only the ball's program looks them up.
+        assert sum(variant.shadows for variant in gpu.programs) == shadowed_programs
+    for point in (UNDER_SPHERE, FAR_FROM_IT):
+        assert image[pixel_of(scene, point)][:3].tolist() == floor_colour(lit=True).tolist()
+
+
+def test_a_scene_without_maps_compiles_no_shadow_code(ctx):
+    scene = sphere_over_plane()
+    assert has_shadow_maps(scene)
+    for obj in scene.objects:
+        obj.receives_shadows = False
+    assert not has_shadow_maps(scene) and not shadow_layout(scene, W, H).any
+    for specialise in (True, False):
+        with GpuRenderer(scene, W, H, context=ctx, specialise=specialise) as gpu:
+            gpu.render(depth=False)
+            assert gpu.shadow_maps is None
+            assert gpu.programs and not any(v.defines()["SHADOW_MAPS"] for v in gpu.programs)
+
+
+def test_the_all_features_build_looks_the_maps_up_too_and_draws_the_same(ctx):
+    scene = sphere_over_plane()
+    images = {}
+    for specialise in (True, False):
+        with GpuRenderer(scene, W, H, context=ctx, specialise=specialise) as gpu:
+            images[specialise] = gpu.render(depth=False).rgba8
+            assert [v.shadows for v in gpu.programs] == [True]
+    assert np.array_equal(images[True], images[False])
+
+
+def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):
+    scene = sphere_over_plane()
+    with GpuRenderer(scene, W, H, context=ctx) as gpu:
+        gpu.render(depth=False)
+        made = (gpu.shadow_maps, gpu.shadow_maps.texture, gpu.shadow_maps.program,
+                dict(gpu.programs), gpu.shadow_maps.vertex_arrays)
+        scene.directional_lights[0] = replace(LIGHT, direction=(-0.3, -1.0, 0.1))
+        gpu.update()
+        gpu.render(depth=False)
+        again = (gpu.shadow_maps, gpu.shadow_maps.texture, gpu.shadow_maps.program,
+                 dict(gpu.programs), gpu.shadow_maps.vertex_arrays)
+    assert all(a is b for a, b in zip(made[:3], again[:3]))
+    assert made[3] == again[3] and all(made[3][v] is again[3][v] for v in made[3])
+    assert made[4] == again[4]
+
+
+def test_the_light_budget_counts_the_shadow_uniforms():
+    sizes = {"float": 1, "vec4[]": 4, "mat4[]": 16}
+    per_light = {kind: sum(sizes[t] * (6 if name.endswith("_tiles") else 1)
+                           for name, t in SHADOW_UNIFORMS.items() if name.startswith(f"u_{kind}_"))
+                 for kind in ("directional", "point")}
+    assert per_light == {"directional": COMPONENTS_PER_DIRECTIONAL_SHADOW,
+                         "point": COMPONENTS_PER_POINT_SHADOW} == {"directional": 24, "point": 36}
+    assert too_many_lights(28, 0, 28, 0) is None and too_many_lights(0, 18, 0, 18) is None
+    message = too_many_lights(29, 0, 29, 0)
+    assert "928 uniform components" in message and message.endswith("set `shadows = false` on some lights")
+    assert "shadows" not in too_many_lights(113, 0)

@@ -32,6 +32,7 @@ from renderer.viewer.presenter import fit
 
 VIEW_UNIT = 1                      # the texture unit the view reads the maps on
 CUBE_GRID = (3, 2)                 # a point light's faces across and down
+CUBE_FACE_NAMES = ("+x", "-x", "+y", "-y", "+z", "-z")    # CUBE_FACE_AXES, the grid's order
 
 
 def drawn_faces(plan: ShadowPlan, light_map: LightMap) -> list[int]:

@@ -188,6 +188,21 @@ def test_shadows_off_draws_the_scene_without_shadows_and_on_again_the_same_image
     assert all(programs[3][v] is program for v, program in programs[1].items())
 
 
+def test_update_makes_new_maps_in_the_renderers_own_context(gl_contexts):
+    """update() may run while another context is current (a viewer's window after a headless
+    render): a new layout's texture is made in the renderer's context all the same."""
+    from renderer.gpu.context import activate
+    scene = sphere_over_plane()
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as gpu:
+        gpu.render(depth=False)
+        scene.directional_lights[0] = replace(LIGHT, shadow=Shadow(resolution=128))
+        activate(gl_contexts["osmesa"])
+        gpu.update()                                  # a new texture: 128 texels, not 256
+        image = gpu.render(depth=False).rgba8
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as fresh:
+        assert np.array_equal(image, fresh.render(depth=False).rgba8)
+
+
 def test_the_light_budget_counts_the_shadow_uniforms():
     sizes = {"float": 1, "vec4[]": 4, "mat4[]": 16}
     per_light = {kind: sum(sizes[t] * (6 if name.endswith("_tiles") else 1)

@@ -292,6 +292,7 @@ class GpuRenderer:
                 a is not b.obj for a, b in zip(scene.objects, self._objects)):
             raise ValueError("the scene's objects changed since this GpuRenderer was made; "
                              "make a new one")
+        activate(self.ctx)          # new meshes and maps are made in this renderer's context
         for item in self._objects:
             if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
                 self._release_buffers(item)

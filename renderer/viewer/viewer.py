@@ -20,8 +20,8 @@ events. The reference view compares the rasteriser only: it is off while ray tra
 Shadows (the O key) switch GpuRenderer.shadows; the reference view is then asked for the scene
 with every light's shadows off, the image the GPU draws. The shadow-map view (the D key,
 renderer/viewer/shadow_view.py) replaces the picture with the map of the chosen light as the
-frame just drawn left it, the map its lighting read; the overlay names the light, the depth
-range shown, or why there is no map to show.
+frame just drawn left it, the map its lighting read; the overlay names the light and the depth
+range shown, or says why there is no map to show.
 
 `Viewer.run(frames=N, orbit=DEG, screenshot=PATH)` is the scripted mode of the command line:
 N frames, the camera orbiting DEG degrees per frame, then what the window shows saved to PNG
@@ -128,7 +128,7 @@ class Viewer:
             self.accumulator = Accumulator()
             self._traced = CpuImage(self.ctx)  # the mean so far
             self._map_view = None              # the ShadowMapView, made on first use
-            self._map_line: str | None = None  # the overlay's line on it (None: not asked for)
+            self._map_lines: tuple = ()        # the overlay's lines on it (none: not asked for)
             self._map_shown = False            # the picture is the map view
             self._version = 0                 # bumped whenever the shaded image would change
             self._view: tuple | None = None   # what the version stands for
@@ -237,8 +237,7 @@ class Viewer:
                 lines.append("reference view: off while ray tracing (it compares the rasteriser)")
         elif self.state.reference == "side-by-side":
             lines.append("left: GPU (GLSL)    right: NumPy reference")
-        if self._map_line is not None:
-            lines.append(self._map_line)
+        lines += self._map_lines
         if self.state.reference != "off" and self.state.method == "raster" and not self._map_shown:
             current = self._reference_version == self._version
             if self._figures is not None and self._reference_version >= 0:
@@ -303,11 +302,11 @@ class Viewer:
 
     def _shadow_map(self, drawn):
         """The map view's framebuffer in place of `drawn` when the D key asks for a map and
-        the frame just drawn drew it; sets the overlay's line: what is shown, or why not."""
+        the frame just drawn drew it; sets the overlay's lines: what is shown, or why not."""
         index, plan = self.state.shadow_map, self.gpu.drawn_shadow_plan
         self._map_shown = False
         if index is None:
-            self._map_line = None
+            self._map_lines = ()
             return drawn
         name = light_names_of(self.authored)[index]
         light_map = None if plan is None else plan.layout.get(*shown_light(self.state, self.authored, index))
@@ -320,7 +319,7 @@ class Viewer:
         else:
             why = None
         if why is not None:
-            self._map_line = f"shadow map of {name}: {why}"
+            self._map_lines = (f"shadow map of {name}: {why}",)
             return drawn
         if self._map_view is None:
             self._map_view = ShadowMapView(self.ctx)
@@ -329,14 +328,14 @@ class Viewer:
         faces = drawn_faces(plan, light_map)
         r = light_map.resolution
         if light_map.kind == "point":
-            drawn_names = " ".join(CUBE_FACE_NAMES[f] for f in faces) or "none"
-            what = f"faces +x -x +y / -y +z -z of {r}x{r} texels, drawn: {drawn_names}"
+            drawn_names = "all" if len(faces) == 6 else " ".join(CUBE_FACE_NAMES[f] for f in faces) or "none"
+            what = f"{r}x{r}, faces +x -x +y / -y +z -z (drawn: {drawn_names})"
         else:
-            what = f"{r}x{r} texels" + ("" if faces else ", not drawn: nothing shadows the view")
+            what = f"{r}x{r}" + ("" if faces else " (not drawn: nothing shadows the view)")
         depths = self._map_view.depth_range
-        stretch = ("; nothing stored" if depths is None else
-                   f"; depth {depths[0]:.6g} black to {depths[1]:.6g} light grey")
-        self._map_line = f"shadow map of {name}: {what}{stretch}, white: 1.0 (cleared)"
+        self._map_lines = (f"shadow map of {name}: {what}",
+                           "nothing stored: all 1.0 (white)" if depths is None else
+                           f"depth {depths[0]:.6g} black to {depths[1]:.6g} grey, 1.0 white")
         self._map_shown = True
         return shown
 

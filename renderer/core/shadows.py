@@ -265,7 +265,8 @@ def _plan_directional(index, light, light_map, layout, points, receivers, caster
     lookup = _map_from_clip(light_map.tiles[0], layout.side) @ clip
     if not drawn:
         return None, lookup, params, texel
-    params[:] = (1.0, texel, light_map.shadow.kernel, light_map.tiles[0].layer)
+    tile = light_map.tiles[0]
+    params[:] = (tile.layer, texel, light_map.shadow.kernel, tile.size / layout.side)
     return (ShadowPass("directional", index, 0, light_map.tiles[0], clip, tuple(drawn)),
             lookup, params, texel)
 

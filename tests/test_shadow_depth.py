@@ -10,6 +10,7 @@ import numpy as np
 
 from reference.shadow.depth import ShadowAtlas, draw_pass, render_atlas
 from renderer.core.builtin import builtin_scenes
+from renderer.core.gl_rules import STANDARD_DEPTH
 from renderer.core.scene import Mesh
 from renderer.core.scene_file import load_scene
 from renderer.core.shadows import ShadowPass, Tile, plan_shadows, shadow_layout
@@ -63,7 +64,7 @@ def gpu_atlas(ctx, scene, matrices, plan) -> np.ndarray:
         framebuffer.clear(depth=1.0)
         ctx.enable(ctx.DEPTH_TEST)
         ctx.disable(ctx.CULL_FACE)
-        ctx.depth_func = "<"
+        ctx.depth_func = STANDARD_DEPTH.depth_func          # GL_LESS
         for shadow_pass in plan.passes:
             tile = shadow_pass.tile
             framebuffer.viewport = (tile.x, tile.y, tile.size, tile.size)

@@ -209,13 +209,18 @@ def self_lookup(scene, dtype):
 def test_d_a_plane_is_lit_in_its_own_map_at_every_angle(filter_name):
     """With the automatic bias, no point of the plane shadows itself (no acne) and no tap is
     even tied, at 1..89 degrees (every 4th in the default run; test_d_every_angle: all), in
-    float64 and float32; without a bias (BiasRule()) the same plane at 45 degrees is acne."""
+    float64 and float32; without a bias (BiasRule()) the same plane at 45 degrees is acne, and
+    at 0 degrees (facing the light: its depth is the same at every texel) every lookup is a
+    tie (ref = stored up to rounding): lit in float64 (ref <= stored), 0 decided the other way
+    where every tap reads the plane."""
     for theta in range(1, 90, 4):
         for dtype in (np.float64, np.float32):
             look = self_lookup(tilted_plane_scene(theta, filter_name, None), dtype)
             assert look.visibility.min() == 1.0 and not look.tied.any(), (theta, dtype)
     acne = self_lookup(tilted_plane_scene(45, filter_name, BiasRule()), np.float64)
     assert acne.visibility.min() < 1.0
+    facing = self_lookup(tilted_plane_scene(0, filter_name, BiasRule()), np.float64)
+    assert facing.tied.all() and (facing.visibility == 1.0).all() and facing.alternative.min() == 0.0
 
 
 @pytest.mark.slow

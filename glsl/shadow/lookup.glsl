@@ -6,8 +6,9 @@
 // with the depth the light's depth pass stored (glsl/shadow/depth.vert) through GL's depth-compare
 // sampler: a tap is lit where its reference depth is <= the stored one (LEQUAL), and LINEAR
 // filtering blends the four nearest texels' comparisons bilinearly (percentage-closer filtering).
-// Every map is a square tile of one atlas (u_shadow_atlas, its side u_shadow_atlas_size a power of
-// two); a point light has six, one per cube face, each widened so that no tap leaves its tile.
+// Every map is a layer of one array texture (u_shadow_maps; layers of side u_shadow_map_size, a
+// power of two), drawn from texel (0, 0); a point light has six, one per cube face, each widened
+// so that no tap leaves its map.
 // Coordinates are camera-relative world coordinates, as lighting.glsl's.
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
@@ -18,19 +19,19 @@
 #endif
 #define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
 
-uniform sampler2DShadow u_shadow_atlas;
-uniform float u_shadow_atlas_size;   // S, texels on a side
+uniform sampler2DArrayShadow u_shadow_maps;
+uniform float u_shadow_map_size;     // S, texels on a side of a layer
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
-uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];  // P -> (u, v, z_w) in the atlas
-uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];         // (drawn, texel size, kernel, 0)
+uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];  // P -> (u, v, z_w) in its layer
+uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];         // (drawn, texel size, kernel, layer)
 uniform vec4 u_directional_shadow_bias[NUM_DIRECTIONAL_LIGHTS];    // (normal, constant, slope) texels
 #endif
 #if NUM_POINT_LIGHTS > 0
 uniform vec4 u_point_shadow[NUM_POINT_LIGHTS];             // (drawn, tan(half angle), kernel, R)
 uniform vec4 u_point_shadow_depth[NUM_POINT_LIGHTS];       // (A, B, near, far): z_w = A + B / m
 uniform vec4 u_point_shadow_bias[NUM_POINT_LIGHTS];        // (normal, constant, slope) texels
-uniform vec4 u_point_shadow_tiles[6 * NUM_POINT_LIGHTS];   // per face (u0, v0, size, drawn)
+uniform vec4 u_point_shadow_tiles[6 * NUM_POINT_LIGHTS];   // per face (layer, size / S, drawn, 0)
 #endif
 
 // The receiver point moved before it is compared (shadow_settings.BiasRule): along N by
@@ -49,17 +50,17 @@ vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bia
 // read through the LINEAR sampler at that texel's centre (exact: S is a power of two, so the
 // centre's weight is 1); K x K PCF is the mean of (K-1)^2 bilinear comparisons on a unit grid
 // centred on the point, j (the map's y) outer.
-float shadow_filter(vec3 uvz, int kernel) {
-    float S = u_shadow_atlas_size;
+float shadow_filter(vec3 uvz, float layer, int kernel) {
+    float S = u_shadow_map_size;
     if (kernel == 1) {
-        return texture(u_shadow_atlas, vec3((floor(uvz.xy * S) + 0.5) / S, uvz.z));
+        return texture(u_shadow_maps, vec4((floor(uvz.xy * S) + 0.5) / S, layer, uvz.z));
     }
     float sum = 0.0;
     float first = -0.5 * float(kernel - 2);
     for (int j = 0; j < kernel - 1; ++j) {
         for (int i = 0; i < kernel - 1; ++i) {
             vec2 offset = vec2(first + float(i), first + float(j));
-            sum += texture(u_shadow_atlas, vec3(uvz.xy + offset / S, uvz.z));
+            sum += texture(u_shadow_maps, vec4(uvz.xy + offset / S, layer, uvz.z));
         }
     }
     return sum / float((kernel - 1) * (kernel - 1));
@@ -76,7 +77,7 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
     vec3 X = normalize(vec3(M[0][0], M[1][0], M[2][0]));     // row 0 of M: the map's x axis
     vec3 Y = normalize(vec3(M[0][1], M[1][1], M[2][1]));     // row 1: its y axis
     vec3 Q = shadow_bias_point(P, N, L, X, Y, p.y, u_directional_shadow_bias[i]);
-    return shadow_filter((M * vec4(Q, 1.0)).xyz, int(p.z));
+    return shadow_filter((M * vec4(Q, 1.0)).xyz, p.w, int(p.z));
 }
 #endif
 
@@ -120,12 +121,12 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
     vec3 d = Q - light;
     int f = cube_face(d);
     vec4 rect = u_point_shadow_tiles[6 * i + f];
-    if (rect.w == 0.0) {
+    if (rect.z == 0.0) {
         return 1.0;                  // the face sees no caster: it was not drawn
     }
     float m = dot(CUBE_FACE_AXIS[f], d);
-    vec2 uv_tile = 0.5 * vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / (m * p.y) + 0.5;
+    vec2 uv = (0.5 * vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / (m * p.y) + 0.5) * rect.y;
     vec4 depth = u_point_shadow_depth[i];
-    return shadow_filter(vec3(rect.xy + uv_tile * rect.z, depth.x + depth.y / m), int(p.z));
+    return shadow_filter(vec3(uv, depth.x + depth.y / m), rect.x, int(p.z));
 }
 #endif

@@ -1,6 +1,6 @@
 """Shadow-map settings: what a light's map is made with (scene file: the light's `shadows`,
 `shadow_resolution`, `shadow_filter`, `shadow_bias` keys), the filters' tap pattern and the bias
-rule. The scene model holds a `Shadow` per light (renderer/core/scene.py); the atlas and each
+rule. The scene model holds a `Shadow` per light (renderer/core/scene.py); the layers and each
 frame's light views are renderer/core/shadows.py. docs/conventions.md, "Shadows", states the rules.
 """
 
@@ -19,8 +19,8 @@ import numpy as np
 FILTERS = {"hard": 1, "pcf2x2": 2, "pcf3x3": 3, "pcf5x5": 5}
 DEFAULT_FILTER = "pcf2x2"
 
-RESOLUTIONS = (256, 512, 1024, 2048, 4096)     # texels on a side of one tile; powers of two
-MAX_ATLAS_SIDE = 8192                          # 256 MiB of float depth; GL guarantees 16384
+RESOLUTIONS = (64, 128, 256, 512, 1024, 2048, 4096)   # texels on a side of a map; powers of two
+MAX_SHADOW_TEXELS = 1 << 26                    # all layers together: 256 MiB of float32 depth
 
 
 @dataclass(frozen=True)

@@ -8,18 +8,19 @@ This module holds what the GPU path and the reference share and neither computes
 
 - (the settings of a light's map, `Shadow`: on/off, resolution, filter, bias, are in
   renderer/core/shadow_settings.py; objects carry `casts_shadows` / `receives_shadows`);
-- the atlas: every map of a scene is a square tile in one DEPTH_COMPONENT32F texture whose
-  side is a power of two (`ShadowLayout`, packed by `pack_tiles`); a directional light has
-  one tile, a point light six (the faces of a cube around it, each a 90-degree perspective
-  view widened by a guard band, so that no filter tap ever leaves its tile: no seams);
+- the layers: every map of a scene is a layer of one DEPTH_COMPONENT32F 2D array texture,
+  drawn from texel (0, 0) (`ShadowLayout`, `Tile`); a directional light has one, a point light
+  six (the faces of a cube around it, each a 90-degree perspective view widened by a guard
+  band, so that no filter tap ever leaves its map: no seams);
 - each frame's light views (`plan_shadows`): an orthographic view for a directional light
   fitted to the receivers the camera can see and the casters that can shadow them, six
   perspective views for a point light, the passes worth drawing (none for a light that
   nothing can shadow, none for a cube face that sees no caster), and the uniform values;
 
-Coordinates are camera-relative, as everything else the pipelines get (FrameMatrices). Tile
-texel (i, j) of a tile at atlas texel (x0, y0) is atlas texel (x0 + i, y0 + j); rows count up
-from the bottom as GL's window rows do (the depth pass draws with the viewport on the tile).
+Coordinates are camera-relative, as everything else the pipelines get (FrameMatrices). A map
+of R texels in layers of side S covers texture coordinates [0, R/S)^2 of its layer; its rows
+count up from the bottom as GL's window rows do (the depth pass draws with the viewport at
+(0, 0), R x R, on that layer).
 """
 
 from __future__ import annotations
@@ -31,7 +32,7 @@ import numpy as np
 
 from renderer.core import transforms
 from renderer.core.gl_rules import depth_mapping
-from renderer.core.shadow_settings import MAX_ATLAS_SIDE, Shadow, auto_resolution, guard_texels
+from renderer.core.shadow_settings import MAX_SHADOW_TEXELS, Shadow, auto_resolution, guard_texels
 from renderer.core.visibility import CLIP_PLANES
 
 # --- cube faces ------------------------------------------------------------------------------
@@ -63,51 +64,26 @@ def cube_face(direction: np.ndarray) -> np.ndarray:
     return 2 * axis + negative.astype(axis.dtype)
 
 
-# --- the atlas -------------------------------------------------------------------------------
+# --- the layers ------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
 class Tile:
-    """A square of `size` texels at atlas texel (x, y) (GL rows: y counts up from the bottom)."""
-    x: int
-    y: int
+    """One map: the texels [0, size)^2 of layer `layer` (GL rows: y counts up from the bottom).
+    Every map starts at texel (0, 0) of its own layer, because llvmpipe evaluates a triangle's
+    depth plane from the window origin in float32: a map drawn at an offset in a larger texture
+    would store depths hundreds of float32 units from the plane's (the probe in
+    /work/notes/llvmpipe-shadow-sampler.md, section 6)."""
+    layer: int
     size: int
 
-    def rect(self, atlas_side: int) -> np.ndarray:
-        """(x0, y0, size, 0) in atlas texture coordinates (what the lookup adds and scales)."""
-        return np.array([self.x, self.y, self.size, 0.0]) / np.array([atlas_side] * 3 + [1.0])
-
-
-def _morton_decode(index: int) -> tuple[int, int]:
-    x = y = 0
-    for bit in range(32):
-        x |= ((index >> (2 * bit)) & 1) << bit
-        y |= ((index >> (2 * bit + 1)) & 1) << bit
-    return x, y
-
-
-def pack_tiles(sizes: list[int]) -> tuple[int, list[Tile]]:
-    """Square power-of-two tiles into the smallest square power-of-two atlas: (side, tiles in
-    the order given). Sorted largest first and laid in Morton (Z) order, each tile starts at a
-    multiple of its own area, so the tiles never overlap and fill the atlas without gaps."""
-    if not sizes:
-        return 0, []
-    order = sorted(range(len(sizes)), key=lambda i: -sizes[i])
-    total = sum(s * s for s in sizes)
-    side = 1 << math.ceil(math.log2(math.isqrt(total - 1) + 1)) if total > 1 else 1
-    side = max(side, max(sizes))
-    tiles: list[Tile | None] = [None] * len(sizes)
-    start = 0                                        # in texels of area, Morton order
-    for i in order:
-        s = sizes[i]
-        x, y = _morton_decode(start // (s * s))
-        tiles[i] = Tile(x * s, y * s, s)
-        start += s * s
-    return side, tiles
+    def rect(self, side: int, drawn: bool) -> np.ndarray:
+        """(layer, size / side, drawn 0 or 1, 0): what the lookup reads for a cube face."""
+        return np.array([float(self.layer), self.size / side, 1.0 if drawn else 0.0, 0.0])
 
 
 @dataclass(frozen=True)
 class LightMap:
-    """One light's shadow map in the atlas."""
+    """One light's shadow map: its layers of the array texture."""
     kind: str                  # "directional" or "point"
     index: int                 # the light's index among lights of its kind
     shadow: Shadow
@@ -121,9 +97,10 @@ class LightMap:
 
 @dataclass(frozen=True)
 class ShadowLayout:
-    """Which lights have a map and where: fixed for a scene at an image size (the programs'
-    uniform arrays and the atlas texture are made from it once)."""
-    atlas_side: int
+    """Which lights have a map and where: fixed for a scene at an image size (the array texture
+    is made from it once). `side`: the layers' side, the largest map's; `layers`: how many."""
+    side: int
+    layers: int
     maps: tuple[LightMap, ...]
 
     def get(self, kind: str, index: int) -> LightMap | None:
@@ -144,29 +121,31 @@ def scene_has_shadows(scene) -> bool:
 
 
 def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
-    """The atlas for `scene` rendered at width x height: a tile per light with shadows on
-    (six for a point light), none at all when nothing casts or nothing receives. A
-    ValueError when the tiles need an atlas over MAX_ATLAS_SIDE."""
+    """The shadow maps of `scene` rendered at width x height: a layer per light with shadows
+    on (six for a point light), none at all when nothing casts or nothing receives. A
+    ValueError when they would take more than MAX_SHADOW_TEXELS."""
     if not scene_has_shadows(scene):
-        return ShadowLayout(0, ())
+        return ShadowLayout(0, 0, ())
     wanted = []
     for kind, lights in (("directional", scene.directional_lights), ("point", scene.point_lights)):
         for i, light in enumerate(lights):
             if light.shadow.enabled:
                 resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
                 wanted.append((kind, i, light.shadow, resolution))
-    sizes = [r for kind, _, _, r in wanted for _ in range(6 if kind == "point" else 1)]
-    side, tiles = pack_tiles(sizes)
-    if side > MAX_ATLAS_SIDE:
-        raise ValueError(f"the shadow maps need a {side}x{side} atlas, more than "
-                         f"{MAX_ATLAS_SIDE}x{MAX_ATLAS_SIDE}: lower shadow_resolution or turn "
-                         f"shadows off for some lights")
-    maps, at = [], 0
+    if not wanted:
+        return ShadowLayout(0, 0, ())
+    side = max(r for *_, r in wanted)
+    maps, layer = [], 0
     for kind, i, shadow, resolution in wanted:
         count = 6 if kind == "point" else 1
-        maps.append(LightMap(kind, i, shadow, resolution, tuple(tiles[at:at + count])))
-        at += count
-    return ShadowLayout(side, tuple(maps))
+        maps.append(LightMap(kind, i, shadow, resolution,
+                             tuple(Tile(layer + k, resolution) for k in range(count))))
+        layer += count
+    if layer * side * side > MAX_SHADOW_TEXELS:
+        raise ValueError(f"the shadow maps need {layer} layers of {side}x{side} texels, more than "
+                         f"{MAX_SHADOW_TEXELS} texels: lower shadow_resolution or turn shadows "
+                         f"off for some lights")
+    return ShadowLayout(side, layer, tuple(maps))
 
 
 # --- each frame's light views ----------------------------------------------------------------
@@ -182,7 +161,7 @@ DEPTH_MARGIN = 2.0 ** -8               # of the depth span, added at both ends o
 class ShadowPass:
     """One tile drawn by the depth pass: `casters` (object indices) seen through
     `clip_from_world` (light clip coordinates from camera-relative world, float64) into
-    `tile` of the atlas, standard depth mapping (z_w = (z_ndc + 1) / 2, cleared to 1, GL_LESS)."""
+    `tile` (a layer, from texel (0, 0)), standard depth mapping (z_w = (z_ndc + 1) / 2, cleared to 1, GL_LESS)."""
     kind: str
     light: int
     face: int
@@ -201,8 +180,8 @@ class ShadowPlan:
     texel_size: dict = field(default_factory=dict)   # (kind, light) -> world size of a texel (directional)
 
     @property
-    def atlas_side(self) -> int:
-        return self.layout.atlas_side
+    def side(self) -> int:
+        return self.layout.side
 
 
 def world_points(scene, matrices) -> list[np.ndarray]:
@@ -231,13 +210,11 @@ def _ortho_rows(centre_x, centre_y, half, near, far) -> np.ndarray:
                      [0.0, 0.0, 0.0, 1.0]])
 
 
-def _atlas_from_clip(tile: Tile, atlas_side: int) -> np.ndarray:
-    """(4, 4) taking light clip coordinates (w = 1) to (u, v) in the atlas and z_w."""
-    scale = 0.5 * tile.size / atlas_side
+def _map_from_clip(tile: Tile, side: int) -> np.ndarray:
+    """(4, 4) taking light clip coordinates (w = 1) to (u, v) in the tile's layer and z_w."""
+    scale = 0.5 * tile.size / side
     m = np.diag([scale, scale, 0.5, 1.0])
-    m[0, 3] = scale + tile.x / atlas_side
-    m[1, 3] = scale + tile.y / atlas_side
-    m[2, 3] = 0.5
+    m[:3, 3] = (scale, scale, 0.5)
     return m
 
 
@@ -277,10 +254,10 @@ def _plan_directional(index, light, light_map, layout, scene, points, receivers,
     margin = max(DEPTH_MARGIN * (far_depth - near_depth), 2.0 * texel)
     near_depth, far_depth = near_depth - margin, far_depth + margin
     clip = _ortho_rows(centre[0], centre[1], half, near_depth, far_depth) @ rotation
-    lookup = _atlas_from_clip(light_map.tiles[0], layout.atlas_side) @ clip
+    lookup = _map_from_clip(light_map.tiles[0], layout.side) @ clip
     if not drawn:
         return None, lookup, params, texel
-    params[:] = (1.0, texel, light_map.shadow.kernel, 0.0)
+    params[:] = (1.0, texel, light_map.shadow.kernel, light_map.tiles[0].layer)
     return (ShadowPass("directional", index, 0, light_map.tiles[0], clip, tuple(drawn)),
             lookup, params, texel)
 
@@ -327,11 +304,11 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
         view[:3, 3] = -CUBE_FACE_ROTATIONS[face] @ position
         clip = projection @ view
         tile = light_map.tiles[face]
-        rects[face] = tile.rect(layout.atlas_side)
         drawn = tuple(i for i in casters if not _outside_frustum(clip, points[i]))
-        if not drawn or all(_outside_frustum(clip, points[i]) for i in receivers):
+        needed = bool(drawn) and not all(_outside_frustum(clip, points[i]) for i in receivers)
+        rects[face] = tile.rect(layout.side, needed)   # not drawn: the lookup reads it as lit
+        if not needed:
             continue
-        rects[face, 3] = 1.0                      # drawn: the lookup reads this face
         passes.append(ShadowPass("point", index, face, tile, clip, drawn))
     if passes:
         params[:] = (1.0, tan_half, light_map.shadow.kernel, light_map.resolution)
@@ -345,7 +322,7 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
     those count as receivers to fit a map to."""
     n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
     uniforms = {
-        "u_shadow_atlas_size": np.array(float(layout.atlas_side)),
+        "u_shadow_map_size": np.array(float(layout.side)),
         "u_directional_shadow_matrix": np.tile(np.eye(4), (n_dir, 1, 1)),
         "u_directional_shadow": np.zeros((n_dir, 4)),
         "u_directional_shadow_bias": np.zeros((n_dir, 4)),

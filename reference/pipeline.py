@@ -9,7 +9,7 @@ memory stays bounded. Objects wholly outside the view volume are skipped (render
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 When the scene has shadow maps (renderer/core/shadows.py: shadow_layout(...).any), the
-frame's atlas is drawn first (reference/shadow/depth.py) and Phong receivers look it up
+frame's maps are drawn first (reference/shadow/depth.py, a layer each) and Phong receivers look it up
 (reference/shadow/lookup.py); where a lookup had a tied tap, the pixel's colour with those
 taps decided the other way goes into Frame.rgba8_tie too (a pixel with both kinds of tie
 shows the depth tie's other surface there: either is an acceptable answer, and one
@@ -34,7 +34,7 @@ from reference.geometry import shade_triangles
 from reference.lighting import Lights
 from reference.output import compose_frame
 from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
-from reference.shadow.depth import render_atlas
+from reference.shadow.depth import render_layers
 from reference.shadow.lookup import ShadowMaps
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
@@ -149,13 +149,13 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
 
 def shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype,
                 tile_pixels=TILE_PIXELS) -> ShadowMaps | None:
-    """The frame's shadow maps (atlas drawn, uniforms in `dtype`), or None when the scene has
+    """The frame's shadow maps (layers drawn, uniforms in `dtype`), or None when the scene has
     none (then no program compiles shadow code)."""
     layout = shadow_layout(scene, width, height)
     if not layout.any:
         return None
     plan = plan_shadows(scene, frame_matrices, layout, visible)
-    return ShadowMaps.from_plan(render_atlas(scene, frame_matrices, plan, dtype, tile_pixels),
+    return ShadowMaps.from_plan(render_layers(scene, frame_matrices, plan, dtype, tile_pixels),
                                 plan, lights, dtype)
 
 

@@ -2,7 +2,8 @@
 case per rule: the depth compare, the bilinear weights of percentage-closer filtering, the
 cube-face choice, the automatic bias. Where a rule is the sampler's or the GLSL's, the same
 inputs go through tests/glsl/shadow_lookup.frag on llvmpipe (EGL and OSMesa) and the two
-agree exactly."""
+agree exactly. A known map is layer LAYER of a three-layer array texture whose other layers
+hold 0.0 (every ref > 0 in shadow there), so reading the wrong layer shows."""
 
 import math
 
@@ -10,7 +11,7 @@ import numpy as np
 import pytest
 
 from reference.lighting import Lights
-from reference.shadow.depth import render_atlas
+from reference.shadow.depth import ShadowLayers, render_layers
 from reference.shadow.lookup import (ShadowMaps, light_visibility_directional, shadow_bias_point,
                                      shadow_filter)
 from renderer.core import primitives
@@ -22,18 +23,26 @@ from shadow_gl import run_lookup_shader
 F32 = np.float32
 
 
-def reference_filter(atlas_depth, uvz, kernel):
+LAYER = 1
+
+
+def layers_of(depth) -> ShadowLayers:
+    """A bare (S, S) float32 map as layer LAYER of three, the others 0.0."""
+    layers = ShadowLayers.cleared(3, depth.shape[0])
+    layers.depth[:] = 0.0
+    layers.depth[LAYER] = depth
+    return layers
+
+
+def reference_filter(depth, uvz, kernel):
     """reference shadow_filter on a bare (S, S) float32 map, no tie bands (-> ShadowLookup)."""
-    from reference.shadow.depth import ShadowAtlas
-    S = atlas_depth.shape[0]
-    atlas = ShadowAtlas(atlas_depth, np.full((S, S), -1, np.int32), np.zeros((S, S), F32))
     uvz = np.asarray(uvz, F32)
-    return shadow_filter(atlas, uvz, kernel, np.zeros(len(uvz)), np.zeros((len(uvz), 2)))
+    return shadow_filter(layers_of(depth), uvz, LAYER, kernel, np.zeros(len(uvz)), np.zeros((len(uvz), 2)))
 
 
-def gpu_filter(ctx, atlas_depth, uvz, kernel):
+def gpu_filter(ctx, depth, uvz, kernel):
     inputs = np.concatenate([np.asarray(uvz, F32), np.full((len(uvz), 1), kernel, F32)], axis=1)
-    return run_lookup_shader(ctx, inputs, mode=0, atlas=atlas_depth)[:, 0]
+    return run_lookup_shader(ctx, inputs, mode=0, maps=layers_of(depth).depth, layer=LAYER)[:, 0]
 
 
 # -- (a) the compare: LEQUAL ---------------------------------------------------------------------
@@ -110,11 +119,8 @@ def test_b_a_tied_tap_gives_the_other_decision_with_its_weight():
 def test_b_hard_lookup_near_a_texel_edge_offers_the_neighbour():
     """Hard lookup at u S = 2 - 1e-9 (within a band of 1e-6 texels of the edge between texels
     1 and 2): texel 1 (shadowed, 0), alternative texel 2 (lit, 1). At u S = 1.5: no tie."""
-    from reference.shadow.depth import ShadowAtlas
-    depth = one_near_texel(1, 2)
-    atlas = ShadowAtlas(depth, np.full((4, 4), -1, np.int32), np.zeros((4, 4), F32))
     uvz = np.array([[(2 - 1e-9) / 4, 2.5 / 4, 0.5], [1.5 / 4, 2.5 / 4, 0.5]])
-    look = shadow_filter(atlas, uvz, 1, np.zeros(2), np.full((2, 2), 1e-6))
+    look = shadow_filter(layers_of(one_near_texel(1, 2)), uvz, LAYER, 1, np.zeros(2), np.full((2, 2), 1e-6))
     assert look.visibility.tolist() == [0.0, 0.0]
     assert look.alternative.tolist() == [1.0, 0.0] and look.tied.tolist() == [True, False]
 
@@ -194,7 +200,7 @@ def self_lookup(scene, dtype):
     """The plane looked up in its own map at 400 points of its inner 90%: ShadowLookup."""
     matrices = scene.matrices(64, 48)
     plan = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48))
-    maps = ShadowMaps.from_plan(render_atlas(scene, matrices, plan, dtype), plan,
+    maps = ShadowMaps.from_plan(render_layers(scene, matrices, plan, dtype), plan,
                                 Lights.from_scene(scene, dtype, origin=matrices.origin), dtype)
     model = np.asarray(matrices.objects[0].model)
     s = np.linspace(-0.9, 0.9, 20)

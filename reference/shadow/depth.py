@@ -1,15 +1,18 @@
 """# Twin: glsl/shadow/depth.vert, glsl/shadow/depth.frag
 
 The shadow maps' depth pass: each `ShadowPass` of a frame's `ShadowPlan` draws its casters
-into its tile of the atlas with the reference's own rasteriser, as GL draws them with the
-viewport on the tile: gl_Position = u_clip_from_model * vec4(in_position, 1) with
-u_clip_from_model = pass.clip_from_world @ model (camera-relative), clipping with standard
-depth (z_w = (z_ndc + 1) / 2), snapping with SUBPIXEL_BITS, no culling, the fill rule, and the
-GL_LESS depth test against 1.0 (of equal depths the first drawn stays). A large tile is drawn
+into its layer of the array texture, as GL draws them with the viewport at (0, 0), R x R on
+that layer: gl_Position = u_clip_from_model * vec4(in_position, 1) with u_clip_from_model =
+pass.clip_from_world @ model (camera-relative), clipping with standard depth
+(z_w = (z_ndc + 1) / 2), snapping with SUBPIXEL_BITS, no culling, the reference rasteriser's
+coverage (reference/rasterizer.py `coverage`: the same edge functions and fill rule), z_w on
+the triangle's affine plane (`depth_planes`, what `rasterize` interpolates), clamped to
+[0, 1] as GL does before its test, and the GL_LESS test against 1.0 (of equal depths the
+first drawn stays). Depth only: no varyings, no perspective weights; a large map is drawn
 band by band (REFERENCE_TILE_PIXELS), so its memory stays bounded.
 
-Output, `ShadowAtlas` (every array (S, S), GL rows: row 0 at the bottom, atlas texel (x, y) at
-[y, x]):
+Output, `ShadowLayers` (every array (layers, S, S), GL rows: row 0 at the bottom, texel (x, y)
+of layer l at [l, y, x]; texels a pass did not draw, and those beyond its R x R, as cleared):
   depth      float32, 1.0 where nothing was drawn, else the winner's z_w rounded to float32
              (what a DEPTH_COMPONENT32F texture stores);
   caster     int32, the object index that won the texel (-1: none), to tell acne (a receiver
@@ -25,34 +28,41 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.clipping import clip_triangles
-from reference.depth_buffer import DepthBuffer
-from reference.rasterizer import rasterize, setup_triangles
+from reference.rasterizer import WindowTriangles, coverage, depth_planes, setup_triangles
 from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.core.memory import REFERENCE_TILE_PIXELS
 
-# llvmpipe sets up and evaluates the depth plane in float32 at ABSOLUTE window coordinates
-# (a0 at the window origin, then a0 + dz/dx x + dz/dy y: lp_state_setup.c calc_coef4,
-# lp_bld_interp.c), so its stored depth is off the exact plane by rounding of the size of
-# 2^-24 (|z| + |dz/dx| x + |dz/dy| y) (measured: up to 8784 ulps, 3e-4, at texel (2976, 1472);
-# /work/notes/llvmpipe-shadow-sampler.md section 6), plus its float32 vertex transform moving
-# the vertices by 2^-24 times the magnitude of the products that make them. The bound below
-# is that sum times STORE_TIE_ROUNDINGS: the roundings of the vertex product (4 terms), the
-# plane's set-up (3) and its evaluation (2) would be 9 at worst, and measured against llvmpipe
-# (five built-in scenes at 320x240, atlases of 2048 and 4096, tests/test_shadow_depth.py) the
-# largest error was 3.7 of them (4872 ulps at a 4096 atlas): 8 is twice what was seen.
-STORE_TIE_ROUNDINGS = 8
+# llvmpipe sets up and evaluates the depth plane in float32 from the window origin (a0 at
+# (0, 0), then a0 + dz/dx x + dz/dy y: lp_state_setup.c calc_coef4, lp_bld_interp.c), so its
+# stored depth is off the exact plane by rounding of the size of 2^-24 (|z| + |dz/dx| x +
+# |dz/dy| y) (/work/notes/llvmpipe-shadow-sampler.md section 5), plus its float32 vertex
+# transform moving the vertices by 2^-24 times the magnitude of the products that make them.
+# Every map is drawn from texel (0, 0) of its layer, so x, y < R. The bound below is that sum
+# times STORE_TIE_ROUNDINGS: the roundings of the vertex product (4 terms), the plane's set-up
+# (3) and its evaluation (2) would be 9 at worst. Measured against llvmpipe (the 14 built-in
+# scenes at 320x240, automatic resolutions, maps of 512 and 1024; tests/test_shadow_depth.py's
+# comparison): coverage identical, the largest error 2.47 of them (tir_bubble; 1.8 or less
+# elsewhere): 5 is twice what was seen. (At a forced 2048 some scenes differ in a texel's
+# coverage and reach 9 to 22 roundings: float32 vertex positions this model does not follow.)
+STORE_TIE_ROUNDINGS = 5
 UNIT_ROUNDOFF32 = 2.0 ** -24
 
 
 @dataclass
-class ShadowAtlas:
+class ShadowLayers:
     depth: np.ndarray
     caster: np.ndarray
     tolerance: np.ndarray
 
+    @classmethod
+    def cleared(cls, layers: int, side: int) -> "ShadowLayers":
+        """Cleared to depth 1.0, caster -1, tolerance 0."""
+        shape = (layers, side, side)
+        return cls(np.ones(shape, np.float32), np.full(shape, -1, np.int32), np.zeros(shape, np.float32))
+
     @property
     def side(self) -> int:
-        return self.depth.shape[0]
+        return self.depth.shape[1]
 
 
 def clip_from_model(shadow_pass, model) -> np.ndarray:
@@ -73,27 +83,17 @@ def _caster_triangles(mesh, clip_from_model_matrix, dtype):
     return clip[faces], magnitude[faces].max(axis=1)
 
 
-def _plane_gradients(window) -> tuple[np.ndarray, np.ndarray]:
-    """(dz/dx, dz/dy) per window triangle, in z_w per texel (float64)."""
-    x, y, z = (np.asarray(a, np.float64) for a in (window.x_w, window.y_w, window.z_w))
-    dx1, dy1, dz1 = x[:, 1] - x[:, 0], y[:, 1] - y[:, 0], z[:, 1] - z[:, 0]
-    dx2, dy2, dz2 = x[:, 2] - x[:, 0], y[:, 2] - y[:, 0], z[:, 2] - z[:, 0]
-    area = dx1 * dy2 - dx2 * dy1
-    area = np.where(area != 0, area, np.inf)          # no area: no fragments to bound
-    return (dz1 * dy2 - dz2 * dy1) / area, (dx1 * dz2 - dx2 * dz1) / area
-
-
 @dataclass
-class _PreparedCaster:
-    index: int
-    window: object                # WindowTriangles, zero-area ones dropped
-    source: np.ndarray            # (T,) mesh triangle of each
-    dzdx: np.ndarray
-    dzdy: np.ndarray
+class _PassTriangles:
+    """A pass's casters' window triangles in draw order (caster by caster, each in its mesh's
+    triangle order), zero-area ones dropped."""
+    window: WindowTriangles
+    caster: np.ndarray            # (T,) object index
+    plane: tuple                  # depth_planes(window)
     vertex_error: np.ndarray      # (T, 3) window x, y (texels), z: rounding scale of the vertices
 
 
-def _prepare_caster(index, mesh, matrix, size, dtype) -> _PreparedCaster:
+def _prepare_caster(index, mesh, matrix, size, dtype):
     triangles, magnitude = _caster_triangles(mesh, matrix, dtype)
     clipped = clip_triangles(triangles, reversed_z=False)
     window = setup_triangles(clipped.gl_Position, size, size, SUBPIXEL_BITS, reversed_z=False)
@@ -104,60 +104,81 @@ def _prepare_caster(index, mesh, matrix, size, dtype) -> _PreparedCaster:
     # a window coordinate (ndc + 1) * size / 2 moves by the rounding of x_clip / w: the
     # products' magnitude (x and w) over w, in texels; z_w = (z_ndc + 1) / 2 likewise
     scale = (m[:, 3] + m[:, :3].T).T / w[:, None]
-    vertex_error = scale * np.array([size / 2.0, size / 2.0, 0.5])
-    dzdx, dzdy = _plane_gradients(window)
-    return _PreparedCaster(index, window, source, dzdx, dzdy, vertex_error)
+    return window, np.full(len(source), index, np.int32), scale * np.array([size / 2.0, size / 2.0, 0.5])
 
 
-def draw_pass(scene, matrices, shadow_pass, atlas: ShadowAtlas, dtype=np.float64,
+def _pass_triangles(scene, matrices, shadow_pass, dtype) -> _PassTriangles:
+    parts = [_prepare_caster(index, scene.objects[index].mesh,
+                             clip_from_model(shadow_pass, matrices.objects[index].model),
+                             shadow_pass.tile.size, dtype)
+             for index in shadow_pass.casters]
+    window = WindowTriangles.concatenate([p[0] for p in parts])
+    return _PassTriangles(window, np.concatenate([p[1] for p in parts]), depth_planes(window),
+                          np.concatenate([p[2] for p in parts]))
+
+
+NONE = np.iinfo(np.int64).max
+
+
+def _nearest_first(z_buffer, winner, first, texel, z, triangle) -> None:
+    """GL_LESS over one batch (`triangle`: draw order): per texel the batch's smallest z, the
+    earliest drawn of equal ones, replaces the stored one only if strictly nearer (the stored
+    one was drawn before). `first`: scratch, NONE everywhere, left so."""
+    before = z_buffer[texel]
+    np.minimum.at(z_buffer, texel, z)
+    after = z_buffer[texel]
+    best = np.flatnonzero((after < before) & (z == after))
+    changed = texel[best]
+    np.minimum.at(first, changed, triangle[best])
+    winner[changed] = first[changed]
+    first[changed] = NONE
+
+
+def _tolerance(tris: _PassTriangles, t, x, y, z) -> np.ndarray:
+    """The per-texel bound of GL's stored depth (STORE_TIE_ROUNDINGS) for winners t at texels
+    (x, y) of depth z: roundings of |z| + |dz/dx| x + |dz/dy| y at the texel centre, the
+    vertices' errors carried along the plane."""
+    gx, gy = (np.abs(np.asarray(g, np.float64)) for g in tris.plane[3:])
+    error = tris.vertex_error
+    constant = error[:, 2] + gx * (0.5 + error[:, 0]) + gy * (0.5 + error[:, 1])
+    return STORE_TIE_ROUNDINGS * UNIT_ROUNDOFF32 * (np.abs(z) + constant[t] + gx[t] * x + gy[t] * y)
+
+
+def draw_pass(scene, matrices, shadow_pass, layers: ShadowLayers, dtype=np.float64,
               tile_pixels: int = REFERENCE_TILE_PIXELS) -> None:
-    """Draw one pass's casters into its tile of `atlas` (band by band)."""
-    tile, size = shadow_pass.tile, shadow_pass.tile.size
-    casters, first_orders, order = [], [], 0
-    for index in shadow_pass.casters:
-        obj = scene.objects[index]
-        matrix = clip_from_model(shadow_pass, matrices.objects[index].model)
-        casters.append(_prepare_caster(index, obj.mesh, matrix, size, dtype))
-        first_orders.append(order)
-        order += len(obj.mesh.faces)
+    """Draw one pass's casters into texels [0, R)^2 of its layer (band by band)."""
+    size, layer = shadow_pass.tile.size, shadow_pass.tile.layer
+    tris = _pass_triangles(scene, matrices, shadow_pass, dtype)
+    x0, y0, z0, dzdx, dzdy = tris.plane
     rows = max(1, tile_pixels // size)
-    for y0 in range(0, size, rows):
-        y1 = min(y0 + rows, size)
-        region = (0, y0, size, y1)
-        buffer = DepthBuffer(size, y1 - y0, dtype, reversed_z=False)
-        for caster, first in zip(casters, first_orders):
-            for fragments in rasterize(caster.window, size, size, region=region):
-                t = fragments.triangle
-                x_abs = (tile.x + fragments.x + 0.5).astype(np.float64)
-                y_abs = (tile.y + fragments.y + 0.5).astype(np.float64)
-                error = caster.vertex_error[t]
-                z = np.asarray(fragments.z_w, np.float64)
-                tolerance = STORE_TIE_ROUNDINGS * UNIT_ROUNDOFF32 * (
-                    np.abs(z) + error[:, 2] + np.abs(caster.dzdx[t]) * (x_abs + error[:, 0])
-                    + np.abs(caster.dzdy[t]) * (y_abs + error[:, 1]))
-                buffer.test_and_write((fragments.y - y0) * size + fragments.x, fragments.z_w,
-                                      first + caster.source[t],
-                                      object=np.full(len(t), caster.index, np.int32),
-                                      tolerance=tolerance)
-        drawn = buffer.drawn.reshape(y1 - y0, size)
-        rows_at = slice(tile.y + y0, tile.y + y1)
-        cols_at = slice(tile.x, tile.x + size)
-        # GL clamps a fragment's depth to [0, 1] and stores it as float32
-        stored = np.clip(np.asarray(buffer.z, np.float64), 0.0, 1.0).astype(np.float32)
-        atlas.depth[rows_at, cols_at] = np.where(drawn, stored.reshape(drawn.shape), np.float32(1.0))
-        if buffer.payload:
-            atlas.caster[rows_at, cols_at] = np.where(
-                drawn, buffer.payload["object"].reshape(drawn.shape), -1)
-            atlas.tolerance[rows_at, cols_at] = np.where(
-                drawn, buffer.payload["tolerance"].reshape(drawn.shape), 0.0)
+    for band0 in range(0, size, rows):
+        band1 = min(band0 + rows, size)
+        z_buffer = np.ones((band1 - band0) * size, dtype)
+        winner = np.full(len(z_buffer), -1, np.int64)
+        first = np.full(len(z_buffer), NONE)
+        for t, px, py in coverage(tris.window, size, size, region=(0, band0, size, band1)):
+            cx, cy = (px + 0.5).astype(dtype), (py + 0.5).astype(dtype)    # texel centres
+            z = z0[t] + dzdx[t] * (cx - x0[t]) + dzdy[t] * (cy - y0[t])
+            # GL clamps a fragment's depth to [0, 1] before its depth test
+            _nearest_first(z_buffer, winner, first, (py - band0) * size + px, np.clip(z, 0, 1), t)
+        drawn = winner >= 0
+        texels = np.flatnonzero(drawn)
+        t, x, y = winner[texels], texels % size, texels // size + band0
+        depth = z_buffer[texels].astype(np.float64)
+        at = (layer, slice(band0, band1), slice(0, size))
+        layers.depth[at] = np.where(drawn, z_buffer, 1.0).astype(np.float32).reshape(-1, size)
+        caster = np.full(len(z_buffer), -1, np.int32)
+        caster[texels] = tris.caster[t]
+        layers.caster[at] = caster.reshape(-1, size)
+        tolerance = np.zeros(len(z_buffer), np.float32)
+        tolerance[texels] = _tolerance(tris, t, x, y, depth)
+        layers.tolerance[at] = tolerance.reshape(-1, size)
 
 
-def render_atlas(scene, matrices, plan, dtype=np.float64,
-                 tile_pixels: int = REFERENCE_TILE_PIXELS) -> ShadowAtlas:
-    """The frame's atlas: cleared to 1.0 (caster -1, tolerance 0), then every pass drawn."""
-    side = plan.atlas_side
-    atlas = ShadowAtlas(np.ones((side, side), np.float32), np.full((side, side), -1, np.int32),
-                        np.zeros((side, side), np.float32))
+def render_layers(scene, matrices, plan, dtype=np.float64,
+                  tile_pixels: int = REFERENCE_TILE_PIXELS) -> ShadowLayers:
+    """The frame's maps: `plan.layout.layers` layers of side S cleared, then every pass drawn."""
+    layers = ShadowLayers.cleared(plan.layout.layers, plan.side)
     for shadow_pass in plan.passes:
-        draw_pass(scene, matrices, shadow_pass, atlas, dtype, tile_pixels)
-    return atlas
+        draw_pass(scene, matrices, shadow_pass, layers, dtype, tile_pixels)
+    return layers

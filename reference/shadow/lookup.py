@@ -5,10 +5,10 @@ renderer/core/shadow_settings.py): whether light i reaches surface points P (N, 
 normals N (the normals that are lit), as lighting.py's `visibility` hook asks: 1 lit, 0 in
 shadow, a fraction where a filter straddles a shadow edge. In the pipeline's dtype, vectorised
 over fragments, with the GLSL's formulas in the GLSL's order: the point moved by the bias
-rule, then compared with the atlas's stored depth (depth.py) as llvmpipe's depth-compare
-sampler does it (/work/notes/llvmpipe-shadow-sampler.md: texel choice and bilinear weights
-from one float32 product u * S, CLAMP_TO_EDGE, compare ref <= stored unclamped, denormals
-flushed).
+rule, then compared with the depth its map's layer stored (depth.py) as llvmpipe's
+depth-compare sampler does it (/work/notes/llvmpipe-shadow-sampler.md: the layer chosen, texel
+choice and bilinear weights within it from one float32 product u * S, CLAMP_TO_EDGE to the
+layer's S x S, compare ref <= stored unclamped, denormals flushed).
 
 Ties (the reference's second acceptable answer): GL's float32 arithmetic puts P, the matrix
 product and the stored depth within rounding of the reference's, so a tap whose reference
@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from reference.lighting import Lights, dot, normalize
-from reference.shadow.depth import ShadowAtlas
+from reference.shadow.depth import ShadowLayers
 from renderer.core.shadow_settings import MAX_SLOPE, tap_offsets
 from renderer.core.shadows import CUBE_FACE_AXES, CUBE_FACE_ROTATIONS, cube_face
 
@@ -67,15 +67,15 @@ class ShadowLookup:
 
 @dataclass
 class ShadowMaps:
-    """What the lookup reads: the frame's atlas, the plan's uniforms in the pipeline's dtype
+    """What the lookup reads: the frame's layers, the plan's uniforms in the pipeline's dtype
     (ShadowPlan.uniforms, named as the GLSL's) and the lights (their direction and position)."""
-    atlas: ShadowAtlas
+    layers: ShadowLayers
     uniforms: dict[str, np.ndarray]
     lights: Lights
 
     @classmethod
-    def from_plan(cls, atlas: ShadowAtlas, plan, lights: Lights, dtype) -> "ShadowMaps":
-        return cls(atlas, {k: np.asarray(v).astype(dtype) for k, v in plan.uniforms.items()}, lights)
+    def from_plan(cls, layers: ShadowLayers, plan, lights: Lights, dtype) -> "ShadowMaps":
+        return cls(layers, {k: np.asarray(v).astype(dtype) for k, v in plan.uniforms.items()}, lights)
 
 
 # --- the bias ---------------------------------------------------------------------------------
@@ -118,12 +118,12 @@ def linear_texels(u: np.ndarray, size: int):
     return i0, np.minimum(i0 + 1, size - 1), x - floor
 
 
-def _taps(atlas: ShadowAtlas, ref, tie_ref, j, i):
-    """(lit, tied) of one texel per fragment."""
-    stored = atlas.depth[j, i]
+def _taps(layers: ShadowLayers, layer, ref, tie_ref, j, i):
+    """(lit, tied) of one texel (i, j) of `layer` per fragment."""
+    stored = layers.depth[layer, j, i]
     lit = compare(ref, stored)
     with np.errstate(invalid="ignore"):
-        tied = np.abs(ref - stored) <= tie_ref + atlas.tolerance[j, i]
+        tied = np.abs(ref - stored) <= tie_ref + layers.tolerance[layer, j, i]
     return lit, tied
 
 
@@ -134,26 +134,27 @@ def _bilinear(lit00, lit01, lit10, lit11, s, t):
     return v0 + t * (v1 - v0)
 
 
-def shadow_filter(atlas: ShadowAtlas, uvz: np.ndarray, kernel: int, tie_ref: np.ndarray,
+def shadow_filter(layers: ShadowLayers, uvz: np.ndarray, layer, kernel: int, tie_ref: np.ndarray,
                   tie_texel: np.ndarray) -> ShadowLookup:
-    """The filter at atlas points uvz (N, 3) = (u, v, reference z_w). Kernel 1 (hard): the
+    """The filter at points uvz (N, 3) = (u, v, reference z_w) of `layer` (int or (N,) ints:
+    GLSL's layer coordinate, an exact integer, so no rounding to choose). Kernel 1 (hard): the
     nearest texel's comparison (GLSL: the LINEAR sampler at its centre, weight exactly 0 for
     the neighbour); K >= 2: the mean of the (K-1)^2 bilinear comparisons at tap_offsets(K) / S.
     tie_ref (N,): the receiver's z_w tie band; tie_texel (N, 2): the band of u S, v S (hard)."""
-    S = atlas.side
+    S = layers.side
     u, v, ref = uvz[:, 0], uvz[:, 1], uvz[:, 2]
     dtype = uvz.dtype
     if kernel == 1:
         x, y = u * dtype.type(S), v * dtype.type(S)
         i = np.clip(np.floor(x), 0, S - 1).astype(np.int64)
         j = np.clip(np.floor(y), 0, S - 1).astype(np.int64)
-        lit, tied = _taps(atlas, ref, tie_ref, j, i)
+        lit, tied = _taps(layers, layer, ref, tie_ref, j, i)
         # the neighbouring texel where u S (v S) is within its band of a texel edge
         near_x = np.abs(x - np.round(x)) <= tie_texel[:, 0]
         near_y = np.abs(y - np.round(y)) <= tie_texel[:, 1]
         i_alt = np.clip(np.where(near_x, np.where(x - np.floor(x) < 0.5, i - 1, i + 1), i), 0, S - 1)
         j_alt = np.clip(np.where(near_y, np.where(y - np.floor(y) < 0.5, j - 1, j + 1), j), 0, S - 1)
-        lit_alt = compare(ref, atlas.depth[j_alt, i_alt])
+        lit_alt = compare(ref, layers.depth[layer, j_alt, i_alt])
         other_texel = lit_alt != lit
         visibility = lit.astype(dtype)
         alternative = np.where(other_texel, lit_alt, np.where(tied, ~lit, lit)).astype(dtype)
@@ -164,7 +165,7 @@ def shadow_filter(atlas: ShadowAtlas, uvz: np.ndarray, kernel: int, tie_ref: np.
     for ox, oy in tap_offsets(kernel):
         i0, i1, s = linear_texels(u + dtype.type(ox) / dtype.type(S), S)
         j0, j1, t = linear_texels(v + dtype.type(oy) / dtype.type(S), S)
-        corners = [_taps(atlas, ref, tie_ref, j, i) for j, i in ((j0, i0), (j0, i1), (j1, i0), (j1, i1))]
+        corners = [_taps(layers, layer, ref, tie_ref, j, i) for j, i in ((j0, i0), (j0, i1), (j1, i0), (j1, i1))]
         weights = [(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t]
         visibility += _bilinear(*(lit for lit, _ in corners), s, t)
         alternative += _bilinear(*(lit ^ tied for lit, tied in corners), s, t)
@@ -192,8 +193,8 @@ def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, N: np.
     scale = np.abs(Q).astype(np.float64) + np.asarray(position_scale, np.float64)[:, None]
     A = np.abs(M.astype(np.float64))
     tie_ref = SHADOW_TIE * (scale @ A[2, :3] + A[2, 3])
-    tie_texel = SHADOW_TIE * maps.atlas.side * (scale @ A[:2, :3].T + A[:2, 3])
-    return shadow_filter(maps.atlas, uvz, int(p[2]), tie_ref, tie_texel)
+    tie_texel = SHADOW_TIE * maps.layers.side * (scale @ A[:2, :3].T + A[:2, 3])
+    return shadow_filter(maps.layers, uvz, int(p[3]), int(p[2]), tie_ref, tie_texel)
 
 
 def _point_tie_bounds(Q, light, d, m, right_up, position_scale, depth, tan_half, rect_size, S):
@@ -231,20 +232,20 @@ def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarra
     d = Q - light
     f = cube_face(d)
     rect = maps.uniforms["u_point_shadow_tiles"][6 * i + f]
-    drawn = rect[:, 3] != 0.0                                   # else the face sees no caster
+    drawn = rect[:, 2] != 0.0                                   # else the face sees no caster
     d, f, rect, Q, scale, rows = d[drawn], f[drawn], rect[drawn], Q[drawn], scale[drawn], rows[drawn]
     m = dot(axes[f], d)[:, 0]
     right_up = np.stack([dot(rotations[f, 0], d)[:, 0], dot(rotations[f, 1], d)[:, 0]], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        uv_tile = 0.5 * right_up / (m * p[1])[:, None] + 0.5
+        uv = (0.5 * right_up / (m * p[1])[:, None] + 0.5) * rect[:, 1:2]
         depth = maps.uniforms["u_point_shadow_depth"][i]
-        uvz = np.concatenate([rect[:, :2] + uv_tile * rect[:, 2:3], (depth[0] + depth[1] / m)[:, None]],
-                             axis=1)
+        uvz = np.concatenate([uv, (depth[0] + depth[1] / m)[:, None]], axis=1)
         tie_ref, tie_texel = _point_tie_bounds(
             Q.astype(np.float64), np.asarray(light, np.float64), d, m.astype(np.float64),
             right_up.astype(np.float64), scale.astype(np.float64), depth, float(p[1]),
-            rect[:, 2].astype(np.float64), maps.atlas.side)
-    out.put(rows, shadow_filter(maps.atlas, uvz, int(p[2]), tie_ref, tie_texel))
+            rect[:, 1].astype(np.float64), maps.layers.side)
+    out.put(rows, shadow_filter(maps.layers, uvz, rect[:, 0].astype(np.int64), int(p[2]), tie_ref,
+                                tie_texel))
     return out
 
 

@@ -56,8 +56,7 @@ class ShadowLookup:
 
     @classmethod
     def lit(cls, n: int, dtype) -> "ShadowLookup":
-        ones = np.ones(n, dtype)
-        return cls(ones, ones, np.zeros(n, bool))
+        return cls(np.ones(n, dtype), np.ones(n, dtype), np.zeros(n, bool))   # not one array twice
 
     def put(self, where: np.ndarray, other: "ShadowLookup") -> None:
         """Overwrite the fragments `where` (indices or mask) with `other`'s."""
@@ -182,8 +181,8 @@ def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, N: np.
     """Directional light i at points P (N, 3), normals N; position_scale (N,): the largest
     |coordinate| of the vertices P was interpolated from (the tie bands)."""
     dtype = P.dtype
-    p = maps.uniforms["u_directional_shadow"][i]
-    if p[0] == 0.0:
+    p = maps.uniforms["u_directional_shadow"][i]                 # (layer, t, kernel, extent)
+    if p[3] == 0.0:
         return ShadowLookup.lit(len(P), dtype)    # no pass this frame: nothing can shadow
     M = maps.uniforms["u_directional_shadow_matrix"][i]
     L = normalize(-maps.lights.u_directional_direction[i])
@@ -194,7 +193,12 @@ def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, N: np.
     A = np.abs(M.astype(np.float64))
     tie_ref = SHADOW_TIE * (scale @ A[2, :3] + A[2, 3])
     tie_texel = SHADOW_TIE * maps.layers.side * (scale @ A[:2, :3].T + A[:2, 3])
-    return shadow_filter(maps.layers, uvz, int(p[3]), int(p[2]), tie_ref, tie_texel)
+    # Outside the map, which holds every caster that can shadow, nothing is there: lit.
+    inside = np.flatnonzero(((uvz[:, :2] >= 0.0) & (uvz[:, :2] <= p[3])).all(axis=1))
+    result = ShadowLookup.lit(len(P), dtype)
+    result.put(inside, shadow_filter(maps.layers, uvz[inside], int(p[0]), int(p[2]),
+                                     tie_ref[inside], tie_texel[inside]))
+    return result
 
 
 def _point_tie_bounds(Q, light, d, m, right_up, position_scale, depth, tan_half, rect_size, S):

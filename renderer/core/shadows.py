@@ -152,7 +152,7 @@ def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
 
 # --- each frame's light views ----------------------------------------------------------------
 
-# A point light's near plane: half the distance to the nearest caster's bounding box, and at
+# A point light's near plane: half the distance to the nearest caster's triangles, and at
 # least NEAR_FRACTION of the far distance (geometry nearer than that to the light casts no
 # shadow; depth precision near the far plane stays ~1e-7 * far^2 / near = ~1e-4 far).
 NEAR_FRACTION = 2.0 ** -10
@@ -220,19 +220,26 @@ def _map_from_clip(tile: Tile, side: int) -> np.ndarray:
     return m
 
 
-def _plan_directional(index, light, light_map, layout, scene, points, receivers, casters,
+def _plan_directional(index, light, light_map, layout, points, receivers, casters,
                       frustum) -> tuple[ShadowPass | None, np.ndarray, np.ndarray, float]:
+    """The light's orthographic view, fitted to the part of the map that can hold a shadow:
+    the receivers' box across the light, within the camera's view volume's box and within the
+    casters' boxes (a parallel light's shadow falls within its caster's box across the light,
+    so a receiver point outside every caster's box is lit: the lookup says so outside the map);
+    in depth, from the nearest caster to the farthest receiver. Square texels; the centre snapped
+    to whole texels so that the map does not shimmer as the camera moves."""
     rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light.direction, (0.0, 1.0, 0.0))
     to_light = lambda p: p @ rotation[:3, :3].T            # noqa: E731  light-space x, y, -depth
-    seen = [to_light(points[i]) for i in receivers]
     params = np.zeros(4)
-    if not seen:
+    if not receivers or not casters:
         return None, np.eye(4), params, 0.0
-    box = np.vstack(seen)
-    lo, hi = box[:, :2].min(axis=0), box[:, :2].max(axis=0)
+    box = np.vstack([to_light(points[i]) for i in receivers])
+    cast = [to_light(points[i]) for i in casters]
     f_light = to_light(frustum)
-    lo = np.maximum(lo, f_light[:, :2].min(axis=0))
-    hi = np.minimum(hi, f_light[:, :2].max(axis=0))
+    lo = np.maximum.reduce([box[:, :2].min(axis=0), f_light[:, :2].min(axis=0),
+                            np.min([c[:, :2].min(axis=0) for c in cast], axis=0)])
+    hi = np.minimum.reduce([box[:, :2].max(axis=0), f_light[:, :2].max(axis=0),
+                            np.max([c[:, :2].max(axis=0) for c in cast], axis=0)])
     if np.any(lo > hi):
         return None, np.eye(4), params, 0.0
     resolution, guard = light_map.resolution, light_map.guard
@@ -244,8 +251,7 @@ def _plan_directional(index, light, light_map, layout, scene, points, receivers,
     depth = -box[:, 2]
     near_depth, far_depth = float(depth.min()), float(depth.max())
     drawn = []
-    for i in casters:
-        p = to_light(points[i])
+    for i, p in zip(casters, cast):
         if np.any(p[:, :2].max(axis=0) < region_lo) or np.any(p[:, :2].min(axis=0) > region_hi):
             continue
         d = -p[:, 2]
@@ -259,14 +265,84 @@ def _plan_directional(index, light, light_map, layout, scene, points, receivers,
     lookup = _map_from_clip(light_map.tiles[0], layout.side) @ clip
     if not drawn:
         return None, lookup, params, texel
-    params[:] = (1.0, texel, light_map.shadow.kernel, light_map.tiles[0].layer)
+    tile = light_map.tiles[0]
+    params[:] = (tile.layer, texel, light_map.shadow.kernel, tile.size / layout.side)
     return (ShadowPass("directional", index, 0, light_map.tiles[0], clip, tuple(drawn)),
             lookup, params, texel)
 
 
-def _box_distance(points: np.ndarray, position: np.ndarray) -> float:
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    return float(np.linalg.norm(np.maximum(np.maximum(lo - position, position - hi), 0.0)))
+# A caster's vertices within PLANAR_TOLERANCE of its extent from one plane make it planar.
+PLANAR_TOLERANCE = 1e-9
+
+
+def _plane_of(points: np.ndarray):
+    """(unit normal, a point) of the plane the points lie in, or None when they do not."""
+    if len(points) < 3:
+        return None
+    centre = points.mean(axis=0)
+    _, singular, rows = np.linalg.svd(points - centre, full_matrices=False)
+    if singular[0] == 0.0 or singular[-1] > PLANAR_TOLERANCE * singular[0]:
+        return None
+    return rows[-1], centre
+
+
+def can_shadow(scene, points, caster: int, receivers: list[int], light_position=None,
+               light_direction=None) -> bool:
+    """Whether object `caster` can shadow any receiver for a light at `light_position` (point)
+    or travelling along `light_direction` (directional). Conservative (True when unsure); False
+    for: a caster with no receiver but itself that cannot shadow itself (a convex analytic
+    shape, or a planar mesh), and a planar caster with every other receiver on the light's side
+    of its plane (a floor under the lit objects: it can shadow only what is below it)."""
+    obj = scene.objects[caster]
+    plane = _plane_of(points[caster])
+    convex = plane is not None or obj.shape is not None
+    others = [r for r in receivers if r != caster]
+    if not others:
+        return not convex and caster in receivers
+    if plane is None:
+        return True
+    normal, origin = plane
+    scale = PLANAR_TOLERANCE * (1.0 + float(np.abs(points[caster]).max()))
+    if light_position is not None:
+        side = float(normal @ (np.asarray(light_position) - origin))
+    else:
+        side = -float(normal @ np.asarray(light_direction, dtype=np.float64))
+    if abs(side) <= scale:
+        return False                         # the light grazes the plane: no shadow of any area
+    facing = normal if side > 0 else -normal
+    return any(bool(((points[r] - origin) @ facing < -scale).any()) for r in others)
+
+
+def triangle_distance(corners: np.ndarray, position: np.ndarray) -> np.ndarray:
+    """(T,) distance from `position` to each triangle `corners` (T, 3, 3): to its plane where
+    the foot lies inside it, else to the nearest of its edges (segments)."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    n = np.cross(b - a, c - a)
+    area2 = np.einsum("ij,ij->i", n, n)
+    best = np.full(len(corners), np.inf)
+    flat = area2 > 0.0
+    if flat.any():
+        w = (position - a[flat])
+        height = np.einsum("ij,ij->i", w, n[flat]) / area2[flat]
+        foot = position - height[:, None] * n[flat]
+        inside = np.ones(int(flat.sum()), bool)
+        for p, q in ((a, b), (b, c), (c, a)):
+            edge_normal = np.cross(q[flat] - p[flat], n[flat])    # points out of the triangle
+            inside &= np.einsum("ij,ij->i", foot - p[flat], edge_normal) <= 0.0
+        best[np.flatnonzero(flat)[inside]] = (np.abs(height) * np.sqrt(area2[flat]))[inside]
+    for p, q in ((a, b), (b, c), (c, a)):                          # the edges, as segments
+        e = q - p
+        length2 = np.einsum("ij,ij->i", e, e)
+        s = np.clip(np.einsum("ij,ij->i", position - p, e) / np.where(length2 > 0, length2, 1.0), 0, 1)
+        nearest = p + s[:, None] * e
+        best = np.minimum(best, np.linalg.norm(position - nearest, axis=1))
+    return best
+
+
+def _caster_distance(scene, points: np.ndarray, caster: int, position: np.ndarray) -> float:
+    """The distance from `position` to the nearest point of object `caster`'s triangles."""
+    faces = np.asarray(scene.objects[caster].mesh.faces, dtype=np.int64)
+    return float(triangle_distance(points[caster][faces], position).min())
 
 
 def _outside_frustum(clip_from_world: np.ndarray, points: np.ndarray) -> bool:
@@ -286,7 +362,7 @@ def point_face_projection(resolution: int, guard: int, near: float, far: float) 
     return projection, tan_half
 
 
-def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters):
+def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters, scene):
     position = matrices.relative(light.position)
     passes = []
     rects = np.zeros((6, 4))
@@ -297,7 +373,8 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
         return passes, rects, params, depth
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
-    near = max(0.5 * min(_box_distance(points[i], position) for i in casters), NEAR_FRACTION * far)
+    near = max(0.5 * min(_caster_distance(scene, points, i, position) for i in casters),
+               NEAR_FRACTION * far)
     near = min(near, 0.5 * far)
     projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
     for face in range(6):
@@ -318,10 +395,12 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
     return passes, rects, params, depth
 
 
-def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | None = None) -> ShadowPlan:
+def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | None = None,
+                 prune: bool = True) -> ShadowPlan:
     """The frame's shadow passes and lookup uniforms (module docstring). `visible`: which
     objects the camera can see (renderer/core/visibility.visible_objects; all if None); only
-    those count as receivers to fit a map to."""
+    those count as receivers to fit a map to. `prune` False draws every caster, also those
+    that cannot shadow any receiver (`can_shadow`): a plane in its own map, to study the bias."""
     n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
     uniforms = {
         "u_shadow_map_size": np.array(float(layout.side)),
@@ -346,9 +425,11 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         i = light_map.index
         bias = light_map.shadow.bias_rule().as_vec4()
         if light_map.kind == "directional":
+            light = scene.directional_lights[i]
+            relevant = [c for c in casters if not prune or can_shadow(
+                scene, points, c, receivers, light_direction=light.direction)]
             shadow_pass, lookup, params, texel = _plan_directional(
-                i, scene.directional_lights[i], light_map, layout, scene, points, receivers,
-                casters, frustum)
+                i, light, light_map, layout, points, receivers, relevant, frustum)
             uniforms["u_directional_shadow_matrix"][i] = lookup
             uniforms["u_directional_shadow"][i] = params
             uniforms["u_directional_shadow_bias"][i] = bias
@@ -356,8 +437,12 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
             if shadow_pass is not None:
                 plan.passes.append(shadow_pass)
         else:
+            light = scene.point_lights[i]
+            position = matrices.relative(light.position)
+            relevant = [c for c in casters if not prune or can_shadow(
+                scene, points, c, receivers, light_position=position)]
             passes, rects, params, depth = _plan_point(
-                i, scene.point_lights[i], light_map, layout, matrices, points, receivers, casters)
+                i, light, light_map, layout, matrices, points, receivers, relevant, scene)
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias

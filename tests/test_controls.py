@@ -13,7 +13,7 @@ import pytest
 
 from renderer.viewer.controls import (KEY_BINDINGS, MOUSE_BINDINGS, ORBIT_DEGREES_PER_PIXEL,
                                Controls, ViewState, apply_view, help_lines, light_names_of,
-                               shadows_off, shown_light, working_copy)
+                               shown_light, working_copy)
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, PointLight, Scene,
                             SceneObject)
@@ -257,15 +257,6 @@ def test_shown_light_counts_only_the_lights_that_are_on():
     assert [shown_light(ViewState(lights_on=[True] * 3), scene, i) for i in range(3)] == [
         ("directional", 0), ("point", 0), ("point", 1)]
     assert shown_light(ViewState(lights_on=[False, False, True]), scene, 2) == ("point", 0)
-
-
-def test_shadows_off_copies_the_scene_with_every_lights_shadows_off():
-    scene = make_scene()
-    off = shadows_off(scene)
-    assert not any(light.shadow.enabled for light in [*off.directional_lights, *off.point_lights])
-    assert all(light.shadow.enabled for light in [*scene.directional_lights, *scene.point_lights])
-    assert off.objects is scene.objects
-    assert [light.position for light in off.point_lights] == [light.position for light in scene.point_lights]
 
 
 def test_v_and_b_switch_vsync_and_buffering_without_a_change_flag():

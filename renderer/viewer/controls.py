@@ -105,15 +105,6 @@ def light_names_of(scene: Scene) -> list[str]:
             + [f"point light {i + 1}" for i in range(len(scene.point_lights))])
 
 
-def shadows_off(scene: Scene) -> Scene:
-    """A copy of `scene` whose lights have their shadows off: what GpuRenderer draws with
-    `shadows = False` (the reference view's scene while O has shadows off)."""
-    def off(light):
-        return replace(light, shadow=replace(light.shadow, enabled=False))
-    return replace(scene, directional_lights=[off(light) for light in scene.directional_lights],
-                   point_lights=[off(light) for light in scene.point_lights])
-
-
 def lights_with_maps(scene: Scene | None) -> list[int]:
     """The lights (indices in key order) that have a shadow map when on: those with shadows
     on, in a scene where something casts and something receives."""

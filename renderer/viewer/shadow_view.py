@@ -3,9 +3,9 @@
 It shows what the lighting pass of the frame just drawn read: the layers of
 GpuRenderer.shadow_maps that its `drawn_shadow_plan` filled, each texel's stored depth z_w as
 a grey level, stretched: the nearest depth the map holds black, the farthest light grey
-(0.85), and 1.0, the cleared value (nothing drawn there), white. A light view's depths span a
-sliver of [0, 1] (0.48 to 0.51 on shadow_plane; a cube face's perspective depths crowd
-below 1: 0.9962 to 0.9995 on shadow_room), too little to see unstretched; `depth_range`
+(0.85), and 1.0, the cleared value (nothing drawn there), white. A light view's depths may
+span a sliver of [0, 1] (0.4979 to 0.5006 on shadow_plane at 480x320: the light view's
+depth range covers every receiver, far deeper than the casters), too little to see unstretched; `depth_range`
 gives the range shown, found on the CPU from the layers read back once per plan (a still
 view reads nothing). A directional light's map is a square; a point light's six cube faces are a
 3 x 2 grid, +x -x +y on top and -y +z -z below (CUBE_FACE_AXES order, renderer/core/shadows.py),

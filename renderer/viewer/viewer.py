@@ -37,8 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
+from renderer.checks.methods import without_shadow_maps
 from renderer.viewer.controls import (Controls, ViewState, apply_view, help_lines, light_names_of,
-                                      shadows_off, shown_light, working_copy)
+                                      shown_light, working_copy)
 from renderer.gpu.context import activate
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.raytracer import RayTracer
@@ -178,7 +179,7 @@ class Viewer:
             return
         if self._requested != self._version:
             scene = working_copy(self.shown)
-            self.background.request(scene if self.state.shadows else shadows_off(scene),
+            self.background.request(scene if self.state.shadows else without_shadow_maps(scene),
                                     self.gpu.width, self.gpu.height, self._version)
             self._requested = self._version
         result = self.background.wait() if wait else self.background.poll()

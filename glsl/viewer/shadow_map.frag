@@ -5,8 +5,9 @@
 // nearest depth the map holds (black) to the farthest (STRETCH_TOP, light grey), and 1.0, the cleared
 // value (nothing drawn there), white: the depths of a light view may span a sliver of [0, 1], too
 // little to see unstretched. A directional light's map is one square; a point light's six cube
-// faces a 3 x 2 grid, faces 0 1 2 (+x -x +y) on top, 3 4 5 (-y +z -z) below. Each face shows texels [0, R)^2 of its layer, GL rows (row 0 at the
-// bottom, as the depth pass drew it), nearest texel: texelFetch, no filtering.
+// faces a 3 x 2 grid, faces 0 1 2 (+x -x +y) on top, 3 4 5 (-y +z -z) below. Each face shows
+// texels [0, R)^2 of its layer, GL rows (row 0 at the bottom, as the depth pass drew it), nearest
+// texel: texelFetch, no filtering.
 
 uniform sampler2DArray u_maps;     // the maps' array texture through a sampler object with compare off
 uniform vec4 u_region;             // (x0, y0, width, height): the viewport, window pixels

@@ -172,6 +172,46 @@ def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):
     assert made[4] == again[4]
 
 
+def test_shadows_off_draws_the_scene_without_shadows_and_on_again_the_same_image(ctx):
+    """GpuRenderer.shadows (the viewer's O key): off is the image of the scene whose lights
+    have shadows off, with no light view drawn and no shadow code; on again is the first
+    image bit for bit; each program is compiled once."""
+    scene = sphere_over_plane()
+    unshadowed = sphere_over_plane(light=replace(LIGHT, shadow=Shadow(enabled=False)))
+    with GpuRenderer(unshadowed, W, H, context=ctx) as gpu:
+        expected_off = gpu.render(depth=False).rgba8
+    with GpuRenderer(scene, W, H, context=ctx) as gpu:
+        on = gpu.render(depth=False).rgba8
+        assert gpu.shadows and gpu.drawn_shadow_plan is gpu.shadow_maps.plan
+        images, programs = [], []
+        for setting in (False, True, False, True):
+            gpu.shadows = setting
+            images.append(gpu.render(depth=False).rgba8)
+            programs.append(dict(gpu.programs))
+            assert (gpu.drawn_shadow_plan is not None) == setting
+    assert not np.array_equal(on, expected_off)                  # the scene has a shadow
+    assert np.array_equal(images[0], expected_off) and np.array_equal(images[2], expected_off)
+    assert np.array_equal(images[1], on) and np.array_equal(images[3], on)
+    assert sorted(v.shadows for v in programs[1]) == [False, True]      # one program each
+    assert programs[3].keys() == programs[1].keys()
+    assert all(programs[3][v] is program for v, program in programs[1].items())
+
+
+def test_update_makes_new_maps_in_the_renderers_own_context(gl_contexts):
+    """update() may run while another context is current (a viewer's window after a headless
+    render): a new layout's texture is made in the renderer's context all the same."""
+    from renderer.gpu.context import activate
+    scene = sphere_over_plane()
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as gpu:
+        gpu.render(depth=False)
+        scene.directional_lights[0] = replace(LIGHT, shadow=Shadow(resolution=128))
+        activate(gl_contexts["osmesa"])
+        gpu.update()                                  # a new texture: 128 texels, not 256
+        image = gpu.render(depth=False).rgba8
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as fresh:
+        assert np.array_equal(image, fresh.render(depth=False).rgba8)
+
+
 def test_the_light_budget_counts_the_shadow_uniforms():
     sizes = {"float": 1, "vec4[]": 4, "mat4[]": 16}
     per_light = {kind: sum(sizes[t] * (6 if name.endswith("_tiles") else 1)

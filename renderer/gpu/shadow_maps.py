@@ -202,7 +202,8 @@ class ShadowMaps:
         self.texture.use(SHADOW_MAPS_UNIT)
 
     def read_layer(self, layer: int) -> np.ndarray:
-        """Layer `layer`'s depths, float32 (S, S), GL rows (row 0 at the bottom): for tests."""
+        """Layer `layer`'s depths, float32 (S, S), GL rows (row 0 at the bottom): for tests and
+        the viewer's map view (renderer/viewer/shadow_view.py)."""
         side = self.layout.side
         data = self._framebuffers[layer][1].read(viewport=(0, 0, side, side), attachment=-1,
                                                  components=1, dtype="f4")

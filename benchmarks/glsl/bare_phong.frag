@@ -21,7 +21,7 @@ uniform sampler2DArrayShadow u_shadow_maps;
 uniform vec3 u_directional_direction[NUM_DIRECTIONAL_LIGHTS];
 uniform vec3 u_directional_intensity[NUM_DIRECTIONAL_LIGHTS];
 uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];
-uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];      // (drawn, texel, kernel, layer)
+uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];      // (layer, texel, kernel, R/S or 0)
 #endif
 #if NUM_POINT_LIGHTS > 0
 uniform vec3 u_point_position[NUM_POINT_LIGHTS];
@@ -74,9 +74,9 @@ void main() {
         vec3 L = normalize(-u_directional_direction[i]);
         vec3 term = shade(N, L, V, u_directional_intensity[i]);
         vec4 p = u_directional_shadow[i];
-        if (p.x != 0.0 && dot(N, L) > 0.0) {
+        if (p.w != 0.0 && dot(N, L) > 0.0) {
             vec3 q = (u_directional_shadow_matrix[i] * vec4(P + p.y * (N + 0.25 * L), 1.0)).xyz;
-            term *= texture(u_shadow_maps, vec4(q.xy, p.w, q.z));
+            term *= texture(u_shadow_maps, vec4(q.xy, p.x, q.z));
         }
         color += term;
     }

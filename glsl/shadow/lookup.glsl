@@ -24,7 +24,7 @@ uniform float u_shadow_map_size;     // S, texels on a side of a layer
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
 uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];  // P -> (u, v, z_w) in its layer
-uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];         // (drawn, texel size, kernel, layer)
+uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];         // (layer, texel size, kernel, R/S or 0)
 uniform vec4 u_directional_shadow_bias[NUM_DIRECTIONAL_LIGHTS];    // (normal, constant, slope) texels
 #endif
 #if NUM_POINT_LIGHTS > 0
@@ -79,7 +79,7 @@ float shadow_filter(vec3 uvz, float layer, int kernel) {
 #if NUM_DIRECTIONAL_LIGHTS > 0
 float light_visibility_directional(int i, vec3 P, vec3 N) {
     vec4 p = u_directional_shadow[i];
-    if (p.x == 0.0) {
+    if (p.w == 0.0) {
         return 1.0;                  // no pass this frame: nothing can shadow the receivers
     }
     mat4 M = u_directional_shadow_matrix[i];
@@ -87,7 +87,11 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
     vec3 X = normalize(vec3(M[0][0], M[1][0], M[2][0]));     // row 0 of M: the map's x axis
     vec3 Y = normalize(vec3(M[0][1], M[1][1], M[2][1]));     // row 1: its y axis
     vec3 Q = shadow_bias_point(P, N, L, X, Y, p.y, u_directional_shadow_bias[i]);
-    return shadow_filter((M * vec4(Q, 1.0)).xyz, p.w, LIGHT_KERNEL(p));
+    vec3 uvz = (M * vec4(Q, 1.0)).xyz;
+    if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(p.w)))) {
+        return 1.0;                  // outside the map, which holds every caster: nothing there
+    }
+    return shadow_filter(uvz, p.x, LIGHT_KERNEL(p));
 }
 #endif
 

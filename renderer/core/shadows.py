@@ -220,19 +220,26 @@ def _map_from_clip(tile: Tile, side: int) -> np.ndarray:
     return m
 
 
-def _plan_directional(index, light, light_map, layout, scene, points, receivers, casters,
+def _plan_directional(index, light, light_map, layout, points, receivers, casters,
                       frustum) -> tuple[ShadowPass | None, np.ndarray, np.ndarray, float]:
+    """The light's orthographic view, fitted to the part of the map that can hold a shadow:
+    the receivers' box across the light, within the camera's view volume's box and within the
+    casters' boxes (a parallel light's shadow falls within its caster's box across the light,
+    so a receiver point outside every caster's box is lit: the lookup says so outside the map);
+    in depth, from the nearest caster to the farthest receiver. Square texels; the centre snapped
+    to whole texels so that the map does not shimmer as the camera moves."""
     rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light.direction, (0.0, 1.0, 0.0))
     to_light = lambda p: p @ rotation[:3, :3].T            # noqa: E731  light-space x, y, -depth
-    seen = [to_light(points[i]) for i in receivers]
     params = np.zeros(4)
-    if not seen:
+    if not receivers or not casters:
         return None, np.eye(4), params, 0.0
-    box = np.vstack(seen)
-    lo, hi = box[:, :2].min(axis=0), box[:, :2].max(axis=0)
+    box = np.vstack([to_light(points[i]) for i in receivers])
+    cast = [to_light(points[i]) for i in casters]
     f_light = to_light(frustum)
-    lo = np.maximum(lo, f_light[:, :2].min(axis=0))
-    hi = np.minimum(hi, f_light[:, :2].max(axis=0))
+    lo = np.maximum.reduce([box[:, :2].min(axis=0), f_light[:, :2].min(axis=0),
+                            np.min([c[:, :2].min(axis=0) for c in cast], axis=0)])
+    hi = np.minimum.reduce([box[:, :2].max(axis=0), f_light[:, :2].max(axis=0),
+                            np.max([c[:, :2].max(axis=0) for c in cast], axis=0)])
     if np.any(lo > hi):
         return None, np.eye(4), params, 0.0
     resolution, guard = light_map.resolution, light_map.guard
@@ -244,8 +251,7 @@ def _plan_directional(index, light, light_map, layout, scene, points, receivers,
     depth = -box[:, 2]
     near_depth, far_depth = float(depth.min()), float(depth.max())
     drawn = []
-    for i in casters:
-        p = to_light(points[i])
+    for i, p in zip(casters, cast):
         if np.any(p[:, :2].max(axis=0) < region_lo) or np.any(p[:, :2].min(axis=0) > region_hi):
             continue
         d = -p[:, 2]
@@ -259,9 +265,52 @@ def _plan_directional(index, light, light_map, layout, scene, points, receivers,
     lookup = _map_from_clip(light_map.tiles[0], layout.side) @ clip
     if not drawn:
         return None, lookup, params, texel
-    params[:] = (1.0, texel, light_map.shadow.kernel, light_map.tiles[0].layer)
+    tile = light_map.tiles[0]
+    params[:] = (tile.layer, texel, light_map.shadow.kernel, tile.size / layout.side)
     return (ShadowPass("directional", index, 0, light_map.tiles[0], clip, tuple(drawn)),
             lookup, params, texel)
+
+
+# A caster's vertices within PLANAR_TOLERANCE of its extent from one plane make it planar.
+PLANAR_TOLERANCE = 1e-9
+
+
+def _plane_of(points: np.ndarray):
+    """(unit normal, a point) of the plane the points lie in, or None when they do not."""
+    if len(points) < 3:
+        return None
+    centre = points.mean(axis=0)
+    _, singular, rows = np.linalg.svd(points - centre, full_matrices=False)
+    if singular[0] == 0.0 or singular[-1] > PLANAR_TOLERANCE * singular[0]:
+        return None
+    return rows[-1], centre
+
+
+def can_shadow(scene, points, caster: int, receivers: list[int], light_position=None,
+               light_direction=None) -> bool:
+    """Whether object `caster` can shadow any receiver for a light at `light_position` (point)
+    or travelling along `light_direction` (directional). Conservative (True when unsure); False
+    for: a caster with no receiver but itself that cannot shadow itself (a convex analytic
+    shape, or a planar mesh), and a planar caster with every other receiver on the light's side
+    of its plane (a floor under the lit objects: it can shadow only what is below it)."""
+    obj = scene.objects[caster]
+    plane = _plane_of(points[caster])
+    convex = plane is not None or obj.shape is not None
+    others = [r for r in receivers if r != caster]
+    if not others:
+        return not convex and caster in receivers
+    if plane is None:
+        return True
+    normal, origin = plane
+    scale = PLANAR_TOLERANCE * (1.0 + float(np.abs(points[caster]).max()))
+    if light_position is not None:
+        side = float(normal @ (np.asarray(light_position) - origin))
+    else:
+        side = -float(normal @ np.asarray(light_direction, dtype=np.float64))
+    if abs(side) <= scale:
+        return False                         # the light grazes the plane: no shadow of any area
+    facing = normal if side > 0 else -normal
+    return any(bool(((points[r] - origin) @ facing < -scale).any()) for r in others)
 
 
 def _box_distance(points: np.ndarray, position: np.ndarray) -> float:
@@ -346,9 +395,11 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         i = light_map.index
         bias = light_map.shadow.bias_rule().as_vec4()
         if light_map.kind == "directional":
+            light = scene.directional_lights[i]
+            relevant = [c for c in casters if can_shadow(scene, points, c, receivers,
+                                                          light_direction=light.direction)]
             shadow_pass, lookup, params, texel = _plan_directional(
-                i, scene.directional_lights[i], light_map, layout, scene, points, receivers,
-                casters, frustum)
+                i, light, light_map, layout, points, receivers, relevant, frustum)
             uniforms["u_directional_shadow_matrix"][i] = lookup
             uniforms["u_directional_shadow"][i] = params
             uniforms["u_directional_shadow_bias"][i] = bias
@@ -356,8 +407,12 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
             if shadow_pass is not None:
                 plan.passes.append(shadow_pass)
         else:
+            light = scene.point_lights[i]
+            position = matrices.relative(light.position)
+            relevant = [c for c in casters if can_shadow(scene, points, c, receivers,
+                                                          light_position=position)]
             passes, rects, params, depth = _plan_point(
-                i, scene.point_lights[i], light_map, layout, matrices, points, receivers, casters)
+                i, light, light_map, layout, matrices, points, receivers, relevant)
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias

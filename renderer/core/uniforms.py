@@ -51,7 +51,7 @@ SHADOW_UNIFORMS = {
     "u_shadow_maps": "sampler2DArrayShadow",   # the maps' texture unit (the GPU path's alone)
     "u_shadow_map_size": "float",           # S, texels on a side of a layer
     "u_directional_shadow_matrix": "mat4[]",   # camera-relative world -> (u, v, z_w, 1)
-    "u_directional_shadow": "vec4[]",       # (drawn, texel size, kernel, layer)
+    "u_directional_shadow": "vec4[]",       # (layer, texel size, kernel, R/S; 0 when not drawn)
     "u_directional_shadow_bias": "vec4[]",  # (normal, constant, slope, 0) in texels
     "u_point_shadow": "vec4[]",             # (drawn, tan(half angle), kernel, tile side)
     "u_point_shadow_depth": "vec4[]",       # (A, B, near, far): z_w = A + B / m

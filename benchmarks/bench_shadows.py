@@ -20,14 +20,13 @@ RGBA8 colour and the float depth (glReadPixels into arrays made once):
 with/bare is the issue's figure (target <= 1.2). update() (uniforms and the frame's shadow
 plan: run when the camera, lights or objects move, not per frame) is timed the same way,
 with and without. The renderer also turns GL's bottom-up rows into row-0-on-top arrays and
-window depth into camera distance, which the bare program does not (about 0.3 ms here:
+window depth into camera distance, which the bare program does not (about 0.2 ms at 640x480:
 benchmarks/bench_pipeline.py). Not a test: this machine is shared and noisy.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import statistics
 import time
 from pathlib import Path
 
@@ -125,9 +124,8 @@ class BareShadows:
         defines = {"NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
                    "NUM_POINT_LIGHTS": len(scene.point_lights),
                    "TWO_SIDED": two_sided, "SPECULAR": specular}
-        program = self.ctx.program(vertex_shader=self._source("bare_phong.vert"),
-                                   fragment_shader=self._source("bare_phong.frag", defines))
-        return program
+        return self.ctx.program(vertex_shader=self._source("bare_phong.vert"),
+                                fragment_shader=self._source("bare_phong.frag", defines))
 
     def _vao(self, program, index: int, layout: str, *attributes: str) -> moderngl.VertexArray:
         vbo, ibo = self.buffers[index]

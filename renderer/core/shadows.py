@@ -352,7 +352,8 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
     lo, hi = _boxes(points, casters + receivers)
-    outside_box = np.maximum(np.maximum(lo[:len(casters)] - position, position - hi[:len(casters)]), 0.0)
+    n = len(casters)
+    outside_box = np.maximum(np.maximum(lo[:n] - position, position - hi[:n]), 0.0)   # per caster
     near = max(0.5 * min(float(np.linalg.norm(v)) for v in outside_box), NEAR_FRACTION * far)
     near = min(near, 0.5 * far)
     projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
@@ -366,7 +367,7 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
     for face in range(6):
         tile = light_map.tiles[face]
         drawn = tuple(i for i, out in zip(casters, outside[face]) if not out)
-        needed = bool(drawn) and not outside[face, len(casters):].all()
+        needed = bool(drawn) and not outside[face, n:].all()
         rects[face] = tile.rect(layout.side, needed)   # not drawn: the lookup reads it as lit
         if not needed:
             continue

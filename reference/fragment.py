@@ -7,14 +7,19 @@ Per-fragment shading, run only for the fragment that survived the depth test at 
            the geometry stage);
 - gouraud: out_color = gl_FrontFacing ? v_color_front : v_color_back, interpolated;
 - phong:   N = normalize_or_zero(v_world_normal); N = -N for a two-sided material seen from the
-           back; out_color = lighting(v_world_position, N).
+           back; out_color = lighting(v_world_position, N), each light's terms times its
+           shadow-map visibility when the object receives shadows and the frame has maps
+           (SHADOWS; reference/shadow/lookup.py). Flat and Gouraud receivers are not shadowed
+           (their lighting is per vertex; issue 15 step 2).
 Alpha is 1. Also out_view_depth, the interpolated -z_eye, for the depth image.
 
 Inputs:  `ObjectVaryings` (the vertex and geometry stage outputs of one object, its faces
          and material), and per fragment: triangle (N,) int64 index into the object's
          faces, weights (N, 3) perspective-correct weights of that triangle's vertices,
          gl_FrontFacing (N,) bool.
-Outputs: out_color (N, 4) and out_view_depth (N,), in the pipeline's dtype.
+Outputs: out_color (N, 4) and out_view_depth (N,), in the pipeline's dtype, and the shadow
+         ties: None, or (tied (N,) bool, out_color (N, 4) with tied shadow-map taps decided
+         the other way) (reference/shadow/lookup.py, "Ties").
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ import numpy as np
 
 from reference.geometry import TriangleOutputs
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
+from reference.shadow.lookup import FragmentShadows, ShadowMaps
 from reference.vertex import VertexOutputs
 
 
@@ -34,6 +40,7 @@ class ObjectVaryings:
     faces: np.ndarray                  # (T, 3) int64
     vertices: VertexOutputs
     triangles: TriangleOutputs | None  # flat shading only
+    receives_shadows: bool = False
 
 
 def interpolate(varying: np.ndarray, faces: np.ndarray, triangle: np.ndarray,
@@ -51,10 +58,13 @@ def select_by_facing(gl_FrontFacing: np.ndarray, front: np.ndarray, back: np.nda
 
 
 def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
-                    gl_FrontFacing: np.ndarray, lights: Lights, u_eye: np.ndarray):
-    """The fragment stage for one object's surviving fragments -> (out_color, out_view_depth)."""
+                    gl_FrontFacing: np.ndarray, lights: Lights, u_eye: np.ndarray,
+                    shadows: ShadowMaps | None = None):
+    """The fragment stage for one object's surviving fragments -> (out_color, out_view_depth,
+    shadow ties or None). `shadows`: the frame's maps, or None (no SHADOW_MAPS)."""
     material, faces, vertices = obj.material, obj.faces, obj.vertices
     dtype = vertices.gl_Position.dtype
+    tie = None
     if material.shading == "flat":
         color = select_by_facing(gl_FrontFacing, obj.triangles.f_color_front[triangle],
                                  obj.triangles.f_color_back[triangle])
@@ -67,10 +77,20 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
         N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
         if material.two_sided:
             N = np.where(gl_FrontFacing[:, None], N, -N)
-        color = lighting(P, N, np.asarray(u_eye, dtype=dtype),
-                         MaterialUniforms.from_material(material, dtype), lights)
+        E, uniforms = np.asarray(u_eye, dtype=dtype), MaterialUniforms.from_material(material, dtype)
+        if shadows is None or not obj.receives_shadows:
+            color = lighting(P, N, E, uniforms, lights)
+        else:
+            # the tie bands' scale: GL interpolates P from these vertices (lookup.py, SHADOW_TIE)
+            scale = np.abs(vertices.v_world_position[faces[triangle]]).max(axis=(1, 2))
+            look = FragmentShadows(shadows, scale)
+            color = lighting(P, N, E, uniforms, lights, look.visibility)
+            tied = look.tied
+            if tied is not None and tied.any():
+                other = lighting(P, N, E, uniforms, lights, look.alternative)
+                tie = (tied, np.concatenate([other, np.ones((len(other), 1), dtype=dtype)], axis=1))
     else:
         raise ValueError(f"unknown shading mode {material.shading!r}")
     out_color = np.concatenate([color, np.ones((len(color), 1), dtype=dtype)], axis=1)
     out_view_depth = interpolate(vertices.v_view_depth, faces, triangle, weights)
-    return out_color, out_view_depth
+    return out_color, out_view_depth, tie

@@ -8,6 +8,12 @@ large frame runs the stages from rasterisation on band by band (TILE_PIXELS), so
 memory stays bounded. Objects wholly outside the view volume are skipped (renderer/core/visibility.py, as the GPU path).
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
+When the scene has shadow maps (renderer/core/shadows.py: shadow_layout(...).any), the
+frame's maps are drawn first (reference/shadow/depth.py, a layer each) and Phong receivers look it up
+(reference/shadow/lookup.py); where a lookup had a tied tap, the pixel's colour with those
+taps decided the other way goes into Frame.rgba8_tie too (a pixel with both kinds of tie
+shows the depth tie's other surface there: either is an acceptable answer, and one
+alternative per pixel is what compare takes), and Frame.shadow_ties marks those pixels.
 
 Input:  a `renderer.core.scene.Scene` and the image size. Output: a `renderer.core.frame.Frame`
 (rgba8 (H, W, 4) uint8 row 0 at the top, optional linear (H, W, 4) float32, depth (H, W)
@@ -28,10 +34,13 @@ from reference.geometry import shade_triangles
 from reference.lighting import Lights
 from reference.output import compose_frame
 from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
+from reference.shadow.depth import render_layers
+from reference.shadow.lookup import ShadowMaps
 from reference.vertex import shade_vertices
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import SUBPIXEL_BITS, check_light_count
 from renderer.core.memory import REFERENCE_TILE_PIXELS
+from renderer.core.shadows import plan_shadows, shadow_layout
 from renderer.core.visibility import visible_objects
 
 
@@ -67,7 +76,8 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
-    return PreparedObject(ObjectVaryings(material, faces, vertices, triangles), window.select(keep),
+    return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows),
+                          window.select(keep),
                           clipped.source[keep], clipped.weights[keep])
 
 
@@ -124,20 +134,33 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
         first_orders.append(first_order)
         first_order += len(obj.mesh.faces)
     objects = [p.varyings if p is not None else None for p in prepared]
+    shadows = shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype, tile_pixels)
 
     bands = tiles(width, height, tile_pixels)
     if len(bands) == 1:
         frame = _render_tile(bands[0], prepared, objects, first_orders, lights, eye, scene,
-                             width, height, linear, depth, dtype)
+                             width, height, linear, depth, dtype, shadows)
     else:
         frame = _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene,
-                                 width, height, linear, depth, dtype)
+                                 width, height, linear, depth, dtype, shadows)
     frame.milliseconds = (time.perf_counter() - start) * 1000.0
     return frame
 
 
+def shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype,
+                tile_pixels=TILE_PIXELS) -> ShadowMaps | None:
+    """The frame's shadow maps (layers drawn, uniforms in `dtype`), or None when the scene has
+    none (then no program compiles shadow code)."""
+    layout = shadow_layout(scene, width, height)
+    if not layout.any:
+        return None
+    plan = plan_shadows(scene, frame_matrices, layout, visible)
+    return ShadowMaps.from_plan(render_layers(scene, frame_matrices, plan, dtype, tile_pixels),
+                                plan, lights, dtype)
+
+
 def _render_tile(region, prepared, objects, first_orders, lights, eye, scene, width, height,
-                 linear, depth, dtype) -> Frame:
+                 linear, depth, dtype, shadows=None) -> Frame:
     """Rasterisation, depth test, fragment shading and output of one tile: a Frame of the
     tile's size."""
     x0, y0, x1, y1 = region
@@ -146,21 +169,30 @@ def _render_tile(region, prepared, objects, first_orders, lights, eye, scene, wi
         if item is not None:
             draw_tile(index, item, depth_buffer, first_orders[index], width, height, region)
     drawn = depth_buffer.drawn
-    color, view_depth = shade_surviving(objects, depth_buffer.payload, drawn, lights, eye, dtype)
+    color, view_depth, shadow_tied, shadow_other = shade_surviving(
+        objects, depth_buffer.payload, drawn, lights, eye, dtype, shadows)
     frame = compose_frame(color, drawn, view_depth if depth else None, scene.background,
                           x1 - x0, y1 - y0, linear=linear)
     # Where two surfaces are closer in depth than GL can order, the other one may show: its
     # colour goes beside the winner's, for comparisons to accept either (renderer/checks/compare.py).
+    # Where a shadow-map tap was tied, the other decision's colour likewise; at a pixel with
+    # both, the depth tie's (one alternative per pixel: either is acceptable).
     ties = depth_buffer.depth_ties()
+    if not (ties.any() or shadow_tied.any()):
+        return frame
+    alternative = np.where(shadow_tied[:, None], shadow_other, color)
     if ties.any():
-        other, _ = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype)
-        frame.rgba8_tie = compose_frame(np.where(ties[:, None], other, color), drawn, None,
-                                        scene.background, x1 - x0, y1 - y0, linear=False).rgba8
+        other = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype, shadows)[0]
+        alternative = np.where(ties[:, None], other, alternative)
+    frame.rgba8_tie = compose_frame(alternative, drawn, None, scene.background, x1 - x0, y1 - y0,
+                                    linear=False).rgba8
+    rows = lambda mask: mask.reshape(y1 - y0, x1 - x0)[::-1]          # noqa: E731  image rows
+    frame.shadow_ties = rows(shadow_tied & ~ties) & (frame.rgba8_tie != frame.rgba8).any(axis=-1)
     return frame
 
 
 def _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene, width, height,
-                     linear, depth, dtype) -> Frame:
+                     linear, depth, dtype, shadows=None) -> Frame:
     """Each band drawn as its own tile and pasted into the frame's arrays (image rows are top
     first: GL rows [y0, y1) are image rows [H - y1, H - y0))."""
     frame = Frame(np.empty((height, width, 4), np.uint8),
@@ -171,34 +203,41 @@ def _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene,
         _, y0, _, y1 = region
         rows = slice(height - y1, height - y0)
         part = _render_tile(region, prepared, objects, first_orders, lights, eye, scene,
-                            width, height, linear, depth, dtype)
+                            width, height, linear, depth, dtype, shadows)
         frame.rgba8[rows] = part.rgba8
         if linear:
             frame.linear[rows] = part.linear
         if depth:
             frame.depth[rows] = part.depth
         if part.rgba8_tie is not None:
-            ties.append((rows, part.rgba8_tie))
+            ties.append((rows, part.rgba8_tie, part.shadow_ties))
     if ties:
         frame.rgba8_tie = frame.rgba8.copy()
-        for rows, tie in ties:
+        frame.shadow_ties = np.zeros((height, width), bool)
+        for rows, tie, shadow_ties in ties:
             frame.rgba8_tie[rows] = tie
+            frame.shadow_ties[rows] = shadow_ties
     return frame
 
 
 def shade_surviving(objects: list[ObjectVaryings | None], payload: dict, pixels_mask: np.ndarray,
-                    lights: Lights, eye, dtype) -> tuple[np.ndarray, np.ndarray]:
+                    lights: Lights, eye, dtype, shadows: ShadowMaps | None = None):
     """Fragment stage for the fragments `payload` names at the pixels of `pixels_mask`:
-    (colour (H*W, 4), view depth (H*W,)), zero elsewhere."""
+    (colour (H*W, 4), view depth (H*W,), shadow-tied (H*W,) bool, the colour with the tied
+    taps decided the other way (H*W, 4)), zero (False) elsewhere."""
     color = np.zeros((len(pixels_mask), 4), dtype=dtype)
     view_depth = np.full(len(pixels_mask), np.inf, dtype=dtype)
+    shadow_tied = np.zeros(len(pixels_mask), bool)
+    shadow_other = color.copy()
     for index, varyings in enumerate(objects):
         if varyings is None:                                   # culled: it has no fragments
             continue
         pixels = np.flatnonzero(pixels_mask & (payload.get("object", -1) == index))
         if len(pixels) == 0:
             continue
-        color[pixels], view_depth[pixels] = shade_fragments(
+        color[pixels], view_depth[pixels], tie = shade_fragments(
             varyings, payload["triangle"][pixels], payload["weights"][pixels],
-            payload["gl_FrontFacing"][pixels], lights, eye)
-    return color, view_depth
+            payload["gl_FrontFacing"][pixels], lights, eye, shadows)
+        if tie is not None:
+            shadow_tied[pixels], shadow_other[pixels] = tie
+    return color, view_depth, shadow_tied, shadow_other

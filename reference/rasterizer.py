@@ -40,7 +40,7 @@ from typing import Iterator
 
 import numpy as np
 
-from renderer.core.gl_rules import (SUBPIXEL_BITS, depth_mapping, is_inside_edge, is_left_or_bottom_edge,
+from renderer.core.gl_rules import (SUBPIXEL_BITS, depth_mapping, inside_columns, is_left_or_bottom_edge,
                                     pixel_centre, snap_to_subpixel_grid)
 
 MAX_CANDIDATES_PER_BATCH = 1 << 19  # (triangle, pixel) pairs tested at once
@@ -72,6 +72,13 @@ class WindowTriangles:
         return WindowTriangles(self.x[mask], self.y[mask], self.x_w[mask], self.y_w[mask],
                                self.z_w[mask], self.inv_w[mask], self.area2[mask],
                                self.subpixel_bits)
+
+    @classmethod
+    def concatenate(cls, parts: list["WindowTriangles"]) -> "WindowTriangles":
+        """The triangles of `parts` one after another (the same sub-pixel bits)."""
+        arrays = [np.concatenate([getattr(p, name) for p in parts])
+                  for name in ("x", "y", "x_w", "y_w", "z_w", "inv_w", "area2")]
+        return cls(*arrays, parts[0].subpixel_bits)
 
 
 @dataclass
@@ -201,6 +208,24 @@ def screen_barycentrics(tris: WindowTriangles, t: np.ndarray, px: np.ndarray,
     return np.stack([1.0 - l1 - l2, l1, l2], axis=-1)
 
 
+def depth_planes(tris: WindowTriangles):
+    """Each triangle's window depth as an affine plane, the same plane `screen_barycentrics`
+    interpolates z_w on (unsnapped positions; snapped where those have no area):
+    (x0, y0, z0, dz/dx, dz/dy) (T,), z_w(x, y) = z0 + dz/dx (x - x0) + dz/dy (y - y0)."""
+    dtype = tris.x_w.dtype
+    x, y, z = tris.x_w, tris.y_w, tris.z_w
+    area = (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0])
+    if not np.all(area != 0):
+        scale = dtype.type(1 << tris.subpixel_bits)
+        flat = (area == 0)[:, None]
+        x = np.where(flat, (tris.x / scale).astype(dtype), x)
+        y = np.where(flat, (tris.y / scale).astype(dtype), y)
+        area = (x[:, 1] - x[:, 0]) * (y[:, 2] - y[:, 0]) - (y[:, 1] - y[:, 0]) * (x[:, 2] - x[:, 0])
+    dx1, dy1, dz1 = x[:, 1] - x[:, 0], y[:, 1] - y[:, 0], z[:, 1] - z[:, 0]
+    dx2, dy2, dz2 = x[:, 2] - x[:, 0], y[:, 2] - y[:, 0], z[:, 2] - z[:, 0]
+    return x[:, 0], y[:, 0], z[:, 0], (dz1 * dy2 - dz2 * dy1) / area, (dx1 * dz2 - dx2 * dz1) / area
+
+
 @dataclass
 class EdgeEquations:
     """E_k(p) = a_k p_y - b_k p_x + c_k for the edge opposite vertex k, oriented so that the
@@ -225,11 +250,13 @@ def edge_equations(tris: WindowTriangles) -> EdgeEquations:
     return EdgeEquations(dx, dy, c, is_left_or_bottom_edge(dx, dy))
 
 
-def rasterize(tris: WindowTriangles, width: int, height: int, *,
-              max_candidates: int = MAX_CANDIDATES_PER_BATCH, region=None) -> Iterator[Fragments]:
-    """Fragments of the triangles in batches of at most about 2 * max_candidates tested
-    (triangle, pixel) pairs, in triangle order. Triangles must have area2 != 0. `region`
-    (x0, y0, x1, y1): only the pixels of that rectangle of the viewport (a tile)."""
+def coverage(tris: WindowTriangles, width: int, height: int, *,
+             max_candidates: int = MAX_CANDIDATES_PER_BATCH, region=None) -> Iterator[tuple]:
+    """The covered (triangle, pixel) pairs, in batches of at most about 2 * max_candidates
+    tested candidates, in triangle order: (t, px, py) int64 each. Triangles must have
+    area2 != 0. `region` (x0, y0, x1, y1): only the pixels of that rectangle of the viewport
+    (a tile). The coverage rules alone (edge functions, fill rule): `rasterize` adds the
+    interpolation, the shadow maps' depth pass (reference/shadow/depth.py) only a depth plane."""
     edges = edge_equations(tris)
     tri, i0, box_w, j0, box_h = _work_items(tris, width, height, max_candidates, region)
     counts = box_w * box_h
@@ -238,8 +265,15 @@ def rasterize(tris: WindowTriangles, width: int, height: int, *,
     boundaries = np.flatnonzero(np.diff(batch_of_item)) + 1
     for items in np.split(np.arange(len(tri)), boundaries):
         if len(items):
-            yield _rasterize_items(tris, edges, tri[items], i0[items], box_w[items],
-                                   j0[items], box_h[items])
+            yield _covered(edges, tris.subpixel_bits, tri[items], i0[items], box_w[items],
+                           j0[items], box_h[items])
+
+
+def rasterize(tris: WindowTriangles, width: int, height: int, *,
+              max_candidates: int = MAX_CANDIDATES_PER_BATCH, region=None) -> Iterator[Fragments]:
+    """Fragments of the triangles, batch by batch as `coverage` finds them."""
+    for t, px, py in coverage(tris, width, height, max_candidates=max_candidates, region=region):
+        yield _fragments(tris, t, px, py)
 
 
 def _expand(starts: np.ndarray, lengths: np.ndarray):
@@ -249,22 +283,24 @@ def _expand(starts: np.ndarray, lengths: np.ndarray):
     return run, starts[run] + offset
 
 
-def _rasterize_items(tris: WindowTriangles, edges: EdgeEquations,
-                     tri, i0, box_w, j0, box_h) -> Fragments:
-    """Test every pixel centre of the items' boxes against the three edges."""
+def _covered(edges: EdgeEquations, bits: int, tri, i0, box_w, j0, box_h):
+    """The covered (triangle, px, py) of the items' boxes: along each row of a box, the three
+    edges' fill rule solved for the columns (gl_rules.inside_columns, exact), so only covered
+    pixels are made, in triangle, row, column order."""
     item_of_row, py = _expand(j0, box_h)                         # every row of every box
-    row_of_pixel, px = _expand(i0[item_of_row], box_w[item_of_row])   # every pixel of it
-    t, py = tri[item_of_row][row_of_pixel], py[row_of_pixel]     # (triangle, pixel) pairs
-    bits = tris.subpixel_bits
-    cx, cy = pixel_centre(px, bits), pixel_centre(py, bits)
-
-    covered = np.ones(len(t), dtype=bool)
+    t = tri[item_of_row]
+    cy = pixel_centre(py, bits)
+    lo, hi = i0[item_of_row], i0[item_of_row] + box_w[item_of_row] - 1
     for k in range(3):
-        value = edges.a[k].take(t) * cy - edges.b[k].take(t) * cx + edges.c[k].take(t)
-        covered &= is_inside_edge(value, edges.inclusive[k].take(t))
-    del cx, cy
+        edge_lo, edge_hi = inside_columns(edges.a[k].take(t) * cy + edges.c[k].take(t),
+                                          edges.b[k].take(t), edges.inclusive[k].take(t), bits)
+        lo, hi = np.maximum(lo, edge_lo), np.minimum(hi, edge_hi)
+    row_of_pixel, px = _expand(lo, np.maximum(hi - lo + 1, 0))  # every covered pixel of it
+    return t[row_of_pixel], px, py[row_of_pixel]
 
-    t, px, py = t[covered], px[covered], py[covered]
+
+def _fragments(tris: WindowTriangles, t, px, py) -> Fragments:
+    """The covered pixels' barycentrics, depth and facing."""
     screen = screen_barycentrics(tris, t, px, py)
     z = tris.z_w[t]
     z_w = screen[:, 0] * z[:, 0] + screen[:, 1] * z[:, 1] + screen[:, 2] * z[:, 2]  # affine

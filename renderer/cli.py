@@ -455,7 +455,8 @@ def cmd_compare_methods(args) -> int:
 
 def cmd_compare(args) -> int:
     import reference
-    from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision, heat_map
+    from renderer.checks.compare import (compare_frames, depth_tie_pixels, either_precision, heat_map,
+                                         shadow_tie_pixels)
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.paths import output_stem
     from renderer.core.jsonio import finite_or_none, to_json
@@ -506,6 +507,7 @@ def cmd_compare(args) -> int:
     figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
+               "shadow_tie_pixels": shadow_tie_pixels(ref_frame) if args.method == "raster" else 0,
                "grazing_ray_pixels": grazing,
                "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}

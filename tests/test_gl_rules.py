@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from renderer.core import gl_rules, transforms
-from renderer.core.gl_rules import (REVERSED_Z_DEPTH, STANDARD_DEPTH, depth_mapping, is_inside_edge,
+from renderer.core.gl_rules import (REVERSED_Z_DEPTH, STANDARD_DEPTH, depth_mapping, inside_columns, is_inside_edge,
                                     is_left_or_bottom_edge, pixel_centre, snap_to_subpixel_grid,
                                     to_unorm8)
 
@@ -84,6 +84,26 @@ def test_fill_rule_left_and_bottom_edges_are_inclusive():
     on_edge = np.zeros(2, dtype=np.int64)
     assert is_inside_edge(on_edge, np.array([True, False])).tolist() == [True, False]
     assert is_inside_edge(np.array([1, -1]), np.array([False, True])).tolist() == [True, False]
+
+
+def test_the_fill_rule_solved_for_columns_gives_the_columns_that_pass_it():
+    """inside_columns(k, b): the columns i whose centre cx = 256 i + 128 (8 bits) passes
+    is_inside_edge(k - b cx). By hand: k = 640, b = 1: value 640 - cx is 0 at column 2's
+    centre (640): inclusive -> columns ..2, exclusive -> ..1; b = -1, k = -640: value
+    cx - 640 -> columns 2.. / 3..; b = 0: all columns for k >= 0 (inclusive), none for k = 0
+    exclusive. Then every (k, b, inclusive) of a grid against testing columns -8..8."""
+    lo, hi = inside_columns(np.array([640, 640, -640, -640]), np.array([1, 1, -1, -1]),
+                            np.array([True, False, True, False]), 8)
+    assert hi[:2].tolist() == [2, 1] and lo[2:].tolist() == [2, 3]
+    lo, hi = inside_columns(np.array([0, 0]), np.array([0, 0]), np.array([True, False]), 8)
+    assert hi[0] >= 8 and lo[0] <= -8 and hi[1] < lo[1]
+    k, b, inclusive = (a.ravel() for a in np.meshgrid(np.arange(-3000, 3000, 37), np.arange(-700, 700, 13),
+                                                       [True, False], indexing="ij"))
+    lo, hi = inside_columns(k, b, inclusive, 8)
+    columns = np.arange(-8, 9)
+    tested = is_inside_edge(k[:, None] - b[:, None] * pixel_centre(columns, 8), inclusive[:, None])
+    solved = (columns >= lo[:, None]) & (columns <= hi[:, None])
+    assert (tested == solved).all()
 
 
 def test_unorm8_is_round_half_up_of_the_clamped_value():

@@ -117,9 +117,21 @@ def depth_max_rel(result: np.ndarray, reference: np.ndarray, deviation: int = DE
 
 
 def depth_tie_pixels(reference_frame) -> int:
-    """Pixels where the reference accepts another colour because of a depth tie."""
+    """Pixels where the reference accepts another colour because of a depth tie (or, from the
+    ray tracer, the adaptive pattern's other decision): not a shadow-map tie."""
     tie = reference_frame.rgba8_tie
-    return 0 if tie is None else int((tie != reference_frame.rgba8).any(axis=-1).sum())
+    if tie is None:
+        return 0
+    other = (tie != reference_frame.rgba8).any(axis=-1)
+    shadow = getattr(reference_frame, "shadow_ties", None)
+    return int((other if shadow is None else other & ~shadow).sum())
+
+
+def shadow_tie_pixels(reference_frame) -> int:
+    """Pixels where the reference accepts another colour because a shadow-map lookup was within
+    float32 rounding of its decision (reference/shadow/lookup.py, "Ties")."""
+    shadow = getattr(reference_frame, "shadow_ties", None)
+    return 0 if shadow is None else int(shadow.sum())
 
 
 def grazing_ray_pixels(reference32, reference64) -> np.ndarray:

@@ -33,7 +33,11 @@ class Frame:
     rgba8_tie: from the reference only, where some pixels' two nearest surfaces are closer in
             window depth than GL's float32 arithmetic can order (reference/depth_buffer.py,
             DEPTH_TIE_TOLERANCE): rgba8 with those pixels showing the other surface. GL may
-            draw either, so comparisons accept either. None when there is no such pixel.
+            draw either, so comparisons accept either; also where a shadow-map lookup was
+            within float32 rounding of its decision (reference/shadow/lookup.py, "Ties"):
+            rgba8 with those pixels lit the other way. None when there is no such pixel.
+    shadow_ties: from the reference only, (H, W) bool: the pixels of rgba8_tie that differ
+            because of a shadow-map tie (not a depth tie); None with rgba8_tie.
     gl_info: for a GPU frame, the GL implementation that drew it (GpuRenderer.gl_info:
             GL_VENDOR, GL_RENDERER, GL_VERSION, context, depth_format); None from the
             reference. Golden tests record it beside each golden.
@@ -52,6 +56,7 @@ class Frame:
     gl_info: dict | None = None
     samples: np.ndarray | None = None
     ray_tree: np.ndarray | None = None
+    shadow_ties: np.ndarray | None = None
 
     def image(self, background: str = "opaque") -> np.ndarray:
         """The pixels an image file of this frame holds: (H, W, 3) for an opaque background,

@@ -122,6 +122,23 @@ def is_inside_edge(edge_value: np.ndarray, inclusive: np.ndarray) -> np.ndarray:
     return np.where(inclusive, edge_value >= 0, edge_value > 0)
 
 
+def inside_columns(k: np.ndarray, b: np.ndarray, inclusive: np.ndarray, subpixel_bits: int):
+    """`is_inside_edge` solved for the pixel column along a row: the edge's value at column
+    i's centre cx = pixel_centre(i) is k - b cx (k: the row's part, int64), and the columns
+    where it passes the fill rule are lo <= i <= hi (int64; b = 0: every column or none,
+    hi < lo for none). Exact integer arithmetic (floor division), so the same pixels."""
+    half, big = 1 << (subpixel_bits - 1), np.int64(1) << 62
+    positive = np.where(b != 0, np.abs(b), 1)
+    k_in = np.where(inclusive, k, k - 1)           # k - b cx > 0  <=>  k - 1 - b cx >= 0
+    # b > 0: cx <= k_in / b;  b < 0: cx >= -k_in / |b|, i.e. cx >= -(k_in // |b|)
+    cx_max = np.where(b > 0, k_in // positive, big)
+    cx_min = np.where(b < 0, -(k_in // positive), -big)
+    empty = (b == 0) & (k_in < 0)
+    lo = -((half - cx_min) >> subpixel_bits)       # ceil((cx_min - half) / 2^bits)
+    hi = np.where(empty, lo - 1, (cx_max - half) >> subpixel_bits)
+    return lo, hi
+
+
 # --- output ----------------------------------------------------------------------------------
 
 def to_unorm8(c: np.ndarray) -> np.ndarray:

@@ -152,7 +152,7 @@ def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
 
 # --- each frame's light views ----------------------------------------------------------------
 
-# A point light's near plane: half the distance to the nearest caster's bounding box, and at
+# A point light's near plane: half the distance to the nearest caster's triangles, and at
 # least NEAR_FRACTION of the far distance (geometry nearer than that to the light casts no
 # shadow; depth precision near the far plane stays ~1e-7 * far^2 / near = ~1e-4 far).
 NEAR_FRACTION = 2.0 ** -10
@@ -318,6 +318,38 @@ def can_shadow(scene, points, caster: int, receivers: list[int], light_position=
     return any(bool(((points[r] - origin) @ facing < -scale).any()) for r in others)
 
 
+def triangle_distance(corners: np.ndarray, position: np.ndarray) -> np.ndarray:
+    """(T,) distance from `position` to each triangle `corners` (T, 3, 3): to its plane where
+    the foot lies inside it, else to the nearest of its edges (segments)."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    n = np.cross(b - a, c - a)
+    area2 = np.einsum("ij,ij->i", n, n)
+    best = np.full(len(corners), np.inf)
+    flat = area2 > 0.0
+    if flat.any():
+        w = (position - a[flat])
+        height = np.einsum("ij,ij->i", w, n[flat]) / area2[flat]
+        foot = position - height[:, None] * n[flat]
+        inside = np.ones(int(flat.sum()), bool)
+        for p, q in ((a, b), (b, c), (c, a)):
+            edge_normal = np.cross(q[flat] - p[flat], n[flat])    # points out of the triangle
+            inside &= np.einsum("ij,ij->i", foot - p[flat], edge_normal) <= 0.0
+        best[np.flatnonzero(flat)[inside]] = (np.abs(height) * np.sqrt(area2[flat]))[inside]
+    for p, q in ((a, b), (b, c), (c, a)):                          # the edges, as segments
+        e = q - p
+        length2 = np.einsum("ij,ij->i", e, e)
+        s = np.clip(np.einsum("ij,ij->i", position - p, e) / np.where(length2 > 0, length2, 1.0), 0, 1)
+        nearest = p + s[:, None] * e
+        best = np.minimum(best, np.linalg.norm(position - nearest, axis=1))
+    return best
+
+
+def _caster_distance(scene, points: np.ndarray, caster: int, position: np.ndarray) -> float:
+    """The distance from `position` to the nearest point of object `caster`'s triangles."""
+    faces = np.asarray(scene.objects[caster].mesh.faces, dtype=np.int64)
+    return float(triangle_distance(points[caster][faces], position).min())
+
+
 def _boxes(points: list[np.ndarray], indices: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """(n, 3) low and high ends of the bounding boxes of points[i] for i in indices."""
     return (np.array([points[i].min(axis=0) for i in indices]).reshape(-1, 3),
@@ -340,7 +372,7 @@ def point_face_projection(resolution: int, guard: int, near: float, far: float) 
     return projection, tan_half
 
 
-def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters):
+def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters, scene):
     position = matrices.relative(light.position)
     passes = []
     rects = np.zeros((6, 4))
@@ -351,12 +383,12 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
         return passes, rects, params, depth
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
-    lo, hi = _boxes(points, casters + receivers)
-    n = len(casters)
-    outside_box = np.maximum(np.maximum(lo[:n] - position, position - hi[:n]), 0.0)   # per caster
-    near = max(0.5 * min(float(np.linalg.norm(v)) for v in outside_box), NEAR_FRACTION * far)
+    near = max(0.5 * min(_caster_distance(scene, points, i, position) for i in casters),
+               NEAR_FRACTION * far)
     near = min(near, 0.5 * far)
     projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
+    lo, hi = _boxes(points, casters + receivers)
+    n = len(casters)
     clips = np.empty((6, 4, 4))
     for face in range(6):
         view = np.eye(4)
@@ -378,10 +410,12 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
     return passes, rects, params, depth
 
 
-def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | None = None) -> ShadowPlan:
+def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | None = None,
+                 prune: bool = True) -> ShadowPlan:
     """The frame's shadow passes and lookup uniforms (module docstring). `visible`: which
     objects the camera can see (renderer/core/visibility.visible_objects; all if None); only
-    those count as receivers to fit a map to."""
+    those count as receivers to fit a map to. `prune` False draws every caster, also those
+    that cannot shadow any receiver (`can_shadow`): a plane in its own map, to study the bias."""
     n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
     uniforms = {
         "u_shadow_map_size": np.array(float(layout.side)),
@@ -408,9 +442,8 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         bias = light_map.shadow.bias_rule().as_vec4()
         if light_map.kind == "directional":
             light = scene.directional_lights[i]
-            relevant = [c for c in casters if can_shadow(scene, points, c, receivers,
-                                                          light_direction=light.direction,
-                                                          planes=planes)]
+            relevant = [c for c in casters if not prune or can_shadow(
+                scene, points, c, receivers, light_direction=light.direction, planes=planes)]
             shadow_pass, lookup, params, texel = _plan_directional(
                 i, light, light_map, layout, points, receivers, relevant, frustum)
             uniforms["u_directional_shadow_matrix"][i] = lookup
@@ -422,10 +455,10 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         else:
             light = scene.point_lights[i]
             position = matrices.relative(light.position)
-            relevant = [c for c in casters if can_shadow(scene, points, c, receivers,
-                                                          light_position=position, planes=planes)]
+            relevant = [c for c in casters if not prune or can_shadow(
+                scene, points, c, receivers, light_position=position, planes=planes)]
             passes, rects, params, depth = _plan_point(
-                i, light, light_map, layout, matrices, points, receivers, relevant)
+                i, light, light_map, layout, matrices, points, receivers, relevant, scene)
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias

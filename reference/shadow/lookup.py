@@ -1,0 +1,287 @@
+"""# Twin: glsl/shadow/lookup.glsl
+
+The shadow-map lookup (docs/conventions.md, "Shadows"; the rules: renderer/core/shadows.py,
+renderer/core/shadow_settings.py): whether light i reaches surface points P (N, 3) with unit
+normals N (the normals that are lit), as lighting.py's `visibility` hook asks: 1 lit, 0 in
+shadow, a fraction where a filter straddles a shadow edge. In the pipeline's dtype, vectorised
+over fragments, with the GLSL's formulas in the GLSL's order: the point moved by the bias
+rule, then compared with the depth its map's layer stored (depth.py) as llvmpipe's
+depth-compare sampler does it (/work/notes/llvmpipe-shadow-sampler.md: the layer chosen, texel
+choice and bilinear weights within it from one float32 product u * S, CLAMP_TO_EDGE to the
+layer's S x S, compare ref <= stored unclamped, denormals flushed).
+
+Ties (the reference's second acceptable answer): GL's float32 arithmetic puts P, the matrix
+product and the stored depth within rounding of the reference's, so a tap whose reference
+depth is that close to the stored one may be decided either way, and a hard lookup whose
+u * S is that close to a texel edge may read the neighbouring texel. Each lookup returns
+its visibility, whether some tap was so tied, and the visibility with the tied taps decided
+the other way (`ShadowLookup`); the pipeline shades such pixels again into Frame.rgba8_tie.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from reference.lighting import Lights, dot, normalize
+from reference.shadow.depth import ShadowLayers
+from renderer.core.shadow_settings import MAX_SLOPE, tap_offsets
+from renderer.core.shadows import CUBE_FACE_AXES, CUBE_FACE_ROTATIONS, cube_face
+
+UNIT_ROUNDOFF32 = 2.0 ** -24
+SMALLEST_NORMAL32 = 2.0 ** -126
+# The tie bands, in float32 roundings of the quantities a lookup is made of. GL's receiver
+# point P is interpolated in float32 from vertices |V| large (camera-relative), with
+# perspective weights set up and evaluated in float32 at absolute window coordinates: P is
+# off by a few (~4) roundings of max |V| (`position_scale`). The bias adds ~2 roundings of
+# |Q|, the 4-term product M (Q, 1) ~4 roundings of sum |M_k Q_k| + |M_3|, the cube lookup a
+# division and a reciprocal; llvmpipe fuses some of these and the reference (in float64) none,
+# so the count is doubled: SHADOW_TIE = 16 roundings of
+#   |M_z| . (|Q| + position_scale) + |M_z3|          (z_w of a directional map),
+#   S (|M_u| . (|Q| + position_scale) + |M_u3|)       (u * S, texels, for the hard texel),
+# and for a point light the same through d = Q - light, z_w = A + B / m, u = 0.5 (r.d) / (m
+# tan) + 0.5 (`_point_tie_bounds`). The stored depth's own rounding is depth.py's per-texel
+# `tolerance` (STORE_TIE_ROUNDINGS); the compare band is their sum.
+SHADOW_TIE = 16 * UNIT_ROUNDOFF32
+
+
+@dataclass
+class ShadowLookup:
+    """Per fragment (N,): the visibility, the visibility with tied taps decided the other way,
+    and whether any tap (of non-zero weight) was tied."""
+    visibility: np.ndarray
+    alternative: np.ndarray
+    tied: np.ndarray
+
+    @classmethod
+    def lit(cls, n: int, dtype) -> "ShadowLookup":
+        return cls(np.ones(n, dtype), np.ones(n, dtype), np.zeros(n, bool))   # not one array twice
+
+    def put(self, where: np.ndarray, other: "ShadowLookup") -> None:
+        """Overwrite the fragments `where` (indices or mask) with `other`'s."""
+        self.visibility[where], self.alternative[where], self.tied[where] = (
+            other.visibility, other.alternative, other.tied)
+
+
+@dataclass
+class ShadowMaps:
+    """What the lookup reads: the frame's layers, the plan's uniforms in the pipeline's dtype
+    (ShadowPlan.uniforms, named as the GLSL's) and the lights (their direction and position)."""
+    layers: ShadowLayers
+    uniforms: dict[str, np.ndarray]
+    lights: Lights
+
+    @classmethod
+    def from_plan(cls, layers: ShadowLayers, plan, lights: Lights, dtype) -> "ShadowMaps":
+        return cls(layers, {k: np.asarray(v).astype(dtype) for k, v in plan.uniforms.items()}, lights)
+
+
+# --- the bias ---------------------------------------------------------------------------------
+
+def shadow_bias_point(P, N, L, X, Y, t, bias) -> np.ndarray:
+    """The receiver point moved before it is compared (shadow_settings.BiasRule): along N by
+    bias.x (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by bias.y +
+    bias.z min(tan(theta), MAX_SLOPE) texels; t (..., 1) or scalar is the world size of a texel."""
+    dtype = np.result_type(P)
+    c = np.clip(dot(N, L), 0.0, 1.0)
+    s = np.sqrt(1.0 - c * c)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tan_theta = np.where(c > 0.0, np.minimum(s / c, dtype.type(MAX_SLOPE)), dtype.type(MAX_SLOPE))
+    normal = bias[0] * (np.abs(dot(N, X)) + np.abs(dot(N, Y)))
+    toward = bias[1] + bias[2] * tan_theta
+    return P + t * (normal * N + toward * L)
+
+
+# --- the sampler ------------------------------------------------------------------------------
+
+def _flush_denormals(x: np.ndarray) -> np.ndarray:
+    return np.where(np.abs(x) < SMALLEST_NORMAL32, np.zeros_like(x), x)
+
+
+def compare(ref: np.ndarray, stored: np.ndarray) -> np.ndarray:
+    """GL's LEQUAL depth compare as llvmpipe does it for DEPTH_COMPONENT32F: lit where
+    ref <= stored, ref not clamped to [0, 1], denormals compared as 0, NaN never lit."""
+    return _flush_denormals(ref) <= _flush_denormals(stored.astype(np.result_type(ref)))
+
+
+def linear_texels(u: np.ndarray, size: int):
+    """LINEAR + CLAMP_TO_EDGE along one axis (llvmpipe lp_build_sample_wrap_linear):
+    x = max(min(u S, S) - 1/2, 0) (NaN: S then 0), texels floor(x) and its successor (clamped
+    to S - 1), and the successor's weight x - floor(x)."""
+    x = u * u.dtype.type(size)
+    x = np.where(np.isnan(x), size, np.minimum(x, size)) - u.dtype.type(0.5)
+    x = np.maximum(x, 0)
+    floor = np.floor(x)
+    i0 = floor.astype(np.int64)
+    return i0, np.minimum(i0 + 1, size - 1), x - floor
+
+
+def _taps(layers: ShadowLayers, layer, ref, tie_ref, j, i):
+    """(lit, tied) of one texel (i, j) of `layer` per fragment."""
+    stored = layers.depth[layer, j, i]
+    lit = compare(ref, stored)
+    with np.errstate(invalid="ignore"):
+        tied = np.abs(ref - stored) <= tie_ref + layers.tolerance[layer, j, i]
+    return lit, tied
+
+
+def _bilinear(lit00, lit01, lit10, lit11, s, t):
+    """llvmpipe's blend of four compare results (m_yx), x first, then y."""
+    v0 = np.where(lit01, s, 0) + np.where(lit00, 1 - s, 0)
+    v1 = np.where(lit11, s, 0) + np.where(lit10, 1 - s, 0)
+    return v0 + t * (v1 - v0)
+
+
+def shadow_filter(layers: ShadowLayers, uvz: np.ndarray, layer, kernel: int, tie_ref: np.ndarray,
+                  tie_texel: np.ndarray) -> ShadowLookup:
+    """The filter at points uvz (N, 3) = (u, v, reference z_w) of `layer` (int or (N,) ints:
+    GLSL's layer coordinate, an exact integer, so no rounding to choose). Kernel 1 (hard): the
+    nearest texel's comparison (GLSL: the LINEAR sampler at its centre, weight exactly 0 for
+    the neighbour); K >= 2: the mean of the (K-1)^2 bilinear comparisons at tap_offsets(K) / S.
+    tie_ref (N,): the receiver's z_w tie band; tie_texel (N, 2): the band of u S, v S (hard)."""
+    S = layers.side
+    u, v, ref = uvz[:, 0], uvz[:, 1], uvz[:, 2]
+    dtype = uvz.dtype
+    if kernel == 1:
+        x, y = u * dtype.type(S), v * dtype.type(S)
+        i = np.clip(np.floor(x), 0, S - 1).astype(np.int64)
+        j = np.clip(np.floor(y), 0, S - 1).astype(np.int64)
+        lit, tied = _taps(layers, layer, ref, tie_ref, j, i)
+        # the neighbouring texel where u S (v S) is within its band of a texel edge
+        near_x = np.abs(x - np.round(x)) <= tie_texel[:, 0]
+        near_y = np.abs(y - np.round(y)) <= tie_texel[:, 1]
+        i_alt = np.clip(np.where(near_x, np.where(x - np.floor(x) < 0.5, i - 1, i + 1), i), 0, S - 1)
+        j_alt = np.clip(np.where(near_y, np.where(y - np.floor(y) < 0.5, j - 1, j + 1), j), 0, S - 1)
+        lit_alt = compare(ref, layers.depth[layer, j_alt, i_alt])
+        other_texel = lit_alt != lit
+        visibility = lit.astype(dtype)
+        alternative = np.where(other_texel, lit_alt, np.where(tied, ~lit, lit)).astype(dtype)
+        return ShadowLookup(visibility, alternative, tied | other_texel)
+    visibility = np.zeros(len(uvz), dtype)
+    alternative = np.zeros(len(uvz), dtype)
+    tied_any = np.zeros(len(uvz), bool)
+    for ox, oy in tap_offsets(kernel):
+        i0, i1, s = linear_texels(u + dtype.type(ox) / dtype.type(S), S)
+        j0, j1, t = linear_texels(v + dtype.type(oy) / dtype.type(S), S)
+        corners = [_taps(layers, layer, ref, tie_ref, j, i) for j, i in ((j0, i0), (j0, i1), (j1, i0), (j1, i1))]
+        weights = [(1 - s) * (1 - t), s * (1 - t), (1 - s) * t, s * t]
+        visibility += _bilinear(*(lit for lit, _ in corners), s, t)
+        alternative += _bilinear(*(lit ^ tied for lit, tied in corners), s, t)
+        for (_, tied), weight in zip(corners, weights):
+            tied_any |= tied & (weight > 0)
+    taps = dtype.type((kernel - 1) ** 2)
+    return ShadowLookup(visibility / taps, alternative / taps, tied_any)
+
+
+# --- the lights -------------------------------------------------------------------------------
+
+def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarray,
+                                 position_scale: np.ndarray) -> ShadowLookup:
+    """Directional light i at points P (N, 3), normals N; position_scale (N,): the largest
+    |coordinate| of the vertices P was interpolated from (the tie bands)."""
+    dtype = P.dtype
+    p = maps.uniforms["u_directional_shadow"][i]                 # (layer, t, kernel, extent)
+    if p[3] == 0.0:
+        return ShadowLookup.lit(len(P), dtype)    # no pass this frame: nothing can shadow
+    M = maps.uniforms["u_directional_shadow_matrix"][i]
+    L = normalize(-maps.lights.u_directional_direction[i])
+    X, Y = normalize(M[0, :3]), normalize(M[1, :3])
+    Q = shadow_bias_point(P, N, L, X, Y, p[1], maps.uniforms["u_directional_shadow_bias"][i])
+    uvz = Q @ M[:3, :3].T + M[:3, 3]
+    scale = np.abs(Q).astype(np.float64) + np.asarray(position_scale, np.float64)[:, None]
+    A = np.abs(M.astype(np.float64))
+    tie_ref = SHADOW_TIE * (scale @ A[2, :3] + A[2, 3])
+    tie_texel = SHADOW_TIE * maps.layers.side * (scale @ A[:2, :3].T + A[:2, 3])
+    # Outside the map, which holds every caster that can shadow, nothing is there: lit.
+    inside = np.flatnonzero(((uvz[:, :2] >= 0.0) & (uvz[:, :2] <= p[3])).all(axis=1))
+    result = ShadowLookup.lit(len(P), dtype)
+    result.put(inside, shadow_filter(maps.layers, uvz[inside], int(p[0]), int(p[2]),
+                                     tie_ref[inside], tie_texel[inside]))
+    return result
+
+
+def _point_tie_bounds(Q, light, d, m, right_up, position_scale, depth, tan_half, rect_size, S):
+    """(tie_ref, tie_texel) of a cube lookup: d = Q - light is off by e (the roundings of
+    |Q|, P's vertices and |light|); m = axis.d by e too; z_w = A + B / m by |B| e / m^2 and
+    the roundings of A and B / m; u S by S size (0.5 / tan) (e / |m| + |r.d| e / m^2)."""
+    e = SHADOW_TIE * (np.abs(Q).max(axis=1) + position_scale + np.abs(light).max())
+    m = np.abs(m)
+    A, B = abs(float(depth[0])), abs(float(depth[1]))
+    tie_ref = B * e / (m * m) + SHADOW_TIE * (A + B / m)
+    per_texel = S * rect_size * 0.5 / tan_half
+    tie_texel = per_texel[:, None] * ((e / m)[:, None] + np.abs(right_up) * (e / (m * m))[:, None])
+    tie_texel += SHADOW_TIE * S
+    return tie_ref, tie_texel
+
+
+def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarray,
+                           position_scale: np.ndarray) -> ShadowLookup:
+    """Point light i at points P (N, 3), normals N (as light_visibility_directional)."""
+    dtype = P.dtype
+    out = ShadowLookup.lit(len(P), dtype)
+    p = maps.uniforms["u_point_shadow"][i]
+    if p[0] == 0.0:
+        return out
+    light = maps.lights.u_point_position[i]
+    to_light = light - P
+    rows = np.flatnonzero(dot(to_light, to_light)[:, 0] != 0.0)   # a light on the surface: lit
+    P, N, to_light, scale = P[rows], N[rows], to_light[rows], np.asarray(position_scale)[rows]
+    L = normalize(to_light)
+    rotations, axes = CUBE_FACE_ROTATIONS.astype(dtype), CUBE_FACE_AXES.astype(dtype)
+    f0 = cube_face(-to_light)
+    t = 2.0 * dot(axes[f0], -to_light) * p[1] / p[3]          # a texel's size at P's distance
+    Q = shadow_bias_point(P, N, L, rotations[f0, 0], rotations[f0, 1], t,
+                          maps.uniforms["u_point_shadow_bias"][i])
+    d = Q - light
+    f = cube_face(d)
+    rect = maps.uniforms["u_point_shadow_tiles"][6 * i + f]
+    drawn = rect[:, 2] != 0.0                                   # else the face sees no caster
+    d, f, rect, Q, scale, rows = d[drawn], f[drawn], rect[drawn], Q[drawn], scale[drawn], rows[drawn]
+    m = dot(axes[f], d)[:, 0]
+    right_up = np.stack([dot(rotations[f, 0], d)[:, 0], dot(rotations[f, 1], d)[:, 0]], axis=1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        uv = (0.5 * right_up / (m * p[1])[:, None] + 0.5) * rect[:, 1:2]
+        depth = maps.uniforms["u_point_shadow_depth"][i]
+        uvz = np.concatenate([uv, (depth[0] + depth[1] / m)[:, None]], axis=1)
+        tie_ref, tie_texel = _point_tie_bounds(
+            Q.astype(np.float64), np.asarray(light, np.float64), d, m.astype(np.float64),
+            right_up.astype(np.float64), scale.astype(np.float64), depth, float(p[1]),
+            rect[:, 1].astype(np.float64), maps.layers.side)
+    out.put(rows, shadow_filter(maps.layers, uvz, rect[:, 0].astype(np.int64), int(p[2]), tie_ref,
+                                tie_texel))
+    return out
+
+
+LOOKUPS = {"directional": light_visibility_directional, "point": light_visibility_point}
+
+
+@dataclass
+class FragmentShadows:
+    """The `visibility` callable lighting() takes, for one object's fragments, keeping each
+    light's lookup: `alternative` then answers the same lights with tied taps decided the
+    other way, and `tied` (N,) says where some light's lookup (where its term is not 0) was."""
+    maps: ShadowMaps
+    position_scale: np.ndarray
+    lookups: dict = field(default_factory=dict)
+
+    def _lookup(self, kind, i, P, N, needed) -> ShadowLookup:
+        key = (kind, i)
+        if key not in self.lookups:
+            out = ShadowLookup.lit(len(P), P.dtype)
+            rows = np.flatnonzero(needed)          # elsewhere the light adds nothing
+            if len(rows):
+                out.put(rows, LOOKUPS[kind](self.maps, i, P[rows], N[rows], self.position_scale[rows]))
+            self.lookups[key] = out
+        return self.lookups[key]
+
+    def visibility(self, kind, i, P, N, needed) -> np.ndarray:
+        return self._lookup(kind, i, P, N, needed).visibility[:, None]
+
+    def alternative(self, kind, i, P, N, needed) -> np.ndarray:
+        return self._lookup(kind, i, P, N, needed).alternative[:, None]
+
+    @property
+    def tied(self) -> np.ndarray | None:
+        masks = [look.tied for look in self.lookups.values()]
+        return np.logical_or.reduce(masks) if masks else None

@@ -350,6 +350,25 @@ def _caster_distance(scene, points: np.ndarray, caster: int, position: np.ndarra
     return float(triangle_distance(points[caster][faces], position).min())
 
 
+# A box nearer than this fraction more than the nearest triangle found so far is searched.
+BOX_BOUND_SLACK = 1e-9
+
+
+def _nearest_caster(scene, points, casters: list[int], lo: np.ndarray, hi: np.ndarray,
+                    position: np.ndarray) -> float:
+    """The distance from `position` to the nearest triangle of the casters (boxes lo, hi):
+    the casters by their boxes' distance, a lower bound of their triangles', and none past the
+    first box farther than the nearest triangle found (BOX_BOUND_SLACK covers rounding: the
+    answer is the minimum over every caster's triangles)."""
+    box = np.linalg.norm(np.maximum(np.maximum(lo - position, position - hi), 0.0), axis=1)
+    nearest = np.inf
+    for k in np.argsort(box, kind="stable"):
+        if box[k] > nearest * (1.0 + BOX_BOUND_SLACK):
+            break
+        nearest = min(nearest, _caster_distance(scene, points, casters[k], position))
+    return nearest
+
+
 def _boxes(points: list[np.ndarray], indices: list[int]) -> tuple[np.ndarray, np.ndarray]:
     """(n, 3) low and high ends of the bounding boxes of points[i] for i in indices."""
     return (np.array([points[i].min(axis=0) for i in indices]).reshape(-1, 3),
@@ -383,12 +402,12 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
         return passes, rects, params, depth
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
-    near = max(0.5 * min(_caster_distance(scene, points, i, position) for i in casters),
+    lo, hi = _boxes(points, casters + receivers)
+    n = len(casters)
+    near = max(0.5 * _nearest_caster(scene, points, casters, lo[:n], hi[:n], position),
                NEAR_FRACTION * far)
     near = min(near, 0.5 * far)
     projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
-    lo, hi = _boxes(points, casters + receivers)
-    n = len(casters)
     clips = np.empty((6, 4, 4))
     for face in range(6):
         view = np.eye(4)

@@ -11,6 +11,10 @@ Outputs: `TriangleOutputs` in the same dtype:
          f_color_front (T, 3)   colour lit with the face normal (flat varying)
          f_color_back (T, 3)    colour lit with -normal for a two-sided material, else
                                 the front colour; the fragment picks by gl_FrontFacing
+         f_terms_front, f_terms_back  the same lighting kept apart (`LightTerms`, (T, 3)
+                                each), whose sums the colours are: what a receiver of
+                                shadows hands on (the GLSL's flat v_ambient and
+                                v_*_terms_* with SHADOW_MAPS)
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
+from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, normalize_or_zero
 
 
 @dataclass
@@ -28,6 +32,8 @@ class TriangleOutputs:
     f_centroid: np.ndarray
     f_color_front: np.ndarray
     f_color_back: np.ndarray
+    f_terms_front: LightTerms
+    f_terms_back: LightTerms
 
 
 def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
@@ -46,7 +52,11 @@ def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,
     uniforms = MaterialUniforms.from_material(material, dtype)
     eye = np.asarray(u_eye, dtype=dtype)
     with np.errstate(invalid="ignore"):
-        f_color_front = lighting(f_centroid, f_face_normal, eye, uniforms, lights)
-        f_color_back = (lighting(f_centroid, -f_face_normal, eye, uniforms, lights)
+        f_terms_front = light_terms(f_centroid, f_face_normal, eye, uniforms, lights)
+        f_terms_back = (light_terms(f_centroid, -f_face_normal, eye, uniforms, lights)
+                        if material.two_sided else f_terms_front)
+        f_color_front = f_terms_front.shade(f_centroid, f_face_normal)
+        f_color_back = (f_terms_back.shade(f_centroid, -f_face_normal)
                         if material.two_sided else f_color_front)
-    return TriangleOutputs(f_face_normal, f_centroid, f_color_front, f_color_back)
+    return TriangleOutputs(f_face_normal, f_centroid, f_color_front, f_color_back, f_terms_front,
+                           f_terms_back)

@@ -15,6 +15,11 @@ Outputs: `VertexOutputs`, every array in `dtype`:
          v_color_front (V, 3)     Gouraud colour lit with N        (None unless gouraud)
          v_color_back (V, 3)      Gouraud colour lit with -N       (the front colour when
                                   the material is one-sided; None unless gouraud)
+         v_terms_front, v_terms_back  the same lighting kept apart (`LightTerms`: the ambient
+                                  term and each light's term, (V, 3) each), whose sums the
+                                  colours are: what a receiver of shadows hands on (the GLSL's
+                                  v_ambient, v_directional_terms_*, v_point_terms_* with
+                                  SHADOW_MAPS); None unless gouraud
 Every output is an affine function of the vertex in clip space or is interpolated as one,
 so clipping and perspective-correct interpolation treat them all alike.
 """
@@ -25,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
+from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, normalize_or_zero
 
 
 @dataclass
@@ -36,6 +41,8 @@ class VertexOutputs:
     v_view_depth: np.ndarray
     v_color_front: np.ndarray | None = None
     v_color_back: np.ndarray | None = None
+    v_terms_front: LightTerms | None = None
+    v_terms_back: LightTerms | None = None
 
 
 def transform_points(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -64,7 +71,10 @@ def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, *, u_model: n
     if material.shading == "gouraud":
         uniforms = MaterialUniforms.from_material(material, dtype)
         eye = np.asarray(u_eye, dtype=dtype)
-        out.v_color_front = lighting(v_world_position, v_world_normal, eye, uniforms, lights)
-        out.v_color_back = (lighting(v_world_position, -v_world_normal, eye, uniforms, lights)
+        out.v_terms_front = light_terms(v_world_position, v_world_normal, eye, uniforms, lights)
+        out.v_terms_back = (light_terms(v_world_position, -v_world_normal, eye, uniforms, lights)
+                            if material.two_sided else out.v_terms_front)
+        out.v_color_front = out.v_terms_front.shade(v_world_position, v_world_normal)
+        out.v_color_back = (out.v_terms_back.shade(v_world_position, -v_world_normal)
                             if material.two_sided else out.v_color_front)
     return out

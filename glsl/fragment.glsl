@@ -26,29 +26,48 @@
 #if defined(SHADING_PHONG)
 in vec3 v_world_position;
 in vec3 v_world_normal;
-#elif defined(SHADOW_MAPS)
-#if defined(SHADING_FLAT)
-#define TERMS flat in                // from geometry.glsl, one per triangle
-in vec3 f_world_position;
-flat in vec3 f_face_normal;
-#else
-#define TERMS in                     // from vertex.glsl, interpolated
-in vec3 v_world_position;
-in vec3 v_world_normal;
-#endif
-TERMS vec3 v_ambient;
+#elif defined(SHADOW_MAPS) && defined(SHADING_FLAT)
+in vec3 f_world_position;            // from geometry.glsl
+flat in vec3 f_face_normal;          // the terms: one per triangle
+flat in vec3 f_ambient;
 #if NUM_DIRECTIONAL_TERMS > 0
-TERMS vec3 v_directional_terms_front[NUM_DIRECTIONAL_TERMS];
+flat in vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
 #ifdef TWO_SIDED
-TERMS vec3 v_directional_terms_back[NUM_DIRECTIONAL_TERMS];
+flat in vec3 f_directional_terms_back[NUM_DIRECTIONAL_TERMS];
 #endif
 #endif
 #if NUM_POINT_TERMS > 0
-TERMS vec3 v_point_terms_front[NUM_POINT_TERMS];
+flat in vec3 f_point_terms_front[NUM_POINT_TERMS];
 #ifdef TWO_SIDED
-TERMS vec3 v_point_terms_back[NUM_POINT_TERMS];
+flat in vec3 f_point_terms_back[NUM_POINT_TERMS];
 #endif
 #endif
+#define AMBIENT f_ambient
+#define DIRECTIONAL_TERMS_FRONT f_directional_terms_front
+#define DIRECTIONAL_TERMS_BACK f_directional_terms_back
+#define POINT_TERMS_FRONT f_point_terms_front
+#define POINT_TERMS_BACK f_point_terms_back
+#elif defined(SHADOW_MAPS)
+in vec3 v_world_position;            // from vertex.glsl, interpolated
+in vec3 v_world_normal;
+in vec3 v_ambient;
+#if NUM_DIRECTIONAL_TERMS > 0
+in vec3 v_directional_terms_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+in vec3 v_directional_terms_back[NUM_DIRECTIONAL_TERMS];
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+in vec3 v_point_terms_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+in vec3 v_point_terms_back[NUM_POINT_TERMS];
+#endif
+#endif
+#define AMBIENT v_ambient
+#define DIRECTIONAL_TERMS_FRONT v_directional_terms_front
+#define DIRECTIONAL_TERMS_BACK v_directional_terms_back
+#define POINT_TERMS_FRONT v_point_terms_front
+#define POINT_TERMS_BACK v_point_terms_back
 #elif defined(SHADING_FLAT)
 flat in vec3 f_color_front;          // from geometry.glsl, one per triangle
 #ifdef TWO_SIDED
@@ -79,13 +98,13 @@ layout(location = 1) out vec4 out_linear_color;
 // The terms of the side seen (`back`: a two-sided back face), each light's weighed by its
 // visibility at P with the lit normal N, added to the ambient term in lighting()'s order.
 vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
-    vec3 color = v_ambient;
+    vec3 color = AMBIENT;
 #if NUM_DIRECTIONAL_TERMS > 0
     for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
 #ifdef TWO_SIDED
-        vec3 term = back ? v_directional_terms_back[i] : v_directional_terms_front[i];
+        vec3 term = back ? DIRECTIONAL_TERMS_BACK[i] : DIRECTIONAL_TERMS_FRONT[i];
 #else
-        vec3 term = v_directional_terms_front[i];
+        vec3 term = DIRECTIONAL_TERMS_FRONT[i];
 #endif
         color += shadowed_directional(i, P, N, term);
     }
@@ -93,9 +112,9 @@ vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
 #if NUM_POINT_TERMS > 0
     for (int i = 0; i < POINT_LIGHTS; ++i) {
 #ifdef TWO_SIDED
-        vec3 term = back ? v_point_terms_back[i] : v_point_terms_front[i];
+        vec3 term = back ? POINT_TERMS_BACK[i] : POINT_TERMS_FRONT[i];
 #else
-        vec3 term = v_point_terms_front[i];
+        vec3 term = POINT_TERMS_FRONT[i];
 #endif
         color += shadowed_point(i, P, N, term);
     }

@@ -20,17 +20,17 @@ in vec3 v_world_position[];
 #ifdef SHADOW_MAPS
 out vec3 f_world_position;           // where fragment.glsl looks the maps up
 flat out vec3 f_face_normal;
-flat out vec3 v_ambient;             // I_a k_a; the terms as vertex.glsl names them
+flat out vec3 f_ambient;             // I_a k_a
 #if NUM_DIRECTIONAL_TERMS > 0
-flat out vec3 v_directional_terms_front[NUM_DIRECTIONAL_TERMS];
+flat out vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
 #ifdef TWO_SIDED
-flat out vec3 v_directional_terms_back[NUM_DIRECTIONAL_TERMS];
+flat out vec3 f_directional_terms_back[NUM_DIRECTIONAL_TERMS];
 #endif
 #endif
 #if NUM_POINT_TERMS > 0
-flat out vec3 v_point_terms_front[NUM_POINT_TERMS];
+flat out vec3 f_point_terms_front[NUM_POINT_TERMS];
 #ifdef TWO_SIDED
-flat out vec3 v_point_terms_back[NUM_POINT_TERMS];
+flat out vec3 f_point_terms_back[NUM_POINT_TERMS];
 #endif
 #endif
 #else
@@ -83,17 +83,17 @@ void main() {
 #ifdef SHADOW_MAPS
         f_world_position = v_world_position[i];
         f_face_normal = face_normal;
-        v_ambient = ambient_term();
+        f_ambient = ambient_term();
 #if NUM_DIRECTIONAL_TERMS > 0
-        v_directional_terms_front = directional_front;
+        f_directional_terms_front = directional_front;
 #ifdef TWO_SIDED
-        v_directional_terms_back = directional_back;
+        f_directional_terms_back = directional_back;
 #endif
 #endif
 #if NUM_POINT_TERMS > 0
-        v_point_terms_front = point_front;
+        f_point_terms_front = point_front;
 #ifdef TWO_SIDED
-        v_point_terms_back = point_back;
+        f_point_terms_back = point_back;
 #endif
 #endif
 #else

@@ -11,8 +11,9 @@ Per-fragment shading, run only for the fragment that survived the depth test at 
 When the object receives shadows and the frame has maps (SHADOW_MAPS), each light's term is
 multiplied by its shadow-map visibility (reference/shadow/lookup.py) at the fragment's
 interpolated world position P with the lit normal N (flipped for a two-sided back face):
-Phong as above; flat with its face normal and the triangle's terms (f_terms_*), Gouraud with
-normalize_or_zero(v_world_normal) and the vertices' terms interpolated (v_terms_*), of the
+Phong as above; flat with P from f_world_position, its face normal and the triangle's terms
+(f_ambient, f_*_terms_*), Gouraud with normalize_or_zero(v_world_normal) and the vertices'
+terms interpolated (v_ambient, v_*_terms_*), of the
 side seen: out_color = ambient + sum_l visibility_l term_l, no lookup where a term is 0.
 Alpha is 1. Also out_view_depth, the interpolated -z_eye, for the depth image.
 
@@ -81,10 +82,13 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
     else:
         # The lit point: P interpolated, N the renormalised interpolated normal (the face normal
         # for flat), flipped for a two-sided back face.
-        P = interpolate(vertices.v_world_position, faces, triangle, weights)
         if material.shading == "flat":
+            corners = obj.triangles.f_world_position[triangle]                   # (N, 3, 3)
+            P = (weights[:, 0:1] * corners[:, 0] + weights[:, 1:2] * corners[:, 1]
+                 + weights[:, 2:3] * corners[:, 2])
             N = obj.triangles.f_face_normal[triangle]
         else:
+            P = interpolate(vertices.v_world_position, faces, triangle, weights)
             N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
         if material.two_sided:
             N = np.where(gl_FrontFacing[:, None], N, -N)
@@ -113,9 +117,8 @@ def _terms_of_side(obj: ObjectVaryings, triangle, weights, gl_FrontFacing, P, N,
     if obj.material.shading == "phong":
         return light_terms(P, N, E, uniforms, lights)
     if obj.material.shading == "flat":
-        front, back = (t.map(lambda a: a[triangle])
-                       for t in (obj.triangles.f_terms_front, obj.triangles.f_terms_back))
+        front, back = (obj.triangles.light_terms(side).map(lambda a: a[triangle]) for side in (False, True))
     else:
-        front, back = (t.map(lambda a: interpolate(a, obj.faces, triangle, weights))
-                       for t in (obj.vertices.v_terms_front, obj.vertices.v_terms_back))
+        front, back = (obj.vertices.light_terms(side).map(lambda a: interpolate(a, obj.faces, triangle, weights))
+                       for side in (False, True))
     return front.where(gl_FrontFacing, back) if obj.material.two_sided else front

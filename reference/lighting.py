@@ -126,22 +126,32 @@ def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> n
 @dataclass
 class LightTerms:
     """The lighting equation kept apart, as the shader's terms (glsl/lighting.glsl): the ambient
-    term I_a k_a (..., 3) and each light's term att I_l (k_d max(N.L, 0) + k_s spec) (..., 3),
-    as (kind, i, term) in lighting()'s order (directional lights, then point lights). Flat and
-    Gouraud receivers of shadows hand these on per triangle or per vertex (the fragment stage
-    weighs each light's term by its visibility there)."""
+    term I_a k_a (..., 3) and each light's term att I_l (k_d max(N.L, 0) + k_s spec), the
+    directional lights' (..., Ld, 3) and the point lights' (..., Lp, 3), in lighting()'s order.
+    Flat and Gouraud receivers of shadows hand these on per triangle or per vertex (the GLSL's
+    *_ambient, *_directional_terms_*, *_point_terms_* varyings); the fragment stage weighs each
+    light's term by its visibility there."""
     ambient: np.ndarray
-    terms: list
+    directional: np.ndarray
+    point: np.ndarray
+
+    @property
+    def terms(self):
+        """(kind, i, term (..., 3)) for each light, in lighting()'s order."""
+        for kind, stacked in (("directional", self.directional), ("point", self.point)):
+            for i in range(stacked.shape[-2]):
+                yield kind, i, stacked[..., i, :]
 
     def map(self, f) -> "LightTerms":
-        """The same terms with `f` applied to each array (interpolation, selection)."""
-        return LightTerms(f(self.ambient), [(kind, i, f(term)) for kind, i, term in self.terms])
+        """The same terms with `f` applied to each array (interpolation, selection by index)."""
+        return LightTerms(f(self.ambient), f(self.directional), f(self.point))
 
     def where(self, condition: np.ndarray, other: "LightTerms") -> "LightTerms":
         """condition (N,) ? self : other, per point."""
-        pick = lambda a, b: np.where(condition[:, None], a, b)       # noqa: E731
-        return LightTerms(pick(self.ambient, other.ambient),
-                          [(kind, i, pick(a, b)) for (kind, i, a), (_, _, b) in zip(self.terms, other.terms)])
+        def pick(a, b):
+            return np.where(condition.reshape(condition.shape + (1,) * (a.ndim - 1)), a, b)
+        return LightTerms(pick(self.ambient, other.ambient), pick(self.directional, other.directional),
+                          pick(self.point, other.point))
 
     def shade(self, P: np.ndarray, N: np.ndarray, visibility=None) -> np.ndarray:
         """I = ambient + sum_l term_l (shade_terms)."""
@@ -183,7 +193,13 @@ def light_terms(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialU
                 lights: Lights) -> LightTerms:
     """The ambient term and every light's term at points P (..., 3) with unit normals N
     (..., 3), kept. E and the material's arrays may vary per point (broadcast against P)."""
-    return LightTerms(ambient_term(P, N, material, lights), list(each_light_term(P, N, E, material, lights)))
+    ambient = ambient_term(P, N, material, lights)
+    stacked = {"directional": [], "point": []}
+    for kind, _, term in each_light_term(P, N, E, material, lights):
+        stacked[kind].append(np.broadcast_to(term, ambient.shape))
+    empty = np.zeros(ambient.shape[:-1] + (0, 3), P.dtype)
+    return LightTerms(ambient, *(np.stack(terms, axis=-2) if terms else empty
+                                 for terms in stacked.values()))
 
 
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,

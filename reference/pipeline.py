@@ -9,8 +9,8 @@ memory stays bounded. Objects wholly outside the view volume are skipped (render
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 When the scene has shadow maps (renderer/core/shadows.py: shadow_layout(...).any), the
-frame's maps are drawn first (reference/shadow/depth.py, a layer each) and Phong receivers look it up
-(reference/shadow/lookup.py); where a lookup had a tied tap, the pixel's colour with those
+frame's maps are drawn first (reference/shadow/depth.py, a layer each) and receivers, of
+every shading mode, look them up (reference/shadow/lookup.py); where a lookup had a tied tap, the pixel's colour with those
 taps decided the other way goes into Frame.rgba8_tie too (a pixel with both kinds of tie
 shows the depth tie's other surface there: either is an acceptable answer, and one
 alternative per pixel is what compare takes), and Frame.shadow_ties marks those pixels.

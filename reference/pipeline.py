@@ -15,6 +15,11 @@ taps decided the other way goes into Frame.rgba8_tie too (a pixel with both kind
 shows the depth tie's other surface there: either is an acceptable answer, and one
 alternative per pixel is what compare takes), and Frame.shadow_ties marks those pixels.
 
+`surface_pixels` runs the same stages up to the depth test and hands out the surface each
+drawn pixel of a Phong object shows (P, the lit N, its triangle's plane normal, its object),
+with the frame's shadow maps, for holding the fragment stage's inputs against another method
+(renderer/checks/shadow_truth.py).
+
 Input:  a `renderer.core.scene.Scene` and the image size. Output: a `renderer.core.frame.Frame`
 (rgba8 (H, W, 4) uint8 row 0 at the top, optional linear (H, W, 4) float32, depth (H, W)
 float32 -z_eye with +inf background). Conventions: docs/conventions.md.

@@ -1,7 +1,8 @@
 """`renderer compare --methods` (renderer/checks/methods.py): the rasteriser against the ray
 tracer, each differing pixel given one cause. The rule on hand-made images (the first step of
 the chain that moves a pixel, the ±1 px allowance splitting edges from tessellation), then
-scenes whose answer is known, rendered on the GPU at 64 x 48: a sphere's shadow lies under it,
+scenes whose answer is known, rendered on the GPU at 64 x 48: a sphere's shadow lies under it
+(and where the rasteriser's shadow map draws it too, only a texel-wide rim of it differs),
 a mirror's reflection on the mirror, meshes lit from the eye show only edges, flat and Gouraud
 materials show as shading; then the command line end to end."""
 
@@ -20,7 +21,7 @@ CAUSE = {cause.name: k for k, cause in enumerate(CAUSES)}
 
 
 def chain_of(*changes, start=100, shape=(3, 3)):
-    """The six images of CHAIN: grey `start` (a number or an (H, W) array), each step adding
+    """The seven images of CHAIN: grey `start` (a number or an (H, W) array), each step adding
     its change (likewise) to every channel of the image before; alpha 255."""
     images = [np.broadcast_to(np.asarray(start, np.int16)[..., None], (*shape, 4))]
     for change in changes:
@@ -38,8 +39,8 @@ def one_pixel(value, shape=(3, 3), at=(1, 1)):
 
 
 def test_a_pixel_s_cause_is_the_first_step_that_moves_it():
-    """Shadows (step 4) move the centre by 40, reflection (step 5) by 40 more: shadows."""
-    causes = explain(chain_of(0, 0, 0, one_pixel(-40), one_pixel(40 + 40)))
+    """Shadow rays (step 5) move the centre by 40, reflection (step 6) by 40 more: shadows."""
+    causes = explain(chain_of(0, 0, 0, 0, one_pixel(-40), one_pixel(40 + 40)))
     assert causes[1, 1] == CAUSE["shadows"]
     assert (np.delete(causes.ravel(), 4) == NO_DIFFERENCE).all()
 
@@ -47,14 +48,14 @@ def test_a_pixel_s_cause_is_the_first_step_that_moves_it():
 def test_small_steps_that_add_up_go_to_the_largest():
     """No step moves the pixel by more than 2 levels, together they move it by 5: the largest
     step (sampling, 2 levels) is the cause; a pixel moved and moved back has no cause."""
-    causes = explain(chain_of(one_pixel(1), 0, one_pixel(2), 0, one_pixel(2)))
+    causes = explain(chain_of(one_pixel(1), 0, 0, one_pixel(2), 0, one_pixel(2)))
     assert causes[1, 1] == CAUSE["sampling"]
-    back = explain(chain_of(0, 0, 0, one_pixel(-40), one_pixel(40)))
+    back = explain(chain_of(0, 0, 0, 0, one_pixel(-40), one_pixel(40)))
     assert (back == NO_DIFFERENCE).all()
 
 
 def test_the_one_pixel_allowance_splits_edges_from_tessellation():
-    """From `phong` to `centre` a vertical edge moves one pixel right (edges), and a pixel
+    """From `unshadowed` to `centre` a vertical edge moves one pixel right (edges), and a pixel
     with no match within ±1 px appears beside it (tessellation)."""
     shape = (5, 6)
     phong = np.zeros(shape, np.int16)
@@ -62,15 +63,22 @@ def test_the_one_pixel_allowance_splits_edges_from_tessellation():
     centre = np.zeros(shape, np.int16)
     centre[:, :3] = 100
     centre[4, 5] = 50
-    causes = explain(chain_of(0, centre - phong, 0, 0, 0, start=phong, shape=shape))
+    causes = explain(chain_of(0, 0, centre - phong, 0, 0, 0, start=phong, shape=shape))
     assert (causes[:, 2] == CAUSE["edges"]).all()
     assert causes[4, 5] == CAUSE["tessellation"]
     assert (causes == NO_DIFFERENCE).sum() == causes.size - shape[0] - 1
 
 
-def test_the_chain_is_six_images():
-    with pytest.raises(ValueError, match="expected the 6 images"):
-        explain(chain_of(0, 0, 0, 0, 0)[:5])
+def test_the_chain_is_seven_images():
+    with pytest.raises(ValueError, match="expected the 7 images"):
+        explain(chain_of(0, 0, 0, 0, 0, 0)[:6])
+
+
+def test_a_shadow_map_taken_away_is_a_shadow_cause_too():
+    """The map's shadow taken away (step 2) moves a pixel the shadow rays (step 5) do not put
+    back (the map shadowed a point the rays light): shadows."""
+    causes = explain(chain_of(0, one_pixel(40), 0, 0, 0, 0))
+    assert causes[1, 1] == CAUSE["shadows"]
 
 
 def scene(objects, materials, lights=(), ambient=(0.1, 0.1, 0.1), background=(0, 0, 0),
@@ -102,9 +110,10 @@ FROM_ABOVE = {"type": "directional", "direction": [0, -1, 0]}
 
 
 def test_a_sphere_above_a_plane_lit_from_above_shadows_the_plane_under_it(gl_contexts):
-    """Only the shadow rays can tell the floor under the ball (x² + z² < 0.5² at y = -1) from
-    the rest; every shadow pixel sees that disc, and most of the disc's pixels are shadow."""
-    s = scene([BALL_ABOVE_FLOOR, FLOOR], MATERIALS, [FROM_ABOVE])
+    """With the light's shadow map off, only the shadow rays can tell the floor under the ball
+    (x² + z² < 0.5² at y = -1) from the rest; every shadow pixel sees that disc, and most of
+    the disc's pixels are shadow."""
+    s = scene([BALL_ABOVE_FLOOR, FLOOR], MATERIALS, [FROM_ABOVE | {"shadows": False}])
     result = compare_methods(s, W, H, context=gl_contexts["egl"])
     shadow = result.causes == CAUSE["shadows"]
     points = world_points(s, result.raytrace.depth)
@@ -116,6 +125,21 @@ def test_a_sphere_above_a_plane_lit_from_above_shadows_the_plane_under_it(gl_con
     assert counts["reflection"] == counts["shading"] == counts["sampling"] == 0
     assert counts["shadows"] == result.as_dict()["differing_pixels"] - counts["edges"] - counts["tessellation"]
     assert result.renders == 3          # raster, centre, shadows: the other steps change nothing here
+
+
+def test_with_its_shadow_map_the_rasteriser_differs_at_the_shadow_s_rim_only(gl_contexts):
+    """The same with the shadow map on: the rasteriser draws the shadow too, and the pixels
+    still put down to shadows lie within a texel (the map's, at 128 texels here: 0.02 units)
+    and a pixel (0.05 units) of the disc's edge; far fewer than the disc's."""
+    s = scene([BALL_ABOVE_FLOOR, FLOOR], MATERIALS, [FROM_ABOVE])
+    result = compare_methods(s, W, H, context=gl_contexts["egl"])
+    shadow = result.causes == CAUSE["shadows"]
+    points = world_points(s, result.raytrace.depth)
+    radius = np.hypot(points[..., 0], points[..., 2])
+    under = (radius < 0.5) & np.isclose(points[..., 1], -1, atol=1e-3)
+    assert shadow.sum() < 0.5 * under.sum()
+    assert (np.abs(radius[shadow] - 0.5) < 0.1).all()
+    assert result.renders == 4          # raster, unshadowed, centre, shadows
 
 
 def test_a_mirror_sphere_differs_by_reflection_on_the_sphere_only(gl_contexts):
@@ -138,8 +162,10 @@ def test_a_mirror_sphere_differs_by_reflection_on_the_sphere_only(gl_contexts):
 MESHES = {"ambient": [0.1, 0.1, 0.1], "camera": {"eye": [0.3, 0.5, 3.5], "look": [0, 0, 0], "fov_y": 40.0},
           "materials": {"red": {"ka": [0.8, 0.2, 0.1], "kd": [0.8, 0.2, 0.1], "ks": [0.6, 0.6, 0.6], "n": 30.0},
                         "blue": {"ka": [0.1, 0.2, 0.6], "kd": [0.1, 0.3, 0.8]}},
-          # a light at the eye: every point the camera sees, the light sees
-          "lights": [{"type": "point", "position": [0.3, 0.5, 3.5], "intensity": [0.9, 0.9, 0.9]}],
+          # a light at the eye: every point the camera sees, the light sees (its shadow map off:
+          # the map's filter would darken a texel-wide rim around the ball's silhouette)
+          "lights": [{"type": "point", "position": [0.3, 0.5, 3.5], "intensity": [0.9, 0.9, 0.9],
+                      "shadows": False}],
           "objects": [{"name": "ball", "mesh": {"primitive": "uv_sphere", "radius": 0.8, "segments": 24, "rings": 12},
                        "material": "red"},
                       {"name": "box", "mesh": {"primitive": "cube", "size": 1.0}, "material": "blue",
@@ -181,6 +207,7 @@ kd = [0.7, 0.7, 0.7]
 [[lights]]
 type = "directional"
 direction = [0, -1, 0]
+shadows = false
 [[objects]]
 name = "ball"
 shape = { type = "sphere", radius = 0.5, centre = [0, 0.5, 0] }

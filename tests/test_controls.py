@@ -13,7 +13,7 @@ import pytest
 
 from renderer.viewer.controls import (KEY_BINDINGS, MOUSE_BINDINGS, ORBIT_DEGREES_PER_PIXEL,
                                Controls, ViewState, apply_view, help_lines, light_names_of,
-                               working_copy)
+                               shown_light, working_copy)
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, PointLight, Scene,
                             SceneObject)
@@ -199,6 +199,64 @@ def test_m_toggles_the_ray_tracer_and_changes_the_picture():
     assert viewer.state.method == "raster" and viewer.state.scene_changed
     assert viewer.messages[-1] == "method: rasteriser"
     assert "  M     rasteriser / ray tracer (refines while the view is still)" in help_lines()
+
+
+def test_o_toggles_shadows():
+    viewer = Viewer()
+    viewer.press(glfw.KEY_O)
+    assert not viewer.state.shadows and viewer.state.scene_changed
+    viewer.press(glfw.KEY_O)
+    assert viewer.state.shadows
+    assert viewer.messages == ["shadows: off", "shadows: on"]
+
+
+def test_d_cycles_through_the_lights_with_maps_then_off():
+    """Directional light 1 (key 1) first, then the point lights; a light that is off or has
+    shadows off is skipped; after the last, off."""
+    scene = make_scene()
+    scene.point_lights[0] = replace(scene.point_lights[0],
+                                    shadow=replace(scene.point_lights[0].shadow, enabled=False))
+    viewer = Viewer(scene)
+    shown = []
+    for _ in range(3):
+        viewer.press(glfw.KEY_D)
+        shown.append(viewer.state.shadow_map)
+    assert shown == [0, 2, None] and viewer.state.scene_changed
+    assert viewer.messages == ["shadow map view: directional light 1",
+                               "shadow map view: point light 2", "shadow map view: off"]
+    viewer.press(glfw.KEY_1)                       # light 1 off: D starts at point light 2
+    viewer.press(glfw.KEY_D)
+    assert viewer.state.shadow_map == 2
+
+
+def test_turning_off_the_light_whose_map_is_shown_turns_the_map_view_off():
+    viewer = Viewer()
+    viewer.press(glfw.KEY_D)
+    viewer.press(glfw.KEY_1)
+    assert viewer.state.shadow_map is None and viewer.messages[-1] == "shadow map view: off"
+
+
+@pytest.mark.parametrize("change", ["nothing casts", "lights off"])
+def test_d_without_a_map_only_says_so(change):
+    scene = make_scene()
+    if change == "nothing casts":
+        for obj in scene.objects:
+            obj.casts_shadows = False
+    viewer = Viewer(scene)
+    if change == "lights off":
+        for key in (glfw.KEY_1, glfw.KEY_2, glfw.KEY_3):
+            viewer.press(key)
+    viewer.state.scene_changed = False
+    viewer.press(glfw.KEY_D)
+    assert viewer.state.shadow_map is None and not viewer.state.scene_changed
+    assert viewer.messages[-1] == "shadow map view: no light that is on has a shadow map"
+
+
+def test_shown_light_counts_only_the_lights_that_are_on():
+    scene = make_scene()                           # keys: directional 1, point 1, point 2
+    assert [shown_light(ViewState(lights_on=[True] * 3), scene, i) for i in range(3)] == [
+        ("directional", 0), ("point", 0), ("point", 1)]
+    assert shown_light(ViewState(lights_on=[False, False, True]), scene, 2) == ("point", 0)
 
 
 def test_v_and_b_switch_vsync_and_buffering_without_a_change_flag():
@@ -485,7 +543,9 @@ def test_help_with_state_and_lights_shows_them():
         "  1   directional light 1: on", "  2   point light 1: off"]
     assert "  shading: Gouraud, wireframe: off, two-sided lighting: as authored" in lines
     assert "  reference view: off, v-sync: on, buffering: triple, method: rasteriser" in lines
-    assert "method: ray tracer" in help_lines(ViewState(method="raytrace"))[-1]
+    assert "method: ray tracer" in help_lines(ViewState(method="raytrace"))[-2]
+    assert help_lines(ViewState(shadows=False, shadow_map=1), ["directional light 1", "point light 1"])[-1] \
+        == "  shadows: off, shadow map view: point light 1"
 
 
 def test_view_state_defaults():
@@ -493,4 +553,5 @@ def test_view_state_defaults():
     assert {f.name: getattr(state, f.name) for f in fields(state)} == {
         "shading": None, "wireframe": False, "two_sided": None, "lights_on": [],
         "reference": "off", "vsync": True, "buffering": 2, "help": False, "method": "raster",
+        "shadows": True, "shadow_map": None,
         "screenshot": False, "quit": False, "camera_changed": False, "scene_changed": False}

@@ -13,7 +13,7 @@ from renderer.core.gl_rules import (COMPONENTS_PER_DIRECTIONAL_SHADOW, COMPONENT
 from renderer.core.primitives import icosphere, plane
 from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
                                  Transform)
-from renderer.core.shadow_settings import Shadow
+from renderer.core.shadow_settings import FILTERS, Shadow, shared_kernel
 from renderer.core.shadows import has_shadow_maps, shadow_layout
 from renderer.core.uniforms import SHADOW_UNIFORMS
 from renderer.gpu.pipeline import GpuRenderer
@@ -146,14 +146,30 @@ def test_a_scene_without_maps_compiles_no_shadow_code(ctx):
             assert gpu.programs and not any(v.defines()["SHADOW_MAPS"] for v in gpu.programs)
 
 
-def test_the_all_features_build_looks_the_maps_up_too_and_draws_the_same(ctx):
-    scene = sphere_over_plane()
+@pytest.mark.parametrize("filter_name", ["pcf2x2", "hard", "pcf5x5"])
+def test_the_all_features_build_looks_the_maps_up_too_and_draws_the_same(ctx, filter_name):
+    """The specialised programs have the scene's one filter compiled in (SHADOW_KERNEL: the
+    taps' loops have constant bounds); the all-features build reads each light's kernel from
+    its uniform. Same pixels."""
+    scene = sphere_over_plane(replace(LIGHT, shadow=Shadow(resolution=256, filter=filter_name)))
     images = {}
     for specialise in (True, False):
         with GpuRenderer(scene, W, H, context=ctx, specialise=specialise) as gpu:
             images[specialise] = gpu.render(depth=False).rgba8
             assert [v.shadows for v in gpu.programs] == [True]
+            assert [v.defines().get("SHADOW_KERNEL") for v in gpu.programs] == [
+                FILTERS[filter_name] if specialise else None]
     assert np.array_equal(images[True], images[False])
+
+
+def test_a_kernel_is_compiled_in_only_when_every_light_with_shadows_shares_it():
+    hard, pcf3 = Shadow(filter="hard"), Shadow(filter="pcf3x3")
+    scene = Scene(directional_lights=[DirectionalLight(shadow=pcf3)],
+                  point_lights=[PointLight(shadow=pcf3), PointLight(shadow=replace(hard, enabled=False))])
+    assert shared_kernel(scene) == 3                   # a light without shadows has no say
+    scene.point_lights[1].shadow = hard
+    assert shared_kernel(scene) == 0                   # 1 and 3: each light's from its uniform
+    assert shared_kernel(Scene(directional_lights=[DirectionalLight(shadow=Shadow(enabled=False))])) == 0
 
 
 def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):
@@ -170,6 +186,46 @@ def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):
     assert all(a is b for a, b in zip(made[:3], again[:3]))
     assert made[3] == again[3] and all(made[3][v] is again[3][v] for v in made[3])
     assert made[4] == again[4]
+
+
+def test_shadows_off_draws_the_scene_without_shadows_and_on_again_the_same_image(ctx):
+    """GpuRenderer.shadows (the viewer's O key): off is the image of the scene whose lights
+    have shadows off, with no light view drawn and no shadow code; on again is the first
+    image bit for bit; each program is compiled once."""
+    scene = sphere_over_plane()
+    unshadowed = sphere_over_plane(light=replace(LIGHT, shadow=Shadow(enabled=False)))
+    with GpuRenderer(unshadowed, W, H, context=ctx) as gpu:
+        expected_off = gpu.render(depth=False).rgba8
+    with GpuRenderer(scene, W, H, context=ctx) as gpu:
+        on = gpu.render(depth=False).rgba8
+        assert gpu.shadows and gpu.drawn_shadow_plan is gpu.shadow_maps.plan
+        images, programs = [], []
+        for setting in (False, True, False, True):
+            gpu.shadows = setting
+            images.append(gpu.render(depth=False).rgba8)
+            programs.append(dict(gpu.programs))
+            assert (gpu.drawn_shadow_plan is not None) == setting
+    assert not np.array_equal(on, expected_off)                  # the scene has a shadow
+    assert np.array_equal(images[0], expected_off) and np.array_equal(images[2], expected_off)
+    assert np.array_equal(images[1], on) and np.array_equal(images[3], on)
+    assert sorted(v.shadows for v in programs[1]) == [False, True]      # one program each
+    assert programs[3].keys() == programs[1].keys()
+    assert all(programs[3][v] is program for v, program in programs[1].items())
+
+
+def test_update_makes_new_maps_in_the_renderers_own_context(gl_contexts):
+    """update() may run while another context is current (a viewer's window after a headless
+    render): a new layout's texture is made in the renderer's context all the same."""
+    from renderer.gpu.context import activate
+    scene = sphere_over_plane()
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as gpu:
+        gpu.render(depth=False)
+        scene.directional_lights[0] = replace(LIGHT, shadow=Shadow(resolution=128))
+        activate(gl_contexts["osmesa"])
+        gpu.update()                                  # a new texture: 128 texels, not 256
+        image = gpu.render(depth=False).rgba8
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as fresh:
+        assert np.array_equal(image, fresh.render(depth=False).rgba8)
 
 
 def test_the_light_budget_counts_the_shadow_uniforms():

@@ -20,6 +20,7 @@ from renderer.gpu import GpuRenderer
 from renderer.core.imageio import read_png
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene_file import load_scene
+from renderer.checks.methods import without_shadow_maps
 from renderer.viewer.viewer import SCREEN_CLEAR, Viewer
 
 SIZE = (160, 120)
@@ -430,3 +431,70 @@ def test_scripted_ray_tracing_from_the_command_line(x_display, tmp_path, cli):
     summary = json.loads(stats.read_text())
     assert summary["raytrace_spp"] == 4 and summary["reference"] is None
     assert read_png(shot).shape[:2] == (60, 80)
+
+
+# -- shadows: O toggles them, D shows a light's map ------------------------------------------------
+SHADOW_SIZE = (120, 220)     # the map view's 120x120 square at rows 50-169, below the overlay
+
+
+@pytest.fixture
+def shadow_viewer(on_x_display):
+    messages = []
+    with Viewer(scene("shadow_plane"), *SHADOW_SIZE, vsync=False, on_message=messages.append) as v:
+        v.messages = messages
+        yield v
+
+
+def test_o_toggles_shadows_in_the_picture_and_the_title(shadow_viewer):
+    authored = scene("shadow_plane")
+    with_shadows = shown_after_a_frame(shadow_viewer)
+    assert_matches(with_shadows, headless(authored, SHADOW_SIZE))
+    press(shadow_viewer, glfw.KEY_O)
+    without = shown_after_a_frame(shadow_viewer)
+    assert_matches(without, headless(without_shadow_maps(authored), SHADOW_SIZE))
+    assert (np.abs(without.astype(int) - with_shadows).max(axis=-1) > 20).mean() > 0.02
+    assert not shadow_viewer.gpu.shadows and "shadows off" in shadow_viewer.title()
+    press(shadow_viewer, glfw.KEY_O)
+    assert np.array_equal(shown_after_a_frame(shadow_viewer), with_shadows)
+    assert "shadows on" in shadow_viewer.title()
+
+
+def test_d_shows_the_map_the_frame_drew_and_again_the_picture(shadow_viewer):
+    """The map fills the 120x120 square in the middle of the 120x220 window, each pixel the
+    texel under its centre as grey: the casters' depths, and white where nothing was drawn."""
+    picture = shown_after_a_frame(shadow_viewer)
+    press(shadow_viewer, glfw.KEY_D)
+    shown = shown_after_a_frame(shadow_viewer)
+    plan = shadow_viewer.gpu.drawn_shadow_plan
+    (light_map,) = plan.layout.maps
+    r = light_map.resolution
+    layer = shadow_viewer.gpu.shadow_maps.read_layer(0)[:r, :r]
+    lo, hi = shadow_viewer._map_view.depth_range
+    square = shown[::-1][50:170].astype(int)             # GL rows, as the layer
+    texel = ((np.arange(120) + 0.5) * r / 120).astype(int)
+    depths = layer[np.ix_(texel, texel)]
+    expected = np.where(depths < 1.0, np.round(0.85 * (depths - lo) / (hi - lo) * 255), 255)
+    assert (np.abs(square[..., 0] - expected) > 1).mean() < 0.01
+    assert (square[..., 0] == square[..., 1]).all() and (square[..., 1] == square[..., 2]).all()
+    # The casters' texels are grey, darker than the cleared texels around them (white).
+    casters = depths < 1.0
+    assert 0.05 < casters.mean() < 0.95
+    assert (square[..., 0][casters] <= 217).mean() > 0.99 and (square[..., 0][~casters] == 255).mean() > 0.99
+    assert shadow_viewer._overlay_text() == (f"shadow map of directional light 1: {r}x{r}",
+                                             f"depth {lo:.6g} black to {hi:.6g} grey, 1.0 white")
+    assert "(map of directional light 1)" in shadow_viewer.title()
+    press(shadow_viewer, glfw.KEY_D)                     # the only map: then off
+    assert shadow_viewer.state.shadow_map is None
+    assert np.array_equal(shown_after_a_frame(shadow_viewer), picture)
+
+
+def test_with_shadows_off_d_says_there_is_no_map_and_the_reference_matches(on_x_display):
+    """The reference view is asked for the scene with shadows off while O has them off."""
+    with Viewer(scene("shadow_plane"), 80, 60, reference="difference",
+                on_message=lambda line: None) as viewer:
+        press(viewer, glfw.KEY_O)
+        press(viewer, glfw.KEY_D)
+        viewer.run(frames=2)                             # the last frame waits for the reference
+        assert viewer.figures is not None and viewer.figures["mismatched"] == 0
+        assert "shadow map of directional light 1: shadows are off (O)" in viewer._overlay_text()
+        assert not viewer._map_shown

@@ -18,7 +18,7 @@ def test_wheel_carries_shaders_and_assets_and_renders_from_another_folder(tmp_pa
     assert build.returncode == 0, build.stderr
     wheel = next((tmp_path / "dist").glob("*.whl"))
     names = set(zipfile.ZipFile(wheel).namelist())
-    for glsl in (REPO / "glsl").rglob("*.glsl"):          # raytrace/ too
+    for glsl in (REPO / "glsl").rglob("*.*"):             # every folder, .vert and .frag too
         assert f"renderer/glsl/{glsl.relative_to(REPO / 'glsl').as_posix()}" in names
     assert "reference/raytrace/random.py" in names
     for asset in (REPO / "assets").rglob("*.*"):

@@ -6,6 +6,7 @@ picture to the full ray tracer's, each changing one thing (CHAIN):
 
     raster     the rasteriser (renderer.gpu.GpuRenderer), the materials' own shading
     phong      the rasteriser with every material Phong-shaded (Scene.with_shading)
+    unshadowed the same without shadow maps (every light's shadows off)
     centre     the ray tracer with one ray through each pixel centre, max depth 0, no shadow
                rays: primary visibility and local shading, what the rasteriser computes
     samples    the same with the user's samples per pixel and pattern
@@ -15,8 +16,10 @@ picture to the full ray tracer's, each changing one thing (CHAIN):
 A pixel counts where `raster` and `raytrace` differ in place by more than the threshold (the
 pipeline tolerance's raw mismatch, renderer/checks/tolerance.py). Its cause (CAUSES) is the
 first step of the chain that changes it in place by more than the threshold, or, where no
-single step does (small changes adding up), the step that changes it most. The step from
-`phong` to `centre` is split by the tolerance's ±deviation allowance (compare.py): `edges`
+single step does (small changes adding up), the step that changes it most. Both steps that
+touch shadows (the maps taken away, the shadow rays added) count as `shadows`: where the
+shadow map and the shadow rays agree the pixel does not differ at all. The step from
+`unshadowed` to `centre` is split by the tolerance's ±deviation allowance (compare.py): `edges`
 where it changes the pixel by more than the threshold and each image has a match within
 ±1 px in the other (a silhouette a pixel apart), `tessellation` otherwise. A step that
 cannot change anything (no flat or Gouraud material, one sample at the pixel centre, no
@@ -25,7 +28,7 @@ light, no reflecting or transmitting material or max depth 0) reuses the frame b
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -35,8 +38,10 @@ from renderer.checks.compare import (DEFAULT_DEVIATION, DEFAULT_THRESHOLD, Compa
 from renderer.core.frame import Frame
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
+from renderer.core.shadow_settings import Shadow
+from renderer.core.shadows import has_shadow_maps
 
-CHAIN = ("raster", "phong", "centre", "samples", "shadows", "raytrace")
+CHAIN = ("raster", "phong", "unshadowed", "centre", "samples", "shadows", "raytrace")
 
 
 @dataclass(frozen=True)
@@ -65,14 +70,19 @@ CAUSES = (
           "the rasteriser takes one at the pixel centre; the average is nearer the pixel's "
           "true colour"),
     Cause("shadows", (230, 0, 230), "magenta",
-          "the rasteriser has no shadows (issue 15 brings shadow maps); the ray tracer's "
-          "shadow rays are right"),
+          "the rasteriser's shadow maps against the ray tracer's shadow rays: a map's texels, "
+          "filter and bias put a shadow's edge a texel or so off (renderer compare "
+          "--shadows-vs-truth measures it), and lights or objects without shadow maps cast none; "
+          "the shadow rays are right"),
     Cause("reflection", (0, 200, 0), "green",
           "mirror reflection (k_r) and refraction (k_t): the rasteriser shades only the local "
           "colour; the ray tracer's secondary rays are right, to its maximum depth"),
 )
 EDGES, TESSELLATION = 1, 2
-STEP_CAUSE = np.array([0, EDGES, 3, 4, 5])   # each step's cause; phong -> centre: EDGES or TESSELLATION
+SHADOWS = 4
+# each step's cause; unshadowed -> centre: EDGES or TESSELLATION
+STEP_CAUSE = np.array([0, SHADOWS, EDGES, 3, SHADOWS, 5])
+VISIBILITY_STEP = 2                           # unshadowed -> centre
 NO_DIFFERENCE = -1
 
 # Remarks that hold for some scenes only (notes()).
@@ -82,6 +92,13 @@ PARALLEL_VIEWER = ("parallel projection: the rasteriser lights with the viewer a
 SHADOW_TERMINATOR = ("shadows on meshes: along a smooth-shaded mesh's terminator its flat facets "
                      "can shadow points its interpolated normals light (the shadow-terminator "
                      "problem); the ray tracer's jagged edge there is an artefact of the facets")
+
+
+def without_shadow_maps(scene: Scene) -> Scene:
+    """A copy of `scene` whose lights have their shadow maps off (meshes shared)."""
+    off = lambda light: replace(light, shadow=Shadow(enabled=False))     # noqa: E731
+    return replace(scene, directional_lights=[off(x) for x in scene.directional_lights],
+                   point_lights=[off(x) for x in scene.point_lights])
 
 
 def explain(chain, threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION) -> np.ndarray:
@@ -94,8 +111,9 @@ def explain(chain, threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_
     beyond = changes > threshold
     step = np.where(beyond.any(axis=0), beyond.argmax(axis=0), changes.argmax(axis=0))
     cause = STEP_CAUSE[step]
-    forgiven = ~position_deviation_mismatch(chain[1], chain[2], threshold, deviation)
-    cause[(step == 1) & ~(beyond[1] & forgiven)] = TESSELLATION
+    k = VISIBILITY_STEP
+    forgiven = ~position_deviation_mismatch(chain[k], chain[k + 1], threshold, deviation)
+    cause[(step == k) & ~(beyond[k] & forgiven)] = TESSELLATION
     differs = channel_difference(chain[0], chain[-1]).max(axis=-1) > threshold
     return np.where(differs, cause, NO_DIFFERENCE).astype(np.int8)
 
@@ -192,6 +210,12 @@ def compare_methods(scene: Scene, width: int, height: int, *, context=None, cont
         else:
             with GpuRenderer(scene.with_shading("phong"), width, height, context=ctx) as raster:
                 frames["phong"] = raster.render()
+        if not has_shadow_maps(scene):
+            frames["unshadowed"] = frames["phong"]
+        else:
+            with GpuRenderer(without_shadow_maps(scene.with_shading("phong")), width, height,
+                             context=ctx) as raster:
+                frames["unshadowed"] = raster.render()
         # What each ray-traced step sets; a step whose effective settings equal the last one's
         # reuses its frame (the sample offsets; no light: no shadow ray; nothing reflects: no bounce).
         lit = bool(scene.directional_lights or scene.point_lights)
@@ -199,7 +223,8 @@ def compare_methods(scene: Scene, width: int, height: int, *, context=None, cont
                       for o in scene.objects)
         steps = {"centre": (1, "regular", 0, False), "samples": (samples, pattern, 0, False),
                  "shadows": (samples, pattern, 0, True), "raytrace": (samples, pattern, max_depth, True)}
-        renders, last = 1 + (frames["phong"] is not frames["raster"]), None
+        renders = 1 + (frames["phong"] is not frames["raster"]) + (frames["unshadowed"] is not frames["phong"])
+        last = None
         for name, (n, kind, depth, shadows) in steps.items():
             centre = n == 1 and kind == "regular"          # one ray through the pixel centre
             sampling = "centre" if centre else (n, kind, seed, adaptive_threshold)

@@ -115,6 +115,14 @@ def scene_has_shadows(scene) -> bool:
             and any(o.receives_shadows for o in scene.objects))
 
 
+def shared_kernel(scene) -> int:
+    """The filter kernel of every light with shadows on, when they all have the same; else 0
+    (or no light has shadows). The GPU path compiles it into the lookup (SHADOW_KERNEL)."""
+    kernels = {light.shadow.kernel for light in [*scene.directional_lights, *scene.point_lights]
+               if light.shadow.enabled}
+    return kernels.pop() if len(kernels) == 1 else 0
+
+
 def auto_resolution(width: int, height: int, point: bool) -> int:
     """The default tile side: the power of two at or above twice the image's longer side, so
     that a map spread over the view has about two texels per pixel on a side (a point light's

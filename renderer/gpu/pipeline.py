@@ -8,7 +8,10 @@
 `render()` is `draw()` plus the read-back; the window viewer (renderer/viewer/viewer.py) calls
 `draw()` on a window's context (`context=`) and copies the framebuffer to the screen, so that
 it shows exactly what the headless path renders. `wireframe = True` draws triangle edges only
-(the viewer's W key).
+(the viewer's W key); `shadows = False` draws no light views and uses the programs without
+shadow code, the image of the scene with every light's shadows off, until `shadows = True`
+(the viewer's O key; each program is compiled once, so toggling compiles nothing after the
+first time either way).
 
 Everything GL is made once per renderer: one program per shader variant the scene's materials
 use, one vertex buffer (positions and normals, float32, interleaved), index buffer and vertex
@@ -161,6 +164,7 @@ class GpuRenderer:
         self.width, self.height = width, height
         self.specialise = bool(specialise)
         self.wireframe = False           # draw() draws edges only (a viewer's toggle)
+        self._shadows = True             # the `shadows` switch
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._released = False
@@ -175,6 +179,7 @@ class GpuRenderer:
         self._shadow_layout = ShadowLayout(0, 0, ())         # update() sets it (renderer/core/shadows.py)
         self._shadow_maps: ShadowMaps | None = None       # made when the layout has maps
         self._shadowed: dict[bool, bool] = {}             # plan -> whether a program looks maps up
+        self._drawn_shadow_plan = None                    # what the last draw() drew into the maps
         try:
             activate(self.ctx)
             self._check_size()
@@ -263,7 +268,8 @@ class GpuRenderer:
     def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
         return ShaderVariant.for_material(self.scene, obj.material, linear,
                                           all_features=not self.specialise,
-                                          shadows=obj.receives_shadows and self._shadow_layout.any)
+                                          shadows=(self._shadows and obj.receives_shadows
+                                                   and self._shadow_layout.any))
 
     def _vertex_array(self, item: _ObjectBuffers, variant: ShaderVariant) -> moderngl.VertexArray:
         vao = item.vertex_arrays.get(variant)
@@ -286,6 +292,7 @@ class GpuRenderer:
                 a is not b.obj for a, b in zip(scene.objects, self._objects)):
             raise ValueError("the scene's objects changed since this GpuRenderer was made; "
                              "make a new one")
+        activate(self.ctx)          # new meshes and maps are made in this renderer's context
         for item in self._objects:
             if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
                 self._release_buffers(item)
@@ -423,10 +430,12 @@ class GpuRenderer:
         self._set_sample_offset(linear, tuple(sample_offset))
         target = self._multisample_framebuffer(samples) if samples > 1 else fbo
         shadowed = self._shadowed[linear]
+        self._drawn_shadow_plan = None
         if shadowed:
             # The light views first, with GL's default clip control (every frame leaves it
             # behind) whatever the camera's depth mapping.
             self._shadow_maps.draw()
+            self._drawn_shadow_plan = self._shadow_maps.plan
         target.use()
         red, green, blue = self.scene.background
         mapping = depth_mapping(self.scene.camera.reversed_z)
@@ -520,9 +529,31 @@ class GpuRenderer:
         return dict(self._programs.items())
 
     @property
+    def shadows(self) -> bool:
+        """Whether draw() draws shadows (default True): False leaves out the light views and
+        draws with the programs that have no shadow code (the scene as if no light had
+        shadows on). The frame's shadow plan is still made by update(), so that turning
+        shadows on again needs no update(); the programs of both settings stay cached."""
+        return self._shadows
+
+    @shadows.setter
+    def shadows(self, on: bool) -> None:
+        if bool(on) != self._shadows:
+            self._shadows = bool(on)
+            self._plans.clear()                   # the draws name other programs now
+            self._jittered.clear()
+
+    @property
     def shadow_maps(self) -> ShadowMaps | None:
         """The maps' texture and depth pass (None while the scene has no shadow maps)."""
         return self._shadow_maps
+
+    @property
+    def drawn_shadow_plan(self):
+        """The ShadowPlan whose light views the last draw() drew into shadow_maps, the maps
+        its lighting read; None when it drew none (shadows off, no map, no receiver drawn
+        with shadow code)."""
+        return self._drawn_shadow_plan
 
     @property
     def drawn_objects(self) -> list[str]:

@@ -25,6 +25,7 @@ from typing import Mapping
 import moderngl
 
 from renderer.core.resources import glsl_dir
+from renderer.core.shadow_settings import shared_kernel
 
 _INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
 _INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
@@ -144,7 +145,11 @@ class ShaderVariant:
     `shadows` (define SHADOW_MAPS) compiles the shadow-map lookup in (glsl/shadow/lookup.glsl):
     set, in either build, only for an object that receives shadows in a scene whose layout has
     maps (renderer/core/shadows.py), and for now only for Phong (flat and Gouraud receivers
-    are drawn unshadowed); every other program has no shadow code at all.
+    are drawn unshadowed); every other program has no shadow code at all. `shadow_kernel`
+    (define SHADOW_KERNEL; specialised builds only) is the filter kernel when every light with
+    shadows has the same filter (shadow_settings.shared_kernel): its taps' loops then have
+    constant bounds; 0 reads each light's from its uniform. It is not in `name`: all the
+    programs of a scene have the same.
     """
     shading: str                     # "flat", "gouraud" or "phong"
     two_sided: bool = False
@@ -154,12 +159,15 @@ class ShaderVariant:
     specular: bool = False           # the k_s term of the lighting equation
     all_features: bool = False
     shadows: bool = False            # the shadow-map lookup (Phong only, for now)
+    shadow_kernel: int = 0           # every map's filter kernel, compiled in (0: read per light)
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
             raise ValueError(f"unknown shading mode {self.shading!r}")
         if self.shadows and self.shading != "phong":
             raise ValueError(f"shadow maps are looked up by Phong shading only, not {self.shading!r}")
+        if self.shadow_kernel and not self.shadows:
+            raise ValueError("a shadow kernel is compiled in only with the shadow-map lookup")
 
     def defines(self) -> dict[str, object]:
         if self.all_features:
@@ -181,6 +189,7 @@ class ShaderVariant:
             "NUM_POINT_LIGHTS": self.num_point_lights,
             "LINEAR_OUTPUT": self.linear_output,
             "SHADOW_MAPS": self.shadows,
+            "SHADOW_KERNEL": self.shadow_kernel or None,
         }
 
     @property
@@ -211,7 +220,7 @@ class ShaderVariant:
                        shadows=shadows)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
                    len(scene.point_lights), bool(linear_output), material.has_specular,
-                   shadows=shadows)
+                   shadows=shadows, shadow_kernel=shared_kernel(scene) if shadows else 0)
 
 
 STAGES = (("vertex_shader", "vertex.glsl"),

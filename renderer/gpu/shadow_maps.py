@@ -179,6 +179,12 @@ class ShadowMaps:
         return vao
 
     @property
+    def framebuffers(self) -> list[moderngl.Framebuffer]:
+        """Per layer, its depth-only framebuffer (benchmarks/bench_shadows.py's bare program
+        draws into the same storage)."""
+        return [view for _name, view in self._framebuffers]
+
+    @property
     def vertex_arrays(self) -> dict:
         """Object index -> its depth-pass vertex array, for those drawn so far."""
         return {index: vao for index, (_vbo, vao) in self._vertex_arrays.items()}
@@ -202,7 +208,8 @@ class ShadowMaps:
         self.texture.use(SHADOW_MAPS_UNIT)
 
     def read_layer(self, layer: int) -> np.ndarray:
-        """Layer `layer`'s depths, float32 (S, S), GL rows (row 0 at the bottom): for tests."""
+        """Layer `layer`'s depths, float32 (S, S), GL rows (row 0 at the bottom): for tests and
+        the viewer's map view (renderer/viewer/shadow_view.py)."""
         side = self.layout.side
         data = self._framebuffers[layer][1].read(viewport=(0, 0, side, side), attachment=-1,
                                                  components=1, dtype="f4")

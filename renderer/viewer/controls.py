@@ -6,7 +6,7 @@ same events directly. Controls changes a `ViewState` and an `OrbitCamera` and sa
 did through `on_message`, one short line a key. Each frame the viewer:
 - takes `orbit.camera` and clears `camera_changed` (set by drags, the wheel and R);
 - calls `apply_view` and clears `scene_changed` (set by every key that changes what the
-  picture shows: F G P A T 1-9, and W C H M, which the viewer reads from the state itself);
+  picture shows: F G P A T 1-9, and W C H M O D, which the viewer reads from the state itself);
 - acts on and clears the requests `screenshot` (S) and `quit` (Esc);
 - applies `vsync` and `buffering` when they differ from what it last applied (V and B set
   no change flag: the picture stays the same).
@@ -24,6 +24,7 @@ import glfw
 
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene import Camera, Scene
+from renderer.core.shadow_settings import scene_has_shadows
 
 REFERENCE_MODES = ("off", "side-by-side", "difference")     # C cycles in this order
 METHODS = ("raster", "raytrace")                            # M toggles
@@ -45,6 +46,8 @@ class ViewState:
     buffering: int = 2                  # 2 (double) or 3 (triple)
     help: bool = False
     method: str = "raster"              # one of METHODS: what draws the picture
+    shadows: bool = True                # shadow maps drawn and looked up (GpuRenderer.shadows)
+    shadow_map: int | None = None       # the light (index in key order) whose map is shown
     # Requests: the viewer acts on them and clears them.
     screenshot: bool = False
     quit: bool = False
@@ -102,6 +105,25 @@ def light_names_of(scene: Scene) -> list[str]:
             + [f"point light {i + 1}" for i in range(len(scene.point_lights))])
 
 
+def lights_with_maps(scene: Scene | None) -> list[int]:
+    """The lights (indices in key order) that have a shadow map when on: those with shadows
+    on, in a scene where something casts and something receives."""
+    if scene is None or not scene_has_shadows(scene):
+        return []
+    lights = [*scene.directional_lights, *scene.point_lights]
+    return [i for i, light in enumerate(lights) if light.shadow.enabled]
+
+
+def shown_light(state: ViewState, authored: Scene, index: int) -> tuple[str, int]:
+    """(kind, index among the shown scene's lights of that kind) of light `index` in key
+    order, which must be on: apply_view leaves the lights that are off out."""
+    n_directional = len(authored.directional_lights)
+    flags = list(state.lights_on) + [True] * (index + 1 - len(state.lights_on))
+    if index < n_directional:
+        return "directional", sum(flags[:index])
+    return "point", sum(flags[n_directional:index])
+
+
 # --------------------------------------------------------------------------- the bindings
 
 @dataclass(frozen=True)
@@ -122,6 +144,8 @@ KEY_BINDINGS = (
             "light 1 to 9 on / off (directional lights first, then point lights)"),
     Binding(glfw.KEY_C, "C", "reference view: off, side by side, difference"),
     Binding(glfw.KEY_M, "M", "rasteriser / ray tracer (refines while the view is still)"),
+    Binding(glfw.KEY_O, "O", "shadows on / off"),
+    Binding(glfw.KEY_D, "D", "shadow map view: each light's map in turn (depth as grey), then off"),
     Binding(glfw.KEY_V, "V", "v-sync on / off"),
     Binding(glfw.KEY_B, "B", "double / triple buffering"),
     Binding(glfw.KEY_S, "S", "save a screenshot"),
@@ -165,7 +189,10 @@ def help_lines(state: ViewState | None = None, light_names: list[str] | None = N
                   f"  shading: {SHADING_NAMES[state.shading]}, wireframe: "
                   f"{_on_off(state.wireframe)}, two-sided lighting: {two_sided}",
                   f"  reference view: {state.reference}, v-sync: {_on_off(state.vsync)}, "
-                  f"buffering: {_buffering(state.buffering)}, method: {METHOD_NAMES[state.method]}"]
+                  f"buffering: {_buffering(state.buffering)}, method: {METHOD_NAMES[state.method]}",
+                  f"  shadows: {_on_off(state.shadows)}, shadow map view: "
+                  + ("off" if state.shadow_map is None or not light_names
+                     else light_names[state.shadow_map])]
     return lines
 
 
@@ -179,7 +206,8 @@ class Controls:
     """Keys and mouse to ViewState and OrbitCamera changes (module docstring: the protocol).
 
     `scene` (optional) is the authored scene; T needs it to know whether every material is
-    authored two-sided (without it, the first T turns two-sided lighting on).
+    authored two-sided (without it, the first T turns two-sided lighting on), D which lights
+    have shadow maps (without it, none).
     Call `resize` with the framebuffer size before panning: cursor positions must be in the
     same units (pixels) for the scene to follow the cursor.
     """
@@ -197,6 +225,7 @@ class Controls:
                              f"{len(self.light_names)} lights")
         self._authored_all_two_sided = (scene is not None and
                                         all(o.material.two_sided for o in scene.objects))
+        self._with_maps = lights_with_maps(scene)
         self._width = 0
         self._height = 0
         self._cursor: tuple[float, float] | None = None
@@ -211,6 +240,8 @@ class Controls:
             glfw.KEY_T: self._two_sided,
             glfw.KEY_C: self._reference,
             glfw.KEY_M: self._method,
+            glfw.KEY_O: self._shadows,
+            glfw.KEY_D: self._shadow_map,
             glfw.KEY_V: self._vsync,
             glfw.KEY_B: self._buffering,
             glfw.KEY_S: self._screenshot,
@@ -309,6 +340,9 @@ class Controls:
         self.state.scene_changed = True
         name = self.light_names[index]
         self._say(f"light {index + 1} ({name}): {_on_off(self.state.lights_on[index])}")
+        if self.state.shadow_map == index:          # its map went with it
+            self.state.shadow_map = None
+            self._say("shadow map view: off")
 
     def _reference(self) -> None:
         i = REFERENCE_MODES.index(self.state.reference)
@@ -322,6 +356,25 @@ class Controls:
                       "counts the samples per pixel)")
         else:
             self._say("method: rasteriser")
+
+    def _shadows(self) -> None:
+        self._set("shadows", not self.state.shadows)
+        self._say(f"shadows: {_on_off(self.state.shadows)}")
+
+    def _shadow_map(self) -> None:
+        """The next light (key order) that is on and has a map, after the one shown; after
+        the last, off."""
+        with_maps = [i for i in self._with_maps if self.state.lights_on[i]]
+        if not with_maps:
+            self._say("shadow map view: no light that is on has a shadow map")
+            return
+        current = self.state.shadow_map
+        later = [i for i in with_maps if current is None or i > current]
+        self._set("shadow_map", later[0] if later else None)
+        if self.state.shadow_map is None:
+            self._say("shadow map view: off")
+        else:
+            self._say(f"shadow map view: {self.light_names[self.state.shadow_map]}")
 
     def _vsync(self) -> None:
         self.state.vsync = not self.state.vsync

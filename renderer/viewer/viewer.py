@@ -17,6 +17,12 @@ shading, lights, materials) takes the tracer's update() and starts the mean agai
 holds progressive.MAX_SPP samples nothing more is traced and the interactive loop waits for
 events. The reference view compares the rasteriser only: it is off while ray tracing.
 
+Shadows (the O key) switch GpuRenderer.shadows; the reference view is then asked for the scene
+with every light's shadows off, the image the GPU draws. The shadow-map view (the D key,
+renderer/viewer/shadow_view.py) replaces the picture with the map of the chosen light as the
+frame just drawn left it, the map its lighting read; the overlay names the light and the depth
+range shown, or says why there is no map to show.
+
 `Viewer.run(frames=N, orbit=DEG, screenshot=PATH)` is the scripted mode of the command line:
 N frames, the camera orbiting DEG degrees per frame, then what the window shows saved to PNG
 and the frame-time statistics returned.
@@ -31,7 +37,9 @@ from pathlib import Path
 
 import numpy as np
 
-from renderer.viewer.controls import Controls, ViewState, apply_view, help_lines, light_names_of, working_copy
+from renderer.checks.methods import without_shadow_maps
+from renderer.viewer.controls import (Controls, ViewState, apply_view, help_lines, light_names_of,
+                                      shown_light, working_copy)
 from renderer.gpu.context import activate
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.raytracer import RayTracer
@@ -42,6 +50,7 @@ from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
 from renderer.viewer.progressive import PATTERN, SAMPLES_PER_FRAME, Accumulator
 from renderer.viewer.reference_view import BackgroundReference, difference_view, figures_line
+from renderer.viewer.shadow_view import CUBE_FACE_NAMES, ShadowMapView, drawn_faces
 from renderer.core.scene import Scene
 from renderer.viewer.window import Window
 
@@ -119,6 +128,9 @@ class Viewer:
             self._traced_version = -1          # the version it and the mean were made for
             self.accumulator = Accumulator()
             self._traced = CpuImage(self.ctx)  # the mean so far
+            self._map_view = None              # the ShadowMapView, made on first use
+            self._map_lines: tuple = ()        # the overlay's lines on it (none: not asked for)
+            self._map_shown = False            # the picture is the map view
             self._version = 0                 # bumped whenever the shaded image would change
             self._view: tuple | None = None   # what the version stands for
             self._requested = -1              # the version the reference was asked for
@@ -147,11 +159,12 @@ class Viewer:
         # The version names what the shaded image depends on (not wireframe, help or the
         # reference mode), so that only a new image asks the reference again.
         view = (self.gpu.width, self.gpu.height, repr(self.orbit.camera), state.shading,
-                state.two_sided, tuple(state.lights_on))
+                state.two_sided, tuple(state.lights_on), state.shadows)
         if view != self._view:
             self._view = view
             self._version += 1
         self.gpu.wireframe = state.wireframe
+        self.gpu.shadows = state.shadows
         if state.vsync != self._vsync_set:
             self.window.set_vsync(state.vsync)
             self._vsync_set = state.vsync
@@ -165,8 +178,9 @@ class Viewer:
         if self.state.reference == "off" or self.state.method == "raytrace":
             return
         if self._requested != self._version:
-            self.background.request(working_copy(self.shown), self.gpu.width, self.gpu.height,
-                                    self._version)
+            scene = working_copy(self.shown)
+            self.background.request(scene if self.state.shadows else without_shadow_maps(scene),
+                                    self.gpu.width, self.gpu.height, self._version)
             self._requested = self._version
         result = self.background.wait() if wait else self.background.poll()
         if result is not None and result.version == self._version:
@@ -189,7 +203,7 @@ class Viewer:
         width, height = self.window.framebuffer_size
         screen.use()
         blit = self.presenter.blitter.copy
-        mode = "off" if self.state.method == "raytrace" else self.state.reference
+        mode = "off" if self.state.method == "raytrace" or self._map_shown else self.state.reference
         have_reference = self._reference_version >= 0
         whole = (0, 0, width, height)
         if mode != "off" or fit(shown.size, whole) != whole:
@@ -224,7 +238,8 @@ class Viewer:
                 lines.append("reference view: off while ray tracing (it compares the rasteriser)")
         elif self.state.reference == "side-by-side":
             lines.append("left: GPU (GLSL)    right: NumPy reference")
-        if self.state.reference != "off" and self.state.method == "raster":
+        lines += self._map_lines
+        if self.state.reference != "off" and self.state.method == "raster" and not self._map_shown:
             current = self._reference_version == self._version
             if self._figures is not None and self._reference_version >= 0:
                 lines.append(figures_line(self._figures) + ("" if current else " (updating)"))
@@ -241,6 +256,7 @@ class Viewer:
         self._follow_reference()
         started = time.perf_counter()
         drawn = self._trace() if self.state.method == "raytrace" else self.gpu.draw()
+        drawn = self._shadow_map(drawn)
         self.ctx.finish()                     # so that draw_ms is the drawing, not queued work
         self.stats.draw_ms.append((time.perf_counter() - started) * 1000.0)
         self.presenter.submit(drawn, started)
@@ -285,6 +301,45 @@ class Viewer:
             self._traced.upload(self.accumulator.rgba8)
         return self._traced.framebuffer
 
+    def _shadow_map(self, drawn):
+        """The map view's framebuffer in place of `drawn` when the D key asks for a map and
+        the frame just drawn drew it; sets the overlay's lines: what is shown, or why not."""
+        index, plan = self.state.shadow_map, self.gpu.drawn_shadow_plan
+        self._map_shown = False
+        if index is None:
+            self._map_lines = ()
+            return drawn
+        name = light_names_of(self.authored)[index]
+        light_map = None if plan is None else plan.layout.get(*shown_light(self.state, self.authored, index))
+        if self.state.method == "raytrace":
+            why = "off while ray tracing (the maps are the rasteriser's)"
+        elif not self.state.shadows:
+            why = "shadows are off (O)"
+        elif light_map is None:
+            why = "none drawn this frame (no receiver with shadow code in view)"
+        else:
+            why = None
+        if why is not None:
+            self._map_lines = (f"shadow map of {name}: {why}",)
+            return drawn
+        if self._map_view is None:
+            self._map_view = ShadowMapView(self.ctx)
+        size = (self.gpu.width, self.gpu.height)
+        shown = self._map_view.draw(self.gpu.shadow_maps, plan, light_map, size, SCREEN_CLEAR)
+        faces = drawn_faces(plan, light_map)
+        r = light_map.resolution
+        if light_map.kind == "point":
+            drawn_names = "all" if len(faces) == 6 else " ".join(CUBE_FACE_NAMES[f] for f in faces) or "none"
+            what = f"{r}x{r}, faces +x -x +y / -y +z -z (drawn: {drawn_names})"
+        else:
+            what = f"{r}x{r}" + ("" if faces else " (not drawn: nothing shadows the view)")
+        depths = self._map_view.depth_range
+        self._map_lines = (f"shadow map of {name}: {what}",
+                           "nothing stored: all 1.0 (white)" if depths is None else
+                           f"depth {depths[0]:.6g} black to {depths[1]:.6g} grey, 1.0 white")
+        self._map_shown = True
+        return shown
+
     @property
     def idle(self) -> bool:
         """Nothing new to draw until an event comes: the ray tracer's mean of the current view
@@ -318,9 +373,12 @@ class Viewer:
         if self.state.method == "raytrace":
             tracing = f" | ray tracing: {self.accumulator.samples} spp" + (
                 " (done)" if self.accumulator.done else "")
-        return (f"renderer view: {self.authored.name}{tracing}{timing} | {self.presenter.name} "
-                f"buffering{latency_text} | v-sync {'on' if self.state.vsync else 'off'} | "
-                f"H for help")
+        shadows = f" | shadows {'on' if self.state.shadows else 'off'}"
+        if self._map_shown:
+            shadows += f" (map of {light_names_of(self.authored)[self.state.shadow_map]})"
+        return (f"renderer view: {self.authored.name}{tracing}{timing}{shadows} | "
+                f"{self.presenter.name} buffering{latency_text} | "
+                f"v-sync {'on' if self.state.vsync else 'off'} | H for help")
 
     # -- screenshots -------------------------------------------------------------------------
     def window_image(self) -> np.ndarray:
@@ -379,7 +437,7 @@ class Viewer:
 
     def close(self) -> None:
         for name in ("background", "_reference_image", "_difference_image", "_overlay",
-                     "_traced", "_tracer", "presenter", "gpu"):
+                     "_traced", "_tracer", "_map_view", "presenter", "gpu"):
             item = getattr(self, name, None)
             if item is not None:
                 (item.close if hasattr(item, "close") else item.release)()

@@ -128,12 +128,14 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
         return 1.0;                  // a light on the surface: fully incident (lighting.glsl)
     }
     vec3 L = normalize(to_light);
-    int f0 = cube_face(-to_light);
-    float t = 2.0 * dot(CUBE_FACE_AXIS[f0], -to_light) * p.y / p.w;   // a texel at P's distance
-    vec3 Q = shadow_bias_point(P, N, L, CUBE_FACE_RIGHT[f0], CUBE_FACE_UP[f0], t,
+    // The face is P's own, also for the moved point Q: the bias is sized with that face's axes,
+    // and its guard band holds Q (at most the normal offset across the map from P). Reading the
+    // face Q falls on instead would meet another face's axes at a seam: acne there.
+    int f = cube_face(-to_light);
+    float t = 2.0 * dot(CUBE_FACE_AXIS[f], -to_light) * p.y / p.w;    // a texel at P's distance
+    vec3 Q = shadow_bias_point(P, N, L, CUBE_FACE_RIGHT[f], CUBE_FACE_UP[f], t,
                                u_point_shadow_bias[i]);
     vec3 d = Q - light;
-    int f = cube_face(d);
     vec4 rect = u_point_shadow_tiles[6 * i + f];
     if (rect.z == 0.0) {
         return 1.0;                  // the face sees no caster: it was not drawn

@@ -213,13 +213,15 @@ def _surely_covered(edges, margin, in_doubt, t, px, py) -> np.ndarray:
 
 def _ring(tris: _PassTriangles, doubt, band0, size, region, dtype):
     """The band's (texel, triangle, depth) (N,) each that a doubtful triangle (`doubt`: their
-    indices) may cover but not surely: within the margins of its edges (`snap_margin`)."""
+    indices) may cover but not surely: within the margins of its edges (`snap_margin`); the
+    depth less its store tolerance (`_tolerance`: the nearest GL may store there)."""
     texels, triangles, depths = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)], [np.zeros(0, dtype)]
     for t, px, py in coverage(tris.window.select(doubt), size, size, region=region,
                               margin=tris.margin[:, doubt]):
+        z = _texel_depth(tris.plane, doubt[t], px, py, dtype)
         texels.append((py - band0) * size + px)
         triangles.append(doubt[t])
-        depths.append(_texel_depth(tris.plane, doubt[t], px, py, dtype))
+        depths.append(z - _tolerance(tris, doubt[t], px, py, z))
     return np.concatenate(texels), np.concatenate(triangles), np.concatenate(depths)
 
 
@@ -244,15 +246,17 @@ def draw_pass(scene, matrices, shadow_pass, layers: ShadowLayers, dtype=np.float
         ring_texel, ring_triangle, ring_z = _ring(tris, doubt, band0, size, region, dtype)
         in_ring = np.zeros(len(z_buffer), bool)
         in_ring[ring_texel] = True
-        behind = np.ones(len(z_buffer), dtype)         # at ring texels: the nearest sure cover
+        behind = np.ones(len(z_buffer), dtype)     # at ring texels: the nearest sure cover + tolerance
         for t, px, py in coverage(tris.window, size, size, region=region):
             texel, z = (py - band0) * size + px, _texel_depth(tris.plane, t, px, py, dtype)
             _nearest_first(z_buffer, winner, first, texel, z, t)
             ring = np.flatnonzero(in_ring[texel])
             ring = ring[_surely_covered(edges, tris.margin, in_doubt, t[ring], px[ring], py[ring])]
-            np.minimum.at(behind, texel[ring], z[ring])
+            farthest = z[ring] + _tolerance(tris, t[ring], px[ring], py[ring], z[ring])
+            np.minimum.at(behind, texel[ring], farthest)
         # GL may store a ring triangle's depth where it did not win here (below: down to the
-        # nearest of them), or, where it won here, not (above: up to the nearest sure cover)
+        # nearest of them), or, where it won here, not (above: up to the nearest sure cover),
+        # each give or take its store tolerance
         where, index = np.unique(ring_texel, return_inverse=True)
         nearest = z_buffer[where].copy()
         np.minimum.at(nearest, index, ring_z)

@@ -123,6 +123,10 @@ class RaySceneRun:
                 runs, warm_up=False)
         return clamped(frame.linear[..., :3]), float(frame.samples.mean()), ms
 
+    def errors(self, setting: RaySetting, image: np.ndarray, truth: np.ndarray) -> dict:
+        from renderer.study.report import metrics
+        return metrics(image, truth)
+
     def release(self) -> None:
         """Nothing to free: each RayTracer is released after its setting."""
 
@@ -131,6 +135,7 @@ class RayStudy:
     """The ray tracer's sweep (module docstring), as report.py's run_report drives it."""
     method = "raytrace"
     columns = RAY_CSV_COLUMNS
+    knobs = ("antialiasing", "max_depth", "precision")
 
     def sweep(self, quick: bool) -> RaySweep:
         return RAY_QUICK if quick else RAY_FULL
@@ -155,6 +160,12 @@ class RayStudy:
 
     def settings(self, sweep: RaySweep, ctx) -> list[RaySetting]:
         return ray_settings(sweep)
+
+    def scene_settings(self, plan: list[RaySetting], scene, width: int, height: int) -> list[RaySetting]:
+        return plan                                      # every scene gets every setting
+
+    def needs_truth(self, plan: list[RaySetting]) -> bool:
+        return bool(plan)
 
     def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
         return ground_truth(scene, width, height, cache_dir, method="raytrace")

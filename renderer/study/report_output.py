@@ -107,8 +107,9 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
             axes.annotate(f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r[error]),
                           fontsize=6, xytext=(4, 3), textcoords="offset points")
     axes.set_xscale("log")
-    if linear_below:
+    if linear_below:                       # errors are >= 0: no negative decades, room above
         axes.set_yscale("symlog", linthresh=linear_below)
+        axes.set_ylim(0.0, 2.0 * max([linear_below, *(r[error] for r in rows)]))
     else:
         axes.set_yscale("log")
     axes.set_xlabel("median time per image (ms)")

@@ -34,6 +34,7 @@ from renderer.core.ray_sampling import FIRST_SET
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED, PATTERNS
 from renderer.core.scene import Plane, Sphere
+from renderer.study.metrics import metrics
 from renderer.study.ground_truth import (RAY_TRUTH_DEPTH, RAY_TRUTH_SAMPLES, ground_truth)
 from renderer.study.report_settings import (RAY_BASE_SAMPLES, RAY_CSV_COLUMNS, RAY_DEFAULT_SIZE,
                                             RAY_MAX_SIZE, RAY_QUICK_SIZE)
@@ -124,7 +125,6 @@ class RaySceneRun:
         return clamped(frame.linear[..., :3]), float(frame.samples.mean()), ms
 
     def errors(self, setting: RaySetting, image: np.ndarray, truth: np.ndarray) -> dict:
-        from renderer.study.report import metrics
         return metrics(image, truth)
 
     def release(self) -> None:

@@ -40,15 +40,14 @@ import numpy as np
 
 from renderer.core import sampling
 from renderer.core.shadow_settings import BIAS_RULES, FILTERS
-from renderer.core.gl_rules import to_unorm8
 from renderer.study.report_output import csv_text, plot_png, report_markdown
 from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
 from renderer.core.imageio import outputs
-from renderer.checks.perceptual import flip_error
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
-from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS,
-                                            QUICK_SIZE, SHADOW_RESOLUTIONS)
+from renderer.study.metrics import metrics
+from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, QUICK_SIZE,
+                                            SHADOW_RESOLUTIONS)
 from renderer.study.shadow_report import (fits, plot_axis, shadow_errors, shadow_variants,
                                           with_shadow_setting)
 from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
@@ -117,18 +116,6 @@ def settings(sweep: Sweep, msaa_counts: list[int]) -> list[Setting]:
                                                sweep.shadow_biases):
         out += [Setting(knob, name, b, "regular", variant, ("pattern", "regular", 1)) for b in both]
     return out
-
-
-def metrics(image: np.ndarray, truth: np.ndarray) -> dict:
-    """Errors of an (H, W, 3) float image in [0, 1] against the truth (module docstring)."""
-    difference = image - truth
-    mse = float(np.mean(difference ** 2))
-    image8, truth8 = to_unorm8(image), to_unorm8(truth)
-    off = np.abs(image8.astype(np.int16) - truth8.astype(np.int16)) > MISMATCH_LEVELS
-    return {"rmse": math.sqrt(mse), "max_abs": float(np.max(np.abs(difference))),
-            "psnr": 10.0 * math.log10(1.0 / mse) if mse > 0 else math.inf,
-            "flip_mean": flip_error(truth8, image8)[0],
-            "mismatched_fraction": float(off.any(axis=-1).mean())}
 
 
 class SceneRun:
@@ -261,6 +248,7 @@ class ReportResult:
     scenes: dict = field(default_factory=dict)        # scene -> the study's describe(scene)
     gl_renderer: str = ""
     files: list = field(default_factory=list)
+    knobs: tuple = ()                                 # the families swept, when not all
 
 
 def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool = False,
@@ -274,6 +262,7 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     from renderer.errors import UserError
     from renderer.gpu.context import make_context, release_context
     runner = study(method)
+    result = ReportResult(knobs=tuple(knobs or ()))
     knobs = tuple(knobs or runner.knobs)
     unknown = [k for k in knobs if k not in runner.knobs]
     if unknown:
@@ -283,7 +272,6 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     runner.check(scenes, width, height)
     sweep = sweep or runner.sweep(quick)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
-    result = ReportResult()
     start = time.perf_counter()
     ctx = make_context(context_kind)
     try:

@@ -252,7 +252,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     lines = [
         "# Error against run time",
         "",
-        generated_line(result, size, sweep.runs, f"renderer report{' --quick' if quick else ''}"),
+        generated_line(result, size, sweep.runs, f"renderer report{' --quick' if quick else ''}"
+                       + (f" --knobs {','.join(result.knobs)}" if result.knobs else "")),
         "",
         "## Scenes",
         "",

@@ -301,7 +301,7 @@ def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli):
 
 def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
     result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa",
-                 "--method", "raster")
+                 "--method", "raster", "--no-sweep")
     assert result.returncode == 0, result.stdout + result.stderr
     document = json.loads((tmp_path / "extremes.json").read_text())
     table = (tmp_path / "extremes.md").read_text()
@@ -317,6 +317,7 @@ def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
             assert all(case["finite"].values()) and set(case["finite"]) == {"osmesa", "reference"}
             assert case["passes"] or case.get("before")
     assert document["size"] == [64, 48] and math.isfinite(cases["far_from_origin"]["worst"]["rmse"])
+    assert "light_elevation_sweep" not in document and "sweep" not in table
 
 
 @pytest.mark.slow

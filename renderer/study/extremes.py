@@ -41,6 +41,7 @@ from renderer.gpu.raytracer import RayTracer
 from renderer.core.imageio import outputs
 from renderer.core.jsonio import json_text
 from renderer.core.scene_file import load_scene
+from renderer.study.shadow_sweep import markdown_section, sweep_acne
 
 REVERSED_Z_STABILITY = ("reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
                         "depth buffer cleared to 0 and GL_GREATER; the shadow map keeps the "
@@ -304,17 +305,25 @@ def _backends(cases: list[dict]) -> list[str]:
     return ["reference"]
 
 
-def write_report(out: Path, cases: list[dict], size: tuple[int, int]) -> tuple[Path, Path]:
-    """extremes.json (every figure of every case) and extremes.md (the table): both or neither
+def write_report(out: Path, cases: list[dict], size: tuple[int, int],
+                 sweep: list[dict] | None = None) -> tuple[Path, Path]:
+    """extremes.json (every figure of every case, and of the light-elevation sweep when
+    measured: renderer/study/shadow_sweep.py) and extremes.md (the tables): both or neither
     (imageio.outputs)."""
     json_path, md_path = Path(out) / "extremes.json", Path(out) / "extremes.md"
     document = {"size": list(size), "cases": cases}
+    table = markdown_table(cases, size)
+    if sweep is not None:
+        document["light_elevation_sweep"] = sweep
+        table += "\n" + markdown_section(sweep, size)
     with outputs(json_path, md_path) as written:
         written.text(json_path, json_text(_json_safe(document)))
-        written.text(md_path, markdown_table(cases, size))
+        written.text(md_path, table)
     return json_path, md_path
 
 
-def all_pass(cases: list[dict]) -> bool:
-    """Every case as authored passes (the reversed_z-off rows are the 'before' and may not)."""
-    return all(case["passes"] for case in cases if not case.get("before"))
+def all_pass(cases: list[dict], sweep: list[dict] = ()) -> bool:
+    """Every case as authored passes (the reversed_z-off rows are the 'before' and may not),
+    and the sweep shows no acne on any backend (where the truth was measured)."""
+    return (all(case["passes"] for case in cases if not case.get("before"))
+            and not any(sweep_acne(row) for row in sweep))

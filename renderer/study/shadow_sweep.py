@@ -121,6 +121,12 @@ def measure_sweep(size: tuple[int, int], contexts: dict, elevations=ELEVATIONS) 
     return rows
 
 
+def sweep_acne(row: dict) -> int:
+    """The most acne pixels of a sweep row over its backends (0 where none was measured)."""
+    return max((figures["acne_pixels"] for key, figures in row.items()
+                if key != "elevation" and figures is not None), default=0)
+
+
 def _cell(row: dict, backends: list[str], key: str) -> str:
     values = [row[b][key] if row.get(b) is not None else None for b in backends]
     return " / ".join("n/a" if v is None else f"{v:,}" for v in values)

@@ -19,8 +19,6 @@ Not a test: this machine is shared and noisy; the load average is printed.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 
@@ -33,12 +31,9 @@ from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.gpu.raytracer import RayTracer
 
+from common import machine                       # benchmarks/common.py
+
 N, TRUTH_SPP, TRUTH_SEED = 16, 64, 64
-
-
-def machine() -> str:
-    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    return f"{platform.node()}: {os.cpu_count()} CPUs, load average {load}"
 
 
 def error_steps(frame, truth) -> tuple[float, float]:

@@ -27,8 +27,6 @@ Not a test: this machine is shared and noisy; the load average is printed.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import statistics
 import time
 
@@ -42,6 +40,8 @@ from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.gpu.context import make_context
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.raytracer import RayTracer
+
+from common import alternating_ms, machine       # benchmarks/common.py
 
 RAYTRACE_SCENES = ("classic", "cornell_box", "mesh_shadow", "tir_bubble")
 ICOSPHERE = "icosphere (20,480 tri)"
@@ -89,22 +89,6 @@ def gpu_ms(tracer, frames: int):
         tracer.render()
         times.append((time.perf_counter() - start) * 1000.0)
     return statistics.median(times)
-
-
-def alternating_ms(calls, frames: int) -> list[float]:
-    """The median ms of each callable, called in turn `frames` times (so all see the same load)."""
-    times = [[] for _ in calls]
-    for _ in range(frames):
-        for call, spent in zip(calls, times):
-            start = time.perf_counter()
-            call()
-            spent.append((time.perf_counter() - start) * 1000.0)
-    return [statistics.median(spent) for spent in times]
-
-
-def machine() -> str:
-    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
-    return f"{platform.node()}: {os.cpu_count()} CPUs, load average {load}"
 
 
 def main() -> None:

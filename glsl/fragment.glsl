@@ -5,20 +5,69 @@
 // interpolated normal, flips it for a two-sided back face, and lights the fragment.
 // out_color is clamped and converted to unorm8 by GL; LINEAR_OUTPUT adds the unclamped
 // float colour as a second output. Alpha is 1: the background is cleared to alpha 0.
-// SHADOW_MAPS (Phong, an object that receives shadows in a scene with maps): each light's
-// diffuse and specular terms are multiplied by its visibility from the shadow maps
-// (lighting.glsl's SHADOWS hook, answered by shadow/lookup.glsl).
+// SHADOW_MAPS (an object that receives shadows in a scene with maps): each light's diffuse
+// and specular terms are multiplied by its visibility from the shadow maps (lighting.glsl's
+// SHADOWS hook, answered by shadow/lookup.glsl), looked up at this fragment's world position
+// with its lit normal (flipped for a two-sided back face). Phong lights the fragment so; flat
+// and Gouraud get the terms apart from geometry.glsl (one per triangle, the face normal) or
+// vertex.glsl (interpolated, the interpolated normal renormalised): the ambient term plus each
+// light's term times its visibility, with no lookup where the term is 0.
 
-#if defined(SHADING_PHONG)
 #ifdef SHADOW_MAPS
 #define SHADOWS
 #endif
+#if defined(SHADING_PHONG) || defined(SHADOW_MAPS)
 #include "lighting.glsl"
+#endif
 #ifdef SHADOW_MAPS
 #include "shadow/lookup.glsl"
 #endif
+
+#if defined(SHADING_PHONG)
 in vec3 v_world_position;
 in vec3 v_world_normal;
+#elif defined(SHADOW_MAPS) && defined(SHADING_FLAT)
+in vec3 f_world_position;            // from geometry.glsl
+flat in vec3 f_face_normal;          // the terms: one per triangle
+flat in vec3 f_ambient;
+#if NUM_DIRECTIONAL_TERMS > 0
+flat in vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+flat in vec3 f_directional_terms_back[NUM_DIRECTIONAL_TERMS];
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+flat in vec3 f_point_terms_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+flat in vec3 f_point_terms_back[NUM_POINT_TERMS];
+#endif
+#endif
+#define AMBIENT f_ambient
+#define DIRECTIONAL_TERMS_FRONT f_directional_terms_front
+#define DIRECTIONAL_TERMS_BACK f_directional_terms_back
+#define POINT_TERMS_FRONT f_point_terms_front
+#define POINT_TERMS_BACK f_point_terms_back
+#elif defined(SHADOW_MAPS)
+in vec3 v_world_position;            // from vertex.glsl, interpolated
+in vec3 v_world_normal;
+in vec3 v_ambient;
+#if NUM_DIRECTIONAL_TERMS > 0
+in vec3 v_directional_terms_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+in vec3 v_directional_terms_back[NUM_DIRECTIONAL_TERMS];
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+in vec3 v_point_terms_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+in vec3 v_point_terms_back[NUM_POINT_TERMS];
+#endif
+#endif
+#define AMBIENT v_ambient
+#define DIRECTIONAL_TERMS_FRONT v_directional_terms_front
+#define DIRECTIONAL_TERMS_BACK v_directional_terms_back
+#define POINT_TERMS_FRONT v_point_terms_front
+#define POINT_TERMS_BACK v_point_terms_back
 #elif defined(SHADING_FLAT)
 flat in vec3 f_color_front;          // from geometry.glsl, one per triangle
 #ifdef TWO_SIDED
@@ -45,15 +94,59 @@ layout(location = 0) out vec4 out_color;
 layout(location = 1) out vec4 out_linear_color;
 #endif
 
+#if defined(SHADOW_MAPS) && !defined(SHADING_PHONG)
+// The terms of the side seen (`back`: a two-sided back face), each light's weighed by its
+// visibility at P with the lit normal N, added to the ambient term in lighting()'s order.
+vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
+    vec3 color = AMBIENT;
+#if NUM_DIRECTIONAL_TERMS > 0
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
+#ifdef TWO_SIDED
+        vec3 term = back ? DIRECTIONAL_TERMS_BACK[i] : DIRECTIONAL_TERMS_FRONT[i];
+#else
+        vec3 term = DIRECTIONAL_TERMS_FRONT[i];
+#endif
+        color += shadowed_directional(i, P, N, term);
+    }
+#endif
+#if NUM_POINT_TERMS > 0
+    for (int i = 0; i < POINT_LIGHTS; ++i) {
+#ifdef TWO_SIDED
+        vec3 term = back ? POINT_TERMS_BACK[i] : POINT_TERMS_FRONT[i];
+#else
+        vec3 term = POINT_TERMS_FRONT[i];
+#endif
+        color += shadowed_point(i, P, N, term);
+    }
+#endif
+    return color;
+}
+#endif
+
 void main() {
+#if defined(SHADING_PHONG) || defined(SHADOW_MAPS)
 #if defined(SHADING_PHONG)
+    vec3 P = v_world_position;
     vec3 N = normalize_or_zero(v_world_normal);
+#elif defined(SHADING_FLAT)
+    vec3 P = f_world_position;
+    vec3 N = f_face_normal;
+#else
+    vec3 P = v_world_position;
+    vec3 N = normalize_or_zero(v_world_normal);
+#endif
+    bool back = false;
 #ifdef TWO_SIDED
     if (BACK_FACE_LIT) {
         N = -N;                      // the back face is seen: light its side
+        back = true;
     }
 #endif
-    vec3 color = lighting(v_world_position, N);
+#if defined(SHADING_PHONG)
+    vec3 color = lighting(P, N);
+#else
+    vec3 color = shadowed_terms(P, N, back);
+#endif
 #elif defined(SHADING_FLAT)
 #ifdef TWO_SIDED
     vec3 color = BACK_FACE_LIT ? f_color_back : f_color_front;

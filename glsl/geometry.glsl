@@ -5,6 +5,10 @@
 // positions in the mesh's vertex order. TWO_SIDED also lights the back side with -N; the
 // fragment shader picks by facing. Positions pass through unchanged, so clipping and
 // rasterisation are those of the triangle as drawn.
+// SHADOW_MAPS: the face's lighting is kept apart as the vertex stage's Gouraud terms are (the
+// ambient term and each light's term, one per triangle), with the face normal and the
+// interpolated world position, for fragment.glsl to weigh each light's term by its
+// visibility per fragment.
 
 #include "lighting.glsl"
 
@@ -13,9 +17,27 @@ layout(triangle_strip, max_vertices = 3) out;
 
 in vec3 v_world_position[];
 
+#ifdef SHADOW_MAPS
+out vec3 f_world_position;           // where fragment.glsl looks the maps up
+flat out vec3 f_face_normal;
+flat out vec3 f_ambient;             // I_a k_a
+#if NUM_DIRECTIONAL_TERMS > 0
+flat out vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+flat out vec3 f_directional_terms_back[NUM_DIRECTIONAL_TERMS];
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+flat out vec3 f_point_terms_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+flat out vec3 f_point_terms_back[NUM_POINT_TERMS];
+#endif
+#endif
+#else
 flat out vec3 f_color_front;         // lit with N
 #ifdef TWO_SIDED
 flat out vec3 f_color_back;          // lit with -N
+#endif
 #endif
 
 void main() {
@@ -24,15 +46,61 @@ void main() {
     vec3 p2 = v_world_position[2];
     vec3 face_normal = normalize_or_zero(cross(p1 - p0, p2 - p0));
     vec3 face_centroid = (p0 + p1 + p2) / 3.0;
+#ifdef SHADOW_MAPS
+    vec3 V = view_vector(face_centroid);
+#if NUM_DIRECTIONAL_TERMS > 0
+    vec3 directional_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+    vec3 directional_back[NUM_DIRECTIONAL_TERMS];
+#endif
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
+        directional_front[i] = directional_term(i, face_normal, V);
+#ifdef TWO_SIDED
+        directional_back[i] = directional_term(i, -face_normal, V);
+#endif
+    }
+#endif
+#if NUM_POINT_TERMS > 0
+    vec3 point_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+    vec3 point_back[NUM_POINT_TERMS];
+#endif
+    for (int i = 0; i < POINT_LIGHTS; ++i) {
+        point_front[i] = point_term(i, face_centroid, face_normal, V);
+#ifdef TWO_SIDED
+        point_back[i] = point_term(i, face_centroid, -face_normal, V);
+#endif
+    }
+#endif
+#else
     vec3 front_color = lighting(face_centroid, face_normal);
 #ifdef TWO_SIDED
     vec3 back_color = lighting(face_centroid, -face_normal);
 #endif
+#endif
     for (int i = 0; i < 3; ++i) {
         gl_Position = gl_in[i].gl_Position;
+#ifdef SHADOW_MAPS
+        f_world_position = v_world_position[i];
+        f_face_normal = face_normal;
+        f_ambient = ambient_term();
+#if NUM_DIRECTIONAL_TERMS > 0
+        f_directional_terms_front = directional_front;
+#ifdef TWO_SIDED
+        f_directional_terms_back = directional_back;
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+        f_point_terms_front = point_front;
+#ifdef TWO_SIDED
+        f_point_terms_back = point_back;
+#endif
+#endif
+#else
         f_color_front = front_color;
 #ifdef TWO_SIDED
         f_color_back = back_color;
+#endif
 #endif
         EmitVertex();
     }

@@ -14,7 +14,10 @@
 //     from light_visibility_directional(i, P, N) / light_visibility_point(i, P, N), which the
 //     including shader defines (shadow rays); a point in shadow keeps only the ambient term.
 //     A light whose terms are 0 at P (behind the surface, or a material with k_d = k_s = 0)
-//     casts no shadow ray: its visibility could change nothing.
+//     casts no shadow ray: its visibility could change nothing. The rasteriser's fragment
+//     stage defines SHADOWS too, answered by shadow maps (glsl/shadow/lookup.glsl).
+// Each light's term is a function of its own (directional_term, point_term), which flat and
+// Gouraud receivers of shadows also call to keep the terms apart (glsl/vertex.glsl).
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
 #define NUM_DIRECTIONAL_LIGHTS 0
@@ -97,41 +100,73 @@ vec3 light_contribution(vec3 N, vec3 L, vec3 V, vec3 att_intensity) {
     return I;
 }
 
+// V, the unit vector from P to the eye (only the specular term looks at it).
+vec3 view_vector(vec3 P) {
+#ifdef SPECULAR
+    return normalize_or_zero(u_eye - P);
+#else
+    return vec3(0.0);
+#endif
+}
+
+// The ambient term I_a k_a.
+vec3 ambient_term() {
+    return u_ambient * u_ka;
+}
+
+// The term of light i at P with unit normal N (its diffuse and specular terms): what
+// lighting() adds per light, and what flat and Gouraud receivers of shadows keep apart
+// (glsl/vertex.glsl, glsl/geometry.glsl) to weigh by visibility per fragment.
+#if NUM_DIRECTIONAL_LIGHTS > 0
+vec3 directional_term(int i, vec3 N, vec3 V) {
+    vec3 L = normalize(-u_directional_direction[i]);
+    return light_contribution(N, L, V, u_directional_intensity[i]);         // att = 1
+}
+#endif
+#if NUM_POINT_LIGHTS > 0
+vec3 point_term(int i, vec3 P, vec3 N, vec3 V) {
+    vec3 to_light = u_point_position[i] - P;
+    float d = length(to_light);
+    vec3 L = d > 0.0 ? to_light / d : N;             // a light on the surface: fully incident
+    vec3 c_l_q = u_point_attenuation[i];
+    float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
+    return light_contribution(N, L, V, att * u_point_intensity[i]);
+}
+#endif
+
+#ifdef SHADOWS
+// A light's term times its visibility at P (lit normal N); no shadow ray where the term is 0.
+#if NUM_DIRECTIONAL_LIGHTS > 0
+vec3 shadowed_directional(int i, vec3 P, vec3 N, vec3 term) {
+    return term != vec3(0.0) ? light_visibility_directional(i, P, N) * term : vec3(0.0);
+}
+#endif
+#if NUM_POINT_LIGHTS > 0
+vec3 shadowed_point(int i, vec3 P, vec3 N, vec3 term) {
+    return term != vec3(0.0) ? light_visibility_point(i, P, N) * term : vec3(0.0);
+}
+#endif
+#endif
+
 // The colour I at world point P with unit normal N (already flipped for a two-sided back face).
 vec3 lighting(vec3 P, vec3 N) {
-#ifdef SPECULAR
-    vec3 V = normalize_or_zero(u_eye - P);
-#else
-    vec3 V = vec3(0.0);                              // only the specular term looks at V
-#endif
-    vec3 I = u_ambient * u_ka;
+    vec3 V = view_vector(P);
+    vec3 I = ambient_term();
 #if NUM_DIRECTIONAL_LIGHTS > 0
     for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
-        vec3 L = normalize(-u_directional_direction[i]);
 #ifdef SHADOWS
-        vec3 term = light_contribution(N, L, V, u_directional_intensity[i]);
-        if (term != vec3(0.0)) {                     // no shadow ray for a light that adds 0
-            I += light_visibility_directional(i, P, N) * term;
-        }
+        I += shadowed_directional(i, P, N, directional_term(i, N, V));
 #else
-        I += light_contribution(N, L, V, u_directional_intensity[i]);       // att = 1
+        I += directional_term(i, N, V);
 #endif
     }
 #endif
 #if NUM_POINT_LIGHTS > 0
     for (int i = 0; i < POINT_LIGHTS; ++i) {
-        vec3 to_light = u_point_position[i] - P;
-        float d = length(to_light);
-        vec3 L = d > 0.0 ? to_light / d : N;         // a light on the surface: fully incident
-        vec3 c_l_q = u_point_attenuation[i];
-        float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
 #ifdef SHADOWS
-        vec3 term = light_contribution(N, L, V, att * u_point_intensity[i]);
-        if (term != vec3(0.0)) {
-            I += light_visibility_point(i, P, N) * term;
-        }
+        I += shadowed_point(i, P, N, point_term(i, P, N, V));
 #else
-        I += light_contribution(N, L, V, att * u_point_intensity[i]);
+        I += point_term(i, P, N, V);
 #endif
     }
 #endif

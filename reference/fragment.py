@@ -7,10 +7,14 @@ Per-fragment shading, run only for the fragment that survived the depth test at 
            the geometry stage);
 - gouraud: out_color = gl_FrontFacing ? v_color_front : v_color_back, interpolated;
 - phong:   N = normalize_or_zero(v_world_normal); N = -N for a two-sided material seen from the
-           back; out_color = lighting(v_world_position, N), each light's terms times its
-           shadow-map visibility when the object receives shadows and the frame has maps
-           (SHADOWS; reference/shadow/lookup.py). Flat and Gouraud receivers are not shadowed
-           (their lighting is per vertex; issue 15 step 2).
+           back; out_color = lighting(v_world_position, N).
+When the object receives shadows and the frame has maps (SHADOW_MAPS), each light's term is
+multiplied by its shadow-map visibility (reference/shadow/lookup.py) at the fragment's
+interpolated world position P with the lit normal N (flipped for a two-sided back face):
+Phong as above; flat with P from f_world_position, its face normal and the triangle's terms
+(f_ambient, f_*_terms_*), Gouraud with normalize_or_zero(v_world_normal) and the vertices'
+terms interpolated (v_ambient, v_*_terms_*), of the
+side seen: out_color = ambient + sum_l visibility_l term_l, no lookup where a term is 0.
 Alpha is 1. Also out_view_depth, the interpolated -z_eye, for the depth image.
 
 Inputs:  `ObjectVaryings` (the vertex and geometry stage outputs of one object, its faces
@@ -29,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.geometry import TriangleOutputs
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
+from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, lighting, normalize_or_zero
 from reference.shadow.lookup import FragmentShadows, ShadowMaps
 from reference.vertex import VertexOutputs
 
@@ -64,33 +68,57 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
     shadow ties or None). `shadows`: the frame's maps, or None (no SHADOW_MAPS)."""
     material, faces, vertices = obj.material, obj.faces, obj.vertices
     dtype = vertices.gl_Position.dtype
+    if material.shading not in ("flat", "gouraud", "phong"):
+        raise ValueError(f"unknown shading mode {material.shading!r}")
+    shadowed = shadows is not None and obj.receives_shadows
     tie = None
-    if material.shading == "flat":
+    if material.shading == "flat" and not shadowed:
         color = select_by_facing(gl_FrontFacing, obj.triangles.f_color_front[triangle],
                                  obj.triangles.f_color_back[triangle])
-    elif material.shading == "gouraud":
+    elif material.shading == "gouraud" and not shadowed:
         color = select_by_facing(gl_FrontFacing,
                                  interpolate(vertices.v_color_front, faces, triangle, weights),
                                  interpolate(vertices.v_color_back, faces, triangle, weights))
-    elif material.shading == "phong":
-        P = interpolate(vertices.v_world_position, faces, triangle, weights)
-        N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
+    else:
+        # The lit point: P interpolated, N the renormalised interpolated normal (the face normal
+        # for flat), flipped for a two-sided back face.
+        if material.shading == "flat":
+            corners = obj.triangles.f_world_position[triangle]                   # (N, 3, 3)
+            P = (weights[:, 0:1] * corners[:, 0] + weights[:, 1:2] * corners[:, 1]
+                 + weights[:, 2:3] * corners[:, 2])
+            N = obj.triangles.f_face_normal[triangle]
+        else:
+            P = interpolate(vertices.v_world_position, faces, triangle, weights)
+            N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
         if material.two_sided:
             N = np.where(gl_FrontFacing[:, None], N, -N)
         E, uniforms = np.asarray(u_eye, dtype=dtype), MaterialUniforms.from_material(material, dtype)
-        if shadows is None or not obj.receives_shadows:
+        if not shadowed:
             color = lighting(P, N, E, uniforms, lights)
         else:
+            terms = _terms_of_side(obj, triangle, weights, gl_FrontFacing, P, N, E, uniforms, lights)
             # the tie bands' scale: GL interpolates P from these vertices (lookup.py, SHADOW_TIE)
             scale = np.abs(vertices.v_world_position[faces[triangle]]).max(axis=(1, 2))
             look = FragmentShadows(shadows, scale)
-            color = lighting(P, N, E, uniforms, lights, look.visibility)
+            color = terms.shade(P, N, look.visibility)
             tied = look.tied
             if tied is not None and tied.any():
-                other = lighting(P, N, E, uniforms, lights, look.alternative)
+                other = terms.shade(P, N, look.alternative)
                 tie = (tied, np.concatenate([other, np.ones((len(other), 1), dtype=dtype)], axis=1))
-    else:
-        raise ValueError(f"unknown shading mode {material.shading!r}")
     out_color = np.concatenate([color, np.ones((len(color), 1), dtype=dtype)], axis=1)
     out_view_depth = interpolate(vertices.v_view_depth, faces, triangle, weights)
     return out_color, out_view_depth, tie
+
+
+def _terms_of_side(obj: ObjectVaryings, triangle, weights, gl_FrontFacing, P, N, E, uniforms,
+                   lights) -> LightTerms:
+    """The lighting's terms at the fragments, of the side seen: Phong lights P with N here;
+    flat takes its triangle's (flat varyings), Gouraud interpolates its vertices'."""
+    if obj.material.shading == "phong":
+        return light_terms(P, N, E, uniforms, lights)
+    if obj.material.shading == "flat":
+        front, back = (obj.triangles.light_terms(side).map(lambda a: a[triangle]) for side in (False, True))
+    else:
+        front, back = (obj.vertices.light_terms(side).map(lambda a: interpolate(a, obj.faces, triangle, weights))
+                       for side in (False, True))
+    return front.where(gl_FrontFacing, back) if obj.material.two_sided else front

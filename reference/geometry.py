@@ -11,6 +11,12 @@ Outputs: `TriangleOutputs` in the same dtype:
          f_color_front (T, 3)   colour lit with the face normal (flat varying)
          f_color_back (T, 3)    colour lit with -normal for a two-sided material, else
                                 the front colour; the fragment picks by gl_FrontFacing
+         f_world_position (T, 3, 3)  the vertices' world positions, passed on (the
+                                fragment interpolates P from them)
+         f_ambient (T, 3), f_directional_terms_front (T, Ld, 3), f_point_terms_front
+         (T, Lp, 3), f_*_terms_back (lit with -normal; the front's when one-sided): the same
+                                lighting kept apart (`LightTerms`), whose sums the colours
+                                are: what a flat receiver of shadows hands on (SHADOW_MAPS)
 """
 
 from __future__ import annotations
@@ -19,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
+from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, normalize_or_zero
 
 
 @dataclass
@@ -28,6 +34,18 @@ class TriangleOutputs:
     f_centroid: np.ndarray
     f_color_front: np.ndarray
     f_color_back: np.ndarray
+    f_world_position: np.ndarray
+    f_ambient: np.ndarray
+    f_directional_terms_front: np.ndarray
+    f_directional_terms_back: np.ndarray
+    f_point_terms_front: np.ndarray
+    f_point_terms_back: np.ndarray
+
+    def light_terms(self, back: bool) -> LightTerms:
+        """The terms of the front (or back) side, per triangle."""
+        if back:
+            return LightTerms(self.f_ambient, self.f_directional_terms_back, self.f_point_terms_back)
+        return LightTerms(self.f_ambient, self.f_directional_terms_front, self.f_point_terms_front)
 
 
 def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
@@ -46,7 +64,11 @@ def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,
     uniforms = MaterialUniforms.from_material(material, dtype)
     eye = np.asarray(u_eye, dtype=dtype)
     with np.errstate(invalid="ignore"):
-        f_color_front = lighting(f_centroid, f_face_normal, eye, uniforms, lights)
-        f_color_back = (lighting(f_centroid, -f_face_normal, eye, uniforms, lights)
+        front = light_terms(f_centroid, f_face_normal, eye, uniforms, lights)
+        back = (light_terms(f_centroid, -f_face_normal, eye, uniforms, lights)
+                if material.two_sided else front)
+        f_color_front = front.shade(f_centroid, f_face_normal)
+        f_color_back = (back.shade(f_centroid, -f_face_normal)
                         if material.two_sided else f_color_front)
-    return TriangleOutputs(f_face_normal, f_centroid, f_color_front, f_color_back)
+    return TriangleOutputs(f_face_normal, f_centroid, f_color_front, f_color_back, v_world_position,
+                           front.ambient, front.directional, back.directional, front.point, back.point)

@@ -10,6 +10,10 @@ Inputs:  P (..., 3) surface points and N (..., 3) unit normals in world space, E
          (the GLSL light uniforms, from renderer/core/uniforms.py). Everything in one float dtype.
 Output:  I (..., 3) linear RGB in that dtype, unclamped.
 
+`light_terms` keeps the equation's terms apart (`LightTerms`: the ambient term and each
+light's term, the GLSL's ambient_term, directional_term and point_term), as flat and Gouraud
+receivers of shadows hand them on; lighting() is their sum, one light at a time.
+
 The sides rule (one-sided / two-sided) is not applied here: callers pass the normal that
 is to be lit (the vertex, geometry and fragment stages flip it for back faces).
 """
@@ -119,9 +123,89 @@ def light_contribution(N, L, V, att, intensity, material: MaterialUniforms) -> n
     return att * intensity * (diffuse + specular)
 
 
+@dataclass
+class LightTerms:
+    """The lighting equation kept apart, as the shader's terms (glsl/lighting.glsl): the ambient
+    term I_a k_a (..., 3) and each light's term att I_l (k_d max(N.L, 0) + k_s spec), the
+    directional lights' (..., Ld, 3) and the point lights' (..., Lp, 3), in lighting()'s order.
+    Flat and Gouraud receivers of shadows hand these on per triangle or per vertex (the GLSL's
+    *_ambient, *_directional_terms_*, *_point_terms_* varyings); the fragment stage weighs each
+    light's term by its visibility there."""
+    ambient: np.ndarray
+    directional: np.ndarray
+    point: np.ndarray
+
+    @property
+    def terms(self):
+        """(kind, i, term (..., 3)) for each light, in lighting()'s order."""
+        for kind, stacked in (("directional", self.directional), ("point", self.point)):
+            for i in range(stacked.shape[-2]):
+                yield kind, i, stacked[..., i, :]
+
+    def map(self, f) -> "LightTerms":
+        """The same terms with `f` applied to each array (interpolation, selection by index)."""
+        return LightTerms(f(self.ambient), f(self.directional), f(self.point))
+
+    def where(self, condition: np.ndarray, other: "LightTerms") -> "LightTerms":
+        """condition (N,) ? self : other, per point."""
+        def pick(a, b):
+            return np.where(condition.reshape(condition.shape + (1,) * (a.ndim - 1)), a, b)
+        return LightTerms(pick(self.ambient, other.ambient), pick(self.directional, other.directional),
+                          pick(self.point, other.point))
+
+    def shade(self, P: np.ndarray, N: np.ndarray, visibility=None) -> np.ndarray:
+        """I = ambient + sum_l term_l (shade_terms)."""
+        return shade_terms(self.ambient, self.terms, P, N, visibility)
+
+
+def shade_terms(ambient: np.ndarray, terms, P: np.ndarray, N: np.ndarray, visibility=None) -> np.ndarray:
+    """I = ambient + sum_l term_l over (kind, i, term) `terms` in order, each term times
+    visibility(kind, i, P, N, needed) when given (lighting()'s `visibility`; `needed`: where
+    the term is not 0)."""
+    I = ambient.astype(ambient.dtype, copy=True)
+    for kind, i, term in terms:
+        I += term if visibility is None else visibility(kind, i, P, N, (term != 0).any(-1)) * term
+    return I
+
+
+def ambient_term(P: np.ndarray, N: np.ndarray, material: MaterialUniforms, lights: Lights) -> np.ndarray:
+    """I_a k_a at each point (the shape P and N broadcast to), in P's dtype (a read-only view)."""
+    ambient = np.asarray(lights.u_ambient * material.u_ka).astype(P.dtype)
+    return np.broadcast_to(ambient, np.broadcast_shapes(ambient.shape, P.shape, N.shape))
+
+
+def each_light_term(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
+                    lights: Lights):
+    """(kind, i, term) for each light, one at a time, in lighting()'s order (glsl/lighting.glsl:
+    directional_term, point_term)."""
+    V = normalize_or_zero(E - P)
+    for i, (direction, intensity) in enumerate(zip(lights.u_directional_direction,
+                                                   lights.u_directional_intensity)):
+        L = directional_light_vector(direction)
+        yield "directional", i, light_contribution(N, L, V, 1.0, intensity, material)
+    for i, (position, intensity, attenuation) in enumerate(zip(
+            lights.u_point_position, lights.u_point_intensity, lights.u_point_attenuation)):
+        L, att = point_light_vector(P, N, position, attenuation)
+        yield "point", i, light_contribution(N, L, V, att, intensity, material)
+
+
+def light_terms(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
+                lights: Lights) -> LightTerms:
+    """The ambient term and every light's term at points P (..., 3) with unit normals N
+    (..., 3), kept. E and the material's arrays may vary per point (broadcast against P)."""
+    ambient = ambient_term(P, N, material, lights)
+    stacked = {"directional": [], "point": []}
+    for kind, _, term in each_light_term(P, N, E, material, lights):
+        stacked[kind].append(np.broadcast_to(term, ambient.shape))
+    empty = np.zeros(ambient.shape[:-1] + (0, 3), P.dtype)
+    return LightTerms(ambient, *(np.stack(terms, axis=-2) if terms else empty
+                                 for terms in stacked.values()))
+
+
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
              lights: Lights, visibility=None) -> np.ndarray:
-    """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3).
+    """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3): the sum
+    of light_terms.
 
     `visibility` (the shader's SHADOWS; the ray tracer's shadow rays): None lights every point
     by every light (the rasteriser's path, unchanged), else a callable
@@ -130,18 +214,7 @@ def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUnif
     GLSL's light_visibility_directional / light_visibility_point): in shadow, ambient only.
     `needed` (...,) is where the light's terms are not 0: elsewhere visibility can change
     nothing, and the GLSL casts no shadow ray (the callable may answer anything there).
-    E and the material's arrays may vary per point (broadcast against P)."""
-    V = normalize_or_zero(E - P)
-    I = np.broadcast_to(lights.u_ambient * material.u_ka, np.broadcast_shapes(P.shape, N.shape))
-    I = I.astype(P.dtype, copy=True)
-    for i, (direction, intensity) in enumerate(zip(lights.u_directional_direction,
-                                                   lights.u_directional_intensity)):
-        L = directional_light_vector(direction)
-        term = light_contribution(N, L, V, 1.0, intensity, material)
-        I += term if visibility is None else visibility("directional", i, P, N, (term != 0).any(-1)) * term
-    for i, (position, intensity, attenuation) in enumerate(zip(
-            lights.u_point_position, lights.u_point_intensity, lights.u_point_attenuation)):
-        L, att = point_light_vector(P, N, position, attenuation)
-        term = light_contribution(N, L, V, att, intensity, material)
-        I += term if visibility is None else visibility("point", i, P, N, (term != 0).any(-1)) * term
-    return I
+    E and the material's arrays may vary per point (broadcast against P). One light's term
+    at a time (the terms are not kept)."""
+    return shade_terms(ambient_term(P, N, material, lights), each_light_term(P, N, E, material, lights),
+                       P, N, visibility)

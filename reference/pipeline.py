@@ -9,11 +9,16 @@ memory stays bounded. Objects wholly outside the view volume are skipped (render
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 When the scene has shadow maps (renderer/core/shadows.py: shadow_layout(...).any), the
-frame's maps are drawn first (reference/shadow/depth.py, a layer each) and Phong receivers look it up
-(reference/shadow/lookup.py); where a lookup had a tied tap, the pixel's colour with those
+frame's maps are drawn first (reference/shadow/depth.py, a layer each) and receivers, of
+every shading mode, look them up (reference/shadow/lookup.py); where a lookup had a tied tap, the pixel's colour with those
 taps decided the other way goes into Frame.rgba8_tie too (a pixel with both kinds of tie
 shows the depth tie's other surface there: either is an acceptable answer, and one
 alternative per pixel is what compare takes), and Frame.shadow_ties marks those pixels.
+
+`surface_pixels` runs the same stages up to the depth test and hands out the surface each
+drawn pixel of a Phong object shows (P, the lit N, its triangle's plane normal, its object),
+with the frame's shadow maps, for holding the fragment stage's inputs against another method
+(renderer/checks/shadow_truth.py).
 
 Input:  a `renderer.core.scene.Scene` and the image size. Output: a `renderer.core.frame.Frame`
 (rgba8 (H, W, 4) uint8 row 0 at the top, optional linear (H, W, 4) float32, depth (H, W)
@@ -29,9 +34,9 @@ import numpy as np
 
 from reference.clipping import clip_triangles
 from reference.depth_buffer import DepthBuffer
-from reference.fragment import ObjectVaryings, shade_fragments
+from reference.fragment import ObjectVaryings, interpolate, shade_fragments
 from reference.geometry import shade_triangles
-from reference.lighting import Lights
+from reference.lighting import Lights, normalize_or_zero
 from reference.output import compose_frame
 from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
 from reference.shadow.depth import render_layers
@@ -117,8 +122,37 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
     `tile_pixels` pixels is drawn band by band (the same image: every stage after culling
     works pixel by pixel), so its memory beyond the output arrays stays bounded."""
     start = time.perf_counter()
-    check_light_count(scene)             # the GPU's limit, held alike (renderer/core/gl_rules.py)
     dtype = np.dtype(dtype)
+    prepared = prepare_frame(scene, width, height, dtype, subpixel_bits, sample_offset, tile_pixels)
+    bands = tiles(width, height, tile_pixels)
+    if len(bands) == 1:
+        frame = _render_tile(bands[0], prepared, scene, width, height, linear, depth, dtype)
+    else:
+        frame = _render_in_tiles(bands, prepared, scene, width, height, linear, depth, dtype)
+    frame.milliseconds = (time.perf_counter() - start) * 1000.0
+    return frame
+
+
+@dataclass
+class PreparedFrame:
+    """What every tile of a frame starts from: the lights and the eye (camera-relative, in the
+    pipeline's dtype), each object after culling (None: outside the view volume, skipped),
+    its first draw order, and the frame's shadow maps (None: the scene has none)."""
+    lights: Lights
+    eye: np.ndarray
+    objects: list[PreparedObject | None]
+    first_orders: list[int]
+    shadows: ShadowMaps | None
+
+    @property
+    def varyings(self) -> list[ObjectVaryings | None]:
+        return [p.varyings if p is not None else None for p in self.objects]
+
+
+def prepare_frame(scene, width: int, height: int, dtype, subpixel_bits: int = SUBPIXEL_BITS,
+                  sample_offset=(0.0, 0.0), tile_pixels: int = TILE_PIXELS) -> PreparedFrame:
+    """Every object through prepare_object (those in view), and the frame's shadow maps."""
+    check_light_count(scene)             # the GPU's limit, held alike (renderer/core/gl_rules.py)
     frame_matrices = scene.matrices(width, height, sample_offset)
     # Camera-relative positions, as the GPU gets them (renderer.core.scene.FrameMatrices).
     lights = Lights.from_scene(scene, dtype, origin=frame_matrices.origin)
@@ -133,18 +167,8 @@ def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: i
                                        subpixel_bits, reversed_z, dtype) if shown else None)
         first_orders.append(first_order)
         first_order += len(obj.mesh.faces)
-    objects = [p.varyings if p is not None else None for p in prepared]
     shadows = shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype, tile_pixels)
-
-    bands = tiles(width, height, tile_pixels)
-    if len(bands) == 1:
-        frame = _render_tile(bands[0], prepared, objects, first_orders, lights, eye, scene,
-                             width, height, linear, depth, dtype, shadows)
-    else:
-        frame = _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene,
-                                 width, height, linear, depth, dtype, shadows)
-    frame.milliseconds = (time.perf_counter() - start) * 1000.0
-    return frame
+    return PreparedFrame(lights, eye, prepared, first_orders, shadows)
 
 
 def shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype,
@@ -159,15 +183,23 @@ def shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype,
                                 plan, lights, dtype)
 
 
-def _render_tile(region, prepared, objects, first_orders, lights, eye, scene, width, height,
-                 linear, depth, dtype, shadows=None) -> Frame:
+def depth_test_tile(region, prepared: PreparedFrame, width, height, reversed_z, dtype) -> DepthBuffer:
+    """Rasterisation and depth test of every object within `region`: the tile's depth buffer,
+    whose payload names each pixel's surviving fragment."""
+    x0, y0, x1, y1 = region
+    depth_buffer = DepthBuffer(x1 - x0, y1 - y0, dtype, reversed_z)
+    for index, item in enumerate(prepared.objects):
+        if item is not None:
+            draw_tile(index, item, depth_buffer, prepared.first_orders[index], width, height, region)
+    return depth_buffer
+
+
+def _render_tile(region, prepared: PreparedFrame, scene, width, height, linear, depth, dtype) -> Frame:
     """Rasterisation, depth test, fragment shading and output of one tile: a Frame of the
     tile's size."""
     x0, y0, x1, y1 = region
-    depth_buffer = DepthBuffer(x1 - x0, y1 - y0, dtype, scene.camera.reversed_z)
-    for index, item in enumerate(prepared):
-        if item is not None:
-            draw_tile(index, item, depth_buffer, first_orders[index], width, height, region)
+    depth_buffer = depth_test_tile(region, prepared, width, height, scene.camera.reversed_z, dtype)
+    objects, lights, eye, shadows = prepared.varyings, prepared.lights, prepared.eye, prepared.shadows
     drawn = depth_buffer.drawn
     color, view_depth, shadow_tied, shadow_other = shade_surviving(
         objects, depth_buffer.payload, drawn, lights, eye, dtype, shadows)
@@ -191,8 +223,7 @@ def _render_tile(region, prepared, objects, first_orders, lights, eye, scene, wi
     return frame
 
 
-def _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene, width, height,
-                     linear, depth, dtype, shadows=None) -> Frame:
+def _render_in_tiles(bands, prepared: PreparedFrame, scene, width, height, linear, depth, dtype) -> Frame:
     """Each band drawn as its own tile and pasted into the frame's arrays (image rows are top
     first: GL rows [y0, y1) are image rows [H - y1, H - y0))."""
     frame = Frame(np.empty((height, width, 4), np.uint8),
@@ -202,8 +233,7 @@ def _render_in_tiles(bands, prepared, objects, first_orders, lights, eye, scene,
     for region in bands:
         _, y0, _, y1 = region
         rows = slice(height - y1, height - y0)
-        part = _render_tile(region, prepared, objects, first_orders, lights, eye, scene,
-                            width, height, linear, depth, dtype, shadows)
+        part = _render_tile(region, prepared, scene, width, height, linear, depth, dtype)
         frame.rgba8[rows] = part.rgba8
         if linear:
             frame.linear[rows] = part.linear
@@ -241,3 +271,60 @@ def shade_surviving(objects: list[ObjectVaryings | None], payload: dict, pixels_
         if tie is not None:
             shadow_tied[pixels], shadow_other[pixels] = tie
     return color, view_depth, shadow_tied, shadow_other
+
+
+@dataclass
+class SurfacePixels:
+    """The surface each drawn pixel of a Phong object shows (its surviving fragment), as the
+    fragment stage sees it: for measuring what it computes there against another method
+    (renderer/checks/shadow_truth.py). Per such pixel, in the pipeline's dtype:"""
+    pixel: np.ndarray             # (K,) index into the image's H*W pixels, row 0 at the top
+    object: np.ndarray            # (K,) the object's index in the scene
+    P: np.ndarray                 # (K, 3) the interpolated point, camera-relative world
+    N: np.ndarray                 # (K, 3) the lit unit normal (flipped on a two-sided back face)
+    Ng: np.ndarray                # (K, 3) the unit normal of the triangle's plane, as wound
+    position_scale: np.ndarray    # (K,) the largest |coordinate| of its triangle's vertices
+
+
+def _phong_surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
+    """(P, N, Ng, position_scale) of one object's fragments: the fragment stage's Phong inputs
+    (reference/fragment.py) and the lookup's tie scale (reference/shadow/lookup.py)."""
+    vertices, faces = varyings.vertices, varyings.faces
+    P = interpolate(vertices.v_world_position, faces, triangle, weights)
+    N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
+    if varyings.material.two_sided:
+        N = np.where(gl_FrontFacing[:, None], N, -N)
+    corners = vertices.v_world_position[faces[triangle]]
+    Ng = normalize_or_zero(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
+    return P, N, Ng, np.abs(corners).max(axis=(1, 2))
+
+
+def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
+                   subpixel_bits: int = SUBPIXEL_BITS,
+                   tile_pixels: int = TILE_PIXELS) -> tuple[SurfacePixels, ShadowMaps | None]:
+    """The surface at every drawn pixel of a Phong object (SurfacePixels) and the frame's
+    shadow maps, from the same stages as `render` (band by band), without shading."""
+    dtype = np.dtype(dtype)
+    prepared = prepare_frame(scene, width, height, dtype, subpixel_bits, tile_pixels=tile_pixels)
+    varyings = prepared.varyings
+    parts = []
+    for region in tiles(width, height, tile_pixels):
+        x0, y0, x1, y1 = region
+        buffer = depth_test_tile(region, prepared, width, height, scene.camera.reversed_z, dtype)
+        payload, drawn = buffer.payload, buffer.drawn
+        for index, item in enumerate(varyings):
+            if item is None or item.material.shading != "phong":
+                continue
+            at = np.flatnonzero(drawn & (payload.get("object", -1) == index))
+            if len(at) == 0:
+                continue
+            gl_row, column = y0 + at // (x1 - x0), x0 + at % (x1 - x0)
+            pixel = (height - 1 - gl_row) * width + column          # image rows: top first
+            parts.append((pixel, np.full(len(at), index), *_phong_surface(
+                item, payload["triangle"][at], payload["weights"][at], payload["gl_FrontFacing"][at])))
+    if not parts:
+        empty = np.zeros((0, 3), dtype)
+        return SurfacePixels(np.zeros(0, np.int64), np.zeros(0, np.int64), empty, empty, empty,
+                             np.zeros(0, dtype)), prepared.shadows
+    columns = [np.concatenate(column) for column in zip(*parts)]
+    return SurfacePixels(*columns), prepared.shadows

@@ -15,6 +15,11 @@ Outputs: `VertexOutputs`, every array in `dtype`:
          v_color_front (V, 3)     Gouraud colour lit with N        (None unless gouraud)
          v_color_back (V, 3)      Gouraud colour lit with -N       (the front colour when
                                   the material is one-sided; None unless gouraud)
+         v_ambient (V, 3), v_directional_terms_front (V, Ld, 3), v_point_terms_front
+         (V, Lp, 3), v_*_terms_back (lit with -N; the front's when one-sided): the same
+                                  lighting kept apart (`LightTerms`), whose sums the colours
+                                  are: what a Gouraud receiver of shadows hands on
+                                  (SHADOW_MAPS); None unless gouraud
 Every output is an affine function of the vertex in clip space or is interpolated as one,
 so clipping and perspective-correct interpolation treat them all alike.
 """
@@ -25,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize_or_zero
+from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, normalize_or_zero
 
 
 @dataclass
@@ -36,6 +41,17 @@ class VertexOutputs:
     v_view_depth: np.ndarray
     v_color_front: np.ndarray | None = None
     v_color_back: np.ndarray | None = None
+    v_ambient: np.ndarray | None = None
+    v_directional_terms_front: np.ndarray | None = None
+    v_directional_terms_back: np.ndarray | None = None
+    v_point_terms_front: np.ndarray | None = None
+    v_point_terms_back: np.ndarray | None = None
+
+    def light_terms(self, back: bool) -> LightTerms:
+        """The terms of the front (or back) side, per vertex."""
+        if back:
+            return LightTerms(self.v_ambient, self.v_directional_terms_back, self.v_point_terms_back)
+        return LightTerms(self.v_ambient, self.v_directional_terms_front, self.v_point_terms_front)
 
 
 def transform_points(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -64,7 +80,13 @@ def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, *, u_model: n
     if material.shading == "gouraud":
         uniforms = MaterialUniforms.from_material(material, dtype)
         eye = np.asarray(u_eye, dtype=dtype)
-        out.v_color_front = lighting(v_world_position, v_world_normal, eye, uniforms, lights)
-        out.v_color_back = (lighting(v_world_position, -v_world_normal, eye, uniforms, lights)
+        front = light_terms(v_world_position, v_world_normal, eye, uniforms, lights)
+        back = (light_terms(v_world_position, -v_world_normal, eye, uniforms, lights)
+                if material.two_sided else front)
+        out.v_ambient = front.ambient
+        out.v_directional_terms_front, out.v_point_terms_front = front.directional, front.point
+        out.v_directional_terms_back, out.v_point_terms_back = back.directional, back.point
+        out.v_color_front = front.shade(v_world_position, v_world_normal)
+        out.v_color_back = (back.shade(v_world_position, -v_world_normal)
                             if material.two_sided else out.v_color_front)
     return out

@@ -170,7 +170,8 @@ def build_parser() -> argparse.ArgumentParser:
                     "Exit status: 0 when the two agree within the pipeline tolerance "
                     f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
                     "(what fails is said on stderr), 2 for bad input. With --methods: the "
-                    "rasteriser against the ray tracer instead, status 0.")
+                    "rasteriser against the ray tracer instead, status 0; with --shadows-vs-truth: "
+                    "the rasteriser's shadow maps against ray-cast shadows, status 0.")
     common(compare)
     raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
@@ -180,6 +181,12 @@ def build_parser() -> argparse.ArgumentParser:
                               "--seed), both on the GPU: where they differ and why (shadows, "
                               "reflection, edges, tessellation, ...); writes raster.png, raytrace.png, "
                               "causes.png and methods.json (default folder: compare-methods-SCENE_NAME)")
+    compare.add_argument("--shadows-vs-truth", action="store_true",
+                         help="how wrong the rasteriser's shadow maps are against ray-cast "
+                              "shadows (pixels wrongly lit or shadowed, inside or outside a "
+                              "1-texel band around the true edge, acne, peter-panning); writes "
+                              "shadow_truth.png and shadow_truth.json (default folder: "
+                              "compare-shadows-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
                          metavar="LEVELS",
                          help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
@@ -456,6 +463,40 @@ def cmd_compare_methods(args) -> int:
     return 0
 
 
+def cmd_compare_shadows(args) -> int:
+    """`compare --shadows-vs-truth` (from cmd_compare): the figures as one JSON line and one
+    readable line on stdout, the classification image and the figures in --out; status 0
+    (a measurement, not a check)."""
+    from renderer.checks.shadow_truth import shadows_vs_truth
+    from renderer.core.imageio import check_folder, check_outputs, outputs
+    from renderer.core.jsonio import json_text, to_json
+    from renderer.core.paths import output_stem
+    from renderer.core.shadows import has_shadow_maps
+    if args.methods:
+        args.parser.error("--shadows-vs-truth and --methods are two different comparisons; give one")
+    if args.method is not None:
+        args.parser.error(f"--shadows-vs-truth measures the rasteriser's shadow maps; leave out "
+                          f"--method {args.method}")
+    check_raytrace_options(args)
+    scene = _load(args.scene)
+    if not has_shadow_maps(scene):
+        raise UserError("the scene has no shadow maps to hold against ray-cast truth (no light "
+                        "with shadows on, nothing that casts or nothing that receives)",
+                        file=scene.source or scene.name)
+    check_memory(scene, args.size, ["reference"])
+    out = check_folder(args.out or Path(f"compare-shadows-{output_stem(scene)}"))
+    names = [out / "shadow_truth.png", out / "shadow_truth.json"]
+    check_outputs(*names)
+    result = shadows_vs_truth(scene, *args.size)
+    figures = result.as_dict()
+    with outputs(*names) as written:             # both or neither
+        written.png(names[0], result.image())
+        written.text(names[1], json_text(figures))
+    print(to_json(figures))
+    print(result.line())
+    return 0
+
+
 def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import (compare_frames, depth_tie_pixels, either_precision, heat_map,
@@ -465,6 +506,8 @@ def cmd_compare(args) -> int:
     from renderer.core.jsonio import finite_or_none, to_json
     if args.out is not None:
         check_folder(args.out)
+    if args.shadows_vs_truth:
+        return cmd_compare_shadows(args)
     check_raytrace_options(args)
     if args.methods:
         return cmd_compare_methods(args)

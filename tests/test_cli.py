@@ -127,7 +127,7 @@ def test_written_files_get_the_usual_permissions(tmp_path, cli):
 
 
 def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path, gl_contexts, cli):
-    """hierarchy draws with three variants (phong, which looks the shadow maps up, gouraud,
+    """hierarchy draws with three variants, each looking the shadow maps up (phong, gouraud,
     flat with its geometry stage); each file is the text the renderer compiles, and it
     compiles as it is."""
     from renderer.core.builtin import builtin_scenes
@@ -142,24 +142,26 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
         ("phong-specular-1dir-1point-shadows: phong-specular-1dir-1point-shadows.vert, "
          "phong-specular-1dir-1point-shadows.frag (objects: sun, planet, plinth)")
     assert sorted(p.name for p in tmp_path.iterdir()) == [
-        "flat-specular-1dir-1point.frag", "flat-specular-1dir-1point.geom",
-        "flat-specular-1dir-1point.vert",
-        "gouraud-specular-1dir-1point.frag", "gouraud-specular-1dir-1point.vert",
+        "flat-specular-1dir-1point-shadows.frag", "flat-specular-1dir-1point-shadows.geom",
+        "flat-specular-1dir-1point-shadows.vert",
+        "gouraud-specular-1dir-1point-shadows.frag", "gouraud-specular-1dir-1point-shadows.vert",
         "phong-specular-1dir-1point-shadows.frag", "phong-specular-1dir-1point-shadows.vert"]
     ctx = gl_contexts["egl"]
     with GpuRenderer(load_scene(builtin_scenes()["hierarchy"]), 16, 16, context=ctx) as gpu:
         gpu.render()
         assert sorted(variant.name for variant in gpu.programs) == \
-            ["flat-specular-1dir-1point", "gouraud-specular-1dir-1point",
+            ["flat-specular-1dir-1point-shadows", "gouraud-specular-1dir-1point-shadows",
              "phong-specular-1dir-1point-shadows"]
-    flat = {stage: (tmp_path / f"flat-specular-1dir-1point.{suffix}").read_text()
+    flat = {stage: (tmp_path / f"flat-specular-1dir-1point-shadows.{suffix}").read_text()
             for stage, suffix in (("vertex_shader", "vert"), ("geometry_shader", "geom"),
                                   ("fragment_shader", "frag"))}
     assert flat == {stage: source.text for stage, source in
-                    program_sources(ShaderVariant("flat", False, 1, 1, specular=True)).items()}
+                    program_sources(ShaderVariant("flat", False, 1, 1, specular=True,
+                                                                  shadows=True)).items()}
     assert "#define SHADING_FLAT" in flat["fragment_shader"]
     assert "#define NUM_POINT_LIGHTS 1" in flat["vertex_shader"]
     assert "#define SPECULAR" in flat["geometry_shader"]
+    assert "#define NUM_DIRECTIONAL_TERMS 1" in flat["geometry_shader"]
     activate(ctx)
     ctx.program(**flat).release()
 

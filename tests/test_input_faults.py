@@ -267,6 +267,20 @@ def test_more_lights_than_the_limit_is_one_line(capsys, work, backend, direction
                     f"18 with; set `shadows = false` on some lights")
 
 
+@pytest.mark.parametrize("backend", ["gpu", "reference"])
+def test_a_gouraud_receiver_with_too_many_lights_is_one_line(capsys, work, backend):
+    """Its varyings (renderer/core/gl_rules.py, too_many_varyings): 7 lights, two-sided, take
+    (1 + 7) x 2 + 2 = 18 vec4 slots, over GL's guaranteed 16."""
+    scene = lights_scene(7, 0, "gouraud").replace('shading = "gouraud"', 'shading = "gouraud", two_sided = true')
+    (work / "lights.toml").write_text(scene)
+    line = refused(capsys, ["render", "lights.toml", "--size", "16x12", "--backend", backend], work)
+    assert line == ("renderer: lights.toml: objects[0]: too many lights for a two-sided gouraud object "
+                    "that receives shadows: with 7 directional and 0 point lights its varyings take "
+                    "18 vec4 slots ((1 + 7) terms x 2 sides + position and normal), the limit is 16 "
+                    "(GL's guaranteed 64 vertex output components); set `shadows = false` on the "
+                    "lights, `receives_shadows = false` on the object, or use phong shading")
+
+
 def test_a_scene_made_in_python_is_held_to_the_same_limit(gl_contexts):
     import reference
     from renderer.core.scene import PointLight

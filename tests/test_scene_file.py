@@ -260,9 +260,9 @@ def summary(scene: Scene) -> dict:
 
 
 # The example's directional light: shadow_bias names normal and slope; constant keeps the
-# automatic rule's value for its filter (0.25 texels).
+# automatic rule's value for its filter (0.5 texels).
 EXAMPLE_SHADOW = Shadow(resolution=2048, filter="pcf3x3",
-                        bias=BiasRule(normal=2.0, constant=0.25, slope=0.5))
+                        bias=BiasRule(normal=2.0, constant=0.5, slope=0.5))
 
 
 def test_complete_example_loads_with_every_value(tmp_path):
@@ -387,19 +387,19 @@ def test_shadow_keys_of_a_light(tmp_path, kind):
 
 def test_shadow_bias_terms_not_given_keep_the_automatic_rule(tmp_path):
     """auto_bias: a normal offset of the filter's footprint radius (1/2 texel for hard, K/2
-    for K x K) and 1/4 texel towards the light; a shadow_bias table replaces what it names."""
+    for K x K) and 1/2 texel towards the light; a shadow_bias table replaces what it names."""
     shadow = light_shadow(tmp_path, 'shadow_filter = "pcf5x5"\nshadow_bias = { slope = 2 }\n')
-    assert shadow.bias_rule() == BiasRule(normal=2.5, constant=0.25, slope=2.0)
+    assert shadow.bias_rule() == BiasRule(normal=2.5, constant=0.5, slope=2.0)
     shadow = light_shadow(tmp_path, 'shadow_filter = "hard"\nshadow_bias = { constant = 0 }\n')
     assert shadow.bias_rule() == BiasRule(normal=0.5, constant=0.0, slope=0.0)
     shadow = light_shadow(tmp_path, "shadow_bias = { normal = 0, constant = 1, slope = 0.5 }\n")
     assert shadow.bias_rule() == BiasRule(normal=0.0, constant=1.0, slope=0.5)
     # an empty table is the automatic rule, written out
     assert light_shadow(tmp_path, "shadow_bias = {}\n").bias == auto_bias("pcf2x2") \
-        == BiasRule(normal=1.0, constant=0.25)
+        == BiasRule(normal=1.0, constant=0.5)
     # the filter counts wherever its key stands
     shadow = light_shadow(tmp_path, 'shadow_bias = { slope = 1 }\nshadow_filter = "pcf3x3"\n')
-    assert shadow.bias_rule() == BiasRule(normal=1.5, constant=0.25, slope=1.0)
+    assert shadow.bias_rule() == BiasRule(normal=1.5, constant=0.5, slope=1.0)
 
 
 def test_objects_cast_and_receive_shadows_as_told(tmp_path):

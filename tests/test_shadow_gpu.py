@@ -13,7 +13,7 @@ from renderer.core.gl_rules import (COMPONENTS_PER_DIRECTIONAL_SHADOW, COMPONENT
 from renderer.core.primitives import icosphere, plane
 from renderer.core.scene import (Camera, DirectionalLight, Material, PointLight, Scene, SceneObject,
                                  Transform)
-from renderer.core.shadow_settings import Shadow
+from renderer.core.shadow_settings import FILTERS, Shadow, shared_kernel
 from renderer.core.shadows import has_shadow_maps, shadow_layout
 from renderer.core.uniforms import SHADOW_UNIFORMS
 from renderer.gpu.pipeline import GpuRenderer
@@ -146,14 +146,30 @@ def test_a_scene_without_maps_compiles_no_shadow_code(ctx):
             assert gpu.programs and not any(v.defines()["SHADOW_MAPS"] for v in gpu.programs)
 
 
-def test_the_all_features_build_looks_the_maps_up_too_and_draws_the_same(ctx):
-    scene = sphere_over_plane()
+@pytest.mark.parametrize("filter_name", ["pcf2x2", "hard", "pcf5x5"])
+def test_the_all_features_build_looks_the_maps_up_too_and_draws_the_same(ctx, filter_name):
+    """The specialised programs have the scene's one filter compiled in (SHADOW_KERNEL: the
+    taps' loops have constant bounds); the all-features build reads each light's kernel from
+    its uniform. Same pixels."""
+    scene = sphere_over_plane(replace(LIGHT, shadow=Shadow(resolution=256, filter=filter_name)))
     images = {}
     for specialise in (True, False):
         with GpuRenderer(scene, W, H, context=ctx, specialise=specialise) as gpu:
             images[specialise] = gpu.render(depth=False).rgba8
             assert [v.shadows for v in gpu.programs] == [True]
+            assert [v.defines().get("SHADOW_KERNEL") for v in gpu.programs] == [
+                FILTERS[filter_name] if specialise else None]
     assert np.array_equal(images[True], images[False])
+
+
+def test_a_kernel_is_compiled_in_only_when_every_light_with_shadows_shares_it():
+    hard, pcf3 = Shadow(filter="hard"), Shadow(filter="pcf3x3")
+    scene = Scene(directional_lights=[DirectionalLight(shadow=pcf3)],
+                  point_lights=[PointLight(shadow=pcf3), PointLight(shadow=replace(hard, enabled=False))])
+    assert shared_kernel(scene) == 3                   # a light without shadows has no say
+    scene.point_lights[1].shadow = hard
+    assert shared_kernel(scene) == 0                   # 1 and 3: each light's from its uniform
+    assert shared_kernel(Scene(directional_lights=[DirectionalLight(shadow=Shadow(enabled=False))])) == 0
 
 
 def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):

@@ -169,17 +169,17 @@ def test_c_cube_face_and_its_table_in_glsl_equal_the_rule_and_core(gl_contexts):
 def test_d_auto_bias_moves_the_point_by_the_rule():
     """A plane at theta = 60 degrees to the light: N = (sin 60, 0, cos 60) = (0.8660254, 0, 0.5),
     L = (0, 0, 1), map axes X = (1, 0, 0), Y = (0, 1, 0), a texel t = 0.01. pcf2x2's auto rule
-    (normal 1 = its footprint radius, constant 0.25, slope 0) moves P by
+    (normal 1 = its footprint radius, constant 0.5, slope 0) moves P by
     t * 1 * (|N.X| + |N.Y|) = 0.01 * 0.8660254 along N = (0.0075, 0, 0.0043301) and by
-    t * 0.25 = 0.0025 along L: Q - P = (0.0075, 0, 0.0068301)."""
+    t * 0.5 = 0.005 along L: Q - P = (0.0075, 0, 0.0093301)."""
     theta = math.radians(60)
     N = np.array([[math.sin(theta), 0.0, math.cos(theta)]])
     P = np.array([[1.0, 2.0, 3.0]])
     L, X, Y = np.array([0.0, 0, 1]), np.array([1.0, 0, 0]), np.array([0.0, 1, 0])
     bias = auto_bias("pcf2x2").as_vec4()
-    assert bias.tolist() == [1.0, 0.25, 0.0, 0.0]
+    assert bias.tolist() == [1.0, 0.5, 0.0, 0.0]
     moved = shadow_bias_point(P, N, L, X, Y, 0.01, bias) - P
-    assert moved[0] == pytest.approx([0.0075, 0.0, 0.0068301270189222], abs=1e-15)   # 0.0025 + 0.01 sqrt(3) / 4
+    assert moved[0] == pytest.approx([0.0075, 0.0, 0.0093301270189222], abs=1e-15)   # 0.005 + 0.01 sqrt(3) / 4
     # the slope term: tan 60 = sqrt 3, capped at MAX_SLOPE = 16 (grazing: c = 0)
     slope = BiasRule(slope=1.0).as_vec4()
     assert (shadow_bias_point(P, N, L, X, Y, 1.0, slope) - P)[0, 2] == pytest.approx(math.sqrt(3))

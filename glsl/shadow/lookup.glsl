@@ -46,6 +46,16 @@ vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bia
     return P + t * (normal * N + toward * L);
 }
 
+// The filter's kernel: SHADOW_KERNEL when every map of the scene has the same filter
+// (renderer/gpu/shaders.py defines it), so that the taps' loops have constant bounds and are
+// unrolled (loops bounded by a uniform cost a shadowed frame a quarter of its time on
+// llvmpipe: benchmarks/bench_shadows.py); else the light's own, from its uniform.
+#ifdef SHADOW_KERNEL
+#define LIGHT_KERNEL(params) SHADOW_KERNEL
+#else
+#define LIGHT_KERNEL(params) int(params.z)
+#endif
+
 // The filter (shadow_settings.FILTERS, tap_offsets): kernel 1 is the nearest texel's comparison,
 // read through the LINEAR sampler at that texel's centre (exact: S is a power of two, so the
 // centre's weight is 1); K x K PCF is the mean of (K-1)^2 bilinear comparisons on a unit grid
@@ -81,7 +91,7 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
     if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(p.w)))) {
         return 1.0;                  // outside the map, which holds every caster: nothing there
     }
-    return shadow_filter(uvz, p.x, int(p.z));
+    return shadow_filter(uvz, p.x, LIGHT_KERNEL(p));
 }
 #endif
 
@@ -118,12 +128,14 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
         return 1.0;                  // a light on the surface: fully incident (lighting.glsl)
     }
     vec3 L = normalize(to_light);
-    int f0 = cube_face(-to_light);
-    float t = 2.0 * dot(CUBE_FACE_AXIS[f0], -to_light) * p.y / p.w;   // a texel at P's distance
-    vec3 Q = shadow_bias_point(P, N, L, CUBE_FACE_RIGHT[f0], CUBE_FACE_UP[f0], t,
+    // The face is P's own, also for the moved point Q: the bias is sized with that face's axes,
+    // and its guard band holds Q (at most the normal offset across the map from P). Reading the
+    // face Q falls on instead would meet another face's axes at a seam: acne there.
+    int f = cube_face(-to_light);
+    float t = 2.0 * dot(CUBE_FACE_AXIS[f], -to_light) * p.y / p.w;    // a texel at P's distance
+    vec3 Q = shadow_bias_point(P, N, L, CUBE_FACE_RIGHT[f], CUBE_FACE_UP[f], t,
                                u_point_shadow_bias[i]);
     vec3 d = Q - light;
-    int f = cube_face(d);
     vec4 rect = u_point_shadow_tiles[6 * i + f];
     if (rect.z == 0.0) {
         return 1.0;                  // the face sees no caster: it was not drawn
@@ -131,6 +143,6 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
     float m = dot(CUBE_FACE_AXIS[f], d);
     vec2 uv = (0.5 * vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / (m * p.y) + 0.5) * rect.y;
     vec4 depth = u_point_shadow_depth[i];
-    return shadow_filter(vec3(uv, depth.x + depth.y / m), rect.x, int(p.z));
+    return shadow_filter(vec3(uv, depth.x + depth.y / m), rect.x, LIGHT_KERNEL(p));
 }
 #endif

@@ -229,12 +229,11 @@ def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarra
     P, N, to_light, scale = P[rows], N[rows], to_light[rows], np.asarray(position_scale)[rows]
     L = normalize(to_light)
     rotations, axes = CUBE_FACE_ROTATIONS.astype(dtype), CUBE_FACE_AXES.astype(dtype)
-    f0 = cube_face(-to_light)
-    t = 2.0 * dot(axes[f0], -to_light) * p[1] / p[3]          # a texel's size at P's distance
-    Q = shadow_bias_point(P, N, L, rotations[f0, 0], rotations[f0, 1], t,
+    f = cube_face(-to_light)          # P's own face, also for Q (the GLSL says why)
+    t = 2.0 * dot(axes[f], -to_light) * p[1] / p[3]           # a texel's size at P's distance
+    Q = shadow_bias_point(P, N, L, rotations[f, 0], rotations[f, 1], t,
                           maps.uniforms["u_point_shadow_bias"][i])
     d = Q - light
-    f = cube_face(d)
     rect = maps.uniforms["u_point_shadow_tiles"][6 * i + f]
     drawn = rect[:, 2] != 0.0                                   # else the face sees no caster
     d, f, rect, Q, scale, rows = d[drawn], f[drawn], rect[drawn], Q[drawn], scale[drawn], rows[drawn]

@@ -214,6 +214,45 @@ def too_many_lights(directional: int, point: int, directional_shadows: int = 0,
             f"the other uniforms), {examples}{advice}")
 
 
+# --- varyings: the lights a flat or Gouraud receiver of shadows may have ---------------------
+#
+# A flat or Gouraud object that receives shadows hands the lighting equation to the fragment
+# stage in pieces (glsl/vertex.glsl, glsl/geometry.glsl): the ambient term, each light's term
+# (front, and back for a two-sided material) and the world position and normal for the lookup,
+# a vec3 varying each, which takes a whole vec4 slot. GL 4.5 guarantees 64 vertex output
+# components (16 slots: Gouraud's limit) and 128 geometry output and fragment input
+# components (32 slots: flat's, whose vertex stage hands on the position alone); llvmpipe
+# allows 32 everywhere. As with the uniforms, the guarantee is the rule.
+
+GL_MIN_VERTEX_OUTPUT_COMPONENTS = 64     # GL 4.5's minimum of GL_MAX_VERTEX_OUTPUT_COMPONENTS
+GL_MIN_FRAGMENT_INPUT_COMPONENTS = 128   # ... of GL_MAX_{GEOMETRY_OUTPUT,FRAGMENT_INPUT}_COMPONENTS
+VARYING_SLOT_LIMITS = {"gouraud": GL_MIN_VERTEX_OUTPUT_COMPONENTS // 4,
+                       "flat": GL_MIN_FRAGMENT_INPUT_COMPONENTS // 4}
+
+
+def light_term_slots(directional: int, point: int, two_sided: bool) -> int:
+    """vec4 slots the varyings of a flat or Gouraud receiver of shadows take: the ambient term
+    and a term per light, per side, and the position and normal:
+    (1 + directional + point) (2 if two-sided else 1) + 2."""
+    return (1 + directional + point) * (2 if two_sided else 1) + 2
+
+
+def too_many_varyings(shading: str, directional: int, point: int, two_sided: bool) -> str | None:
+    """Why a `shading` receiver of shadows cannot be drawn with these lights, or None."""
+    limit = VARYING_SLOT_LIMITS.get(shading)
+    used = light_term_slots(directional, point, two_sided)
+    if limit is None or used <= limit:
+        return None
+    sides = 2 if two_sided else 1
+    stage = "vertex output" if shading == "gouraud" else "fragment input"
+    return (f"too many lights for a {'two-sided ' if two_sided else ''}{shading} object that "
+            f"receives shadows: with {directional} directional and {point} point lights its "
+            f"varyings take {used} vec4 slots ((1 + {directional + point}) terms x {sides} "
+            f"side{'s' if two_sided else ''} + position and normal), the limit is {limit} (GL's "
+            f"guaranteed {limit * 4} {stage} components); set `shadows = false` on the lights, "
+            f"`receives_shadows = false` on the object, or use phong shading")
+
+
 def scene_light_problem(scene) -> str | None:
     """too_many_lights for `scene`: its lights, and those with shadows on when the scene has
     shadow maps (the programs then declare their lookup uniforms)."""
@@ -224,10 +263,29 @@ def scene_light_problem(scene) -> str | None:
                            sum(maps and light.shadow.enabled for light in point))
 
 
+def scene_varying_problem(scene) -> tuple[int, str] | None:
+    """(index, too_many_varyings) of the first flat or Gouraud object of `scene` that receives
+    shadows and is over the limit, when the scene has shadow maps; else None."""
+    directional, point = scene.directional_lights, scene.point_lights
+    if not (scene_has_shadows(scene) and any(light.shadow.enabled for light in (*directional, *point))):
+        return None
+    for index, obj in enumerate(scene.objects):
+        problem = obj.receives_shadows and too_many_varyings(
+            obj.material.shading, len(directional), len(point), obj.material.two_sided)
+        if problem:
+            return index, problem
+    return None
+
+
 def check_light_count(scene) -> None:
     """A SceneError (naming the scene's file, if any) when `scene` has more lights than
-    too_many_lights allows: what GpuRenderer and the reference check before drawing."""
+    too_many_lights allows, or than too_many_varyings allows a flat or Gouraud receiver of
+    shadows: what GpuRenderer and the reference check before drawing."""
     from renderer.errors import SceneError
     problem = scene_light_problem(scene)
+    varyings = None if problem else scene_varying_problem(scene)
+    if varyings:
+        index, reason = varyings
+        problem = f"object {scene.objects[index].name!r}: {reason}"
     if problem:
         raise SceneError(problem, file=getattr(scene, "source", "") or None)

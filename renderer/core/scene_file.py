@@ -25,7 +25,7 @@ from typing import Any, NoReturn
 import numpy as np
 
 from renderer.core import transforms
-from renderer.core.gl_rules import scene_light_problem
+from renderer.core.gl_rules import scene_light_problem, scene_varying_problem
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
 from renderer.errors import SceneError, show_number
 from renderer.core import memory
@@ -369,6 +369,9 @@ class _Reader:
         problem = scene_light_problem(scene)     # after the objects: do they cast and receive?
         if problem:
             self.fail("lights", problem)
+        varyings = scene_varying_problem(scene)
+        if varyings:
+            self.fail(f"objects[{varyings[0]}]", varyings[1])
         self.check_names_and_parents(scene.objects, raw_objects)
         self.check_shapes(scene)
         self.check_float32_range(scene)

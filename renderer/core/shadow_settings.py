@@ -39,7 +39,7 @@ class BiasRule:
 
 
 MAX_SLOPE = 16.0                       # tan(theta) is capped here in the slope term (86.4 deg)
-CONSTANT_BIAS_TEXELS = 0.25            # towards the light: rounding of depth and position
+CONSTANT_BIAS_TEXELS = 0.5             # towards the light: rounding; facets off the smooth normal
 # The most a bias term may be (scene files refuse more): far beyond any useful bias (the
 # automatic one is at most 2.5 texels), and the guard band it asks for (guard_texels: at most
 # ceil(2.5 + 8 sqrt 2) + 1 = 15 texels at each edge) leaves the smallest map (64 texels) more
@@ -66,7 +66,8 @@ def auto_bias(filter_name: str) -> BiasRule:
     then shadows the point when o / cos(theta) >= r tan(theta), i.e. o >= radius (|n_x| + |n_y|):
     finite at every angle, unlike a slope-scaled depth bias (tan(theta) is unbounded at grazing
     light). CONSTANT_BIAS_TEXELS more towards the light covers rounding (depth stored in
-    float32, positions interpolated in float32)."""
+    float32, positions interpolated in float32) and a mesh's facets lying off the interpolated
+    normal N (steeper than N says on concave and grazing parts)."""
     return BiasRule(normal=footprint_radius(FILTERS[filter_name]), constant=CONSTANT_BIAS_TEXELS)
 
 
@@ -112,6 +113,14 @@ def scene_has_shadows(scene) -> bool:
     light budget, renderer/core/gl_rules.py, counts no shadow uniforms)."""
     return (any(o.casts_shadows and o.mesh.triangle_count for o in scene.objects)
             and any(o.receives_shadows for o in scene.objects))
+
+
+def shared_kernel(scene) -> int:
+    """The filter kernel of every light with shadows on, when they all have the same; else 0
+    (or no light has shadows). The GPU path compiles it into the lookup (SHADOW_KERNEL)."""
+    kernels = {light.shadow.kernel for light in [*scene.directional_lights, *scene.point_lights]
+               if light.shadow.enabled}
+    return kernels.pop() if len(kernels) == 1 else 0
 
 
 def auto_resolution(width: int, height: int, point: bool) -> int:

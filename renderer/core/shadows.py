@@ -34,7 +34,7 @@ from renderer.core import transforms
 from renderer.core.gl_rules import depth_mapping
 from renderer.core.shadow_settings import (MAX_SHADOW_TEXELS, Shadow, auto_resolution, guard_texels,
                                            scene_has_shadows)
-from renderer.core.visibility import CLIP_PLANES
+from renderer.core.visibility import all_outside, corners
 
 # --- cube faces ------------------------------------------------------------------------------
 
@@ -287,14 +287,19 @@ def _plane_of(points: np.ndarray):
 
 
 def can_shadow(scene, points, caster: int, receivers: list[int], light_position=None,
-               light_direction=None) -> bool:
+               light_direction=None, planes: dict | None = None) -> bool:
     """Whether object `caster` can shadow any receiver for a light at `light_position` (point)
     or travelling along `light_direction` (directional). Conservative (True when unsure); False
     for: a caster with no receiver but itself that cannot shadow itself (a convex analytic
     shape, or a planar mesh), and a planar caster with every other receiver on the light's side
-    of its plane (a floor under the lit objects: it can shadow only what is below it)."""
+    of its plane (a floor under the lit objects: it can shadow only what is below it).
+    `planes`: object index -> its plane (or None), filled as they are found, so that the
+    lights of one plan find each caster's once."""
     obj = scene.objects[caster]
-    plane = _plane_of(points[caster])
+    planes = {} if planes is None else planes
+    if caster not in planes:
+        planes[caster] = _plane_of(points[caster])
+    plane = planes[caster]
     convex = plane is not None or obj.shape is not None
     others = [r for r in receivers if r != caster]
     if not others:
@@ -345,13 +350,37 @@ def _caster_distance(scene, points: np.ndarray, caster: int, position: np.ndarra
     return float(triangle_distance(points[caster][faces], position).min())
 
 
-def _outside_frustum(clip_from_world: np.ndarray, points: np.ndarray) -> bool:
-    """True when the points' bounding box lies wholly outside one clip plane (as
-    renderer/core/visibility.py tests objects against the camera's)."""
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    corners = np.array([[(hi if (k >> a) & 1 else lo)[a] for a in range(3)] + [1.0] for k in range(8)])
-    clip = corners @ clip_from_world.T
-    return any(bool(np.all(clip[:, 3] + sign * clip[:, axis] < 0.0)) for axis, sign in CLIP_PLANES)
+# A box nearer than this fraction more than the nearest triangle found so far is searched.
+BOX_BOUND_SLACK = 1e-9
+
+
+def _nearest_caster(scene, points, casters: list[int], lo: np.ndarray, hi: np.ndarray,
+                    position: np.ndarray) -> float:
+    """The distance from `position` to the nearest triangle of the casters (boxes lo, hi):
+    the casters by their boxes' distance, a lower bound of their triangles', and none past the
+    first box farther than the nearest triangle found (BOX_BOUND_SLACK covers rounding: the
+    answer is the minimum over every caster's triangles)."""
+    box = np.linalg.norm(np.maximum(np.maximum(lo - position, position - hi), 0.0), axis=1)
+    nearest = np.inf
+    for k in np.argsort(box, kind="stable"):
+        if box[k] > nearest * (1.0 + BOX_BOUND_SLACK):
+            break
+        nearest = min(nearest, _caster_distance(scene, points, casters[k], position))
+    return nearest
+
+
+def _boxes(points: list[np.ndarray], indices: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 3) low and high ends of the bounding boxes of points[i] for i in indices."""
+    return (np.array([points[i].min(axis=0) for i in indices]).reshape(-1, 3),
+            np.array([points[i].max(axis=0) for i in indices]).reshape(-1, 3))
+
+
+def _outside_frusta(clips_from_world: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(F, n) whether box j (lo[j], hi[j]) lies wholly outside one clip plane of view f
+    (clips_from_world (F, 4, 4)), as renderer/core/visibility.py tests objects against the
+    camera's."""
+    clip = corners(lo, hi)[None] @ np.swapaxes(clips_from_world, 1, 2)[:, None]   # (F, n, 8, 4)
+    return all_outside(clip)
 
 
 def point_face_projection(resolution: int, guard: int, near: float, far: float) -> tuple[np.ndarray, float]:
@@ -373,22 +402,27 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
         return passes, rects, params, depth
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
-    near = max(0.5 * min(_caster_distance(scene, points, i, position) for i in casters),
+    lo, hi = _boxes(points, casters + receivers)
+    n = len(casters)
+    near = max(0.5 * _nearest_caster(scene, points, casters, lo[:n], hi[:n], position),
                NEAR_FRACTION * far)
     near = min(near, 0.5 * far)
     projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
+    clips = np.empty((6, 4, 4))
     for face in range(6):
         view = np.eye(4)
         view[:3, :3] = CUBE_FACE_ROTATIONS[face]
         view[:3, 3] = -CUBE_FACE_ROTATIONS[face] @ position
-        clip = projection @ view
+        clips[face] = projection @ view
+    outside = _outside_frusta(clips, lo, hi)              # (6, the casters then the receivers)
+    for face in range(6):
         tile = light_map.tiles[face]
-        drawn = tuple(i for i in casters if not _outside_frustum(clip, points[i]))
-        needed = bool(drawn) and not all(_outside_frustum(clip, points[i]) for i in receivers)
+        drawn = tuple(i for i, out in zip(casters, outside[face]) if not out)
+        needed = bool(drawn) and not outside[face, n:].all()
         rects[face] = tile.rect(layout.side, needed)   # not drawn: the lookup reads it as lit
         if not needed:
             continue
-        passes.append(ShadowPass("point", index, face, tile, clip, drawn))
+        passes.append(ShadowPass("point", index, face, tile, clips[face], drawn))
     if passes:
         params[:] = (1.0, tan_half, light_map.shadow.kernel, light_map.resolution)
         depth[:] = (0.5 - 0.5 * projection[2, 2], 0.5 * projection[2, 3], near, far)
@@ -421,13 +455,14 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
                  if o.receives_shadows and visible[i] and o.mesh.triangle_count]
     casters = [i for i, o in enumerate(scene.objects) if o.casts_shadows and o.mesh.triangle_count]
     frustum = _camera_frustum_corners(matrices, scene.camera.reversed_z)
+    planes = {}                                   # caster -> its plane, for every light
     for light_map in layout.maps:
         i = light_map.index
         bias = light_map.shadow.bias_rule().as_vec4()
         if light_map.kind == "directional":
             light = scene.directional_lights[i]
             relevant = [c for c in casters if not prune or can_shadow(
-                scene, points, c, receivers, light_direction=light.direction)]
+                scene, points, c, receivers, light_direction=light.direction, planes=planes)]
             shadow_pass, lookup, params, texel = _plan_directional(
                 i, light, light_map, layout, points, receivers, relevant, frustum)
             uniforms["u_directional_shadow_matrix"][i] = lookup
@@ -440,7 +475,7 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
             light = scene.point_lights[i]
             position = matrices.relative(light.position)
             relevant = [c for c in casters if not prune or can_shadow(
-                scene, points, c, receivers, light_position=position)]
+                scene, points, c, receivers, light_position=position, planes=planes)]
             passes, rects, params, depth = _plan_point(
                 i, light, light_map, layout, matrices, points, receivers, relevant, scene)
             uniforms["u_point_shadow"][i] = params

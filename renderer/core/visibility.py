@@ -32,12 +32,20 @@ from renderer.errors import show_number
 CLIP_PLANES = ((0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0), (2, 1.0), (2, -1.0))
 
 
+# Corner k of a box takes its high end on axis a where bit a of k is set.
+CORNER_PICK = np.array([[(i >> k) & 1 for k in range(3)] for i in range(8)], dtype=bool)
+
+
+def corners(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(..., 8, 4) homogeneous corners of boxes with low and high ends lo, hi (..., 3)."""
+    lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+    picked = np.where(CORNER_PICK, hi[..., None, :], lo[..., None, :])
+    return np.concatenate([picked, np.ones(picked.shape[:-1] + (1,))], axis=-1)
+
+
 def box_corners(mesh: Mesh) -> np.ndarray:
     """(8, 4) homogeneous corners of the mesh's axis-aligned bounding box in object space."""
-    lo, hi = mesh.positions.min(axis=0), mesh.positions.max(axis=0)
-    pick = np.array([[(i >> k) & 1 for k in range(3)] for i in range(8)], dtype=bool)
-    corners = np.where(pick, hi, lo)
-    return np.hstack([corners, np.ones((8, 1))])
+    return corners(mesh.positions.min(axis=0), mesh.positions.max(axis=0))
 
 
 def clip_corners(clip_from_object: np.ndarray, mesh: Mesh) -> np.ndarray:
@@ -45,12 +53,19 @@ def clip_corners(clip_from_object: np.ndarray, mesh: Mesh) -> np.ndarray:
     return box_corners(mesh) @ np.asarray(clip_from_object, dtype=np.float64).T
 
 
+def all_outside(clip: np.ndarray) -> np.ndarray:
+    """(...) whether the points clip (..., 8, 4) (a box's corners in clip space) all lie
+    outside one clip plane: then nothing of the box is in the view volume."""
+    w = clip[..., 3]
+    return np.any([np.all(w + sign * clip[..., axis] < 0.0, axis=-1) for axis, sign in CLIP_PLANES],
+                  axis=0)
+
+
 def outside_view_volume(clip_from_object: np.ndarray, mesh: Mesh) -> bool:
     """True when the mesh is wholly outside one clip plane under `clip_from_object` (P V M)."""
     if mesh.triangle_count == 0:
         return True
-    clip = clip_corners(clip_from_object, mesh)                                     # (8, 4)
-    return any(bool(np.all(clip[:, 3] + sign * clip[:, axis] < 0.0)) for axis, sign in CLIP_PLANES)
+    return bool(all_outside(clip_corners(clip_from_object, mesh)))
 
 
 def visible_objects(scene: Scene, matrices: FrameMatrices) -> list[bool]:

@@ -34,7 +34,7 @@ Shadows (docs/conventions.md, "Shadows"): when the scene's shadow layout has map
 (renderer/core/shadows.py: something casts, something receives, a light has shadows on), a
 ShadowMaps (renderer/gpu/shadow_maps.py) holds the maps (layers of one depth array texture)
 and draws each frame's light views into them before the camera pass; the programs of objects
-that receive shadows (Phong, for now) are compiled with SHADOW_MAPS and read the maps on
+that receive shadows (in every shading mode) are compiled with SHADOW_MAPS and read the maps on
 texture unit 0. The layout is recomputed by update() (the texture is made again only when it
 changes size: an automatic map resolution follows the image size), the plan (light views,
 casters, lookup uniforms) every update().
@@ -377,7 +377,10 @@ class GpuRenderer:
             for name, data in self._frame_uniforms.items():
                 uniform = program.get(name, None)
                 if uniform is not None:
-                    uniform.write(data)
+                    # GL may keep only the first elements of an array (the all-features build
+                    # of a flat or Gouraud receiver of shadows reads the scene's lights only:
+                    # its light terms are sized so): write those. 4 bytes a component.
+                    uniform.write(data[:4 * uniform.dimension * uniform.array_length])
         self._plans[linear] = plan
         return plan
 

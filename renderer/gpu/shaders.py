@@ -25,6 +25,7 @@ from typing import Mapping
 import moderngl
 
 from renderer.core.resources import glsl_dir
+from renderer.core.shadow_settings import shared_kernel
 
 _INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
 _INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
@@ -143,8 +144,15 @@ class ShaderVariant:
 
     `shadows` (define SHADOW_MAPS) compiles the shadow-map lookup in (glsl/shadow/lookup.glsl):
     set, in either build, only for an object that receives shadows in a scene whose layout has
-    maps (renderer/core/shadows.py), and for now only for Phong (flat and Gouraud receivers
-    are drawn unshadowed); every other program has no shadow code at all.
+    maps (renderer/core/shadows.py); every other program has no shadow code at all. A flat or
+    Gouraud receiver hands the lighting equation's terms to the fragment stage apart, a
+    varying per light (`light_terms`): NUM_DIRECTIONAL_TERMS and NUM_POINT_TERMS size them
+    with the scene's light counts in either build (the all-features build's 2 x 8 lights a
+    side would not fit GL's guaranteed varyings: renderer/core/gl_rules.py, too_many_varyings).
+    `shadow_kernel` (define SHADOW_KERNEL; specialised builds only) is the filter kernel when
+    every light with shadows has the same filter (shadow_settings.shared_kernel): its taps'
+    loops then have constant bounds; 0 reads each light's from its uniform. It is not in
+    `name`: all the programs of a scene have the same.
     """
     shading: str                     # "flat", "gouraud" or "phong"
     two_sided: bool = False
@@ -153,15 +161,24 @@ class ShaderVariant:
     linear_output: bool = False      # second fragment output: the unclamped float colour
     specular: bool = False           # the k_s term of the lighting equation
     all_features: bool = False
-    shadows: bool = False            # the shadow-map lookup (Phong only, for now)
+    shadows: bool = False            # the shadow-map lookup
+    shadow_kernel: int = 0           # every map's filter kernel, compiled in (0: read per light)
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
             raise ValueError(f"unknown shading mode {self.shading!r}")
-        if self.shadows and self.shading != "phong":
-            raise ValueError(f"shadow maps are looked up by Phong shading only, not {self.shading!r}")
+        if self.shadow_kernel and not self.shadows:
+            raise ValueError("a shadow kernel is compiled in only with the shadow-map lookup")
+
+    @property
+    def light_terms(self) -> bool:
+        """Whether the lighting stage hands each light's term apart to the fragment stage
+        (a flat or Gouraud receiver of shadows)."""
+        return self.shadows and self.shading != "phong"
 
     def defines(self) -> dict[str, object]:
+        terms = {"NUM_DIRECTIONAL_TERMS": self.num_directional_lights,
+                 "NUM_POINT_TERMS": self.num_point_lights} if self.light_terms else {}
         if self.all_features:
             return {
                 f"SHADING_{self.shading.upper()}": True,
@@ -172,6 +189,7 @@ class ShaderVariant:
                 "NUM_POINT_LIGHTS": ALL_FEATURES_LIGHTS,
                 "LINEAR_OUTPUT": self.linear_output,
                 "SHADOW_MAPS": self.shadows,
+                **terms,
             }
         return {
             f"SHADING_{self.shading.upper()}": True,
@@ -181,6 +199,8 @@ class ShaderVariant:
             "NUM_POINT_LIGHTS": self.num_point_lights,
             "LINEAR_OUTPUT": self.linear_output,
             "SHADOW_MAPS": self.shadows,
+            "SHADOW_KERNEL": self.shadow_kernel or None,
+            **terms,
         }
 
     @property
@@ -189,7 +209,9 @@ class ShaderVariant:
         linear = "-linear" if self.linear_output else ""
         shadows = "-shadows" if self.shadows else ""
         if self.all_features:
-            return f"{self.shading}-all-features{linear}{shadows}"
+            terms = (f"-{self.num_directional_lights}dir-{self.num_point_lights}point"
+                     if self.light_terms else "")
+            return f"{self.shading}-all-features{terms}{linear}{shadows}"
         sides = "-two-sided" if self.two_sided else ""
         specular = "-specular" if self.specular else ""
         return (f"{self.shading}{sides}{specular}-{self.num_directional_lights}dir-"
@@ -204,14 +226,16 @@ class ShaderVariant:
                      all_features: bool = False, shadows: bool = False) -> "ShaderVariant":
         """The variant that draws `material` (a renderer.core.scene.Material) in `scene`:
         specialised to what they use, or the all-features build. `shadows`: the object
-        receives shadows and the scene's layout has maps (a Phong material then looks them up)."""
-        shadows = bool(shadows) and material.shading == "phong"
+        receives shadows and the scene's layout has maps."""
+        shadows = bool(shadows)
         if all_features:
-            return cls(material.shading, linear_output=bool(linear_output), all_features=True,
-                       shadows=shadows)
+            counts = ((len(scene.directional_lights), len(scene.point_lights))
+                      if shadows and material.shading != "phong" else (0, 0))
+            return cls(material.shading, False, *counts, linear_output=bool(linear_output),
+                       all_features=True, shadows=shadows)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
                    len(scene.point_lights), bool(linear_output), material.has_specular,
-                   shadows=shadows)
+                   shadows=shadows, shadow_kernel=shared_kernel(scene) if shadows else 0)
 
 
 STAGES = (("vertex_shader", "vertex.glsl"),

@@ -179,6 +179,12 @@ class ShadowMaps:
         return vao
 
     @property
+    def framebuffers(self) -> list[moderngl.Framebuffer]:
+        """Per layer, its depth-only framebuffer (benchmarks/bench_shadows.py's bare program
+        draws into the same storage)."""
+        return [view for _name, view in self._framebuffers]
+
+    @property
     def vertex_arrays(self) -> dict:
         """Object index -> its depth-pass vertex array, for those drawn so far."""
         return {index: vao for index, (_vbo, vao) in self._vertex_arrays.items()}

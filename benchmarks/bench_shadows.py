@@ -1,0 +1,241 @@
+"""Shadow maps' cost per scene, printed (issue 15's benchmark): frames with shadows against
+the same scene without, and against a bare moderngl program doing the same two passes.
+
+    .venv/bin/python benchmarks/bench_shadows.py [--size 640x480] [--rounds 15] [--quick]
+        [--scenes shadow_plane,shadow_room,shadow_curved,classic] [--context egl]
+
+For each scene, on one GL context, three frames are timed in turn, round after round (so all
+three see the same machine load), each with the same read-back as GpuRenderer.render(): the
+RGBA8 colour and the float depth (glReadPixels into arrays made once):
+- without: GpuRenderer.render(out=frame) of the scene with every light's shadows off
+  (Shadow(enabled=False)): no maps, no lookup code;
+- with: GpuRenderer.render(out=frame) of the scene as it is (every light's map on);
+- bare: a moderngl program with nothing of the project in the loop (BareShadows): the same
+  passes with the matrices renderer/core/shadows.plan_shadows gives (planned once, before the
+  timed frames), drawn into the same storage (the layers of a DEPTH_COMPONENT32F array
+  texture, a framebuffer per layer, each map cleared and drawn R x R from texel (0, 0)), then
+  the camera pass with minimal GLSL (benchmarks/glsl/bare_*.vert/.frag): Phong with one
+  LINEAR depth-compare lookup per light (pcf2x2's one bilinear comparison), a fixed normal
+  offset in place of the bias rule. It is the lower bound for the same GL work.
+with/bare is the issue's figure (target <= 1.2). update() (uniforms and the frame's shadow
+plan: run when the camera, lights or objects move, not per frame) is timed the same way,
+with and without. The renderer also turns GL's bottom-up rows into row-0-on-top arrays and
+window depth into camera distance, which the bare program does not (about 0.2 ms at 640x480:
+benchmarks/bench_pipeline.py). Not a test: this machine is shared and noisy.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+from renderer.core.gl_rules import STANDARD_DEPTH
+from renderer.core.scene import Scene
+from renderer.core.scene_file import load_scene
+from renderer.core.shadow_settings import Shadow
+from renderer.core.shadows import plan_shadows, shadow_layout
+from renderer.core.transforms import to_glsl
+from renderer.core.visibility import visible_objects
+from renderer.gpu import GpuRenderer
+from renderer.gpu.context import activate, make_context
+from renderer.gpu.pipeline import CULL_FLAGS, make_float_depth
+from renderer.gpu.shaders import shader_source
+from renderer.gpu.shadow_maps import ShadowMaps
+from renderer.gpu.uniforms import SHADOW_MAPS_UNIT, frame_uniform_values, object_uniform_values
+
+from common import alternating_ms, machine, parser       # benchmarks/common.py
+
+SCENES = ("shadow_plane", "shadow_room", "shadow_curved", "classic")
+GLSL = Path(__file__).resolve().parent / "glsl"
+TARGET = 1.2                       # issue 15: with shadows within 1.2x the bare program
+QUICK_ROUNDS = 3
+
+
+def without_shadows(scene: Scene) -> Scene:
+    """`scene` with every light's shadow map off (the objects are shared)."""
+    off = Shadow(enabled=False)
+    return dataclasses.replace(
+        scene, directional_lights=[dataclasses.replace(l, shadow=off) for l in scene.directional_lights],
+        point_lights=[dataclasses.replace(l, shadow=off) for l in scene.point_lights])
+
+
+class BareShadows:
+    """The two passes of a shadowed frame with nothing else: everything is resolved in
+    __init__ (plan, matrices, uniforms as bytes, vertex arrays), and frame() only draws the
+    maps, draws the camera pass and reads the colour and depth back."""
+
+    def __init__(self, ctx: moderngl.Context, scene: Scene, width: int, height: int):
+        self.ctx = ctx
+        matrices = scene.matrices(width, height)
+        visible = visible_objects(scene, matrices)
+        layout = shadow_layout(scene, width, height)
+        plan = plan_shadows(scene, matrices, layout, visible)
+        self.storage = ShadowMaps(ctx, layout)          # its texture and framebuffers only
+        self.depth_program = ctx.program(vertex_shader=self._source("bare_depth.vert"),
+                                         fragment_shader=self._source("bare_depth.frag"))
+        self.clip_from_model = self.depth_program["u_clip_from_model"]
+        self.buffers = []
+        for obj in scene.objects:
+            vertices = np.hstack([obj.mesh.positions, obj.mesh.normals]).astype(np.float32)
+            self.buffers.append((ctx.buffer(vertices.tobytes()),
+                                 ctx.buffer(obj.mesh.faces.astype(np.uint32).tobytes())))
+        self.passes = []                                  # (framebuffer, R, [(vao, bytes)])
+        for shadow_pass in plan.passes:
+            draws = [(self._vao(self.depth_program, i, "3f 3x4", "in_position"),
+                      to_glsl(shadow_pass.clip_from_world @ matrices.objects[i].model))
+                     for i in shadow_pass.casters]
+            self.passes.append((self.storage.framebuffers[shadow_pass.tile.layer],
+                                shadow_pass.tile.size, draws))
+        frame_values = frame_uniform_values(scene, matrices, shadows=plan.uniforms)
+        programs, self.draws = {}, []                     # (vao, enable, cull, [(uniform, bytes)])
+        for i, obj in enumerate(scene.objects):
+            if not visible[i] or not obj.mesh.triangle_count:
+                continue
+            key = (obj.material.two_sided, obj.material.has_specular)
+            program = programs.get(key)
+            if program is None:
+                program = programs[key] = self._camera_program(scene, *key)
+                for name, data in frame_values.items():
+                    if name in program:
+                        program[name].write(data)
+            uploads = [(program[name], data) for name, data in
+                       object_uniform_values(obj, matrices.objects[i]).items() if name in program]
+            cull = CULL_FLAGS[obj.cull]
+            enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
+            self.draws.append((self._vao(program, i, "3f 3f", "in_position", "in_normal"),
+                               enable, cull, uploads))
+        self.background = scene.background
+        self.colour = ctx.renderbuffer((width, height), 4)
+        self.depth = ctx.depth_renderbuffer((width, height))
+        make_float_depth(ctx, self.depth, width, height)          # the renderer's depth format
+        self.fbo = ctx.framebuffer([self.colour], self.depth)
+        self.colour_out = np.empty((height, width, 4), np.uint8)
+        self.depth_out = np.empty((height, width), np.float32)
+
+    @staticmethod
+    def _source(name: str, defines: dict | None = None) -> str:
+        return shader_source(name, defines, directory=GLSL).text
+
+    def _camera_program(self, scene: Scene, two_sided: bool, specular: bool) -> moderngl.Program:
+        defines = {"NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
+                   "NUM_POINT_LIGHTS": len(scene.point_lights),
+                   "TWO_SIDED": two_sided, "SPECULAR": specular}
+        return self.ctx.program(vertex_shader=self._source("bare_phong.vert"),
+                                fragment_shader=self._source("bare_phong.frag", defines))
+
+    def _vao(self, program, index: int, layout: str, *attributes: str) -> moderngl.VertexArray:
+        vbo, ibo = self.buffers[index]
+        return self.ctx.vertex_array(program, [(vbo, layout, *attributes)], index_buffer=ibo,
+                                     index_element_size=4)
+
+    def frame(self) -> tuple[np.ndarray, np.ndarray]:
+        ctx, clear_depth = self.ctx, STANDARD_DEPTH.clear_depth
+        activate(ctx)                                     # as GpuRenderer.draw does
+        ctx.enable_only(moderngl.DEPTH_TEST)
+        ctx.depth_func = STANDARD_DEPTH.depth_func
+        for framebuffer, size, draws in self.passes:
+            framebuffer.use()
+            ctx.viewport = (0, 0, size, size)
+            framebuffer.clear(depth=clear_depth, viewport=(0, 0, size, size))
+            for vao, clip_from_model in draws:
+                self.clip_from_model.write(clip_from_model)
+                vao.render(moderngl.TRIANGLES)
+        self.fbo.use()
+        self.storage.texture.use(SHADOW_MAPS_UNIT)
+        self.fbo.clear(*self.background, 0.0, depth=clear_depth)
+        for vao, enable, cull, uploads in self.draws:
+            ctx.enable_only(enable)
+            if cull:
+                ctx.cull_face = cull
+            for uniform, data in uploads:
+                uniform.write(data)
+            vao.render(moderngl.TRIANGLES)
+        self.fbo.read_into(self.colour_out, components=4, alignment=1)
+        self.fbo.read_into(self.depth_out, components=1, attachment=-1, alignment=1, dtype="f4")
+        return self.colour_out, self.depth_out
+
+    def release(self) -> None:
+        for vao, *_ in self.draws:
+            vao.release()
+        for _framebuffer, _size, draws in self.passes:
+            for vao, _ in draws:
+                vao.release()
+        for buffer in (b for pair in self.buffers for b in pair):
+            buffer.release()
+        for gl_object in (self.fbo, self.colour, self.depth, self.depth_program):
+            gl_object.release()
+        self.storage.release()
+
+
+def maps_label(renderer: GpuRenderer) -> str:
+    """The scene's maps: each light's resolution (x6 for a point light's cube), the layers'
+    side and count, and the passes (maps drawn) and caster draws of the current plan."""
+    layout, plan = renderer.shadow_maps.layout, renderer.shadow_maps.plan
+    sizes = " + ".join(f"{m.resolution}" + ("x6" if m.kind == "point" else "") for m in layout.maps)
+    draws = sum(len(p.casters) for p in plan.passes)
+    return f"{sizes} ({layout.layers}x{layout.side}²), {len(plan.passes)} passes, {draws} draws"
+
+
+def measure(ctx, scene: Scene, size, rounds: int) -> dict:
+    plain_scene = without_shadows(scene)
+    bare = BareShadows(ctx, scene, *size)
+    with GpuRenderer(scene, *size, context=ctx) as shadowed, \
+            GpuRenderer(plain_scene, *size, context=ctx) as plain:
+        frames = shadowed.render(), plain.render()      # compiles; not timed
+        bare_colour, _ = bare.frame()
+        differ = float(np.mean(np.abs(bare_colour[::-1].astype(int) - frames[0].rgba8).max(axis=2) > 8))
+        plain_ms, shadowed_ms, bare_ms = alternating_ms(
+            (lambda: plain.render(out=frames[1]), lambda: shadowed.render(out=frames[0]), bare.frame),
+            rounds)
+        update_plain, update_shadowed = alternating_ms((plain.update, shadowed.update), rounds)
+        label = maps_label(shadowed)
+    bare.release()
+    return {"scene": scene.name, "maps": label, "without": plain_ms, "with": shadowed_ms,
+            "bare": bare_ms, "update without": update_plain, "update with": update_shadowed,
+            "bare differs": differ}
+
+
+def main() -> None:
+    options = parser(__doc__, "rounds", 15)
+    options.add_argument("--quick", action="store_true", help=f"{QUICK_ROUNDS} rounds")
+    options.add_argument("--scenes", type=lambda text: text.split(","), default=list(SCENES),
+                         help=f"comma-separated scene names (default: {','.join(SCENES)})")
+    args = options.parse_args()
+    rounds = QUICK_ROUNDS if args.quick else args.rounds
+    ctx = make_context(args.context)
+    width, height = args.size
+    print(f"{machine()}; {ctx.info['GL_RENDERER']}; {time.strftime('%Y-%m-%d %H:%M')}")
+    print(f"{width}x{height}, {args.context}; medians of {rounds} rounds, the three frames of a "
+          f"round in turn; colour and depth read back")
+    header = (f"{'scene':<14} {'maps (sizes, passes)':<44} {'without':>8} {'with':>8} {'bare':>8} "
+              f"{'with/without':>12} {'with/bare':>9}  {'<= ' + str(TARGET):>6}  "
+              f"{'update ms without/with':>22}")
+    print(header)
+    print("-" * len(header))
+    rows = []
+    for name in args.scenes:
+        row = measure(ctx, load_scene(name), args.size, rounds)
+        rows.append(row)
+        ratio = row["with"] / row["bare"]
+        print(f"{row['scene']:<14} {row['maps']:<44} {row['without']:8.2f} {row['with']:8.2f} "
+              f"{row['bare']:8.2f} {row['with'] / row['without']:11.2f}x {ratio:8.2f}x  "
+              f"{'yes' if ratio <= TARGET else 'NO':>6}  "
+              f"{row['update without']:10.2f} / {row['update with']:<9.2f}", flush=True)
+    print("ms: medians per frame (update: per update() call). The bare program's image differs "
+          "from the renderer's (more than 8/255 in a channel) in "
+          + ", ".join(f"{r['scene']} {100 * r['bare differs']:.2f}%" for r in rows)
+          + " of the pixels (its fixed bias).")
+    print(f"{machine()}")
+    scenes = "" if args.scenes == list(SCENES) else f" --scenes {','.join(args.scenes)}"
+    quick = " --quick" if args.quick else f" --rounds {args.rounds}"
+    print(f"Reproduce: .venv/bin/python benchmarks/bench_shadows.py --size {width}x{height}"
+          f"{quick}{scenes} --context {args.context}")
+    ctx.release()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,20 @@
+#version 330 core
+// benchmarks/bench_shadows.py's bare program, pass 2: world position and normal for Phong.
+
+uniform mat4 u_model;
+uniform mat3 u_normal_matrix;
+uniform mat4 u_view;
+uniform mat4 u_projection;
+
+in vec3 in_position;
+in vec3 in_normal;
+
+out vec3 v_world_position;
+out vec3 v_world_normal;
+
+void main() {
+    vec4 world = u_model * vec4(in_position, 1.0);
+    gl_Position = u_projection * (u_view * world);
+    v_world_position = world.xyz;
+    v_world_normal = u_normal_matrix * in_normal;
+}

@@ -58,7 +58,6 @@ def test_the_gpu_visibility_is_the_ratio_of_the_lights_terms(gl_contexts):
 
 @pytest.mark.slow
 def test_no_acne_at_any_elevation_on_either_backend(gl_contexts):
-    pytest.importorskip("renderer.checks.shadow_truth")   # SEAM: on branch shadow-truth
     rows = measure_sweep((160, 120), gl_contexts)
     assert [row["elevation"] for row in rows] == list(ELEVATIONS)
     for row in rows:
@@ -69,7 +68,6 @@ def test_no_acne_at_any_elevation_on_either_backend(gl_contexts):
 
 @pytest.mark.slow
 def test_without_a_bias_the_same_measure_finds_acne(gl_contexts):
-    pytest.importorskip("renderer.checks.shadow_truth")   # SEAM: on branch shadow-truth
     scene = elevation_scene(30)
     [light] = scene.directional_lights
     scene = replace(scene, directional_lights=[replace(light, shadow=replace(light.shadow, bias=BiasRule()))])

@@ -25,6 +25,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from renderer.checks.shadow_truth import shadows_vs_truth
 from renderer.core.primitives import cube, uv_sphere
 from renderer.core.scene import Camera, DirectionalLight, Material, Scene, SceneObject, Transform
 from renderer.gpu.pipeline import GpuRenderer
@@ -80,27 +81,15 @@ def gpu_visibility(scene: Scene, size: tuple[int, int], ctx) -> np.ndarray:
     return v
 
 
-# --- SEAM: renderer/checks/shadow_truth.py (branch shadow-truth) is not on main yet --------
-# The sweep needs, per scene, the truth's figures with the map's visibility from the reference
-# (shadows_vs_truth(scene, width, height)) and with a given visibility image for the one light
-# (the GPU's): shadows_vs_truth(scene, width, height, visibility={("directional", 0): v}),
-# v (H, W), NaN where not measured. Until that lands, `truth_figures` returns None and the
-# table says "n/a".
-def truth_figures(scene: Scene, size: tuple[int, int], visibility: np.ndarray | None = None) -> dict | None:
-    """The truth's figures for `scene` (ShadowTruth.as_dict()): acne_pixels,
-    wrong_outside_band_pixels, peter_panning, ...; None while shadow_truth is missing."""
-    try:
-        from renderer.checks.shadow_truth import shadows_vs_truth
-    except ImportError:
-        return None
-    overrides = {} if visibility is None else {"visibility": {("directional", 0): visibility}}
-    return shadows_vs_truth(scene, *size, **overrides).as_dict()
-# --- end of SEAM --------------------------------------------------------------------------
+def truth_figures(scene: Scene, size: tuple[int, int], visibility: np.ndarray | None = None) -> dict:
+    """The truth's figures for `scene` (ShadowTruth.as_dict(): acne_pixels,
+    wrong_outside_band_pixels, peter_panning, ...), the one light's visibility from the
+    reference's lookup, or `visibility` (H, W) (gpu_visibility's image)."""
+    given = None if visibility is None else {("directional", 0): visibility}
+    return shadows_vs_truth(scene, *size, visibility=given).as_dict()
 
 
-def _summary(figures: dict | None) -> dict | None:
-    if figures is None:
-        return None
+def _summary(figures: dict) -> dict:
     return {"acne_pixels": figures["acne_pixels"],
             "wrong_outside_band_pixels": figures["wrong_outside_band_pixels"],
             "wrong_outside_band_fraction": figures["wrong_outside_band_fraction"],
@@ -110,7 +99,7 @@ def _summary(figures: dict | None) -> dict | None:
 
 def measure_sweep(size: tuple[int, int], contexts: dict, elevations=ELEVATIONS) -> list[dict]:
     """One row per elevation: the truth's figures with v from the reference ("reference")
-    and from each context's images (its kind); None where the truth is not available."""
+    and from each context's images (its kind)."""
     rows = []
     for elevation in elevations:
         scene = elevation_scene(elevation)
@@ -122,14 +111,12 @@ def measure_sweep(size: tuple[int, int], contexts: dict, elevations=ELEVATIONS) 
 
 
 def sweep_acne(row: dict) -> int:
-    """The most acne pixels of a sweep row over its backends (0 where none was measured)."""
-    return max((figures["acne_pixels"] for key, figures in row.items()
-                if key != "elevation" and figures is not None), default=0)
+    """The most acne pixels of a sweep row over its backends."""
+    return max(figures["acne_pixels"] for key, figures in row.items() if key != "elevation")
 
 
 def _cell(row: dict, backends: list[str], key: str) -> str:
-    values = [row[b][key] if row.get(b) is not None else None for b in backends]
-    return " / ".join("n/a" if v is None else f"{v:,}" for v in values)
+    return " / ".join(f"{row[b][key]:,}" for b in backends)
 
 
 def markdown_section(rows: list[dict], size: tuple[int, int]) -> str:

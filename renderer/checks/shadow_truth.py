@@ -1,8 +1,8 @@
 """The rasteriser's shadow maps held against ray-cast truth (`renderer compare SCENE
 --shadows-vs-truth`; docs/conventions.md, "Shadows", "Held against truth").
 
-Per drawn pixel of a Phong object that receives shadows, and per light with a shadow map
-whose terms are not 0 there (N.L > 0, N the lit normal):
+Per drawn pixel of an object that receives shadows (any shading mode), and per light with a
+shadow map whose terms are not 0 there (N.L > 0, N the lit normal):
 
 - v, the map's visibility: the reference's lookup (reference/shadow/lookup.py) at the
   surviving fragment's point P and normal N (reference/pipeline.py `surface_pixels`; the

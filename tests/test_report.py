@@ -93,7 +93,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     image_rows = [row for row in rows if not row["knob"].startswith("shadows-")]
     assert all(0 <= float(row["rmse"]) <= float(row["max_abs"]) <= 1 for row in image_rows)
     # More samples, smaller error: jittered 16 beats one sample on both backends.
-    error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in rows}
+    error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in image_rows}
     for backend in ("gpu", "reference"):
         assert error[("jittered 16", backend)] < error[("jittered 1", backend)]
     plots = sorted(path.name for path in (out / "plots").iterdir())

@@ -217,6 +217,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help="raster (default): the rasteriser's knobs; raytrace: the ray "
                              "tracer's (samples per pixel by pattern, adaptive thresholds, max "
                              "depth), against a ray-traced ground truth")
+    report.add_argument("--knobs", type=lambda text: tuple(k.strip() for k in text.split(",")),
+                        metavar="K,K", help="only these knob families (default all): raster: "
+                        "antialiasing, tessellation, shading, precision, shadows (map resolution, "
+                        "filter, bias rule against ray-cast truth); raytrace: antialiasing, "
+                        "max_depth, precision")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -619,7 +624,7 @@ def cmd_report(args) -> int:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")
     result = run_report(scenes, args.out, method=args.method, quick=args.quick, size=args.size,
-                        cache_dir=args.cache, context_kind=args.context)
+                        cache_dir=args.cache, context_kind=args.context, knobs=args.knobs)
     print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "
           f"{len(result.files) - 2} plots in {result.seconds:.0f} s")
     return 0

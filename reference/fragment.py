@@ -61,6 +61,25 @@ def select_by_facing(gl_FrontFacing: np.ndarray, front: np.ndarray, back: np.nda
     return np.where(gl_FrontFacing[:, None], front, back)
 
 
+def lit_point(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
+              gl_FrontFacing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(P, N) a fragment is lit at (Phong) or looks its shadows up at (every mode): P
+    interpolated (flat: from its triangle's corners, the geometry stage's), N the renormalised
+    interpolated normal (flat: the face normal), flipped for a two-sided back face."""
+    vertices, faces = obj.vertices, obj.faces
+    if obj.material.shading == "flat":
+        corners = obj.triangles.f_world_position[triangle]                   # (N, 3, 3)
+        P = (weights[:, 0:1] * corners[:, 0] + weights[:, 1:2] * corners[:, 1]
+             + weights[:, 2:3] * corners[:, 2])
+        N = obj.triangles.f_face_normal[triangle]
+    else:
+        P = interpolate(vertices.v_world_position, faces, triangle, weights)
+        N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
+    if obj.material.two_sided:
+        N = np.where(gl_FrontFacing[:, None], N, -N)
+    return P, N
+
+
 def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
                     gl_FrontFacing: np.ndarray, lights: Lights, u_eye: np.ndarray,
                     shadows: ShadowMaps | None = None):
@@ -80,18 +99,7 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
                                  interpolate(vertices.v_color_front, faces, triangle, weights),
                                  interpolate(vertices.v_color_back, faces, triangle, weights))
     else:
-        # The lit point: P interpolated, N the renormalised interpolated normal (the face normal
-        # for flat), flipped for a two-sided back face.
-        if material.shading == "flat":
-            corners = obj.triangles.f_world_position[triangle]                   # (N, 3, 3)
-            P = (weights[:, 0:1] * corners[:, 0] + weights[:, 1:2] * corners[:, 1]
-                 + weights[:, 2:3] * corners[:, 2])
-            N = obj.triangles.f_face_normal[triangle]
-        else:
-            P = interpolate(vertices.v_world_position, faces, triangle, weights)
-            N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
-        if material.two_sided:
-            N = np.where(gl_FrontFacing[:, None], N, -N)
+        P, N = lit_point(obj, triangle, weights, gl_FrontFacing)
         E, uniforms = np.asarray(u_eye, dtype=dtype), MaterialUniforms.from_material(material, dtype)
         if not shadowed:
             color = lighting(P, N, E, uniforms, lights)

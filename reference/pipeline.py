@@ -34,7 +34,7 @@ import numpy as np
 
 from reference.clipping import clip_triangles
 from reference.depth_buffer import DepthBuffer
-from reference.fragment import ObjectVaryings, interpolate, shade_fragments
+from reference.fragment import ObjectVaryings, lit_point, shade_fragments
 from reference.geometry import shade_triangles
 from reference.lighting import Lights, normalize_or_zero
 from reference.output import compose_frame
@@ -275,8 +275,8 @@ def shade_surviving(objects: list[ObjectVaryings | None], payload: dict, pixels_
 
 @dataclass
 class SurfacePixels:
-    """The surface each drawn pixel of a Phong object shows (its surviving fragment), as the
-    fragment stage sees it: for measuring what it computes there against another method
+    """The surface each drawn pixel shows (its surviving fragment), as the fragment stage sees
+    it: for measuring what it computes there against another method
     (renderer/checks/shadow_truth.py). Per such pixel, in the pipeline's dtype:"""
     pixel: np.ndarray             # (K,) index into the image's H*W pixels, row 0 at the top
     object: np.ndarray            # (K,) the object's index in the scene
@@ -286,15 +286,12 @@ class SurfacePixels:
     position_scale: np.ndarray    # (K,) the largest |coordinate| of its triangle's vertices
 
 
-def _phong_surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
-    """(P, N, Ng, position_scale) of one object's fragments: the fragment stage's Phong inputs
-    (reference/fragment.py) and the lookup's tie scale (reference/shadow/lookup.py)."""
-    vertices, faces = varyings.vertices, varyings.faces
-    P = interpolate(vertices.v_world_position, faces, triangle, weights)
-    N = normalize_or_zero(interpolate(vertices.v_world_normal, faces, triangle, weights))
-    if varyings.material.two_sided:
-        N = np.where(gl_FrontFacing[:, None], N, -N)
-    corners = vertices.v_world_position[faces[triangle]]
+def _surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
+    """(P, N, Ng, position_scale) of one object's fragments: where the fragment stage looks its
+    shadows up (reference/fragment.py, lit_point) and the lookup's tie scale
+    (reference/shadow/lookup.py)."""
+    P, N = lit_point(varyings, triangle, weights, gl_FrontFacing)
+    corners = varyings.vertices.v_world_position[varyings.faces[triangle]]
     Ng = normalize_or_zero(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
     return P, N, Ng, np.abs(corners).max(axis=(1, 2))
 
@@ -302,7 +299,7 @@ def _phong_surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
 def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
                    subpixel_bits: int = SUBPIXEL_BITS,
                    tile_pixels: int = TILE_PIXELS) -> tuple[SurfacePixels, ShadowMaps | None]:
-    """The surface at every drawn pixel of a Phong object (SurfacePixels) and the frame's
+    """The surface at every drawn pixel (SurfacePixels) and the frame's
     shadow maps, from the same stages as `render` (band by band), without shading."""
     dtype = np.dtype(dtype)
     prepared = prepare_frame(scene, width, height, dtype, subpixel_bits, tile_pixels=tile_pixels)
@@ -313,14 +310,14 @@ def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
         buffer = depth_test_tile(region, prepared, width, height, scene.camera.reversed_z, dtype)
         payload, drawn = buffer.payload, buffer.drawn
         for index, item in enumerate(varyings):
-            if item is None or item.material.shading != "phong":
+            if item is None:
                 continue
             at = np.flatnonzero(drawn & (payload.get("object", -1) == index))
             if len(at) == 0:
                 continue
             gl_row, column = y0 + at // (x1 - x0), x0 + at % (x1 - x0)
             pixel = (height - 1 - gl_row) * width + column          # image rows: top first
-            parts.append((pixel, np.full(len(at), index), *_phong_surface(
+            parts.append((pixel, np.full(len(at), index), *_surface(
                 item, payload["triangle"][at], payload["weights"][at], payload["gl_FrontFacing"][at])))
     if not parts:
         empty = np.zeros((0, 3), dtype)

@@ -217,6 +217,11 @@ def build_parser() -> argparse.ArgumentParser:
                         help="raster (default): the rasteriser's knobs; raytrace: the ray "
                              "tracer's (samples per pixel by pattern, adaptive thresholds, max "
                              "depth), against a ray-traced ground truth")
+    report.add_argument("--knobs", type=lambda text: tuple(k.strip() for k in text.split(",")),
+                        metavar="K,K", help="only these knob families (default all): raster: "
+                        "antialiasing, tessellation, shading, precision, shadows (map resolution, "
+                        "filter, bias rule against ray-cast truth); raytrace: antialiasing, "
+                        "max_depth, precision")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -232,6 +237,9 @@ def build_parser() -> argparse.ArgumentParser:
     extremes.add_argument("--method", choices=("both", "raster", "raytrace"), default="both",
                           help="which cases: rasterised, ray traced (scene files named rt_*), or "
                                "both (default)")
+    extremes.add_argument("--no-sweep", action="store_true",
+                          help="leave out the light-elevation sweep of shadow maps (measured "
+                               "with the rasterised cases otherwise)")
     for name in ("render", "view", "compare", "shaders", "report", "extremes"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
@@ -616,7 +624,7 @@ def cmd_report(args) -> int:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")
     result = run_report(scenes, args.out, method=args.method, quick=args.quick, size=args.size,
-                        cache_dir=args.cache, context_kind=args.context)
+                        cache_dir=args.cache, context_kind=args.context, knobs=args.knobs)
     print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "
           f"{len(result.files) - 2} plots in {result.seconds:.0f} s")
     return 0
@@ -634,6 +642,7 @@ def cmd_extremes(args) -> int:
     from renderer.core.builtin import resolve_scene
     from renderer.gpu.context import make_context, release_context
     from renderer.study.extremes import all_pass, extreme_scenes, measure_extremes, write_report
+    from renderer.study.shadow_sweep import measure_sweep, sweep_acne
     from renderer.core.scene_file import load_scene
     from renderer.core.imageio import check_folder, check_outputs
     check_outputs(check_folder(args.out) / "extremes.json", args.out / "extremes.md")
@@ -647,17 +656,20 @@ def cmd_extremes(args) -> int:
             contexts[kind] = make_context(kind)
         methods = ("raster", "raytrace") if args.method == "both" else (args.method,)
         cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods)
+        sweep = None if args.no_sweep or "raster" not in methods else measure_sweep(args.size, contexts)
     finally:
         for ctx in contexts.values():
             release_context(ctx)
-    json_path, md_path = write_report(args.out, cases, args.size)
+    json_path, md_path = write_report(args.out, cases, args.size, sweep)
     for case in cases:
         state = "refused" if "refused" in case else ("pass" if case["passes"] else "FAIL")
         if case.get("before"):
             state = f"{state.lower()} (the 'before' of reversed-Z)"
         print(f"{case['case']}: {state}")
+    for row in sweep or ():
+        print(f"light elevation {row['elevation']}: {sweep_acne(row)} acne pixels")
     print(f"wrote {json_path} and {md_path}")
-    return 0 if all_pass(cases) else 1
+    return 0 if all_pass(cases, sweep or ()) else 1
 
 
 # Options that name a file or folder to write (or, --cache, to read and write): each goes

@@ -134,6 +134,7 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
     from renderer.gpu.context import activate
     from renderer.gpu.pipeline import GpuRenderer
     from renderer.core.scene_file import load_scene
+    from renderer.core.shadow_settings import DEFAULT_FILTER, FILTERS
     from renderer.gpu.shaders import ShaderVariant, program_sources
 
     result = cli("shaders", "hierarchy", "--out", str(tmp_path))
@@ -156,8 +157,8 @@ def test_shaders_writes_the_exact_glsl_of_each_variant_the_scene_draws(tmp_path,
             for stage, suffix in (("vertex_shader", "vert"), ("geometry_shader", "geom"),
                                   ("fragment_shader", "frag"))}
     assert flat == {stage: source.text for stage, source in
-                    program_sources(ShaderVariant("flat", False, 1, 1, specular=True,
-                                                                  shadows=True)).items()}
+                    program_sources(ShaderVariant("flat", False, 1, 1, specular=True, shadows=True,
+                                                  shadow_kernel=FILTERS[DEFAULT_FILTER])).items()}
     assert "#define SHADING_FLAT" in flat["fragment_shader"]
     assert "#define NUM_POINT_LIGHTS 1" in flat["vertex_shader"]
     assert "#define SPECULAR" in flat["geometry_shader"]

@@ -14,8 +14,11 @@ from renderer.core.builtin import builtin_scenes, made_for_raytracing
 from renderer.study.ground_truth import RAY_TRUTH_DEPTH, ground_truth
 from renderer.study.ray_report import (RAY_QUICK, RayStudy, RaySceneRun, RaySetting,
                                        ray_settings)
-from renderer.study.report import QUICK, ReportResult, metrics, settings
-from renderer.study.report_settings import CSV_COLUMNS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS
+from renderer.core.shadow_settings import BIAS_RULES, DEFAULT_FILTER, FILTERS, named_bias
+from renderer.study.report import FULL, QUICK, RasterStudy, ReportResult, metrics, run_report, settings
+from renderer.study.report_settings import (CSV_COLUMNS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS,
+                                            SHADOW_COLUMNS, SHADOW_TARGETS, ShadowTarget)
+from renderer.study.shadow_report import cheapest_shadow, shadow_sections, with_shadow_setting
 from renderer.study.report_output import convergence_slopes, pareto_front, series_name
 from renderer.core.scene_file import load_scene
 
@@ -66,7 +69,9 @@ def test_every_knob_runs_on_its_backends():
     backends = {(s.knob, s.backend) for s in plan}
     assert backends == {("antialiasing", "gpu"), ("antialiasing", "reference"),
                         ("tessellation", "gpu"), ("tessellation", "reference"),
-                        ("shading", "gpu"), ("shading", "reference"), ("precision", "reference")}
+                        ("shading", "gpu"), ("shading", "reference"), ("precision", "reference"),
+                        *((f"shadows-{knob}", b) for knob in ("resolution", "filter", "bias")
+                          for b in ("gpu", "reference"))}
     assert {s.setting for s in plan if s.pattern == "msaa"} == {"msaa 1", "msaa 4"}
     assert {s.setting for s in plan if s.pattern == "regular" and s.knob == "antialiasing"} == \
         {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
@@ -85,14 +90,16 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     assert len(rows) == len(settings(QUICK, [1, 4]))
     assert {row["scene"] for row in rows} == {"point_light_plane"}
     assert all(int(row["runs"]) >= 5 and float(row["median_ms"]) > 0 for row in rows)
-    assert all(0 <= float(row["rmse"]) <= float(row["max_abs"]) <= 1 for row in rows)
+    image_rows = [row for row in rows if not row["knob"].startswith("shadows-")]
+    assert all(0 <= float(row["rmse"]) <= float(row["max_abs"]) <= 1 for row in image_rows)
     # More samples, smaller error: jittered 16 beats one sample on both backends.
-    error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in rows}
+    error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in image_rows}
     for backend in ("gpu", "reference"):
         assert error[("jittered 16", backend)] < error[("jittered 1", backend)]
     plots = sorted(path.name for path in (out / "plots").iterdir())
     assert plots == [f"point_light_plane-{knob}.png"
-                     for knob in ("antialiasing", "precision", "shading", "tessellation")]
+                     for knob in ("antialiasing", "precision", "shading", "shadows-bias",
+                                  "shadows-filter", "shadows-resolution", "tessellation")]
     assert all((out / "plots" / name).read_bytes().startswith(b"\x89PNG") for name in plots)
     report = (out / "report.md").read_text()
     for heading in ("# Error against run time", "## Method", "## Convergence of the sampling patterns",
@@ -111,6 +118,9 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     (("sphere", "--size", "400x300"), "--size: 400x300 is too large for the ground truth"),
     (("sphere", "--method", "raytrace", "--size", "400x300"),
      "--size: 400x300 is too large for the ray tracer's ground truth"),
+    (("sphere", "--knobs", "shading,shadow"), "--knobs: shadow: no such knob for --method raster"),
+    (("sphere", "--method", "raytrace", "--knobs", "shadows"),
+     "--knobs: shadows: no such knob for --method raytrace"),
 ])
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_here):
     out = tmp_path / "report"
@@ -119,6 +129,100 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_he
     assert result.stderr.strip().splitlines() == [result.stderr.strip()]
     assert reason in result.stderr and "Traceback" not in result.stderr
     assert not out.exists() and not (tmp_path / "cache").exists()
+
+
+# -- the shadow knobs (renderer/study/shadow_report.py) ----------------------------------------
+
+def test_shadow_knobs_sweep_resolution_filter_and_bias_one_at_a_time():
+    plan = [s for s in settings(FULL, [1, 4]) if s.knob.startswith("shadows-")]
+    by_knob = {knob: [(s.setting, s.variant) for s in plan if s.knob == knob and s.backend == "gpu"]
+               for knob in ("shadows-resolution", "shadows-filter", "shadows-bias")}
+    assert by_knob["shadows-resolution"] == [(str(r), ("shadow", "resolution", r))
+                                             for r in (256, 512, 1024, 2048, 4096)]
+    assert by_knob["shadows-filter"] == [(f, ("shadow", "filter", f)) for f in FILTERS]
+    assert by_knob["shadows-bias"] == [(b, ("shadow", "bias", b)) for b in BIAS_RULES]
+    assert len(plan) == 2 * (5 + 4 + 4)                       # each on both backends
+    assert {s.sampling for s in plan} == {("pattern", "regular", 1)}     # one sample, a frame
+
+
+def test_a_shadow_setting_changes_every_light_with_a_map_and_nothing_else():
+    scene = load_scene(builtin_scenes()["coloured_lights"])    # 2 directional, 2 point lights
+    scene = replace(scene, point_lights=[replace(scene.point_lights[0], shadow=replace(
+        scene.point_lights[0].shadow, enabled=False)), *scene.point_lights[1:]])
+    lights = lambda s: [*s.directional_lights, *s.point_lights]          # noqa: E731
+    for field, value, expected in (("resolution", 512, {"resolution": 512}),
+                                   ("filter", "pcf5x5", {"filter": "pcf5x5"}),
+                                   ("bias", "slope", {"bias": named_bias("slope", DEFAULT_FILTER)})):
+        changed = with_shadow_setting(scene, field, value)
+        for before, after in zip(lights(scene), lights(changed)):
+            wanted = replace(before.shadow, **expected) if before.shadow.enabled else before.shadow
+            assert after == replace(before, shadow=wanted)
+    assert named_bias("slope", DEFAULT_FILTER) != named_bias("auto", DEFAULT_FILTER)
+
+
+def test_a_scene_gets_the_shadow_settings_its_maps_allow():
+    plan = settings(FULL, [1])
+    shadowless = replace(load_scene(builtin_scenes()["shadow_plane"]),
+                         objects=[replace(o, casts_shadows=False)
+                                  for o in load_scene(builtin_scenes()["shadow_plane"]).objects])
+    room = load_scene(builtin_scenes()["shadow_room"])         # a point light: six layers
+    shadow_settings = lambda scene: {s.setting for s in RasterStudy().scene_settings(   # noqa: E731
+        plan, scene, 160, 120) if s.knob == "shadows-resolution"}
+    assert shadow_settings(shadowless) == set()
+    assert "2048" in shadow_settings(room) and "4096" not in shadow_settings(room)   # 6 x 4096^2 texels
+    assert len(RasterStudy().scene_settings(plan, shadowless, 160, 120)) == \
+        len([s for s in plan if not s.knob.startswith("shadows-")])
+
+
+def _shadow_row(scene, setting, backend, ms, outside, wrong, acne):
+    return {"scene": scene, "knob": "shadows-filter", "setting": setting, "backend": backend,
+            "median_ms": ms, "wrong_outside_band_fraction": outside, "wrong_fraction": wrong,
+            "acne_pixels": acne, "peter_panning_max_texels": 0}
+
+
+def test_the_cheapest_shadow_setting_is_the_fastest_meeting_every_bound_of_the_target():
+    target = ShadowTarget(wrong_outside_band=0.001, wrong=0.002, acne_pixels=0)
+    rows = [_shadow_row("a", "none", "gpu", 1.0, 0.0, 0.001, 3),        # fastest, but acne
+            _shadow_row("a", "hard", "gpu", 2.0, 0.001, 0.001, 0),      # 0.1 % outside: not below
+            _shadow_row("a", "pcf2x2", "gpu", 3.0, 0.0005, 0.0025, 0),  # too wrong in all
+            _shadow_row("a", "pcf3x3", "gpu", 5.0, 0.0, 0.002, 0),      # meets it (at the bound)
+            _shadow_row("a", "pcf5x5", "gpu", 4.0, 0.0, 0.0019, 0),     # meets it, faster
+            _shadow_row("a", "pcf5x5", "reference", 0.5, 0.0, 0.0019, 0),      # another backend
+            _shadow_row("b", "pcf5x5", "gpu", 0.5, 0.0, 0.0, 0),               # another scene
+            {"scene": "a", "knob": "shading", "backend": "gpu", "median_ms": 0.1, "rmse": 0.1}]
+    assert cheapest_shadow(rows, "a", "gpu", target)["setting"] == "pcf5x5"
+    assert cheapest_shadow(rows, "a", "gpu", target)["median_ms"] == 4.0
+    assert cheapest_shadow(rows[:3], "a", "gpu", target) is None
+    loose = ShadowTarget(wrong_outside_band=0.002, wrong=1.0, acne_pixels=0)
+    assert cheapest_shadow(rows, "a", "gpu", loose)["setting"] == "hard"
+    # report.md: a section per target (SHADOW_TARGETS: the second also bounds wrong in all)
+    first, second = "\n".join(shadow_sections(rows[:3] + rows[5:], ["a", "b"])).split("\n## ")[1:]
+    assert first.startswith(f"Cheapest shadow setting: {SHADOW_TARGETS[0].text()}")
+    assert "| a | filter: pcf2x2 | 3 | 0.050% | 0.250% | filter: pcf5x5 | 0.5 |" in first
+    assert "| a | none reaches it |  |  |  | filter: pcf5x5 | 0.5 |" in second
+    assert "| b | filter: pcf5x5 | 0.5 | 0.000% | 0.000% | none reaches it |  |" in second
+
+
+@pytest.mark.slow                       # about 3 s idle: plots, a context, 16 frames
+def test_a_tiny_shadow_sweep_writes_its_rows_plots_and_targets(tmp_path):
+    scene = load_scene(builtin_scenes()["shadow_plane"])
+    sweep = replace(QUICK, shadow_resolutions=(256,), shadow_filters=("hard",),
+                    shadow_biases=("auto", "none"), runs=1)
+    result = run_report([scene], tmp_path, quick=True, size=(16, 12), knobs=("shadows",),
+                        sweep=sweep, context_kind="osmesa")
+    assert [(r["setting"], r["backend"]) for r in result.rows] == [
+        (name, b) for name in ("256", "hard", "auto", "none") for b in ("gpu", "reference")]
+    assert result.truth_hits == 0 and not any("rmse" in r for r in result.rows)  # no image truth
+    figures = {r["setting"]: tuple(r[c] for c in SHADOW_COLUMNS) for r in result.rows}
+    assert figures["auto"][2] == 0 < figures["none"][2]          # no bias: acne
+    with open(tmp_path / "results.csv", newline="") as handle:
+        assert tuple(csv.DictReader(handle).fieldnames) == CSV_COLUMNS
+    assert sorted(p.name for p in (tmp_path / "plots").iterdir()) == [
+        f"shadow_plane-shadows-{knob}.png" for knob in ("bias", "filter", "resolution")]
+    report = (tmp_path / "report.md").read_text()
+    assert f"## Cheapest shadow setting: {SHADOW_TARGETS[0].text()}" in report
+    assert "| shadow_plane |" in report and "## Convergence" not in report
+    assert "Generated by `renderer report --quick --knobs shadows`" in report
 
 
 # -- the ray tracer's report (renderer/study/ray_report.py) ------------------------------------

@@ -1,8 +1,8 @@
 """The rasteriser's shadow maps held against ray-cast truth (`renderer compare SCENE
 --shadows-vs-truth`; docs/conventions.md, "Shadows", "Held against truth").
 
-Per drawn pixel of a Phong object that receives shadows, and per light with a shadow map
-whose terms are not 0 there (N.L > 0, N the lit normal):
+Per drawn pixel of an object that receives shadows (any shading mode), and per light with a
+shadow map whose terms are not 0 there (N.L > 0, N the lit normal):
 
 - v, the map's visibility: the reference's lookup (reference/shadow/lookup.py) at the
   surviving fragment's point P and normal N (reference/pipeline.py `surface_pixels`; the
@@ -236,12 +236,19 @@ class ShadowTruth:
         return image
 
 
-def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, shape):
+def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, shape, given=None):
     """(classes, acne, peter-panning) images of one light over the surface pixels `rows`
-    (receivers where its terms are not 0)."""
+    (receivers where its terms are not 0). `given` (H, W): the map's visibility measured
+    elsewhere (a GPU's images: renderer/study/shadow_sweep.py), NaN where it was not (those
+    pixels are not considered); None: the reference's lookup."""
     height, width = shape
+    if given is not None:
+        rows = rows[np.isfinite(given.reshape(-1)[surface.pixel[rows]])]
     P, N, Ng = surface.P[rows], surface.N[rows], surface.Ng[rows]
-    v = LOOKUPS[light.kind](light.maps, light.index, P, N, surface.position_scale[rows]).visibility
+    if given is None:
+        v = LOOKUPS[light.kind](light.maps, light.index, P, N, surface.position_scale[rows]).visibility
+    else:
+        v = given.reshape(-1)[surface.pixel[rows]]
     truth = light.lit(P, Ng)
     said_lit = v >= LIT_FROM
     wrong = said_lit != truth
@@ -291,9 +298,11 @@ def _image(pixel, values, fill, width, height) -> np.ndarray:
     return image.reshape(height, width)
 
 
-def shadows_vs_truth(scene, width: int, height: int) -> ShadowTruth:
+def shadows_vs_truth(scene, width: int, height: int, visibility: dict | None = None) -> ShadowTruth:
     """The scene's shadow maps at width x height held against ray-cast truth (the module
-    docstring). A ValueError when the scene has no shadow maps."""
+    docstring). `visibility`: {(kind, light index): (H, W) v, NaN where not measured} in place
+    of the reference's lookup for those lights (v from a GPU's images). A ValueError when the
+    scene has no shadow maps."""
     layout = shadow_layout(scene, width, height)
     if not layout.any:
         raise ValueError("the scene has no shadow maps: no light with shadows on, or nothing "
@@ -308,7 +317,8 @@ def shadows_vs_truth(scene, width: int, height: int) -> ShadowTruth:
         light = LightRays(light_map.kind, light_map.index, maps, rays)
         lit_side = np.einsum("ij,ij->i", surface.N, light.direction_to(surface.P)) > 0.0
         rows = np.flatnonzero(receives[surface.object] & lit_side)
-        classes, acne, reach = _classify(light, surface, rows, (height, width))
+        given = (visibility or {}).get((light_map.kind, light_map.index))
+        classes, acne, reach = _classify(light, surface, rows, (height, width), given)
         lights.append(LightTruth(light_map.kind, light_map.index, light_map.resolution,
                                  light_map.shadow.filter, classes, acne, reach))
     total_ms = (time.perf_counter() - start) * 1000.0

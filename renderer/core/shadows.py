@@ -391,7 +391,8 @@ def point_face_projection(resolution: int, guard: int, near: float, far: float) 
     return projection, tan_half
 
 
-def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters, scene):
+def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters, scene,
+                prune=True):
     position = matrices.relative(light.position)
     passes = []
     rects = np.zeros((6, 4))
@@ -418,7 +419,7 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
     for face in range(6):
         tile = light_map.tiles[face]
         drawn = tuple(i for i, out in zip(casters, outside[face]) if not out)
-        needed = bool(drawn) and not outside[face, n:].all()
+        needed = not prune or (bool(drawn) and not outside[face, n:].all())
         rects[face] = tile.rect(layout.side, needed)   # not drawn: the lookup reads it as lit
         if not needed:
             continue
@@ -434,7 +435,9 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
     """The frame's shadow passes and lookup uniforms (module docstring). `visible`: which
     objects the camera can see (renderer/core/visibility.visible_objects; all if None); only
     those count as receivers to fit a map to. `prune` False draws every caster, also those
-    that cannot shadow any receiver (`can_shadow`): a plane in its own map, to study the bias."""
+    that cannot shadow any receiver (`can_shadow`), into every cube face, also those that see
+    no caster or no receiver: a plane in its own map, to study the bias, and the work the
+    pruning saves (benchmarks/bench_shadow_pruning.py)."""
     n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
     uniforms = {
         "u_shadow_map_size": np.array(float(layout.side)),
@@ -477,7 +480,7 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
             relevant = [c for c in casters if not prune or can_shadow(
                 scene, points, c, receivers, light_position=position, planes=planes)]
             passes, rects, params, depth = _plan_point(
-                i, light, light_map, layout, matrices, points, receivers, relevant, scene)
+                i, light, light_map, layout, matrices, points, receivers, relevant, scene, prune)
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias

@@ -157,12 +157,17 @@ class GpuRenderer:
 
     def __init__(self, scene: Scene, width: int, height: int,
                  context: moderngl.Context | None = None, context_kind: str = "auto",
-                 specialise: bool = True):
+                 specialise: bool = True, prune_shadows: bool = True):
         width, height = image_size(width, height)
         check_light_count(scene)         # before a program fails to link (renderer/core/gl_rules.py)
         self.scene = scene
         self.width, self.height = width, height
         self.specialise = bool(specialise)
+        # False draws every caster into every shadow map and cube face, also those that can
+        # change nothing (renderer/core/shadows.py, plan_shadows(prune=False)): what the frame
+        # would cost without leaving them out (benchmarks/bench_shadow_pruning.py); a
+        # directional map is then fitted to every caster, so the image may differ.
+        self.prune_shadows = bool(prune_shadows)
         self.wireframe = False           # draw() draws edges only (a viewer's toggle)
         self._shadows = True             # the `shadows` switch
         self._owns_context = context is None
@@ -327,7 +332,7 @@ class GpuRenderer:
         self._shadow_layout = layout
         if not layout.any:
             return None
-        plan = plan_shadows(self.scene, matrices, layout, visible)
+        plan = plan_shadows(self.scene, matrices, layout, visible, prune=self.prune_shadows)
         self._shadow_maps.set_plan(plan, [(item.vbo, item.ibo) for item in self._objects],
                                    [m.model for m in matrices.objects])
         return plan.uniforms

@@ -41,6 +41,12 @@ from renderer.gpu.raytracer import RayTracer
 from renderer.core.imageio import outputs
 from renderer.core.jsonio import json_text
 from renderer.core.scene_file import load_scene
+from renderer.study.shadow_sweep import markdown_section, sweep_acne
+
+REVERSED_Z_STABILITY = ("reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
+                        "depth buffer cleared to 0 and GL_GREATER; the shadow map keeps the "
+                        "standard mapping, its depth spanning only the light's casters and "
+                        "receivers")
 
 # What makes each case stable, keyed by the scene file's name (docs/conventions.md has the rules).
 STABILITY = {
@@ -52,17 +58,16 @@ STABILITY = {
                        "(GL's clipper; the reference divides only after clipping)",
     "degenerate_triangles": "zero-area triangles are never rasterised; a face normal of zero "
                             "length stays zero (normalize_or_zero), never NaN",
-    "depth_ratio_1e5": "reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
-                       "depth buffer cleared to 0 and GL_GREATER",
-    "depth_ratio_1e8": "reversed-Z: glClipControl ZERO_TO_ONE, near -> 1, far -> 0, a float32 "
-                       "depth buffer cleared to 0 and GL_GREATER",
+    "depth_ratio_1e5": REVERSED_Z_STABILITY,
+    "depth_ratio_1e8": REVERSED_Z_STABILITY,
     "duplicate_vertices": "coincident vertices of a file without normals are merged (and split "
                           "again at creases); the repeated faces share their vertices, tie "
                           "exactly and the first drawn wins in both",
     "extreme_scale": "the normal matrix is the cofactor matrix (det(M) M^-T), scaled in float64 "
                      "before the float32 upload",
     "far_from_origin": "camera-relative transforms: T(-eye) M in float64, the view a rotation, "
-                       "eye and lights relative to the eye",
+                       "eye and lights relative to the eye; the light views are built from the "
+                       "same camera-relative points",
     "grazing_light": "max(N.L, 0) and no highlight unless N.L > 0 and R.V > 0",
     "light_behind": "max(N.L, 0) and no highlight unless N.L > 0 and R.V > 0: ambient only",
     "nan_mesh": "refused when loaded: one line naming file, key and reason, exit status 2",
@@ -74,6 +79,23 @@ STABILITY = {
                       "zeroes lights as ambient (normalize_or_zero)",
     "subpixel_triangles": "vertices snapped to 1/256 px and the fill rule decide coverage "
                           "identically in both pipelines",
+    # shadow maps (docs/conventions.md, "Shadows")
+    "shadow_contact": "the automatic bias moves a lookup at most the filter's reach (plus 1/4 "
+                      "texel towards the light), so a shadow starts within a texel of where its "
+                      "caster touches; the floor, planar with everything on its lit side, is "
+                      "left out of the map and cannot self-shadow at the contact",
+    "shadow_grazing_light": "the normal-offset bias is finite at every angle (o >= r(|N.X| + "
+                            "|N.Y|) texels, where a slope-scaled bias grows as tan(theta)); the "
+                            "floor cannot shadow its own lit side and is left out of the map",
+    "shadow_light_inside": "a point light's near plane is half the distance to the nearest "
+                           "caster triangle, so the enclosing mesh is never clipped away and "
+                           "every face's depth holds it; a lookup beyond it is shadowed",
+    "shadow_point_in_box": "the cube-face rule's ties (largest |d_k|, x before y before z) are "
+                           "the same in both twins, and each face is widened by a guard band "
+                           "holding real depth, so filter taps at a face's edge read no seam",
+    "shadow_tiny_caster": "a directional map is fitted to the receivers in view cut to the "
+                          "casters' box across the light: its texels are the caster's size / R, "
+                          "not the floor's; the floor is not drawn into it",
     # ray traced (docs/conventions.md, "Rays")
     "rt_coplanar": "hit ties: a surface replaces the nearest hit only when nearer by more than "
                    "2^-18 relative, so the plane, found first, shows wherever the triangle lies "
@@ -283,17 +305,25 @@ def _backends(cases: list[dict]) -> list[str]:
     return ["reference"]
 
 
-def write_report(out: Path, cases: list[dict], size: tuple[int, int]) -> tuple[Path, Path]:
-    """extremes.json (every figure of every case) and extremes.md (the table): both or neither
+def write_report(out: Path, cases: list[dict], size: tuple[int, int],
+                 sweep: list[dict] | None = None) -> tuple[Path, Path]:
+    """extremes.json (every figure of every case, and of the light-elevation sweep when
+    measured: renderer/study/shadow_sweep.py) and extremes.md (the tables): both or neither
     (imageio.outputs)."""
     json_path, md_path = Path(out) / "extremes.json", Path(out) / "extremes.md"
     document = {"size": list(size), "cases": cases}
+    table = markdown_table(cases, size)
+    if sweep is not None:
+        document["light_elevation_sweep"] = sweep
+        table += "\n" + markdown_section(sweep, size)
     with outputs(json_path, md_path) as written:
         written.text(json_path, json_text(_json_safe(document)))
-        written.text(md_path, markdown_table(cases, size))
+        written.text(md_path, table)
     return json_path, md_path
 
 
-def all_pass(cases: list[dict]) -> bool:
-    """Every case as authored passes (the reversed_z-off rows are the 'before' and may not)."""
-    return all(case["passes"] for case in cases if not case.get("before"))
+def all_pass(cases: list[dict], sweep: list[dict] = ()) -> bool:
+    """Every case as authored passes (the reversed_z-off rows are the 'before' and may not),
+    and the sweep shows no acne on any backend (where the truth was measured)."""
+    return (all(case["passes"] for case in cases if not case.get("before"))
+            and not any(sweep_acne(row) for row in sweep))

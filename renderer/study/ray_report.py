@@ -34,6 +34,7 @@ from renderer.core.ray_sampling import FIRST_SET
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED, PATTERNS
 from renderer.core.scene import Plane, Sphere
+from renderer.study.metrics import metrics
 from renderer.study.ground_truth import (RAY_TRUTH_DEPTH, RAY_TRUTH_SAMPLES, ground_truth)
 from renderer.study.report_settings import (RAY_BASE_SAMPLES, RAY_CSV_COLUMNS, RAY_DEFAULT_SIZE,
                                             RAY_MAX_SIZE, RAY_QUICK_SIZE)
@@ -123,6 +124,9 @@ class RaySceneRun:
                 runs, warm_up=False)
         return clamped(frame.linear[..., :3]), float(frame.samples.mean()), ms
 
+    def errors(self, setting: RaySetting, image: np.ndarray, truth: np.ndarray) -> dict:
+        return metrics(image, truth)
+
     def release(self) -> None:
         """Nothing to free: each RayTracer is released after its setting."""
 
@@ -131,6 +135,7 @@ class RayStudy:
     """The ray tracer's sweep (module docstring), as report.py's run_report drives it."""
     method = "raytrace"
     columns = RAY_CSV_COLUMNS
+    knobs = ("antialiasing", "max_depth", "precision")
 
     def sweep(self, quick: bool) -> RaySweep:
         return RAY_QUICK if quick else RAY_FULL
@@ -155,6 +160,12 @@ class RayStudy:
 
     def settings(self, sweep: RaySweep, ctx) -> list[RaySetting]:
         return ray_settings(sweep)
+
+    def scene_settings(self, plan: list[RaySetting], scene, width: int, height: int) -> list[RaySetting]:
+        return plan                                      # every scene gets every setting
+
+    def needs_truth(self, plan: list[RaySetting]) -> bool:
+        return bool(plan)
 
     def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
         return ground_truth(scene, width, height, cache_dir, method="raytrace")

@@ -13,6 +13,9 @@ image against the ground truth (renderer/study/ground_truth.py) make one row of 
     shading         flat, gouraud, phong                              authored tessellation,
                                                                       4-sample grid
     precision       float32, float64 (reference only)                 the truth's, 4-sample grid
+    shadows-*       map resolution, filter, bias rule (shadow_report.py;  as authored, one
+                    scenes with shadow maps): error against ray-cast      sample per pixel
+                    truth, not the image's
 
 Errors are on the float image in [0, 1] (renderer/study/supersample.py) against the float truth:
 rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 8 bits) and
@@ -22,7 +25,7 @@ has finished, each atomically.
 
 run_report drives a study: RasterStudy, this sweep, or (method="raytrace") renderer/study/
 ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, with the same
-metrics, plots and tables.
+metrics, plots and tables. `knobs` (the command's --knobs) keeps only some knob families.
 """
 
 from __future__ import annotations
@@ -36,15 +39,17 @@ from pathlib import Path
 import numpy as np
 
 from renderer.core import sampling
-from renderer.core.gl_rules import to_unorm8
+from renderer.core.shadow_settings import BIAS_RULES, FILTERS
 from renderer.study.report_output import csv_text, plot_png, report_markdown
 from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
 from renderer.core.imageio import outputs
-from renderer.checks.perceptual import flip_error
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
-from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, MISMATCH_LEVELS,
-                                            QUICK_SIZE)
+from renderer.study.metrics import metrics
+from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, QUICK_SIZE,
+                                            SHADOW_RESOLUTIONS)
+from renderer.study.shadow_report import (fits, plot_axis, shadow_errors, shadow_variants,
+                                          with_shadow_setting)
 from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
 from renderer.study.timing import median_timed
 
@@ -54,11 +59,16 @@ class Sweep:
     sample_counts: tuple = (1, 4, 16, 64)          # per pattern; regular keeps the squares
     adaptive: tuple = ((4, 16, 0.05), (4, 64, 0.05))   # (first, total, threshold)
     levels: tuple = LEVELS
+    shadow_resolutions: tuple = SHADOW_RESOLUTIONS
+    shadow_filters: tuple = tuple(FILTERS)
+    shadow_biases: tuple = BIAS_RULES
     runs: int = 5
 
 
 FULL = Sweep()
-QUICK = Sweep(adaptive=((4, 16, 0.05),), levels=(0.25, 1.0, FINEST))
+QUICK = Sweep(adaptive=((4, 16, 0.05),), levels=(0.25, 1.0, FINEST), shadow_resolutions=(256, 1024),
+              shadow_filters=("hard", "pcf2x2"), shadow_biases=("auto", "none"))
+KNOB_FAMILIES = ("antialiasing", "tessellation", "shading", "precision", "shadows")
 
 
 @dataclass(frozen=True)
@@ -68,7 +78,8 @@ class Setting:
     setting: str
     backend: str                     # "gpu" or "reference"
     pattern: str                     # a sampling pattern, "adaptive", "msaa", or "regular"
-    variant: tuple                   # ("truth",) | ("level", L) | ("shading", mode)
+    variant: tuple                   # ("truth",) | ("level", L) | ("shading", mode) |
+                                     # ("shadow", field, value): shadow_report.py
     sampling: tuple                  # ("pattern", name, N) | ("adaptive", first, total, t) | ("msaa", N)
     dtype: str = "float64"
 
@@ -101,19 +112,10 @@ def settings(sweep: Sweep, msaa_counts: list[int]) -> list[Setting]:
         out += [Setting("shading", mode, b, "regular", ("shading", mode), base) for b in both]
     out += [Setting("precision", dtype, "reference", "regular", ("truth",), base, dtype)
             for dtype in ("float32", "float64")]
+    for knob, name, variant in shadow_variants(sweep.shadow_resolutions, sweep.shadow_filters,
+                                               sweep.shadow_biases):
+        out += [Setting(knob, name, b, "regular", variant, ("pattern", "regular", 1)) for b in both]
     return out
-
-
-def metrics(image: np.ndarray, truth: np.ndarray) -> dict:
-    """Errors of an (H, W, 3) float image in [0, 1] against the truth (module docstring)."""
-    difference = image - truth
-    mse = float(np.mean(difference ** 2))
-    image8, truth8 = to_unorm8(image), to_unorm8(truth)
-    off = np.abs(image8.astype(np.int16) - truth8.astype(np.int16)) > MISMATCH_LEVELS
-    return {"rmse": math.sqrt(mse), "max_abs": float(np.max(np.abs(difference))),
-            "psnr": 10.0 * math.log10(1.0 / mse) if mse > 0 else math.inf,
-            "flip_mean": flip_error(truth8, image8)[0],
-            "mismatched_fraction": float(off.any(axis=-1).mean())}
 
 
 class SceneRun:
@@ -125,6 +127,7 @@ class SceneRun:
         self.subpixel_bits = int(ctx.info["GL_SUBPIXEL_BITS"])      # the reference snaps as GL does
         self._scenes: dict[tuple, object] = {}
         self._gpus: dict[tuple, object] = {}
+        self._shadow_errors: dict[tuple, dict] = {}
 
     def drawn(self, variant: tuple):
         if variant not in self._scenes:
@@ -132,6 +135,7 @@ class SceneRun:
             self._scenes[variant] = (
                 truth_scene(self.scene) if kind == "truth" else
                 scene_at_level(self.scene.with_shading("phong"), variant[1]) if kind == "level" else
+                with_shadow_setting(self.scene, *variant[1:]) if kind == "shadow" else
                 self.scene.with_shading(variant[1]))
         return self._scenes[variant]
 
@@ -163,6 +167,16 @@ class SceneRun:
                                             warm_up=setting.backend == "gpu")
         return image, samples, ms
 
+    def errors(self, setting: Setting, image: np.ndarray, truth: np.ndarray | None) -> dict:
+        """A row's errors: a shadow setting's against ray-cast truth (one measurement for both
+        backends: shadow_report.py), any other's image against the ground truth (metrics)."""
+        if setting.variant[0] != "shadow":
+            return metrics(image, truth)
+        if setting.variant not in self._shadow_errors:
+            self._shadow_errors[setting.variant] = shadow_errors(self.drawn(setting.variant),
+                                                                 self.width, self.height)
+        return self._shadow_errors[setting.variant]
+
     def release(self) -> None:
         for gpu in self._gpus.values():
             gpu.release()
@@ -174,6 +188,7 @@ class RasterStudy:
     ray_report.py's RayStudy is the ray tracer's, with the same methods."""
     method = "raster"
     columns = CSV_COLUMNS
+    knobs = KNOB_FAMILIES
 
     def sweep(self, quick: bool) -> Sweep:
         return QUICK if quick else FULL
@@ -191,6 +206,14 @@ class RasterStudy:
     def settings(self, sweep: Sweep, ctx) -> list[Setting]:
         from renderer.gpu.pipeline import multisample_counts
         return settings(sweep, multisample_counts(ctx))
+
+    def scene_settings(self, plan: list[Setting], scene, width: int, height: int) -> list[Setting]:
+        """The settings `scene` gets: the shadow knobs only where it has shadow maps that fit."""
+        return [s for s in plan if s.variant[0] != "shadow" or fits(scene, s.variant, width, height)]
+
+    def needs_truth(self, plan: list[Setting]) -> bool:
+        """Whether some setting's error is against the ground truth image (not a shadow knob's)."""
+        return any(s.variant[0] != "shadow" for s in plan)
 
     def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
         return ground_truth(scene, width, height, cache_dir)
@@ -225,43 +248,55 @@ class ReportResult:
     scenes: dict = field(default_factory=dict)        # scene -> the study's describe(scene)
     gl_renderer: str = ""
     files: list = field(default_factory=list)
+    knobs: tuple = ()                                 # the families swept, when not all
 
 
 def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool = False,
-               size=None, cache_dir=None, context_kind: str = "auto", sweep=None) -> ReportResult:
+               size=None, cache_dir=None, context_kind: str = "auto", sweep=None,
+               knobs=None) -> ReportResult:
     """Sweep `scenes` (Scene objects) with `method`'s study (study()), write results.csv,
-    plots/ and report.md under `out`."""
+    plots/ and report.md under `out`. `knobs`: the knob families to sweep (default all of the
+    study's `knobs`; a setting's family is its knob up to a "-")."""
     from tqdm import tqdm
 
+    from renderer.errors import UserError
     from renderer.gpu.context import make_context, release_context
     runner = study(method)
+    result = ReportResult(knobs=tuple(knobs or ()))
+    knobs = tuple(knobs or runner.knobs)
+    unknown = [k for k in knobs if k not in runner.knobs]
+    if unknown:
+        raise UserError(f"{', '.join(unknown)}: no such knob for --method {method} (one of "
+                        f"{', '.join(runner.knobs)})", key="--knobs")
     width, height = size or runner.size(quick)
     runner.check(scenes, width, height)
     sweep = sweep or runner.sweep(quick)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
-    result = ReportResult()
     start = time.perf_counter()
     ctx = make_context(context_kind)
     try:
         result.gl_renderer = ctx.info["GL_RENDERER"]
-        plan = runner.settings(sweep, ctx)
-        with tqdm(total=len(scenes) * (len(plan) + 1), unit="setting", file=sys.stderr,
+        plan = [s for s in runner.settings(sweep, ctx) if s.knob.split("-")[0] in knobs]
+        plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
+        with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
                   mininterval=0.5, dynamic_ncols=True) as bar:
-            for scene in scenes:
-                bar.set_description(f"{scene.name}: ground truth")
-                truth, hit = runner.truth(scene, width, height, cache_dir)
-                result.truth_hits += hit
+            for scene, scene_plan in zip(scenes, plans):
+                truth = None
+                if runner.needs_truth(scene_plan):
+                    bar.set_description(f"{scene.name}: ground truth")
+                    truth, hit = runner.truth(scene, width, height, cache_dir)
+                    result.truth_hits += hit
                 result.scenes[scene.name] = runner.describe(scene)
                 bar.update()
                 run = runner.scene_run(scene, width, height, ctx)
                 try:
-                    for setting in plan:
+                    for setting in scene_plan:
                         bar.set_description(f"{scene.name}: {setting.knob} {setting.setting} "
                                             f"({setting.backend})")
                         image, samples, ms = run.timed(setting, sweep.runs)
                         result.rows.append({
                             "scene": scene.name, **setting.columns(), "samples": samples,
-                            "runs": sweep.runs, "median_ms": ms, **metrics(image, truth)})
+                            "runs": sweep.runs, "median_ms": ms, **run.errors(setting, image, truth)})
                         bar.update()
                 finally:
                     run.release()
@@ -281,7 +316,8 @@ def write_outputs(result: ReportResult, out: Path, runner, size, sweep, quick: b
             for knob in dict.fromkeys(row["knob"] for row in result.rows if row["scene"] == scene):
                 rows = [row for row in result.rows if row["scene"] == scene and row["knob"] == knob]
                 plots[(scene, knob)] = f"plots/{scene}-{knob}.png"
-                written.bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}"))
+                written.bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}",
+                                                                   **plot_axis(knob)))
         written.text(out / "results.csv", csv_text(result.rows, runner.columns))
         written.text(out / "report.md", runner.markdown(result, plots, size, sweep, quick))
     result.files = ["report.md", "results.csv", *plots.values()]

@@ -18,6 +18,7 @@ from renderer.core import sampling
 from renderer.study.ground_truth import TRUTH_GRID
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, MISMATCH_LEVELS, TARGETS_RMSE,
                                             TEXTBOOK_SLOPES)
+from renderer.study.shadow_report import method_bullet, shadow_sections
 
 BACKENDS = ("gpu", "reference")
 STYLES = {"gpu": ("o", "-"), "reference": ("s", "--")}          # marker, line per backend
@@ -65,9 +66,11 @@ def _colour(name: str, names: list[str]) -> str:
     return COLOURS.get(name) or f"C{len(COLOURS) + extra.index(name)}"
 
 
-def plot_png(rows: list[dict], title: str) -> bytes:
-    """PNG bytes: RMSE against median milliseconds, log-log, a line per series, the Pareto
-    front drawn as a dashed staircase through circled points."""
+def plot_png(rows: list[dict], title: str, error: str = "rmse",
+             label: str = "RMSE against the ground truth (0..1)", linear_below: float = 0.0) -> bytes:
+    """PNG bytes: `error` (a column) against median milliseconds, log-log, a line per series,
+    the Pareto front drawn as a dashed staircase through circled points. `linear_below` > 0:
+    the error axis is linear below it (symlog), so that errors of 0 are drawn too."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
@@ -76,7 +79,7 @@ def plot_png(rows: list[dict], title: str) -> bytes:
     axes = figure.add_subplot()
     series = defaultdict(list)
     for row in rows:
-        if row["rmse"] > 0:
+        if row[error] > 0 or linear_below:
             series[series_key(row)].append(row)
     names = list(dict.fromkeys(series_name(row) for row in rows))
     for index, (name, members) in enumerate(series.items()):
@@ -86,26 +89,31 @@ def plot_png(rows: list[dict], title: str) -> bytes:
         marker, line = STYLES[first["backend"]]
         colour = (_colour(series_name(first), names) if first["knob"] == "antialiasing"
                   else f"C{index}")
-        axes.plot([r["median_ms"] for r in members], [r["rmse"] for r in members], marker=marker,
+        axes.plot([r["median_ms"] for r in members], [r[error] for r in members], marker=marker,
                   linestyle=line, markersize=4, linewidth=1, color=colour, label=name)
         if first["knob"] != "antialiasing":              # few points: name each one
             for r in members:
-                axes.annotate(r["setting"], (r["median_ms"], r["rmse"]), fontsize=6,
+                acne = f" (acne {r['acne_pixels']})" if r.get("acne_pixels") else ""
+                axes.annotate(r["setting"] + acne, (r["median_ms"], r[error]), fontsize=6,
                               xytext=(4, -8), textcoords="offset points", color=colour)
     points = [row for members in series.values() for row in members]
-    front = [points[i] for i in pareto_front([(r["median_ms"], r["rmse"]) for r in points])]
+    front = [points[i] for i in pareto_front([(r["median_ms"], r[error]) for r in points])]
     if front:
-        axes.step([r["median_ms"] for r in front], [r["rmse"] for r in front], where="post",
+        axes.step([r["median_ms"] for r in front], [r[error] for r in front], where="post",
                   color="black", linestyle="--", linewidth=0.8)
-        axes.scatter([r["median_ms"] for r in front], [r["rmse"] for r in front], s=90,
+        axes.scatter([r["median_ms"] for r in front], [r[error] for r in front], s=90,
                      facecolors="none", edgecolors="black", label="Pareto front", zorder=3)
         for r in front if front[0]["knob"] == "antialiasing" else ():
-            axes.annotate(f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r["rmse"]),
+            axes.annotate(f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r[error]),
                           fontsize=6, xytext=(4, 3), textcoords="offset points")
     axes.set_xscale("log")
-    axes.set_yscale("log")
+    if linear_below:                       # errors are >= 0: no negative decades, room above
+        axes.set_yscale("symlog", linthresh=linear_below)
+        axes.set_ylim(0.0, 2.0 * max([linear_below, *(r[error] for r in rows)]))
+    else:
+        axes.set_yscale("log")
     axes.set_xlabel("median time per image (ms)")
-    axes.set_ylabel("RMSE against the ground truth (0..1)")
+    axes.set_ylabel(label)
     axes.set_title(title)
     axes.grid(True, which="both", linewidth=0.3)
     axes.legend(fontsize=7)
@@ -153,8 +161,10 @@ def convergence_slopes(rows: list[dict], series=tuple(sampling.PATTERNS), x: str
 
 
 def cheapest(rows: list[dict], scene: str, backend: str, target: float) -> dict | None:
-    """The fastest row of `scene` on `backend` whose RMSE is at most `target`, or None."""
-    good = [r for r in rows if r["scene"] == scene and r["backend"] == backend and r["rmse"] <= target]
+    """The fastest row of `scene` on `backend` whose RMSE is at most `target`, or None (a row
+    without an RMSE, a shadow knob's, never)."""
+    good = [r for r in rows if r["scene"] == scene and r["backend"] == backend
+            and r.get("rmse") is not None and r["rmse"] <= target]
     return min(good, key=lambda r: r["median_ms"]) if good else None
 
 
@@ -224,9 +234,10 @@ def spread(fit: Slope) -> str:
 
 def plots_section(scenes: list[str], plots: dict) -> list[str]:
     lines = ["## Plots", "",
-             "RMSE against the median time per image, log-log; circled points joined by the "
-             "dashed staircase are the Pareto front (no other setting is both faster and more "
-             "accurate).", ""]
+             "RMSE against the median time per image, log-log (the shadow knobs: the fraction "
+             "of pixels wrong outside the 1-texel band, linear below 0.01 %, so that 0 shows); "
+             "circled points joined by the dashed staircase are the Pareto front (no other "
+             "setting is both faster and more accurate).", ""]
     for scene in scenes:
         lines += [f"### {scene}", ""]
         for (plot_scene, knob), path in plots.items():
@@ -241,7 +252,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     lines = [
         "# Error against run time",
         "",
-        generated_line(result, size, sweep.runs, f"renderer report{' --quick' if quick else ''}"),
+        generated_line(result, size, sweep.runs, f"renderer report{' --quick' if quick else ''}"
+                       + (f" --knobs {','.join(result.knobs)}" if result.knobs else "")),
         "",
         "## Scenes",
         "",
@@ -277,6 +289,11 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         f"the authored tessellation) and **precision** (reference in float32 and float64, the "
         f"truth's scene) are sampled with a {BASE_SAMPLES}-sample regular grid, the same for "
         "every setting of a knob, so the differences between settings are the knob's.",
+        method_bullet(),
+    ]
+    if not any(r.get("rmse") is not None for r in rows):         # only the shadow knobs ran
+        return "\n".join(lines + shadow_sections(rows, scenes) + [""] + plots_section(scenes, plots))
+    lines += [
         "",
         "## Convergence of the sampling patterns",
         "",
@@ -295,5 +312,6 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread(fit)} | {fit.points} | "
                      f"{fit.samples[0]:g}-{fit.samples[1]:g} | {rate} | {why} |")
     lines += cheapest_sections(rows, scenes, "which draw the truth's geometry and shading")
+    lines += shadow_sections(rows, scenes) + [""]
     lines += plots_section(scenes, plots)
     return "\n".join(lines)

@@ -1,5 +1,8 @@
 """The fixed settings of `renderer report`: sizes, targets, the CSV's columns and the textbook
-convergence rates, read by the sweep (report.py) and by its output (report_output.py)."""
+convergence rates, read by the sweep (report.py, shadow_report.py) and by its output
+(report_output.py)."""
+
+from dataclasses import dataclass
 
 DEFAULT_SIZE = (160, 120)
 QUICK_SIZE = (64, 48)
@@ -9,8 +12,36 @@ QUICK_SCENES = ("flat_shading", "gouraud_vs_phong")
 TARGETS_RMSE = (0.01, 0.003)
 MISMATCH_LEVELS = 2                  # of 255: a pixel further off than this is mismatched
 BASE_SAMPLES = 4                     # regular grid for the knobs other than antialiasing
+# The shadow knobs' errors against ray-cast truth (renderer/checks/shadow_truth.py), empty in
+# the other knobs' rows, whose image errors (rmse .. mismatched_fraction) are empty in theirs.
+SHADOW_COLUMNS = ("wrong_outside_band_fraction", "wrong_fraction", "acne_pixels",
+                  "peter_panning_max_texels")
 CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "runs", "median_ms",
-               "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction")
+               "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction", *SHADOW_COLUMNS)
+
+
+@dataclass(frozen=True)
+class ShadowTarget:
+    """What the shadow knobs' "cheapest setting" must reach, as fractions of all pixels."""
+    wrong_outside_band: float          # wrong outside the 1-texel band: below this
+    wrong: float                       # wrong in all (inside the band too): at most this
+    acne_pixels: int                   # at most this many
+
+    def met(self, row: dict) -> bool:
+        return (row["wrong_outside_band_fraction"] < self.wrong_outside_band
+                and row["wrong_fraction"] <= self.wrong and row["acne_pixels"] <= self.acne_pixels)
+
+    def text(self) -> str:
+        total = f", at most {self.wrong:.2%} wrong in all" if self.wrong < 1.0 else ""
+        return (f"fewer than {self.wrong_outside_band:.1%} of pixels wrong outside the 1-texel "
+                f"band{total}, {self.acne_pixels} acne pixels")
+
+
+# Issue 15's bar for the default settings, then a sharper one that also bounds the errors
+# within a texel of the true edge (which only a finer map or a wider filter lowers).
+SHADOW_TARGETS = (ShadowTarget(0.001, 1.0, 0), ShadowTarget(0.001, 0.002, 0))
+SHADOW_RESOLUTIONS = (256, 512, 1024, 2048, 4096)    # the resolution knob's maps
+
 TEXTBOOK_SLOPES = {                  # RMSE against N (Mitchell 1996; docs/report)
     "regular": ("N^-0.5 at worst", "coverage steps of 1/k on a k x k grid: the worst case, "
                 "edges along the grid; other edges do better, but the grid aliases"),

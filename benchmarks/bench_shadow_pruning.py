@@ -1,0 +1,67 @@
+"""What leaving out the shadow work a scene does not need saves, printed (issue 15).
+
+    .venv/bin/python benchmarks/bench_shadow_pruning.py [--size 640x480] [--rounds 15]
+        [--scenes classic,cornell_box,hierarchy,sphere,point_light_plane,shadow_plane,shadow_room]
+        [--context egl]
+
+renderer/core/shadows.py plans each frame's shadow passes: a caster that cannot shadow any
+receiver (a convex shape or a planar mesh alone, a floor with everything on its lit side:
+`can_shadow`) is not drawn into a map, a cube face that sees no caster or no receiver is not
+drawn at all (its lookups read as lit), and a light whose map would hold nothing draws no pass.
+For each scene two renderers are timed in turn, round after round (both see the same load):
+GpuRenderer as it is, and GpuRenderer(prune_shadows=False), which draws every caster into
+every map and cube face. Both read back colour and depth as render() does. Without pruning a
+directional map is fitted to every caster, so that image may differ; the frame's work is
+what is compared. Programs whose object receives no shadow compile no lookup at all (the
+scene-level counterpart: benchmarks/bench_shadows.py, with shadows against without).
+Not a test: this machine is shared and noisy.
+"""
+
+from __future__ import annotations
+
+from renderer.core.scene_file import load_scene
+from renderer.gpu.context import make_context, release_context
+from renderer.gpu.pipeline import GpuRenderer
+
+from common import alternating_ms, machine, parser       # benchmarks/common.py
+
+SCENES = "classic,cornell_box,hierarchy,sphere,point_light_plane,shadow_plane,shadow_room"
+
+
+def work(gpu: GpuRenderer) -> tuple[int, int]:
+    """(passes, caster draws) of the shadow plan the renderer's last frame drew."""
+    plan = gpu.drawn_shadow_plan
+    if plan is None:
+        return 0, 0
+    return len(plan.passes), sum(len(p.casters) for p in plan.passes)
+
+
+def main() -> None:
+    options = parser(__doc__, "rounds", 15)
+    options.add_argument("--scenes", default=SCENES)
+    args = options.parse_args()
+    width, height = args.size
+    print(f"Shadow pruning at {width}x{height}, median of {args.rounds} frames each, in turn")
+    ctx = make_context(args.context)
+    print(f"{machine()}; {ctx.info['GL_RENDERER']} ({args.context})")
+    print(f"{'scene':<14} {'passes, draws (pruned)':>23} {'(all)':>9} {'pruned ms':>10} "
+          f"{'all ms':>8} {'saved':>7}")
+    try:
+        for name in args.scenes.split(","):
+            scene = load_scene(name)
+            with GpuRenderer(scene, width, height, context=ctx) as pruned, \
+                    GpuRenderer(scene, width, height, context=ctx, prune_shadows=False) as full:
+                frames = [pruned.render(), full.render()]
+                calls = [lambda: pruned.render(out=frames[0]), lambda: full.render(out=frames[1])]
+                ms_pruned, ms_full = alternating_ms(calls, args.rounds)
+                (p0, d0), (p1, d1) = work(pruned), work(full)
+            print(f"{name:<14} {f'{p0}, {d0}':>23} {f'{p1}, {d1}':>9} {ms_pruned:>10.1f} "
+                  f"{ms_full:>8.1f} {1 - ms_pruned / ms_full:>7.0%}")
+    finally:
+        release_context(ctx)
+    print(f"Reproduce: .venv/bin/python benchmarks/bench_shadow_pruning.py --size {width}x{height} "
+          f"--rounds {args.rounds}")
+
+
+if __name__ == "__main__":
+    main()

@@ -144,26 +144,28 @@ def setup_triangles(gl_Position: np.ndarray, width: int, height: int,
     return WindowTriangles(x, y, x_w, y_w, z_w, inv_w, signed_area_twice(x, y), subpixel_bits)
 
 
-def bounding_boxes(tris: WindowTriangles, width: int, height: int, region=None):
+def bounding_boxes(tris: WindowTriangles, width: int, height: int, region=None, grow: int = 0):
     """Pixel ranges [i0, i1] x [j0, j1] whose centres may be covered, clipped to the viewport,
-    or to `region` (x0, y0, x1, y1), a rectangle of pixels of it (GL rows; ends excluded)."""
+    or to `region` (x0, y0, x1, y1), a rectangle of pixels of it (GL rows; ends excluded);
+    `grow`: the box widened by that many sub-pixel units on every side."""
     bits = tris.subpixel_bits
     half = 1 << (bits - 1)
-    i0 = -((half - tris.x.min(axis=1)) >> bits)           # ceil((x_min - half) / one)
-    j0 = -((half - tris.y.min(axis=1)) >> bits)
-    i1 = (tris.x.max(axis=1) - half) >> bits               # floor((x_max - half) / one)
-    j1 = (tris.y.max(axis=1) - half) >> bits
+    i0 = -((half - tris.x.min(axis=1) + grow) >> bits)    # ceil((x_min - grow - half) / one)
+    j0 = -((half - tris.y.min(axis=1) + grow) >> bits)
+    i1 = (tris.x.max(axis=1) + grow - half) >> bits        # floor((x_max + grow - half) / one)
+    j1 = (tris.y.max(axis=1) + grow - half) >> bits
     x0, y0, x1, y1 = (0, 0, width, height) if region is None else region
     return (np.maximum(i0, x0), np.minimum(i1, x1 - 1),
             np.maximum(j0, y0), np.minimum(j1, y1 - 1))
 
 
-def _work_items(tris: WindowTriangles, width: int, height: int, max_candidates: int, region=None):
+def _work_items(tris: WindowTriangles, width: int, height: int, max_candidates: int, region=None,
+                grow: int = 0):
     """Split each triangle's bounding box into row bands of at most `max_candidates` pixels.
 
     Returns per item: triangle, i0, box width, j0, band height.
     """
-    i0, i1, j0, j1 = bounding_boxes(tris, width, height, region)
+    i0, i1, j0, j1 = bounding_boxes(tris, width, height, region, grow)
     box_w = np.maximum(i1 - i0 + 1, 0)
     box_h = np.maximum(j1 - j0 + 1, 0)
     rows_per_band = np.maximum(max_candidates // np.maximum(box_w, 1), 1)
@@ -251,14 +253,20 @@ def edge_equations(tris: WindowTriangles) -> EdgeEquations:
 
 
 def coverage(tris: WindowTriangles, width: int, height: int, *,
-             max_candidates: int = MAX_CANDIDATES_PER_BATCH, region=None) -> Iterator[tuple]:
+             max_candidates: int = MAX_CANDIDATES_PER_BATCH, region=None,
+             margin: np.ndarray | None = None) -> Iterator[tuple]:
     """The covered (triangle, pixel) pairs, in batches of at most about 2 * max_candidates
     tested candidates, in triangle order: (t, px, py) int64 each. Triangles must have
     area2 != 0. `region` (x0, y0, x1, y1): only the pixels of that rectangle of the viewport
     (a tile). The coverage rules alone (edge functions, fill rule): `rasterize` adds the
-    interpolation, the shadow maps' depth pass (reference/shadow/depth.py) only a depth plane."""
+    interpolation, the shadow maps' depth pass (reference/shadow/depth.py) only a depth plane.
+    `margin` (3, T) int64 >= 0, for the depth pass: instead, the pixels whose coverage is in
+    doubt when each edge function may be off by up to its margin: those that pass the fill
+    rule with E + margin but not with E - margin (boxes grown by the one sub-pixel unit a
+    vertex may move)."""
     edges = edge_equations(tris)
-    tri, i0, box_w, j0, box_h = _work_items(tris, width, height, max_candidates, region)
+    tri, i0, box_w, j0, box_h = _work_items(tris, width, height, max_candidates, region,
+                                            0 if margin is None else 1)
     counts = box_w * box_h
     ends = np.cumsum(counts)
     batch_of_item = (ends - counts) // max_candidates
@@ -266,7 +274,7 @@ def coverage(tris: WindowTriangles, width: int, height: int, *,
     for items in np.split(np.arange(len(tri)), boundaries):
         if len(items):
             yield _covered(edges, tris.subpixel_bits, tri[items], i0[items], box_w[items],
-                           j0[items], box_h[items])
+                           j0[items], box_h[items], margin)
 
 
 def rasterize(tris: WindowTriangles, width: int, height: int, *,
@@ -283,18 +291,36 @@ def _expand(starts: np.ndarray, lengths: np.ndarray):
     return run, starts[run] + offset
 
 
-def _covered(edges: EdgeEquations, bits: int, tri, i0, box_w, j0, box_h):
+def _spans(edges: EdgeEquations, bits: int, t, cy, lo, hi, shift=None):
+    """Each row's columns [lo, hi] narrowed to those passing the three edges' fill rule
+    (gl_rules.inside_columns, exact), the edge functions first moved by `shift` (3, T)."""
+    for k in range(3):
+        c = edges.c[k].take(t) if shift is None else edges.c[k].take(t) + shift[k].take(t)
+        edge_lo, edge_hi = inside_columns(edges.a[k].take(t) * cy + c, edges.b[k].take(t),
+                                          edges.inclusive[k].take(t), bits)
+        lo, hi = np.maximum(lo, edge_lo), np.minimum(hi, edge_hi)
+    return lo, hi
+
+
+def _covered(edges: EdgeEquations, bits: int, tri, i0, box_w, j0, box_h, margin=None):
     """The covered (triangle, px, py) of the items' boxes: along each row of a box, the three
-    edges' fill rule solved for the columns (gl_rules.inside_columns, exact), so only covered
-    pixels are made, in triangle, row, column order."""
+    edges' fill rule solved for the columns, so only covered pixels are made, in triangle,
+    row, column order; with `margin` (coverage) the doubtful ones: the columns of the row's
+    span with + margin left and right of its span with - margin."""
     item_of_row, py = _expand(j0, box_h)                         # every row of every box
     t = tri[item_of_row]
     cy = pixel_centre(py, bits)
     lo, hi = i0[item_of_row], i0[item_of_row] + box_w[item_of_row] - 1
-    for k in range(3):
-        edge_lo, edge_hi = inside_columns(edges.a[k].take(t) * cy + edges.c[k].take(t),
-                                          edges.b[k].take(t), edges.inclusive[k].take(t), bits)
-        lo, hi = np.maximum(lo, edge_lo), np.minimum(hi, edge_hi)
+    if margin is None:
+        lo, hi = _spans(edges, bits, t, cy, lo, hi)
+    else:
+        lo, hi = _spans(edges, bits, t, cy, lo, hi, margin)
+        sure_lo, sure_hi = _spans(edges, bits, t, cy, lo, hi, -margin)
+        none = sure_hi < sure_lo
+        sure_lo, sure_hi = np.where(none, hi + 1, sure_lo), np.where(none, hi, sure_hi)
+        # [lo, sure_lo - 1] and [sure_hi + 1, hi]
+        t, py = np.concatenate([t, t]), np.concatenate([py, py])
+        lo, hi = np.concatenate([lo, sure_hi + 1]), np.concatenate([sure_lo - 1, hi])
     row_of_pixel, px = _expand(lo, np.maximum(hi - lo + 1, 0))  # every covered pixel of it
     return t[row_of_pixel], px, py[row_of_pixel]
 

@@ -51,6 +51,32 @@ def test_a_known_map_by_hand():
     assert (layers.tolerance[1, :4, :4] > 0).all() and (layers.tolerance[1, :4, :4] < 1e-6).all()
 
 
+def test_a_texel_whose_coverage_snapping_may_change_spans_both_depths():
+    """One triangle in a 4x4 map (identity pass: x_w = 2 (x + 1) texels): (0.1, 0.1), (X, 0.1),
+    (X, 3.9) texels at z_w 0.5, its right edge at X = (384.5 - 1e-4) / 256 texels, 1e-4
+    sub-pixel units below the rounding boundary 384.5: the reference snaps it to 384, on
+    texel column 1's centres (1.5 texels = 384), which a right edge leaves out (depth 1.0);
+    GL's float32 position may round to 385 and cover them (seen on llvmpipe: shadow_room
+    640x480). So those texels may hold 0.5 or 1.0: below = 0.5 (and the triangle's store
+    tolerance, under 1e-6). Texel (0, 0), 64 sub-pixel
+    units inside every edge, is surely covered, and (0, 1), 30 units outside the hypotenuse,
+    surely not: no range."""
+    X = (384.5 - 1e-4) / 256
+    ndc = lambda x: x / 2 - 1                                     # noqa: E731  texels -> x_ndc
+    positions = np.array([[ndc(0.1), ndc(0.1), 0.0], [ndc(X), ndc(0.1), 0.0], [ndc(X), ndc(3.9), 0.0]])
+    mesh = Mesh(positions, np.tile([0.0, 0.0, 1.0], (3, 1)), np.array([[0, 1, 2]]))
+    scene = SimpleNamespace(objects=[SimpleNamespace(mesh=mesh)])
+    matrices = SimpleNamespace(objects=[SimpleNamespace(model=np.eye(4))])
+    layers = ShadowLayers.cleared(1, 4)
+    draw_pass(scene, matrices, ShadowPass("directional", 0, 0, Tile(0, 4), np.eye(4), (0,)), layers)
+    assert layers.depth[0, :, 1].tolist() == [1.0] * 4                    # the edge's column
+    assert ((layers.below[0, :, 1] > 0.5) & (layers.below[0, :, 1] < 0.5 + 1e-6)).all()
+    assert (layers.above[0, :, 1] == 0).all()
+    assert layers.depth[0, 0, 0] == 0.5 and layers.below[0, 0, 0] == layers.above[0, 0, 0] == 0
+    assert layers.depth[0, 1, 0] == 1.0 and layers.below[0, 1, 0] == layers.above[0, 1, 0] == 0
+    assert (layers.below[0, :, 2:] == 0).all() and (layers.above[0] == 0).all()
+
+
 def gpu_layers(ctx, scene, matrices, plan) -> np.ndarray:
     """llvmpipe's maps (layers, S, S) float32, GL rows: every pass drawn as the design says
     (viewport (0, 0, R, R), cleared to 1.0, GL_LESS, no culling) into an R x R texture of its

@@ -116,6 +116,18 @@ def test_b_a_tied_tap_gives_the_other_decision_with_its_weight():
     assert look.tied.tolist() == [True]
 
 
+def test_b_a_texel_whose_coverage_is_in_doubt_ties_every_depth_it_may_hold():
+    """Texel (1, 2) stores 1.0 but GL may have covered it at 0.25 (below = 0.75, depth.py):
+    a hard lookup there with ref 0.5 is lit, tied, the alternative shadowed; ref 0.2 (nearer
+    than either) is lit and certain."""
+    layers = layers_of(np.full((4, 4), 1.0, F32))
+    layers.below[LAYER, 2, 1] = 0.75
+    uvz = np.array([[U, V, 0.5], [U, V, 0.2]])
+    look = shadow_filter(layers, uvz, LAYER, 1, np.zeros(2), np.zeros((2, 2)))
+    assert look.visibility.tolist() == [1.0, 1.0]
+    assert look.alternative.tolist() == [0.0, 1.0] and look.tied.tolist() == [True, False]
+
+
 def test_b_hard_lookup_near_a_texel_edge_offers_the_neighbour():
     """Hard lookup at u S = 2 - 1e-9 (within a band of 1e-6 texels of the edge between texels
     1 and 2): texel 1 (shadowed, 0), alternative texel 2 (lit, 1). At u S = 1.5: no tie."""

@@ -18,7 +18,13 @@ of layer l at [l, y, x]; texels a pass did not draw, and those beyond its R x R,
   caster     int32, the object index that won the texel (-1: none), to tell acne (a receiver
              shadowing itself) from a shadow;
   tolerance  float32, how far GL's stored depth may lie from `depth` (z_w units,
-             STORE_TIE_ROUNDINGS below): the lookup's ties (lookup.py) add it.
+             STORE_TIE_ROUNDINGS below): the lookup's ties (lookup.py) add it;
+  below, above  float32 >= 0, how much nearer (below) and farther (above) than `depth` GL's
+             stored depth may be because its float32 vertex positions may snap to the
+             neighbouring sub-pixel (SNAP_TIE_ROUNDINGS below), so that a triangle covers a
+             texel centre near its edge in GL and not here, or the other way round: the
+             nearest depth of the triangles that may cover the texel, and of those that surely
+             do (1.0: none). 0 wherever no vertex near the texel is in doubt (almost all).
 """
 
 from __future__ import annotations
@@ -28,8 +34,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.clipping import clip_triangles
-from reference.rasterizer import WindowTriangles, coverage, depth_planes, setup_triangles
-from renderer.core.gl_rules import SUBPIXEL_BITS
+from reference.rasterizer import WindowTriangles, coverage, depth_planes, edge_equations, setup_triangles
+from renderer.core.gl_rules import SUBPIXEL_BITS, is_inside_edge, pixel_centre
 from renderer.core.memory import REFERENCE_TILE_PIXELS
 
 # llvmpipe sets up and evaluates the depth plane in float32 from the window origin (a0 at
@@ -45,6 +51,19 @@ from renderer.core.memory import REFERENCE_TILE_PIXELS
 # elsewhere): 5 is twice what was seen. (At a forced 2048 some scenes differ in a texel's
 # coverage and reach 9 to 22 roundings: float32 vertex positions this model does not follow.)
 STORE_TIE_ROUNDINGS = 5
+# GL snaps x_w = (x_clip / w + 1) R / 2 to 1 / 2^SUBPIXEL_BITS computed in float32: x_clip and
+# w are 4-term products (up to 4 roundings each of the products' magnitude |M_x|.|p| and
+# |M_w|.|p|), the division 1 rounding of |x_ndc| <= 1, the viewport's multiply-add 1 of x_w
+# <= R; in texels that is at most ~7 roundings of the triangle's `vertex_error`
+# ((|M_x|.|p| + |M_w|.|p|) / w R / 2, >= R / 2). SNAP_TIE_ROUNDINGS = 8 of them: a vertex
+# whose float64 position (in sub-pixel units) lies that close to a rounding boundary n + 1/2
+# may snap one unit the other way in GL (seen: shadow_room 640x480, 32082.506 here, 32082.5
+# in float32, rounded to even). Moving an edge's endpoints a = (xa, ya), b by e, f in
+# {-1, 0, 1}^2 changes its edge function at p by exactly
+#   e_x (y_b - p_y) + e_y (p_x - x_b) + f_x (p_y - y_a) + f_y (x_a - p_x) + f_y e_x - f_x e_y,
+# at most (|e_x| + |f_x|) H + (|e_y| + |f_y|) W + |f_y e_x| + |f_x e_y| for p in the
+# triangle's box (W, H its sides plus 2, sub-pixel units): the edge's margin (`snap_margin`).
+SNAP_TIE_ROUNDINGS = 8
 UNIT_ROUNDOFF32 = 2.0 ** -24
 
 
@@ -53,12 +72,15 @@ class ShadowLayers:
     depth: np.ndarray
     caster: np.ndarray
     tolerance: np.ndarray
+    below: np.ndarray
+    above: np.ndarray
 
     @classmethod
     def cleared(cls, layers: int, side: int) -> "ShadowLayers":
-        """Cleared to depth 1.0, caster -1, tolerance 0."""
+        """Cleared to depth 1.0, caster -1, tolerance, below and above 0."""
         shape = (layers, side, side)
-        return cls(np.ones(shape, np.float32), np.full(shape, -1, np.int32), np.zeros(shape, np.float32))
+        return cls(np.ones(shape, np.float32), np.full(shape, -1, np.int32),
+                   *(np.zeros(shape, np.float32) for _ in range(3)))
 
     @property
     def side(self) -> int:
@@ -91,6 +113,29 @@ class _PassTriangles:
     caster: np.ndarray            # (T,) object index
     plane: tuple                  # depth_planes(window)
     vertex_error: np.ndarray      # (T, 3) window x, y (texels), z: rounding scale of the vertices
+    margin: np.ndarray            # (3, T) int64 snap_margin: edges whose coverage is in doubt
+
+
+def snap_margin(window: WindowTriangles, vertex_error: np.ndarray) -> np.ndarray:
+    """(3, T) int64: by how much each edge function (row k: the edge opposite vertex k, as
+    rasterizer.edge_equations) may differ in GL, whose float32 vertex positions may snap to
+    the neighbouring sub-pixel where the float64 ones lie within SNAP_TIE_ROUNDINGS roundings
+    of `vertex_error` (T, 3 texels) of a rounding boundary; 0 where no endpoint is in doubt."""
+    one = 1 << window.subpixel_bits
+    doubt = SNAP_TIE_ROUNDINGS * UNIT_ROUNDOFF32 * one * np.asarray(vertex_error[:, :2], np.float64)
+
+    def may_flip(position, band):                 # (T, 3) bool
+        s = np.asarray(position, np.float64) * one
+        return np.abs(s - np.floor(s) - 0.5) <= band[:, None]
+
+    fx = may_flip(window.x_w, doubt[:, 0]).astype(np.int64)
+    fy = may_flip(window.y_w, doubt[:, 1]).astype(np.int64)
+    width = (np.ptp(window.x, axis=1) + 2)[:, None]
+    height = (np.ptp(window.y, axis=1) + 2)[:, None]
+    start, end = [1, 2, 0], [2, 0, 1]
+    margin = ((fx[:, start] + fx[:, end]) * height + (fy[:, start] + fy[:, end]) * width
+              + fx[:, start] * fy[:, end] + fy[:, start] * fx[:, end])
+    return margin.T
 
 
 def _prepare_caster(index, mesh, matrix, size, dtype):
@@ -104,7 +149,8 @@ def _prepare_caster(index, mesh, matrix, size, dtype):
     # a window coordinate (ndc + 1) * size / 2 moves by the rounding of x_clip / w: the
     # products' magnitude (x and w) over w, in texels; z_w = (z_ndc + 1) / 2 likewise
     scale = (m[:, 3] + m[:, :3].T).T / w[:, None]
-    return window, np.full(len(source), index, np.int32), scale * np.array([size / 2.0, size / 2.0, 0.5])
+    error = scale * np.array([size / 2.0, size / 2.0, 0.5])
+    return window, np.full(len(source), index, np.int32), error, snap_margin(window, error)
 
 
 def _pass_triangles(scene, matrices, shadow_pass, dtype) -> _PassTriangles:
@@ -114,7 +160,8 @@ def _pass_triangles(scene, matrices, shadow_pass, dtype) -> _PassTriangles:
              for index in shadow_pass.casters]
     window = WindowTriangles.concatenate([p[0] for p in parts])
     return _PassTriangles(window, np.concatenate([p[1] for p in parts]), depth_planes(window),
-                          np.concatenate([p[2] for p in parts]))
+                          np.concatenate([p[2] for p in parts]),
+                          np.concatenate([p[3] for p in parts], axis=1))
 
 
 NONE = np.iinfo(np.int64).max
@@ -144,23 +191,78 @@ def _tolerance(tris: _PassTriangles, t, x, y, z) -> np.ndarray:
     return STORE_TIE_ROUNDINGS * UNIT_ROUNDOFF32 * (np.abs(z) + constant[t] + gx[t] * x + gy[t] * y)
 
 
+def _texel_depth(plane, t, px, py, dtype) -> np.ndarray:
+    """Triangles t's z_w at texel centres (px, py), clamped to [0, 1] as GL does before its
+    depth test."""
+    x0, y0, z0, dzdx, dzdy = plane
+    cx, cy = (px + 0.5).astype(dtype), (py + 0.5).astype(dtype)
+    return np.clip(z0[t] + dzdx[t] * (cx - x0[t]) + dzdy[t] * (cy - y0[t]), 0, 1)
+
+
+def _surely_covered(edges, margin, in_doubt, t, px, py) -> np.ndarray:
+    """Whether triangles t cover texels (px, py) whatever GL's snapping (`snap_margin`): in no
+    doubt, or inside every edge moved inwards by its margin."""
+    sure = ~in_doubt[t]
+    d = np.flatnonzero(~sure)
+    t, cx, cy = t[d], pixel_centre(px[d], SUBPIXEL_BITS), pixel_centre(py[d], SUBPIXEL_BITS)
+    sure[d] = np.logical_and.reduce([
+        is_inside_edge(edges.a[k, t] * cy - edges.b[k, t] * cx + edges.c[k, t] - margin[k, t],
+                       edges.inclusive[k, t]) for k in range(3)])
+    return sure
+
+
+def _ring(tris: _PassTriangles, doubt, band0, size, region, dtype):
+    """The band's (texel, triangle, depth) (N,) each that a doubtful triangle (`doubt`: their
+    indices) may cover but not surely: within the margins of its edges (`snap_margin`); the
+    depth less its store tolerance (`_tolerance`: the nearest GL may store there)."""
+    texels, triangles, depths = [np.zeros(0, np.int64)], [np.zeros(0, np.int64)], [np.zeros(0, dtype)]
+    for t, px, py in coverage(tris.window.select(doubt), size, size, region=region,
+                              margin=tris.margin[:, doubt]):
+        z = _texel_depth(tris.plane, doubt[t], px, py, dtype)
+        texels.append((py - band0) * size + px)
+        triangles.append(doubt[t])
+        depths.append(z - _tolerance(tris, doubt[t], px, py, z))
+    return np.concatenate(texels), np.concatenate(triangles), np.concatenate(depths)
+
+
 def draw_pass(scene, matrices, shadow_pass, layers: ShadowLayers, dtype=np.float64,
               tile_pixels: int = REFERENCE_TILE_PIXELS) -> None:
-    """Draw one pass's casters into texels [0, R)^2 of its layer (band by band)."""
+    """Draw one pass's casters into texels [0, R)^2 of its layer (band by band), and where GL's
+    snapping may change a triangle's coverage, the range of depths it may store (below, above:
+    `_ring`)."""
     size, layer = shadow_pass.tile.size, shadow_pass.tile.layer
     tris = _pass_triangles(scene, matrices, shadow_pass, dtype)
-    x0, y0, z0, dzdx, dzdy = tris.plane
+    doubt = np.flatnonzero(tris.margin.any(axis=0))      # triangles with a margin
+    in_doubt = np.zeros(len(tris.window), bool)
+    in_doubt[doubt] = True
+    edges = edge_equations(tris.window)
     rows = max(1, tile_pixels // size)
     for band0 in range(0, size, rows):
         band1 = min(band0 + rows, size)
+        region = (0, band0, size, band1)
         z_buffer = np.ones((band1 - band0) * size, dtype)
         winner = np.full(len(z_buffer), -1, np.int64)
         first = np.full(len(z_buffer), NONE)
-        for t, px, py in coverage(tris.window, size, size, region=(0, band0, size, band1)):
-            cx, cy = (px + 0.5).astype(dtype), (py + 0.5).astype(dtype)    # texel centres
-            z = z0[t] + dzdx[t] * (cx - x0[t]) + dzdy[t] * (cy - y0[t])
-            # GL clamps a fragment's depth to [0, 1] before its depth test
-            _nearest_first(z_buffer, winner, first, (py - band0) * size + px, np.clip(z, 0, 1), t)
+        ring_texel, ring_triangle, ring_z = _ring(tris, doubt, band0, size, region, dtype)
+        in_ring = np.zeros(len(z_buffer), bool)
+        in_ring[ring_texel] = True
+        behind = np.ones(len(z_buffer), dtype)     # at ring texels: the nearest sure cover + tolerance
+        for t, px, py in coverage(tris.window, size, size, region=region):
+            texel, z = (py - band0) * size + px, _texel_depth(tris.plane, t, px, py, dtype)
+            _nearest_first(z_buffer, winner, first, texel, z, t)
+            ring = np.flatnonzero(in_ring[texel])
+            ring = ring[_surely_covered(edges, tris.margin, in_doubt, t[ring], px[ring], py[ring])]
+            farthest = z[ring] + _tolerance(tris, t[ring], px[ring], py[ring], z[ring])
+            np.minimum.at(behind, texel[ring], farthest)
+        # GL may store a ring triangle's depth where it did not win here (below: down to the
+        # nearest of them), or, where it won here, not (above: up to the nearest sure cover),
+        # each give or take its store tolerance
+        where, index = np.unique(ring_texel, return_inverse=True)
+        nearest = z_buffer[where].copy()
+        np.minimum.at(nearest, index, ring_z)
+        layers.below[layer, where // size + band0, where % size] = z_buffer[where] - nearest
+        unsure = ring_texel[winner[ring_texel] == ring_triangle]
+        layers.above[layer, unsure // size + band0, unsure % size] = behind[unsure] - z_buffer[unsure]
         drawn = winner >= 0
         texels = np.flatnonzero(drawn)
         t, x, y = winner[texels], texels % size, texels // size + band0

@@ -12,7 +12,8 @@ layer's S x S, compare ref <= stored unclamped, denormals flushed).
 
 Ties (the reference's second acceptable answer): GL's float32 arithmetic puts P, the matrix
 product and the stored depth within rounding of the reference's, so a tap whose reference
-depth is that close to the stored one may be decided either way, and a hard lookup whose
+depth is that close to the stored one (or to any depth GL may store there: at a caster's
+edge its float32 vertices may snap otherwise) may be decided either way, and a hard lookup whose
 u * S is that close to a texel edge may read the neighbouring texel. Each lookup returns
 its visibility, whether some tap was so tied, and the visibility with the tied taps decided
 the other way (`ShadowLookup`); the pipeline shades such pixels again into Frame.rgba8_tie.
@@ -42,7 +43,8 @@ SMALLEST_NORMAL32 = 2.0 ** -126
 #   S (|M_u| . (|Q| + position_scale) + |M_u3|)       (u * S, texels, for the hard texel),
 # and for a point light the same through d = Q - light, z_w = A + B / m, u = 0.5 (r.d) / (m
 # tan) + 0.5 (`_point_tie_bounds`). The stored depth's own rounding is depth.py's per-texel
-# `tolerance` (STORE_TIE_ROUNDINGS); the compare band is their sum.
+# `tolerance` (STORE_TIE_ROUNDINGS); the compare band is their sum, around the range of depths
+# GL may have stored where its snapping may change a caster's coverage (depth.py below, above).
 SHADOW_TIE = 16 * UNIT_ROUNDOFF32
 
 
@@ -118,11 +120,15 @@ def linear_texels(u: np.ndarray, size: int):
 
 
 def _taps(layers: ShadowLayers, layer, ref, tie_ref, j, i):
-    """(lit, tied) of one texel (i, j) of `layer` per fragment."""
+    """(lit, tied) of one texel (i, j) of `layer` per fragment: tied where ref lies within the
+    band (tie_ref plus the texel's tolerance) of the depths GL may have stored there, from
+    depth - below to depth + above (depth.py: its coverage may differ at a caster's edge)."""
     stored = layers.depth[layer, j, i]
     lit = compare(ref, stored)
+    band = tie_ref + layers.tolerance[layer, j, i]
+    nearest, farthest = stored - layers.below[layer, j, i], stored + layers.above[layer, j, i]
     with np.errstate(invalid="ignore"):
-        tied = np.abs(ref - stored) <= tie_ref + layers.tolerance[layer, j, i]
+        tied = (ref >= nearest - band) & (ref <= farthest + band)
     return lit, tied
 
 

@@ -89,7 +89,7 @@ def in_process_digest(name, kind, ctx):
 
 # -- one process ----------------------------------------------------------------------------
 
-@pytest.mark.parametrize("context_kind", CONTEXT_KINDS)
+@pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
 @pytest.mark.parametrize("name", raster_scene_params(SCENE_NAMES))
 def test_every_frame_of_a_scene_is_byte_identical(name, context_kind, gl_contexts):
     frames = render_repeatedly(name, gl_contexts[context_kind])

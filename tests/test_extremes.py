@@ -253,7 +253,7 @@ def test_ray_traced_extreme_case_is_finite_and_within_tolerance_of_float64(name,
         assert case["grazing_pixels"] >= 24 and case["worst_truth"]["mismatched_pixels"] > 0
 
 
-@pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
+@pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
 @pytest.mark.parametrize("name", RENDERED)
 def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts,
                                                           reference_frames):
@@ -299,6 +299,7 @@ def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli):
     assert "vertex 2 is not finite (nan, 1, 0)" in line and "Traceback" not in result.stderr
 
 
+@pytest.mark.slow
 def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
     result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "osmesa",
                  "--method", "raster", "--no-sweep")

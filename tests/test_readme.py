@@ -12,6 +12,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 OUTPUT_OPTIONS = {"-o", "--out", "--depth", "--screenshot", "--stats", "--goldens-results"}
@@ -100,6 +102,7 @@ def test_the_using_it_example_loads_a_builtin_scene_by_name():
     assert 'load_scene("sphere")' in using_it_python_block()
 
 
+@pytest.mark.slow
 def test_the_using_it_example_runs_from_another_folder(tmp_path):
     result = subprocess.run([sys.executable, "-c", using_it_python_block() + CHECKS],
                             cwd=tmp_path, capture_output=True, text=True, timeout=120)

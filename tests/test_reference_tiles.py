@@ -24,8 +24,15 @@ def test_bands_cover_the_frame_once_in_whole_rows():
     assert TILE_PIXELS * 300 < 512 * 2 ** 20                 # a band's working set: well under 512 MiB
 
 
-@pytest.mark.parametrize("tile_pixels", (SIZE[0] * 7, 10), ids=("7-row bands", "1-row bands"))
-@pytest.mark.parametrize("name", ("near_plane", "hierarchy", "orthographic", "x_depth_ratio_1e8"))
+# 1-row bands (the shadow maps' depth passes too) in the default run for one scene, the rest
+# in the full run (--all).
+BANDS = [pytest.param(name, tile, id=f"{name}-{label}",
+                      marks=[pytest.mark.slow] if tile == 10 and name != "orthographic" else [])
+         for name in ("near_plane", "hierarchy", "orthographic", "x_depth_ratio_1e8")
+         for tile, label in ((SIZE[0] * 7, "7-row bands"), (10, "1-row bands"))]
+
+
+@pytest.mark.parametrize("name, tile_pixels", BANDS)
 def test_bands_give_the_same_frame_bit_for_bit(name, tile_pixels, reference_frames):
     scene = assets_dir() / "extreme" / f"{name[2:]}.toml" if name.startswith("x_") else name
     whole = reference_frames(scene, *SIZE, linear=True)
@@ -37,6 +44,7 @@ def test_bands_give_the_same_frame_bit_for_bit(name, tile_pixels, reference_fram
         np.testing.assert_array_equal(banded.rgba8_tie, whole.rgba8_tie)
 
 
+@pytest.mark.slow
 def test_depth_ties_are_pasted_band_by_band(reference_frames):
     """flat_shading at 256x256 has two pixels where the reference accepts another surface
     (a depth tie); drawn in 1-row bands, the tie image is the same."""

@@ -70,7 +70,7 @@ def as_rgba8(image):
     return np.dstack([to_unorm8(image), np.full(image.shape[:2], 255, np.uint8)])
 
 
-@pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
+@pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
 @pytest.mark.parametrize("name", ("coloured_lights", "hierarchy"))
 def test_gpu_and_reference_accumulate_the_same_samples(name, context_kind, gl_contexts):
     scene = scene_named(name)

@@ -138,8 +138,18 @@ def snap_margin(window: WindowTriangles, vertex_error: np.ndarray) -> np.ndarray
     return margin.T
 
 
-def _prepare_caster(index, mesh, matrix, size, dtype):
-    triangles, magnitude = _caster_triangles(mesh, matrix, dtype)
+def _pass_triangles(scene, matrices, shadow_pass, dtype) -> _PassTriangles:
+    """The pass's casters' triangles, all at once (clipping keeps each source triangle's place,
+    so the draw order is the casters', each in its mesh's order): clipped, set up at the
+    tile's size, zero-area ones dropped (no culling)."""
+    size = shadow_pass.tile.size
+    parts = [_caster_triangles(scene.objects[index].mesh,
+                               clip_from_model(shadow_pass, matrices.objects[index].model), dtype)
+             for index in shadow_pass.casters]
+    triangles = np.concatenate([p[0] for p in parts])
+    magnitude = np.concatenate([p[1] for p in parts])
+    caster = np.concatenate([np.full(len(p[0]), index, np.int32)
+                             for index, p in zip(shadow_pass.casters, parts)])
     clipped = clip_triangles(triangles, reversed_z=False)
     window = setup_triangles(clipped.gl_Position, size, size, SUBPIXEL_BITS, reversed_z=False)
     keep = window.area2 != 0                          # no culling; zero area draws nothing
@@ -150,18 +160,8 @@ def _prepare_caster(index, mesh, matrix, size, dtype):
     # products' magnitude (x and w) over w, in texels; z_w = (z_ndc + 1) / 2 likewise
     scale = (m[:, 3] + m[:, :3].T).T / w[:, None]
     error = scale * np.array([size / 2.0, size / 2.0, 0.5])
-    return window, np.full(len(source), index, np.int32), error, snap_margin(window, error)
-
-
-def _pass_triangles(scene, matrices, shadow_pass, dtype) -> _PassTriangles:
-    parts = [_prepare_caster(index, scene.objects[index].mesh,
-                             clip_from_model(shadow_pass, matrices.objects[index].model),
-                             shadow_pass.tile.size, dtype)
-             for index in shadow_pass.casters]
-    window = WindowTriangles.concatenate([p[0] for p in parts])
-    return _PassTriangles(window, np.concatenate([p[1] for p in parts]), depth_planes(window),
-                          np.concatenate([p[2] for p in parts]),
-                          np.concatenate([p[3] for p in parts], axis=1))
+    return _PassTriangles(window, caster[source], depth_planes(window), error,
+                          snap_margin(window, error))
 
 
 NONE = np.iinfo(np.int64).max

@@ -31,10 +31,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from renderer.core import transforms
-from renderer.core.gl_rules import depth_mapping
-from renderer.core.shadow_settings import (MAX_SHADOW_TEXELS, Shadow, auto_resolution, guard_texels,
-                                           scene_has_shadows)
+from renderer.core.shadow_settings import (MAX_SHADOW_TEXELS, RESOLUTIONS, Shadow, auto_resolution,
+                                           guard_texels, scene_has_shadows)
 from renderer.core.visibility import all_outside, corners
+from renderer.errors import SceneError
 
 # --- cube faces ------------------------------------------------------------------------------
 
@@ -124,8 +124,10 @@ def has_shadow_maps(scene) -> bool:
 
 def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
     """The shadow maps of `scene` rendered at width x height: a layer per light with shadows
-    on (six for a point light), none at all when nothing casts or nothing receives. A
-    ValueError when they would take more than MAX_SHADOW_TEXELS."""
+    on (six for a point light), none at all when nothing casts or nothing receives. Together
+    they hold at most MAX_SHADOW_TEXELS: automatic resolutions are halved, the largest first,
+    until they fit (a large image with several lights); a SceneError when the resolutions the
+    file sets do not fit even so."""
     if not scene_has_shadows(scene):
         return ShadowLayout(0, 0, ())
     wanted = []
@@ -133,20 +135,29 @@ def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
         for i, light in enumerate(lights):
             if light.shadow.enabled:
                 resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
-                wanted.append((kind, i, light.shadow, resolution))
+                wanted.append([kind, i, light.shadow, resolution])
     if not wanted:
         return ShadowLayout(0, 0, ())
-    side = max(r for *_, r in wanted)
+    layers = sum(6 if kind == "point" else 1 for kind, *_ in wanted)
+    while layers * max(w[3] for w in wanted) ** 2 > MAX_SHADOW_TEXELS:
+        shrinkable = [w for w in wanted if w[2].resolution is None and w[3] > RESOLUTIONS[0]]
+        if not shrinkable:
+            side = max(w[3] for w in wanted)
+            raise SceneError(f"the shadow maps need {layers} layers of {side}x{side} texels, more "
+                             f"than {MAX_SHADOW_TEXELS} texels: lower shadow_resolution or turn "
+                             f"shadows off for some lights", file=getattr(scene, "source", "") or None,
+                             key="lights")
+        largest = max(w[3] for w in shrinkable)
+        for w in shrinkable:
+            if w[3] == largest:
+                w[3] //= 2
+    side = max(w[3] for w in wanted)
     maps, layer = [], 0
     for kind, i, shadow, resolution in wanted:
         count = 6 if kind == "point" else 1
         maps.append(LightMap(kind, i, shadow, resolution,
                              tuple(Tile(layer + k, resolution) for k in range(count))))
         layer += count
-    if layer * side * side > MAX_SHADOW_TEXELS:
-        raise ValueError(f"the shadow maps need {layer} layers of {side}x{side} texels, more than "
-                         f"{MAX_SHADOW_TEXELS} texels: lower shadow_resolution or turn shadows "
-                         f"off for some lights")
     return ShadowLayout(side, layer, tuple(maps))
 
 
@@ -195,14 +206,19 @@ def world_points(scene, matrices) -> list[np.ndarray]:
     return out
 
 
-def _camera_frustum_corners(matrices, reversed_z: bool) -> np.ndarray:
-    """(8, 3) corners of the camera's view volume, camera-relative world."""
-    mapping = depth_mapping(reversed_z)
-    inverse = np.linalg.inv(matrices.projection @ matrices.view)
-    corners = np.array([[x, y, z, 1.0] for x in (-1.0, 1.0) for y in (-1.0, 1.0)
-                        for z in (mapping.ndc_near, mapping.ndc_far)])
-    world = corners @ inverse.T
-    return world[:, :3] / world[:, 3:4]
+def _camera_frustum_corners(camera, matrices) -> np.ndarray:
+    """(8, 3) corners of the camera's view volume, camera-relative world, from the camera's
+    near and far distances and the projection's scales (P[0][0], P[1][1]: the half-width and
+    half-height are their inverses, times the distance in perspective). Not by inverting P V:
+    a near plane of 1e-300 makes that singular (the fuzz test's extreme cameras)."""
+    P = matrices.projection
+    half = np.array([1.0 / P[0, 0], 1.0 / P[1, 1]])
+    perspective = camera.projection == "perspective"
+    corners = []
+    for distance in (float(camera.near), float(camera.far)):
+        x, y = half * distance if perspective else half
+        corners += [(sx * x, sy * y, -distance) for sx in (-1.0, 1.0) for sy in (-1.0, 1.0)]
+    return np.asarray(corners) @ np.asarray(matrices.view)[:3, :3]          # R^T p, rows
 
 
 def _ortho_rows(centre_x, centre_y, half, near, far) -> np.ndarray:
@@ -301,9 +317,9 @@ def can_shadow(scene, points, caster: int, receivers: list[int], light_position=
         planes[caster] = _plane_of(points[caster])
     plane = planes[caster]
     convex = plane is not None or obj.shape is not None
-    others = [r for r in receivers if r != caster]
-    if not others:
-        return not convex and caster in receivers
+    receives = caster in receivers
+    if len(receivers) == int(receives):              # no receiver but (maybe) itself
+        return not convex and receives
     if plane is None:
         return True
     normal, origin = plane
@@ -315,7 +331,7 @@ def can_shadow(scene, points, caster: int, receivers: list[int], light_position=
     if abs(side) <= scale:
         return False                         # the light grazes the plane: no shadow of any area
     facing = normal if side > 0 else -normal
-    return any(bool(((points[r] - origin) @ facing < -scale).any()) for r in others)
+    return any(bool(((points[r] - origin) @ facing < -scale).any()) for r in receivers if r != caster)
 
 
 def triangle_distance(corners: np.ndarray, position: np.ndarray) -> np.ndarray:
@@ -457,7 +473,7 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
     receivers = [i for i, o in enumerate(scene.objects)
                  if o.receives_shadows and visible[i] and o.mesh.triangle_count]
     casters = [i for i, o in enumerate(scene.objects) if o.casts_shadows and o.mesh.triangle_count]
-    frustum = _camera_frustum_corners(matrices, scene.camera.reversed_z)
+    frustum = _camera_frustum_corners(scene.camera, matrices)
     planes = {}                                   # caster -> its plane, for every light
     for light_map in layout.maps:
         i = light_map.index

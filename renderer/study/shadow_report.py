@@ -22,6 +22,7 @@ from dataclasses import replace
 
 from renderer.core.shadow_settings import named_bias
 from renderer.core.shadows import has_shadow_maps, shadow_layout
+from renderer.errors import SceneError
 from renderer.checks.shadow_truth import MAX_REACH_TEXELS, shadows_vs_truth
 from renderer.study.report_settings import SHADOW_COLUMNS, SHADOW_TARGETS
 
@@ -58,7 +59,7 @@ def fits(scene, variant: tuple, width: int, height: int) -> bool:
         return False
     try:
         shadow_layout(with_shadow_setting(scene, *variant[1:]), width, height)
-    except ValueError:
+    except SceneError:
         return False
     return True
 

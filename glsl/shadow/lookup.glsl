@@ -9,14 +9,10 @@
 // Every map is a layer of one array texture (u_shadow_maps; layers of side u_shadow_map_size, a
 // power of two), drawn from texel (0, 0); a point light has six, one per cube face, each widened
 // so that no tap leaves its map.
-// Coordinates are camera-relative world coordinates, as lighting.glsl's.
+// Coordinates are camera-relative world coordinates, as lighting.glsl's, whose light counts
+// and light uniforms (directions, positions) this reads.
 
-#ifndef NUM_DIRECTIONAL_LIGHTS
-#define NUM_DIRECTIONAL_LIGHTS 0
-#endif
-#ifndef NUM_POINT_LIGHTS
-#define NUM_POINT_LIGHTS 0
-#endif
+#include "lighting.glsl"
 #define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
 
 uniform sampler2DArrayShadow u_shadow_maps;

@@ -78,7 +78,9 @@ def _expand(path: Path, files: list[Path], stack: tuple[Path, ...]) -> list[str]
             raise ShaderSourceError(f'{where}: #include "{name_match.group(1)}": no such file '
                                     f"in {path.parent} or {glsl_dir()}")
         if target in files:             # already included once: include guard by default
-            out.append(f"// {line.strip()} (already included)")
+            # The note names the file without the directive: moderngl expands any "#include"
+            # it finds in the source text itself, comments too, and fails on it.
+            out.append(f"// {name_match.group(1)}: already included")
             continue
         files.append(target)
         out.append(f"#line 1 {len(files) - 1}")

@@ -4,7 +4,6 @@
 // int(in.w)), 0, 0, 0) on the uploaded array texture (unit 0); 1: out = (cube_face(in.xyz),
 // the face's right, up and axis as three base-4 digits (component + 1) each).
 #define NUM_POINT_LIGHTS 1
-uniform vec3 u_point_position[NUM_POINT_LIGHTS];      // lighting.glsl's, which lookup.glsl reads
 #include "shadow/lookup.glsl"
 uniform sampler2D u_inputs;
 uniform int u_mode;

@@ -467,7 +467,8 @@ BAD_SCENES = [
     ("unknown top-level key", "objcts = []\n", "objcts: unknown key; did you mean 'objects'?"),
     ("unknown camera key", "[camera]\nfovy = 40\n", "camera.fovy: unknown key; did you mean 'fov_y'?"),
     ("unknown key, no close match", "[camera]\nzoom = 2\n",
-     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far, reversed_z"),
+     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far, "
+     "reversed_z, shutter"),
     ("unknown inline material key", OBJECT + 'material = { kdd = [1, 0, 0] }\n',
      "objects[0].material.kdd: unknown key; did you mean 'kd'?"),
     ("unknown light key for its type", '[[lights]]\ntype = "directional"\nposition = [0, 1, 0]\n',

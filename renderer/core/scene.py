@@ -37,6 +37,10 @@ class Camera:
     near: float = 0.1            # scene units along the viewing axis
     far: float = 100.0
     reversed_z: bool = False     # depth 1 at near, 0 at far (glClipControl ZERO_TO_ONE, GL_GREATER)
+    # The ray tracer's shutter (open, close), open <= close, in the units of time that object
+    # velocities are given in; a sample's time lies in [open, close] (renderer/core/motion.py).
+    # The rasteriser draws time 0.
+    shutter: tuple = (0.0, 0.0)
 
     def view(self) -> np.ndarray:
         return transforms.look_at(self.eye, self.look, self.up)
@@ -205,6 +209,11 @@ class SceneObject:
     shape: Shape | None = None   # an analytic shape the ray tracer intersects; None: triangles
     casts_shadows: bool = True   # drawn into the lights' shadow maps (renderer/core/shadows.py)
     receives_shadows: bool = True  # looks itself up in them: lit only where a light reaches it
+    # Motion blur (the ray tracer; renderer/core/motion.py): scene units per unit time, and
+    # degrees per unit time about that axis through the object's world origin. None: the
+    # object declares no motion (a zero vector declares it, still). Children do not follow.
+    velocity: tuple | None = None
+    angular_velocity: tuple | None = None
 
 
 @dataclass

@@ -31,9 +31,10 @@ import time
 import moderngl
 import numpy as np
 
-from renderer.core.bvh import build_bvh, texels
+from renderer.core.bvh import build_bvh, forest, roots, texels
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame, image_size
+from renderer.core.motion import declares_motion, moves, scene_motion
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import check_first_sample, ray_sampling
@@ -80,7 +81,8 @@ class RayTracer:
 
     def _build(self) -> None:
         ctx = self.ctx
-        rs = self.ray_scene = ray_scene(self.scene)
+        self._motion_layout = self._motion_now()
+        rs = self.ray_scene = ray_scene(self.scene, motion=self._motion_layout)
         self._surfaces = self._surfaces_now()
         self.defines = self._defines(rs)
         self._compile()
@@ -110,6 +112,7 @@ class RayTracer:
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
             **self.sampling.defines(),
+            **self._motion_defines(rs),
         }
 
     def _compile(self) -> None:
@@ -145,6 +148,7 @@ class RayTracer:
         if len(rs.plane_offset):
             values["u_planes"] = np.concatenate([rs.plane_normal, rs.plane_offset[:, None]], 1).astype(np.float32).tobytes()
             values["u_plane_object"] = rs.plane_object.astype(np.int32).tobytes()
+        values.update(self._motion_uniforms(rs))
         for name, value in values.items():
             if name in program:
                 program[name].write(value)
@@ -161,10 +165,9 @@ class RayTracer:
         arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object
-            bvh = rs.bvh
-            if bvh is None:                           # all features, no triangles: a placeholder
+            bvh = self._bvh(rs)
+            if rs.bvh is None:                        # all features, no triangles: a placeholder
                 triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
-                bvh = build_bvh(triangles)
             arrays["u_nodes"], arrays["u_triangles"] = bvh.nodes, bvh.triangles
             data = np.zeros((len(triangles), 6, 4))
             data[:, :3, :3] = triangles
@@ -172,6 +175,46 @@ class RayTracer:
             data[:, 3, 3] = owner
             arrays["u_triangle_data"] = data
         return arrays
+
+    # -- motion blur (docs/conventions.md, "Motion blur") ------------------------------------
+    def _motion_now(self) -> bool:
+        """Whether the ray scene takes motion blur's data and trees (ray_scene's `motion`): where
+        something moves in the image, or, compiling every feature, wherever an object declares
+        a motion (as the twin)."""
+        return moves(self.scene) or (not self.specialise and declares_motion(self.scene))
+
+    def _motion_defines(self, rs) -> dict:
+        """MOTION where something moves (every feature: always) and NUM_MOVING_MESHES, the
+        moving mesh objects with their own trees."""
+        if not (moves(self.scene) or not self.specialise):
+            return {}
+        return {"MOTION": True, "NUM_MOVING_MESHES": int((rs.mesh_object >= 0).sum())}
+
+    def _bvh(self, rs):
+        """The BVH the GPU walks: the scene's, with a placeholder tree at root 0 where MESHES
+        walks one and the scene has no static triangles (no triangles at all, or only moving
+        meshes): one degenerate triangle, which no ray hits."""
+        placeholder = build_bvh(np.zeros((1, 3, 3)))
+        if rs.bvh is None:
+            return placeholder
+        return rs.bvh if rs.static_tree else forest([placeholder, rs.bvh])
+
+    def _motion_uniforms(self, rs) -> dict:
+        """The shutter and every sphere's, plane's and moving mesh's motion rows (renderer/
+        core/motion.py), the moving meshes' roots in u_nodes and their objects."""
+        if "MOTION" not in self.defines:
+            return {}
+        motion = rs.motion if rs.motion is not None else scene_motion(self.scene)
+        moving = rs.mesh_object[rs.mesh_object >= 0]
+        values = {"u_shutter": np.asarray(self.scene.camera.shutter, np.float32),
+                  "u_sphere_motion": motion.rows(rs.sphere_object),
+                  "u_plane_motion": motion.rows(rs.plane_object),
+                  "u_mesh_motion": motion.rows(moving)}
+        if len(moving):
+            values["u_mesh_root"] = roots(self._bvh(rs))[-len(moving):].astype(np.int32)
+            values["u_mesh_object"] = moving.astype(np.int32)
+        return {name: np.asarray(value, value.dtype if value.dtype.kind == "i" else np.float32).tobytes()
+                for name, value in values.items() if value.size}
 
     def _build_targets(self) -> None:
         """The framebuffer at the image size and its float targets (self._targets)."""
@@ -202,7 +245,10 @@ class RayTracer:
                              "make a new one")
         check_light_count(self.scene)
         activate(self.ctx)
-        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh)
+        if self._motion_now() != self._motion_layout:
+            raise ValueError("the scene's motion blur switched on or off since this RayTracer "
+                             "was made; make a new one")
+        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh, motion=self._motion_layout)
         defines = self._defines(rs)
         if defines != self.defines:
             self.defines = defines

@@ -33,7 +33,8 @@ from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_cl
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
                                           triangle_normal)
 from reference.raytrace.motion import (motion_at, motion_direction, motion_direction_back,
-                                       motion_plane, motion_point, motion_point_back)
+                                       motion_plane, motion_point, motion_point_back, motion_time)
+from renderer.core.ray_sampling import TIME_DIMENSION
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
@@ -102,6 +103,16 @@ def scene_hit(rs, O, D, s_min, s_max, from_shape=None, time=None):
 # camera sample's time: the spheres and planes move (motion_point, motion_plane) and the rays
 # move into each moving mesh's time-0 frame (motion_point_back), the GLSL's trace_motion_at.
 # Without a time (a caller tracing the still scene) everything stays at time 0.
+
+def sample_times(rs, samples, R: int, t):
+    """The times (R,) of camera rays 0 .. R-1 of `samples` (a sampling.RaySamples), in dtype
+    t: open + u (close - open) with u their TIME_DIMENSION number at slot 0 (the GLSL's
+    trace_sample_time); None where the scene has no motion or no samples are given."""
+    if rs.motion is None or samples is None:
+        return None
+    u = samples.point_1d(np.arange(R), 0, TIME_DIMENSION)
+    return motion_time(rs.motion.shutter, u.astype(t))
+
 
 def shapes_at(rs, time, t):
     """(centres, planes): each sphere's centre and each plane's (N, d) in dtype t, (3,) and ()
@@ -291,25 +302,31 @@ def ray_tree_event(kind, index):
 
 
 def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
-          ray_trees=None, time=None):
+          ray_trees=None, samples=None, time=None):
     """Trace rays O, D (R, 3): (colour (R, 3), hit (R,), s (R,)) with hit and s of each ray's
     first hit (primary rays between s_min and s_max; secondary rays from 0 to inf). float32 as
     the GLSL, or float64 for float64 rays (and then `lights` in float64). shadows=False lights
     every point by every light (no shadow rays; the GLSL without SHADOWS). `ray_trees`, an
-    (R,) uint64 array, has each ray tree's hash added to it (the comment above). `time` (R,):
-    each ray's time (motion blur), which its secondary and shadow rays share.
+    (R,) uint64 array, has each ray tree's hash added to it (the comment above). `samples`, a
+    sampling.RaySamples of the R camera rays, says whose numbers each hit draws (the
+    distributed effects); each ray of a tree carries its key (the GLSL's g_ray_key: the camera
+    ray 0, the reflected child of r 2r + 1, the transmitted 2r + 2, as uint32). Motion blur:
+    each camera ray's time (`time` (R,), else drawn from `samples`: sample_times), which its
+    secondary and shadow rays share.
     A secondary ray is spawned only when some channel of its weight is at least
     RAY_WEIGHT_CUTOFF (renderer/core/ray_depth.py)."""
     t = np.asarray(O).dtype.type if np.asarray(O).dtype == np.float64 else F32
     O = np.asarray(O, t)
     D = np.asarray(D, t)
     R = len(O)
+    time = sample_times(rs, samples, R, t) if time is None else np.asarray(time, t)
     colour = np.zeros((R, 3), t)
     background = np.asarray(background, t)
     specular = rs.specular
     owner = np.arange(R)
     from_shape = np.full(R, -1)
     path = np.full(R, ROOT_PATH, np.uint64)
+    key = np.zeros(R, np.uint32)
     weight = np.ones((R, 3), t)
     first_hit, first_s = None, None
     lo, hi = t(s_min), t(s_max)
@@ -327,8 +344,8 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         if depth == 0:
             first_hit, first_s = hit.copy(), s.copy()
         np.add.at(colour, owner[~hit], weight[~hit] * background)
-        O, D, kind, index, s, uv, owner, path, weight = (
-            a[hit] for a in (O, D, kind, index, s, uv, owner, path, weight))
+        O, D, kind, index, s, uv, owner, path, key, weight = (
+            a[hit] for a in (O, D, kind, index, s, uv, owner, path, key, weight))
         P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv, _at(time, owner))
         shape = shape_id(rs, kind, index)
         Du = normalize(D)
@@ -358,6 +375,9 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         owner = np.concatenate([owner[go_r], owner[go_t]])
         from_shape = np.concatenate([shape[go_r], shape[go_t]])
         path = np.concatenate([mix64(path[go_r] ^ np.uint64(1)), mix64(path[go_t] ^ np.uint64(2))])
+        with np.errstate(over="ignore"):                 # keys wrap modulo 2^32, as the GLSL's
+            key = np.concatenate([np.uint32(2) * key[go_r] + np.uint32(1),
+                                  np.uint32(2) * key[go_t] + np.uint32(2)])
         weight = np.concatenate([w_r[go_r], w_t[go_t]])
         lo, hi = leaving_s_min(O), t(np.inf)
     return colour, first_hit, first_s

@@ -35,6 +35,7 @@ class SceneMotion:
     velocity: np.ndarray         # (M, 3) v, scene units per unit time
     axis: np.ndarray             # (M, 3) unit axis of w, or 0
     rate: np.ndarray             # (M,) |w|, radians per unit time
+    shutter: tuple = (0.0, 0.0)  # the camera's (open, close)
 
     def rows(self, objects) -> np.ndarray:
         """(len(objects), 3, 4) float64: the uniform rows of those objects' motions, as
@@ -85,5 +86,5 @@ def scene_motion(scene: Scene) -> SceneMotion:
             length = float(np.linalg.norm(w))
             if length > 0.0:
                 axis[k], rate[k] = w / length, math.radians(length)
-    return SceneMotion(centre, velocity, axis, rate)
+    return SceneMotion(centre, velocity, axis, rate, tuple(float(x) for x in scene.camera.shutter))
 

@@ -37,7 +37,7 @@ from renderer.core.frame import Frame, image_size
 from renderer.core.motion import declares_motion, moves, scene_motion
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import check_first_sample, ray_sampling
+from renderer.core.ray_sampling import TIME_DIMENSION, check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
@@ -188,7 +188,8 @@ class RayTracer:
         moving mesh objects with their own trees."""
         if not (moves(self.scene) or not self.specialise):
             return {}
-        return {"MOTION": True, "NUM_MOVING_MESHES": int((rs.mesh_object >= 0).sum())}
+        return {"MOTION": True, "NUM_MOVING_MESHES": int((rs.mesh_object >= 0).sum()),
+                "TIME_DIMENSION": TIME_DIMENSION}
 
     def _bvh(self, rs):
         """The BVH the GPU walks: the scene's, with a placeholder tree at root 0 where MESHES
@@ -206,7 +207,7 @@ class RayTracer:
             return {}
         motion = rs.motion if rs.motion is not None else scene_motion(self.scene)
         moving = rs.mesh_object[rs.mesh_object >= 0]
-        values = {"u_shutter": np.asarray(self.scene.camera.shutter, np.float32),
+        values = {"u_shutter": np.asarray(motion.shutter, np.float32),
                   "u_sphere_motion": motion.rows(rs.sphere_object),
                   "u_plane_motion": motion.rows(rs.plane_object),
                   "u_mesh_motion": motion.rows(moving)}

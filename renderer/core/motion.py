@@ -58,15 +58,11 @@ def declares_motion(scene: Scene) -> bool:
     return any(has_motion(obj) for obj in scene.objects)
 
 
-def shutter_open(scene: Scene) -> bool:
-    open_, close = scene.camera.shutter
-    return float(open_) < float(close)
-
-
 def moves(scene: Scene) -> bool:
-    """Whether anything moves in the image: the shutter is open (open < close) and some object
-    has a velocity or angular velocity that is not zero (the GPU's MOTION define)."""
-    return shutter_open(scene) and any(
+    """Whether the image needs the motion code (the GPU's MOTION define): the shutter is not
+    [0, 0] (an open one, or an instant [t, t] that shows the scene at time t) and some object
+    has a velocity or angular velocity that is not zero."""
+    return any(float(x) != 0.0 for x in scene.camera.shutter) and any(
         any(float(x) != 0.0 for x in (obj.velocity or ())) or
         any(float(x) != 0.0 for x in (obj.angular_velocity or ()))
         for obj in scene.objects)

@@ -8,8 +8,9 @@ hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, n
 
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
-MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, and the sample
-pattern's constants from renderer/core/ray_sampling.py); the uniforms (camera rays from
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, MOTION and
+NUM_MOVING_MESHES where something moves during the shutter (docs/conventions.md, "Motion
+blur"), and the sample pattern's constants from renderer/core/ray_sampling.py); the uniforms (camera rays from
 renderer/core/camera_rays.py, lights from renderer/core/uniforms.py, shapes, the pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
 renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
@@ -19,8 +20,9 @@ changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
-`shadows`), SECONDARY (where max_depth > 0) and MESHES (the BVH walk; a scene without triangles
-gets a one-triangle BVH of a degenerate triangle, which no ray hits). The light, sphere and
+`shadows`), SECONDARY (where max_depth > 0), MOTION (each moving mesh in its own tree wherever
+an object declares a motion) and MESHES (the BVH walk; a scene without static triangles gets a
+one-triangle tree of a degenerate triangle at root 0, which no ray hits). The light, sphere and
 plane counts stay compile-time constants. The image is the same.
 """
 

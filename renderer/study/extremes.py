@@ -12,8 +12,8 @@ reversed-Z is measured a second time with it off, to show the depth error it rem
 scene whose file is refused (a NaN vertex) is listed with the one-line error a user sees.
 
 A scene file whose name starts with `rt_` is ray traced instead (RayTracer on each context
-against reference/raytrace in float64, 1 sample per pixel, at each of its RAYTRACE_DEPTHS,
-the default depth otherwise): where the float32 and float64 references disagree on a grazing
+against reference/raytrace in float64, 1 sample per pixel (RAYTRACE_SAMPLES: more, regular
+pattern), at each of its RAYTRACE_DEPTHS, the default depth otherwise): where the float32 and float64 references disagree on a grazing
 ray (renderer/checks/compare.py, grazing_ray_pixels) either one's colour and depth is
 accepted, as at the rasteriser's depth ties. Ray-traced cases are not rasterised: the
 rasteriser draws their spheres and planes as tessellations, whose extremes are the rasteriser
@@ -100,6 +100,9 @@ STABILITY = {
     "rt_coplanar": "hit ties: a surface replaces the nearest hit only when nearer by more than "
                    "2^-18 relative, so the plane, found first, shows wherever the triangle lies "
                    "in it; rays leaving it start at s > 2^-18 |O| and skip it",
+    "rt_fast_motion": "motion in the displacement form about camera-relative centres (X + (R - I)(X - c) "
+                      "+ t v), rays moved into a mesh's time-0 frame and its normals turned back: "
+                      "rounding relative to the distance moved, whatever the speed or the turns",
     "rt_far_from_origin": "camera-relative coordinates: the shapes and lights relative to the "
                           "eye in float64 before the float32 upload",
     "rt_grazing_sphere": "the robust discriminant (Ray Tracing Gems ch. 7); where float32 "
@@ -124,8 +127,10 @@ STABILITY = {
                                     "from Waechter and Binder's offset",
 }
 
-# Ray-traced cases measured at other maximum depths than the default.
+# Ray-traced cases measured at other maximum depths than the default, and with more samples
+# per pixel than 1 (regular pattern; motion blur: each sample its own time).
 RAYTRACE_DEPTHS = {"rt_mirrors": (0, 64)}
+RAYTRACE_SAMPLES = {"rt_fast_motion": 4}
 RAY_TRACED_PREFIX = "rt_"
 
 
@@ -177,18 +182,21 @@ def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
 
 
 def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
-                       max_depth: int = DEFAULT_MAX_DEPTH) -> dict:
+                       max_depth: int = DEFAULT_MAX_DEPTH, samples: int = 1) -> dict:
     """Figures of one ray-traced scene, as measure_scene: each GPU frame against the float64
     reference, which accepts the float32 reference's colour and depth at grazing pixels
-    (`grazing_pixels`: where the two references' ray trees differ); `truth` without that."""
+    (`grazing_pixels`: where the two references' ray trees differ); `truth` without that.
+    `samples` per pixel, regular pattern."""
     width, height = size
     gpu_frames = {}
     for kind, ctx in contexts.items():
-        with RayTracer(scene, width, height, context=ctx, max_depth=max_depth) as tracer:
+        with RayTracer(scene, width, height, context=ctx, max_depth=max_depth,
+                       samples=samples) as tracer:
             gpu_frames[kind] = tracer.render()
     rs = ray_scene(scene)                        # the BVH built once, for both precisions
-    truth = reference_raytrace(scene, width, height, max_depth=max_depth, dtype=np.float64, rs=rs)
-    twin = reference_raytrace(scene, width, height, max_depth=max_depth, rs=rs)
+    truth = reference_raytrace(scene, width, height, max_depth=max_depth, samples=samples,
+                               dtype=np.float64, rs=rs)
+    twin = reference_raytrace(scene, width, height, max_depth=max_depth, samples=samples, rs=rs)
     tie, tie_depth, grazing = either_precision(truth, twin)
     finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
     finite["reference"] = is_finite_frame(truth) and is_finite_frame(twin)
@@ -230,8 +238,10 @@ def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: d
             depths = RAYTRACE_DEPTHS.get(name, (DEFAULT_MAX_DEPTH,))
             for depth in depths:
                 case = name if len(depths) == 1 else f"{name} (max depth {depth})"
-                cases.append(base | {"case": case, "tests": description, "max_depth": depth}
-                             | measure_ray_traced(scene, size, contexts, depth))
+                samples = RAYTRACE_SAMPLES.get(name, 1)
+                cases.append(base | {"case": case, "tests": description, "max_depth": depth,
+                                     "samples": samples}
+                             | measure_ray_traced(scene, size, contexts, depth, samples))
             continue
         cases.append(base | {"tests": description, "reversed_z": scene.camera.reversed_z}
                      | measure_scene(scene, size, contexts))

@@ -271,6 +271,26 @@ def test_the_gpu_traces_the_twins_motion_small(name, gl_contexts):
     assert_within_tolerance(frame, reference)
 
 
+def test_a_moving_scenes_tracer_follows_a_new_eye(gl_contexts):
+    """RayTracer.update (the viewer's orbit): the forest of trees refitted, the centres of the
+    motions relative to the new eye, the frame bit for bit a new tracer's; switching the motion
+    on or off needs a new tracer."""
+    from renderer.gpu.raytracer import RayTracer
+    scene = load_scene("motion_blur")
+    options = dict(context=gl_contexts["egl"], samples=4, pattern="jittered")
+    with RayTracer(scene, 48, 36, **options) as tracer:
+        scene.camera = dataclasses.replace(scene.camera, eye=(0.5, 2.0, 5.0))
+        tracer.update()
+        moved = tracer.render()
+        with RayTracer(scene, 48, 36, **options) as fresh:
+            expected = fresh.render()
+        assert moved.linear.tobytes() == expected.linear.tobytes()
+        assert np.array_equal(moved.rgba8, expected.rgba8)
+        scene.camera = dataclasses.replace(scene.camera, shutter=(0.0, 0.0))
+        with pytest.raises(ValueError, match="motion blur switched"):
+            tracer.update()
+
+
 @pytest.fixture(scope="module")
 def motion_blur_references():
     """The twin's motion_blur frames at 320x240, 4 and 16 jittered samples, made once."""

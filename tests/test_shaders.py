@@ -18,9 +18,9 @@ RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
                   "raytrace/optics.glsl": "reference/raytrace/optics.py",
                   "raytrace/bvh.glsl": "reference/raytrace/bvh.py",
                   "raytrace/sampling.glsl": "reference/raytrace/sampling.py",
-                  "raytrace/trace.glsl": "reference/raytrace/trace.py",
                   "raytrace/warp.glsl": "reference/raytrace/warp.py",
-                  "raytrace/motion.glsl": "reference/raytrace/motion.py"}
+                  "raytrace/motion.glsl": "reference/raytrace/motion.py",
+                  "raytrace/trace.glsl": "reference/raytrace/trace.py"}
 
 
 def write(folder, files):

@@ -8,6 +8,10 @@ in the window point, their coefficients the uniforms of renderer/core/camera_ray
 Inputs:  window (..., 2) window points; uniforms as camera_ray_uniforms returns them.
 Output:  (O, D), (..., 3) each, in the dtype of `window` (float64 for integer input), as the
          GLSL's mat3 * vec3: each component the sum a x_w + b y_w + c in that order.
+
+The thin lens (docs/conventions.md, "Depth of field"): `thin_lens_ray` moves a camera ray's
+origin to its lens point and turns it through the same point of the focus plane, with the
+uniforms of renderer/core/camera_rays.py's lens_uniforms, in the GLSL's order.
 """
 
 from __future__ import annotations
@@ -36,3 +40,14 @@ def camera_ray(window, uniforms):
         return x * m[:, 0] + y * m[:, 1] + m[:, 2]
 
     return affine(uniforms["u_ray_origin"]), affine(uniforms["u_ray_direction"])
+
+
+def thin_lens_ray(lens, O, D, uniforms):
+    """(O', D') of the rays (O, D) (..., 3) through the lens points `lens` (..., 2) of the unit
+    disc: offset = l.x u_lens_right + l.y u_lens_up, O' = O + offset, D' = D - offset
+    u_inverse_focus, in the dtype of O."""
+    dtype = np.asarray(O).dtype
+    lens = np.asarray(lens).astype(dtype)
+    right, up = (np.asarray(uniforms[name], dtype) for name in ("u_lens_right", "u_lens_up"))
+    offset = lens[..., 0:1] * right + lens[..., 1:2] * up
+    return O + offset, D - offset * dtype.type(uniforms["u_inverse_focus"])

@@ -151,6 +151,15 @@ def scene_from_dict(data: dict, source: str = "<dict>", base_dir=None) -> Scene:
     return reader.scene(data)
 
 
+def with_lens(camera: Camera, values: dict, source: str) -> Camera:
+    """A copy of `camera` with the thin-lens keys in `values` ("aperture", "focus_distance")
+    set and checked as a scene file's [camera] keys are (a SceneError naming the key): the
+    command line's --aperture and --focus-distance."""
+    camera = dataclasses.replace(camera)
+    _Reader(source, Path.cwd()).lens(values, camera, "")
+    return camera
+
+
 def _check_nesting(data: Any, reader: "_Reader") -> None:
     """Refuse arrays and tables nested more than MAX_NESTING levels (the top-level table is
     level 1), naming the key path where it happens. Walked with a stack, not recursion, so

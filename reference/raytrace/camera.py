@@ -18,6 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from reference.raytrace.sampling import distributed_2d
+from reference.raytrace.warp import square_to_disc
+from renderer.core.ray_sampling import LENS_DIMENSION
+
 
 def pixel_windows(width: int, height: int, sample_offset=(0.0, 0.0), dtype=np.float64) -> np.ndarray:
     """(height, width, 2) window points (i + 0.5 + dx, j + 0.5 + dy) of every pixel, row j = 0
@@ -51,3 +55,11 @@ def thin_lens_ray(lens, O, D, uniforms):
     right, up = (np.asarray(uniforms[name], dtype) for name in ("u_lens_right", "u_lens_up"))
     offset = lens[..., 0:1] * right + lens[..., 1:2] * up
     return O + offset, D - offset * dtype.type(uniforms["u_inverse_focus"])
+
+
+def lens_point(x, y, k: int, first_sample: int, sampling, dtype=np.float32) -> np.ndarray:
+    """(..., 2) the lens point in the unit disc of samples k at pixels (x, y) (broadcast): the
+    concentric map of the sampling layer's point of LENS_DIMENSION at slot 0 (the camera's),
+    in `dtype`."""
+    u = distributed_2d(x, y, k, first_sample, sampling, 0, LENS_DIMENSION)
+    return square_to_disc(np.asarray(u).astype(dtype))

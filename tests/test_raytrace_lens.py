@@ -181,6 +181,24 @@ def test_a_defocused_ball_blurs_into_the_thin_lens_circle_of_confusion():
             <= expected + reach + math.sqrt(2)
 
 
+def test_the_depth_of_field_scene_focuses_on_its_middle_sphere(traced_references):
+    """The built-in scene's five spheres recede from the camera; the focus plane (the default
+    focus distance, |look - eye|) passes the middle one's centre, so its circle of confusion is
+    0 there, and at 320x240 the nearest sphere's is over 14 px, the farthest's over 5 px, every
+    other's over 2 px."""
+    s = traced_references.scene("depth_of_field")
+    cam = s.camera
+    assert cam.focus_distance is None and cam.aperture > 0
+    view = s.matrices(320, 240).view
+    spheres = sorted((-(view[:3, :3] @ (np.subtract(o.shape.centre, cam.eye)))[2], o.name)
+                     for o in s.objects if o.shape is not None and hasattr(o.shape, "radius"))
+    assert [name for _, name in spheres] == ["nearest", "near", "middle", "far", "farthest"]
+    scale = 240 / (2 * cam.focus * math.tan(math.radians(cam.fov_y) / 2))
+    coc = {name: cam.aperture * abs(z - cam.focus) / z * scale for z, name in spheres}
+    assert coc["middle"] < 1e-12
+    assert coc["nearest"] > 14 and coc["farthest"] > 5 and min(coc["near"], coc["far"]) > 2
+
+
 # --------------------------------------------------------------------------- aperture 0
 
 LIMIT_SCENE = {
@@ -220,6 +238,47 @@ def test_aperture_0_is_the_pinhole_camera_bit_for_bit(gl_contexts):
         gpu_zero = every.render()
     assert np.array_equal(gpu_zero.rgba8, gpu.rgba8) and np.array_equal(gpu_zero.linear, gpu.linear)
     assert_within_tolerance(gpu, reference)
+
+
+# --------------------------------------------------------------------------- the command line
+
+def test_command_line_aperture_and_focus_distance(tmp_path, cli_here):
+    """`--aperture` and `--focus-distance` set the scene's lens for the ray tracer (the image
+    changes, and equals the scene file's with those keys); a value the scene file would refuse
+    is refused naming the option, one line, status 2, nothing written; with the rasteriser
+    they are refused (the line and the usage)."""
+    from PIL import Image
+    small = ["--size", "24x18", "--backend", "reference", "--spp", "4", "--pattern", "jittered", "-q"]
+    out = {name: tmp_path / f"{name}.png" for name in ("pinhole", "option", "file")}
+    traced = ["render", "depth_of_field", "--method", "raytrace", *small]
+    assert cli_here(*traced, "-o", out["pinhole"], "--aperture", "0").returncode == 0
+    assert cli_here(*traced, "-o", out["option"], "--aperture", "0.4", "--focus-distance", "3").returncode == 0
+    text = (Path(__file__).resolve().parents[1] / "assets" / "scenes" / "depth_of_field.toml").read_text()
+    assert "aperture = 0.25\n" in text
+    lensed = tmp_path / "lensed.toml"
+    lensed.write_text(text.replace("aperture = 0.25\n", "aperture = 0.4\nfocus_distance = 3\n"))
+    traced[1] = lensed
+    assert cli_here(*traced, "-o", out["file"]).returncode == 0
+    image = {name: np.asarray(Image.open(path)) for name, path in out.items()}
+    assert np.array_equal(image["option"], image["file"])
+    assert not np.array_equal(image["option"], image["pinhole"])
+    for args, line in (
+            (["sphere", "--method", "raytrace", "--aperture", "-1"], "renderer: --aperture -1: must be >= 0, got -1"),
+            (["sphere", "--method", "raytrace", "--aperture", "nan"],
+             "renderer: --aperture nan: expected a finite number, got nan"),
+            (["sphere", "--method", "raytrace", "--focus-distance", "0"],
+             "renderer: --focus-distance 0: must be > 0, got 0"),
+            (["orthographic", "--method", "raytrace", "--aperture", "0.1"],
+             "renderer: --aperture 0.1: must be 0 with a parallel camera, got 0.1: a lens focuses "
+             "rays from one eye, and a parallel camera has none"),
+            (["sphere", "--aperture", "0.3"], "renderer render: --aperture is for --method raytrace")):
+        result = cli_here("render", *args, "--size", "8x6", "-o", tmp_path / "no.png")
+        assert result.returncode == 2 and result.stderr.splitlines()[0] == line, result.stderr
+        assert "Traceback" not in result.stderr and not (tmp_path / "no.png").exists()
+        assert len(result.stderr.splitlines()) == (2 if "usage" in result.stderr else 1)
+    result = cli_here("compare", "sphere", "--focus-distance", "2", "--out", tmp_path / "cmp")
+    assert result.returncode == 2 and result.stderr.startswith(
+        "renderer compare: --focus-distance is for --method raytrace or --methods")
 
 
 # --------------------------------------------------------------------------- GPU against twin

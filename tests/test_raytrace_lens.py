@@ -16,20 +16,14 @@ import pytest
 
 from reference.raytrace.camera import camera_ray, lens_point, pixel_windows, thin_lens_ray
 from reference.raytrace.pipeline import render as reference_raytrace
-from renderer.checks.compare import compare_frames
-from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.ray_sampling import LENS_DIMENSION, ray_sampling
 from renderer.core.scene import Camera
 from renderer.core.scene_file import scene_from_dict
 
+from test_raytrace_trace import SHAPES, assert_within_tolerance
+
 F32 = np.float32
-
-
-def assert_within_tolerance(frame, reference):
-    result = compare_frames(frame.rgba8, reference.rgba8, frame.depth, reference.depth,
-                            PIPELINE_TOLERANCE.threshold, PIPELINE_TOLERANCE.deviation)
-    assert PIPELINE_TOLERANCE.passes(result), (PIPELINE_TOLERANCE.failures(result), result.as_dict())
 
 
 def with_camera(data, **camera):
@@ -201,19 +195,8 @@ def test_the_depth_of_field_scene_focuses_on_its_middle_sphere(traced_references
 
 # --------------------------------------------------------------------------- aperture 0
 
-LIMIT_SCENE = {
-    "background": [0.1, 0.2, 0.3], "ambient": [0.1, 0.1, 0.1],
-    "camera": {"eye": [0, 1, 6], "look": [0, 0, 0], "fov_y": 40.0},
-    "materials": {"red": {"ka": [0.8, 0.2, 0.1], "kd": [0.8, 0.2, 0.1], "ks": [0.5, 0.5, 0.5], "n": 20.0},
-                  "mirror": {"kd": [0, 0, 0], "ka": [0, 0, 0], "kr": [0.9, 0.9, 0.9]},
-                  "glass": {"kd": [0, 0, 0], "ka": [0, 0, 0], "kt": [0.9, 0.9, 0.9], "ior": 1.5},
-                  "floor": {"kd": [0.6, 0.6, 0.6], "ka": [0.6, 0.6, 0.6], "two_sided": True}},
-    "lights": [{"type": "directional", "direction": [0.3, -1, -0.4]},
-               {"type": "point", "position": [2, 3, 3], "intensity": [0.5, 0.5, 0.5]}],
-    "objects": [{"name": "a", "shape": {"type": "sphere", "radius": 0.8}, "material": "red", "translate": [-1, 0, 0]},
-                {"name": "b", "shape": {"type": "sphere", "radius": 0.8}, "material": "mirror", "translate": [1, 0, 0]},
-                {"name": "c", "shape": {"type": "sphere", "radius": 0.5}, "material": "glass", "translate": [0, 0, 1.5]},
-                {"name": "f", "shape": {"type": "plane", "normal": [0, 1, 0], "offset": 0.8}, "material": "floor"}]}
+# test_raytrace_trace's shapes (mirror, glass, diffuse spheres, a floor), without its mesh
+LIMIT_SCENE = {**SHAPES, "objects": [obj for obj in SHAPES["objects"] if "shape" in obj]}
 LIMIT_W, LIMIT_H = 32, 24
 
 

@@ -209,10 +209,10 @@ class RayTracer:
         """The BVH the GPU walks: the scene's, with a placeholder tree at root 0 where MESHES
         walks one and the scene has no static triangles (no triangles at all, or only moving
         meshes): one degenerate triangle, which no ray hits."""
+        if rs.bvh is not None and rs.static_tree:
+            return rs.bvh
         placeholder = build_bvh(np.zeros((1, 3, 3)))
-        if rs.bvh is None:
-            return placeholder
-        return rs.bvh if rs.static_tree else forest([placeholder, rs.bvh])
+        return placeholder if rs.bvh is None else forest([placeholder, rs.bvh])
 
     def _motion_uniforms(self, rs) -> dict:
         """The shutter and every sphere's, plane's and moving mesh's motion rows (renderer/
@@ -221,15 +221,14 @@ class RayTracer:
             return {}
         motion = rs.motion if rs.motion is not None else scene_motion(self.scene)
         moving = rs.mesh_object[rs.mesh_object >= 0]
-        values = {"u_shutter": np.asarray(motion.shutter, np.float32),
-                  "u_sphere_motion": motion.rows(rs.sphere_object),
-                  "u_plane_motion": motion.rows(rs.plane_object),
-                  "u_mesh_motion": motion.rows(moving)}
-        if len(moving):
-            values["u_mesh_root"] = roots(self._bvh(rs))[-len(moving):].astype(np.int32)
-            values["u_mesh_object"] = moving.astype(np.int32)
-        return {name: np.asarray(value, value.dtype if value.dtype.kind == "i" else np.float32).tobytes()
-                for name, value in values.items() if value.size}
+        rows = {"u_shutter": motion.shutter, "u_sphere_motion": motion.rows(rs.sphere_object),
+                "u_plane_motion": motion.rows(rs.plane_object), "u_mesh_motion": motion.rows(moving)}
+        values = {name: np.asarray(value, np.float32).tobytes() for name, value in rows.items()
+                  if np.size(value)}
+        if len(moving):                   # the moving meshes' trees are the last ones
+            values["u_mesh_root"] = roots(self._bvh(rs))[-len(moving):].astype(np.int32).tobytes()
+            values["u_mesh_object"] = moving.astype(np.int32).tobytes()
+        return values
 
     def _build_targets(self) -> None:
         """The framebuffer at the image size and its float targets (self._targets)."""
@@ -258,11 +257,11 @@ class RayTracer:
                 a is not b for old, new in zip(self._surfaces, now) for a, b in zip(old, new)):
             raise ValueError("the scene's objects changed since this RayTracer was made; "
                              "make a new one")
-        check_light_count(self.scene)
-        activate(self.ctx)
         if self._motion_now() != self._motion_layout:
             raise ValueError("the scene's motion blur switched on or off since this RayTracer "
                              "was made; make a new one")
+        check_light_count(self.scene)
+        activate(self.ctx)
         rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh, motion=self._motion_layout)
         defines = self._defines(rs)
         if defines != self.defines:

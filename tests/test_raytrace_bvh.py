@@ -298,7 +298,9 @@ def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30, any_hit=False, root=
     """(s, triangle, u, v) per ray from bvh_closest_hit; any_hit: (1 or 0, 0, 0, 0) from
     bvh_any_hit; both walking the tree whose root node is `root`."""
     from renderer.gpu.bvh import bvh_textures
+    from renderer.gpu.context import activate
     from renderer.gpu.shaders import shader_source
+    activate(ctx)               # a test run before (the command line's) may leave another current
     fragment = shader_source("raytrace_bvh.frag", {"ANY_HIT": any_hit}, directory=GLSL).text
     program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
                           fragment_shader=fragment)

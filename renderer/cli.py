@@ -25,6 +25,7 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
+from renderer.core.light_areas import DEFAULT_LIGHT_SAMPLES, MAX_LIGHT_SAMPLES
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
@@ -121,6 +122,9 @@ def build_parser() -> argparse.ArgumentParser:
                             f"{MAX_DEPTH_LIMIT} (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
                        help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
+        p.add_argument("--light-samples", type=int, default=None, metavar="M",
+                       help=f"ray tracer: points sampled on each area light per hit, 1 to "
+                            f"{MAX_LIGHT_SAMPLES} (default 1; docs/conventions.md, \"Area lights\")")
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
@@ -290,6 +294,7 @@ def check_raytrace_options(args) -> None:
                           f"--method raytrace{also}")
     if not 0 <= args.max_depth <= MAX_DEPTH_LIMIT:
         args.parser.error(f"--max-depth must be between 0 and {MAX_DEPTH_LIMIT}, got {args.max_depth}")
+    check_light_samples_option(args, traced)
     if args.adaptive_threshold is not None and args.pattern != "adaptive":
         args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
     if traced:
@@ -304,11 +309,23 @@ def check_raytrace_options(args) -> None:
             args.parser.error(f"{' '.join(given)}: {error}")
 
 
+def check_light_samples_option(args, traced: bool) -> None:
+    """--light-samples: for the ray tracer only, 1 to MAX_LIGHT_SAMPLES."""
+    if args.light_samples is None:
+        return
+    if not traced:
+        also = " or --methods" if hasattr(args, "methods") else ""
+        args.parser.error(f"--light-samples is for --method raytrace{also}")
+    if not 1 <= args.light_samples <= MAX_LIGHT_SAMPLES:
+        args.parser.error(f"--light-samples must be between 1 and {MAX_LIGHT_SAMPLES}, got {args.light_samples}")
+
+
 def _raytrace_options(args) -> dict:
     from renderer.core.sampling import DEFAULT_SEED
     return {"samples": args.spp, "pattern": args.pattern, "max_depth": args.max_depth,
             "seed": DEFAULT_SEED if args.seed is None else args.seed,
-            "adaptive_threshold": args.adaptive_threshold}
+            "adaptive_threshold": args.adaptive_threshold,
+            "light_samples": DEFAULT_LIGHT_SAMPLES if args.light_samples is None else args.light_samples}
 
 
 def samples_fired(frame) -> str:

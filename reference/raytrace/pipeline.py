@@ -35,6 +35,7 @@ from reference.raytrace.trace import mix64, trace
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
+from renderer.core.light_areas import DEFAULT_LIGHT_SAMPLES, check_light_samples
 from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
@@ -50,7 +51,7 @@ DECISION_MARGIN = 2.0 ** -12
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
            max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
            rs=None, first_sample: int = 0, adaptive_threshold: float | None = None,
-           dtype=F32) -> Frame:
+           dtype=F32, light_samples: int = DEFAULT_LIGHT_SAMPLES) -> Frame:
     """The frame (module docstring) of sample indices first_sample .. first_sample + N - 1;
     `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays; `dtype`
     float32 (the GPU's twin) or float64."""
@@ -59,6 +60,7 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
     rs = rs if rs is not None else ray_scene(scene)
     sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
     first_sample = check_first_sample(first_sample, sampling.samples)
+    light_samples = check_light_samples(light_samples)
     matrices = scene.matrices(width, height)
     uniforms = camera_ray_uniforms(matrices.view, matrices.projection, width, height)
     uniforms = {k: v.astype(t) for k, v in uniforms.items()}

@@ -165,6 +165,20 @@ def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
                             rs.n[obj].astype(dtype)[:, None], specular=specular)
 
 
+def blocked_towards(rs, Q, P, Ng, shape):
+    """Whether the shadow ray from each hit P (outward geometric normal Ng, on analytic shape
+    `shape`) to the point Q (a point light, or a point of an area light; (3,) or one per hit)
+    is blocked: from ray_origin(P, Ng on Q's side), towards Q (unit direction), s_max the
+    distance; a light at the origin (d = 0) is not blocked (the GLSL's light_visibility_at)."""
+    n = np.where((_dot(Ng, Q - P) >= 0)[:, None], Ng, -Ng)
+    O = ray_origin(P, n, shape)
+    to_light = Q - O
+    d = np.sqrt(_dot(to_light, to_light))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        L = to_light / d[:, None]
+    return occluded(rs, O, L, d, shape) & (d > 0)
+
+
 def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
     """The visibility callable of lighting.py for hits with outward geometric normals Ng on
     analytic shapes `shape` (shape_id): one shadow ray per point and light (the GLSL's
@@ -181,14 +195,7 @@ def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
             O = ray_origin(P, n, on)
             blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on)
         else:
-            Q = lights.u_point_position[i]
-            n = np.where((_dot(n, Q - P) >= 0)[:, None], n, -n)
-            O = ray_origin(P, n, on)
-            to_light = Q - O
-            d = np.sqrt(_dot(to_light, to_light))
-            with np.errstate(divide="ignore", invalid="ignore"):
-                L = to_light / d[:, None]
-            blocked[needed] = occluded(rs, O, L, d, on) & (d > 0)
+            blocked[needed] = blocked_towards(rs, lights.u_point_position[i], P, n, on)
         if record is not None:
             light = i if kind == "directional" else len(lights.u_directional_direction) + i
             record(blocked, ray_tree_event(SHADOW, light))

@@ -25,9 +25,8 @@ from pathlib import Path
 from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
-from renderer.core.light_areas import DEFAULT_LIGHT_SAMPLES, MAX_LIGHT_SAMPLES
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import RAY_PATTERNS
+from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -301,11 +300,13 @@ def check_raytrace_options(args) -> None:
         from renderer.core.ray_sampling import ray_sampling
         options = _raytrace_options(args)
         try:
-            ray_sampling(options["pattern"], options["samples"], options["seed"], options["adaptive_threshold"])
+            ray_sampling(options["pattern"], options["samples"], options["seed"], options["adaptive_threshold"],
+                         options["light_samples"])
         except ValueError as error:
             given = [f"--spp {args.spp}", f"--pattern {args.pattern}"]
             given += [] if args.seed is None else [f"--seed {args.seed}"]
             given += [] if args.adaptive_threshold is None else [f"--adaptive-threshold {args.adaptive_threshold:g}"]
+            given += [] if args.light_samples is None else [f"--light-samples {args.light_samples}"]
             args.parser.error(f"{' '.join(given)}: {error}")
 
 
@@ -325,7 +326,7 @@ def _raytrace_options(args) -> dict:
     return {"samples": args.spp, "pattern": args.pattern, "max_depth": args.max_depth,
             "seed": DEFAULT_SEED if args.seed is None else args.seed,
             "adaptive_threshold": args.adaptive_threshold,
-            "light_samples": DEFAULT_LIGHT_SAMPLES if args.light_samples is None else args.light_samples}
+            "light_samples": 1 if args.light_samples is None else args.light_samples}
 
 
 def samples_fired(frame) -> str:

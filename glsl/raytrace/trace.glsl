@@ -6,10 +6,14 @@
 // and down to a weight cut-off, depth first (the reflected ray first, the transmitted one
 // waiting on a fixed-size stack) in a loop of bounded length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
-// SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR.
+// SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR;
+// AREA_LIGHTS (some point light has an area of size > 0: LIGHT_SAMPLES shadow rays to points
+// of it per hit, area_light_term).
 
 #include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
 #include "raytrace/optics.glsl"
+#include "raytrace/sampling.glsl"     // distributed_2d: the numbers a hit draws
+#include "raytrace/warp.glsl"
 #ifdef MESHES
 uniform sampler2D u_nodes;           // renderer/core/bvh.py's layout
 uniform sampler2D u_triangles;
@@ -207,6 +211,7 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
 // rows 3i .. 3i + 2 of u_point_area and p a point of the unit shape named by row 3i's w
 // (AREA_NONE: no area, the point light's own code).
 uniform vec4 u_point_area[3 * NUM_POINT_LIGHTS];
+const uint LIGHT_DIMENSION = 1u;     // renderer/core/ray_sampling.py: light i's points, LIGHT_DIMENSION + i
 const float AREA_NONE = 0.0;
 const float AREA_RECTANGLE = 1.0;
 const float AREA_DISC = 2.0;
@@ -233,7 +238,7 @@ vec3 area_light_point(int i, vec2 u) {
 vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
     vec3 sum = vec3(0.0);
     for (int m = 0; m < LIGHT_SAMPLES; ++m) {
-        vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, RAY_DIMENSION_LIGHT + uint(i),
+        vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, LIGHT_DIMENSION + uint(i),
                                 uint(m), uint(LIGHT_SAMPLES));
         vec3 Q = area_light_point(i, u);
         vec3 term = point_term_at(i, Q, P, N, V);

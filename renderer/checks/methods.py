@@ -36,7 +36,6 @@ from renderer.checks.compare import (DEFAULT_DEVIATION, DEFAULT_THRESHOLD, Compa
                                      channel_difference, compare_frames,
                                      position_deviation_mismatch)
 from renderer.core.frame import Frame
-from renderer.core.light_areas import DEFAULT_LIGHT_SAMPLES
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.core.shadow_settings import Shadow
@@ -191,7 +190,7 @@ class MethodComparison:
 def compare_methods(scene: Scene, width: int, height: int, *, context=None, context_kind: str = "auto",
                     samples: int = 1, pattern: str = "regular", max_depth: int | None = None,
                     seed: int = DEFAULT_SEED, adaptive_threshold: float | None = None,
-                    light_samples: int = DEFAULT_LIGHT_SAMPLES, threshold: int = DEFAULT_THRESHOLD,
+                    light_samples: int = 1, threshold: int = DEFAULT_THRESHOLD,
                     deviation: int = DEFAULT_DEVIATION) -> MethodComparison:
     """Render CHAIN on the GPU in one GL context (`context`, else a new one of
     `context_kind`) and explain where the rasteriser and the ray tracer (samples, pattern,

@@ -1,6 +1,7 @@
 """Area lights for the ray tracer (docs/conventions.md, "Area lights"): what both twins read
-about each point light's area (renderer/core/scene.py, LightArea) and the `light_samples`
-render setting. The rasteriser reads none of it: it lights from each light's centre.
+about each point light's area (renderer/core/scene.py, LightArea); the points per hit,
+`light_samples`, are the sampling rule's (renderer/core/ray_sampling.py). The rasteriser reads
+none of it: it lights from each light's centre.
 
 A point of light i's area is q = Q_i + p.x a_0 + p.y a_1 + p.z a_2, with Q_i the light's
 position (u_point_position) and p the point of the unit shape at the sample's u in [0, 1)^2:
@@ -19,8 +20,6 @@ point light's code). An area of size 0 has a = 0, so q = Q_i exactly: p is finit
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from renderer.core.scene import AREA_SHAPES, LightArea, Scene
@@ -29,28 +28,14 @@ from renderer.core.scene import AREA_SHAPES, LightArea, Scene
 AREA_SHAPE_CODES = {shape: code for code, shape in enumerate(AREA_SHAPES, start=1)}
 NO_AREA = 0
 AREA_UNIFORM = "u_point_area"          # vec4[3 * NUM_POINT_LIGHTS]
-# light_samples, M: the points drawn on each area light per hit (1 .. MAX_LIGHT_SAMPLES; the
-# GLSL loop's bound is the LIGHT_SAMPLES define).
-MAX_LIGHT_SAMPLES = 64
-DEFAULT_LIGHT_SAMPLES = 1
-
-
-def check_light_samples(light_samples) -> int:
-    """light_samples as an int; ValueError (one line) unless a whole number 1 .. MAX_LIGHT_SAMPLES."""
-    if isinstance(light_samples, bool) or not isinstance(light_samples, (int, np.integer)) \
-            or not 1 <= light_samples <= MAX_LIGHT_SAMPLES:
-        raise ValueError(f"light samples must be a whole number from 1 to {MAX_LIGHT_SAMPLES}, "
-                         f"got {light_samples!r}")
-    return int(light_samples)
-
-
 def orthonormal_basis(n) -> tuple[np.ndarray, np.ndarray]:
     """(b1, b2) completing the unit vector n to a right-handed orthonormal basis (b1, b2, n):
     Duff, Burgess, Christensen, Hery, Kensler, Liani and Villemin, "Building an Orthonormal
-    Basis, Revisited", JCGT 6(1) 2017, listing 3, in float64. n = (0, -1, 0), the default
-    normal, gives b1 = (1, 0, 0), b2 = (0, 0, 1)."""
+    Basis, Revisited", JCGT 6(1) 2017, listing 3, in float64, with n.z = 0 counting as
+    positive as in warp.glsl's. n = (0, -1, 0), the default normal, gives b1 = (1, 0, 0),
+    b2 = (0, 0, 1)."""
     x, y, z = (float(c) for c in n)
-    sign = math.copysign(1.0, z)
+    sign = 1.0 if z >= 0.0 else -1.0
     a = -1.0 / (sign + z)
     b = x * y * a
     return (np.array([1.0 + sign * x * x * a, sign * b, -sign * x]),
@@ -92,9 +77,8 @@ def uses_area_lights(scene: Scene) -> bool:
     return any(light.area is not None and light.area.has_size for light in scene.point_lights)
 
 
-def area_light_defines(scene: Scene, light_samples: int, every: bool = False) -> dict[str, object]:
-    """trace.glsl's and lighting.glsl's constants: AREA_LIGHTS where the scene uses area lights
-    (or `every`: the build that compiles every feature in, where the scene has point lights)
-    and then LIGHT_SAMPLES, M."""
-    on = bool(scene.point_lights) and (every or uses_area_lights(scene))
-    return {"AREA_LIGHTS": on, "LIGHT_SAMPLES": check_light_samples(light_samples) if on else None}
+def area_light_defines(scene: Scene, every: bool = False) -> dict[str, object]:
+    """trace.glsl's and lighting.glsl's AREA_LIGHTS: where the scene uses area lights, or
+    `every` (the build that compiles every feature in) where it has point lights. (LIGHT_SAMPLES,
+    M, is the sampling rule's define.)"""
+    return {"AREA_LIGHTS": bool(scene.point_lights) and (every or uses_area_lights(scene))}

@@ -38,8 +38,7 @@ from renderer.core.bvh import build_bvh, texels
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
-from renderer.core.light_areas import (DEFAULT_LIGHT_SAMPLES, area_light_defines, area_light_uniforms,
-                                       check_light_samples)
+from renderer.core.light_areas import area_light_defines, area_light_uniforms
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
@@ -61,18 +60,17 @@ class RayTracer:
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
                  seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True,
-                 adaptive_threshold: float | None = None, light_samples: int = DEFAULT_LIGHT_SAMPLES):
+                 adaptive_threshold: float | None = None, light_samples: int = 1):
         width, height = image_size(width, height)
         if not 0 <= int(max_depth) <= MAX_DEPTH_LIMIT:
             raise ValueError(f"max_depth must be between 0 and {MAX_DEPTH_LIMIT}, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
         self.width, self.height = width, height
-        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
+        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold, light_samples)
         self.max_depth = int(max_depth)
         self.shadows = bool(shadows)
         self.specialise = bool(specialise)
-        self.light_samples = check_light_samples(light_samples)
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._resources: list = []
@@ -116,7 +114,7 @@ class RayTracer:
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
             **self.sampling.defines(),
-            **area_light_defines(scene, self.light_samples, every),
+            **area_light_defines(scene, every),
         }
 
     def _compile(self) -> None:

@@ -191,13 +191,14 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
 #endif
 #if NUM_POINT_LIGHTS > 0
 // 0 where the shadow ray from P to the point Q (a point light, or a point of an area light) is
-// blocked, else 1.
+// blocked, else 1. It ends short of Q by the hit tie (s_max = d (1 - TRACE_HIT_TIE)): a surface
+// through Q itself (a light lying in a plane) ties with the light, which keeps it.
 float light_visibility_at(vec3 Q, vec3 P) {
     vec3 n = dot(g_geometric_normal, Q - P) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
     vec3 O = ray_origin(P, n, g_shape);
     vec3 to_light = Q - O;
     float d = sqrt(dot(to_light, to_light));
-    return (d > 0.0 && occluded(O, to_light / d, d, g_shape)) ? 0.0 : 1.0;
+    return (d > 0.0 && occluded(O, to_light / d, d * (1.0 - TRACE_HIT_TIE), g_shape)) ? 0.0 : 1.0;
 }
 
 float light_visibility_point(int i, vec3 P, vec3 N) {

@@ -175,14 +175,15 @@ def blocked_towards(rs, Q, P, Ng, shape):
     """Whether the shadow ray from each hit P (outward geometric normal Ng, on analytic shape
     `shape`) to the point Q (a point light, or a point of an area light; (3,) or one per hit)
     is blocked: from ray_origin(P, Ng on Q's side), towards Q (unit direction), s_max the
-    distance; a light at the origin (d = 0) is not blocked (the GLSL's light_visibility_at)."""
+    distance less the hit tie, d (1 - HIT_TIE) (a surface through Q ties with the light, which
+    keeps it); a light at the origin (d = 0) is not blocked (the GLSL's light_visibility_at)."""
     n = np.where((_dot(Ng, Q - P) >= 0)[:, None], Ng, -Ng)
     O = ray_origin(P, n, shape)
     to_light = Q - O
     d = np.sqrt(_dot(to_light, to_light))
     with np.errstate(divide="ignore", invalid="ignore"):
         L = to_light / d[:, None]
-    return occluded(rs, O, L, d, shape) & (d > 0)
+    return occluded(rs, O, L, d * (d.dtype.type(1) - d.dtype.type(HIT_TIE)), shape) & (d > 0)
 
 
 def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):

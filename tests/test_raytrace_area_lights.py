@@ -10,6 +10,8 @@ and 16 samples per pixel, EGL and OSMesa in the full run."""
 
 import dataclasses
 import math
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,9 +23,9 @@ from reference.raytrace.trace import area_light_point, trace
 from reference.raytrace.warp import orthonormal_basis as warp_basis
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.core.light_areas import (AREA_SHAPE_CODES, AREA_UNIFORM, area_axes, area_light_defines,
-                                       area_light_uniforms, orthonormal_basis)
-from renderer.core.ray_sampling import ray_sampling
+from renderer.core.light_areas import (AREA_SHAPE_CODES, AREA_UNIFORM, NO_AREA, area_axes,
+                                       area_light_defines, area_light_uniforms, orthonormal_basis)
+from renderer.core.ray_sampling import LIGHT_DIMENSION, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene import LightArea
 from renderer.core.scene_file import load_scene, scene_from_dict
@@ -87,6 +89,16 @@ def test_the_scene_file_keys_make_the_area():
     assert areas == [LightArea("rectangle", (1.0, 2.0)), LightArea("disc", radius=0.5, normal=(0.0, 0.0, 2.0)),
                      LightArea("sphere", radius=0.0), None]
     assert areas[0].normal == (0.0, -1.0, 0.0) and areas[0].has_size and not areas[2].has_size
+
+
+def test_the_glsl_constants_are_the_twins():
+    """trace.glsl's LIGHT_DIMENSION and shape codes are renderer/core's (the twin reads those)."""
+    text = (Path(__file__).resolve().parent.parent / "glsl" / "raytrace" / "trace.glsl").read_text()
+    constants = dict(re.findall(r"const (?:uint|float) (LIGHT_DIMENSION|AREA_[A-Z]+) = ([0-9.]+)u?;", text))
+    assert int(constants.pop("LIGHT_DIMENSION")) == LIGHT_DIMENSION
+    assert {name: float(value) for name, value in constants.items()} == {
+        "AREA_NONE": NO_AREA, **{f"AREA_{shape.upper()}": code for shape, code in AREA_SHAPE_CODES.items()
+                                 if shape != "sphere"}}      # the sphere: the one left
 
 
 def points_on(area, u, dtype=np.float64, centre=(1.0, 2.0, 3.0)):

@@ -124,6 +124,15 @@ def build_parser() -> argparse.ArgumentParser:
         p.add_argument("--light-samples", type=int, default=None, metavar="M",
                        help=f"ray tracer: points sampled on each area light per hit, 1 to "
                             f"{MAX_LIGHT_SAMPLES} (default 1; docs/conventions.md, \"Area lights\")")
+        lens_options(p)
+
+    def lens_options(p):
+        p.add_argument("--aperture", type=float, default=None, metavar="A",
+                       help="ray tracer: the thin lens's radius in scene units, >= 0, instead of "
+                            "the scene's camera.aperture (depth of field; 0: a pinhole)")
+        p.add_argument("--focus-distance", type=float, default=None, metavar="F",
+                       help="ray tracer: the view depth in focus, > 0, instead of the scene's "
+                            "camera.focus_distance")
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
@@ -296,6 +305,7 @@ def check_raytrace_options(args) -> None:
     check_light_samples_option(args, traced)
     if args.adaptive_threshold is not None and args.pattern != "adaptive":
         args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
+    check_lens_options(args, traced)
     if traced:
         from renderer.core.ray_sampling import ray_sampling
         options = _raytrace_options(args)
@@ -319,6 +329,35 @@ def check_light_samples_option(args, traced: bool) -> None:
         args.parser.error(f"--light-samples is for --method raytrace{also}")
     if not 1 <= args.light_samples <= MAX_LIGHT_SAMPLES:
         args.parser.error(f"--light-samples must be between 1 and {MAX_LIGHT_SAMPLES}, got {args.light_samples}")
+
+
+LENS_OPTIONS = {"aperture": "--aperture", "focus_distance": "--focus-distance"}
+
+
+def check_lens_options(args, traced: bool) -> None:
+    """The thin lens's options are the ray tracer's (the rasteriser's camera is a pinhole)."""
+    given = [option for key, option in LENS_OPTIONS.items() if getattr(args, key, None) is not None]
+    if given and not traced:
+        also = " or --methods" if hasattr(args, "methods") else ""
+        args.parser.error(f"{' and '.join(given)} {'is' if len(given) == 1 else 'are'} for "
+                          f"--method raytrace{also}")
+
+
+def _load_traced(args):
+    """The scene, its camera's lens set by --aperture and --focus-distance where given, each
+    checked as the scene file's key is: one line naming the option, status 2."""
+    from renderer.core.scene_file import with_lens
+    from renderer.errors import SceneError, show_number
+    scene = _load(args.scene)
+    values = {key: getattr(args, key) for key in LENS_OPTIONS if getattr(args, key, None) is not None}
+    if not values:
+        return scene
+    try:
+        camera = with_lens(scene.camera, values, source=scene.source or scene.name)
+    except SceneError as error:
+        raise UserError(f"{LENS_OPTIONS[error.key]} {show_number(values[error.key])}: "
+                        f"{error.reason}") from None
+    return replace(scene, camera=camera)
 
 
 def _raytrace_options(args) -> dict:
@@ -384,7 +423,7 @@ def cmd_render(args) -> int:
                         file=str(args.depth))
     check_outputs(args.output, args.depth)   # a folder, a file as parent, the same file twice
     check_raytrace_options(args)
-    scene = _load(args.scene)
+    scene = _load_traced(args)
     if args.method == "raytrace":
         check_raytrace_memory(scene, args.size, [args.backend], args.spp)
     else:
@@ -468,7 +507,7 @@ def cmd_compare_methods(args) -> int:
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.jsonio import json_text
     from renderer.core.paths import output_stem
-    scene = _load(args.scene)
+    scene = _load_traced(args)
     check_memory(scene, args.size, ["gpu"])
     check_raytrace_memory(scene, args.size, ["gpu"], args.spp)
     out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
@@ -534,7 +573,7 @@ def cmd_compare(args) -> int:
     check_raytrace_options(args)
     if args.methods:
         return cmd_compare_methods(args)
-    scene = _load(args.scene)
+    scene = _load_traced(args)
     if args.method == "raytrace":
         check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)
     else:

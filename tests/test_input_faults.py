@@ -352,7 +352,11 @@ def test_a_bad_ray_traced_scene_is_one_line_naming_file_key_and_reason(capsys, w
     (["--max-depth", "-1"], "--max-depth must be between 0 and 64, got -1"),
     (["--max-depth", "65"], "--max-depth must be between 0 and 64, got 65"),
     (["--pattern", "hexagonal"], "argument --pattern: invalid choice: 'hexagonal' (choose from"),
-], ids=["spp 0", "max depth -1", "max depth 65", "unknown pattern"])
+    (["--light-samples", "0"], "--light-samples must be between 1 and 64, got 0"),
+    (["--light-samples", "65"], "--light-samples must be between 1 and 64, got 65"),
+    (["--light-samples", "two"], "argument --light-samples: invalid int value: 'two'"),
+], ids=["spp 0", "max depth -1", "max depth 65", "unknown pattern", "light samples 0",
+        "light samples 65", "light samples not a number"])
 def test_a_bad_ray_tracer_option_is_its_reason_then_the_usage(capsys, work, command, option, reason):
     """Argument errors print the reason on one line (the option named), then the usage line
     (tests/test_cli.py); status 2, nothing written. 65 is absurd: renderer/core/ray_depth.py's
@@ -362,4 +366,16 @@ def test_a_bad_ray_tracer_option_is_its_reason_then_the_usage(capsys, work, comm
     assert main(args) == 2
     first, usage = capsys.readouterr().err.splitlines()
     assert first.startswith(f"renderer {command}: {reason}") and usage.startswith(f"usage: renderer {command}")
+    assert sorted(p.name for p in work.iterdir()) == before
+
+
+@pytest.mark.parametrize("command", ["render", "compare"])
+def test_light_samples_are_for_the_ray_tracer(capsys, work, command):
+    """--light-samples without --method raytrace (the rasteriser lights from each area light's
+    centre): its reason, then the usage; status 2, nothing written."""
+    before = sorted(p.name for p in work.iterdir())
+    assert main([command, "sphere", "--size", "16x12", "--light-samples", "4"]) == 2
+    first, usage = capsys.readouterr().err.splitlines()
+    assert first.startswith(f"renderer {command}: --light-samples is for --method raytrace")
+    assert usage.startswith(f"usage: renderer {command}")
     assert sorted(p.name for p in work.iterdir()) == before

@@ -1,6 +1,7 @@
 """The built-in scenes made for the ray tracer (conftest.RAYTRACE_SCENES: classic, cornell_box,
-mesh_shadow, tir_bubble): what each is built to show, checked by hand on a few rays, then
-issue 14's done-when rule for every one of them, the GPU ray tracer (renderer/gpu/raytracer.py)
+mesh_shadow, tir_bubble, soft_shadows): what each is built to show, checked by hand on a few
+rays (soft_shadows: tests/test_raytrace_area_lights.py), then issue 14's done-when rule for
+every one of them, the GPU ray tracer (renderer/gpu/raytracer.py)
 against the NumPy ray tracer (reference/raytrace/) under PIPELINE_TOLERANCE: 0 mismatched
 pixels after the +-1 px allowance and raw mismatch <= 0.1 %, depth within 1e-3 relative.
 

@@ -15,7 +15,9 @@ bounce (every ray of one depth at once), no Python loop over pixels or rays.
   offset_ray_origin(P, Ng on the light's side): directional, towards L with s_max = inf; point,
   towards the light, unit direction, s_max = the distance. Any hit is a shadow (every surface
   is opaque to shadow rays); in shadow a light adds nothing but its ambient share; a light
-  whose terms are 0 at P (behind it; k_d = k_s = 0) casts no shadow ray, as the GLSL;
+  whose terms are 0 at P (behind it; k_d = k_s = 0) casts no shadow ray, as the GLSL; an area
+  light (a point light with an area) is M = light_samples point lights at points of its area,
+  each with its shadow ray, averaged (area_light_terms);
 - secondary rays (depth < max_depth): with Du = normalize(D), N and Ng flipped to the incoming
   side, eta = 1/ior entering (front seen), ior leaving, F = fresnel_schlick(Du, N, eta):
   reflected weight k_r + k_t F along ray_reflect(Du, N) from offset_ray_origin(P, Ng);
@@ -28,12 +30,16 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
+from reference.lighting import (Lights, MaterialUniforms, lighting, normalize, normalize_or_zero,
+                                point_term_at)
 from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
                                           triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
+from reference.raytrace.warp import square_to_disc, square_to_sphere
+from renderer.core.light_areas import AREA_SHAPE_CODES, NO_AREA
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
+from renderer.core.ray_sampling import LIGHT_DIMENSION
 
 F32 = np.float32
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
@@ -165,6 +171,21 @@ def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
                             rs.n[obj].astype(dtype)[:, None], specular=specular)
 
 
+def blocked_towards(rs, Q, P, Ng, shape):
+    """Whether the shadow ray from each hit P (outward geometric normal Ng, on analytic shape
+    `shape`) to the point Q (a point light, or a point of an area light; (3,) or one per hit)
+    is blocked: from ray_origin(P, Ng on Q's side), towards Q (unit direction), s_max the
+    distance less the hit tie, d (1 - HIT_TIE) (a surface through Q ties with the light, which
+    keeps it); a light at the origin (d = 0) is not blocked (the GLSL's light_visibility_at)."""
+    n = np.where((_dot(Ng, Q - P) >= 0)[:, None], Ng, -Ng)
+    O = ray_origin(P, n, shape)
+    to_light = Q - O
+    d = np.sqrt(_dot(to_light, to_light))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        L = to_light / d[:, None]
+    return occluded(rs, O, L, d * (d.dtype.type(1) - d.dtype.type(HIT_TIE)), shape) & (d > 0)
+
+
 def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
     """The visibility callable of lighting.py for hits with outward geometric normals Ng on
     analytic shapes `shape` (shape_id): one shadow ray per point and light (the GLSL's
@@ -181,19 +202,67 @@ def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
             O = ray_origin(P, n, on)
             blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on)
         else:
-            Q = lights.u_point_position[i]
-            n = np.where((_dot(n, Q - P) >= 0)[:, None], n, -n)
-            O = ray_origin(P, n, on)
-            to_light = Q - O
-            d = np.sqrt(_dot(to_light, to_light))
-            with np.errstate(divide="ignore", invalid="ignore"):
-                L = to_light / d[:, None]
-            blocked[needed] = occluded(rs, O, L, d, on) & (d > 0)
+            blocked[needed] = blocked_towards(rs, lights.u_point_position[i], P, n, on)
         if record is not None:
             light = i if kind == "directional" else len(lights.u_directional_direction) + i
             record(blocked, ray_tree_event(SHADOW, light))
         return np.where(blocked, t(0), t(1))[:, None]
     return visibility
+
+
+# -- area lights ---------------------------------------------------------------------------------
+# docs/conventions.md, "Area lights"; the uniform's layout: renderer/core/light_areas.py.
+
+def area_light_point(areas, i: int, centre, u) -> np.ndarray:
+    """(R, 3) points of point light i's area at u (R, 2) in [0, 1)^2, in centre's dtype (the
+    GLSL's area_light_point): centre + p.x a_0 + p.y a_1 + p.z a_2 with p = (2u - 1, 0) on a
+    rectangle, (square_to_disc(u), 0) on a disc, square_to_sphere(u) on a sphere; `areas` the
+    (3 Lp, 4) u_point_area rows, `centre` the light's position (3,)."""
+    t = centre.dtype.type
+    u = np.asarray(u).astype(t)
+    shape = areas[3 * i, 3]
+    if shape == AREA_SHAPE_CODES["rectangle"]:
+        p = np.concatenate([t(2) * u - t(1), np.zeros((len(u), 1), t)], -1)
+    elif shape == AREA_SHAPE_CODES["disc"]:
+        p = np.concatenate([square_to_disc(u), np.zeros((len(u), 1), t)], -1)
+    else:
+        p = square_to_sphere(u)
+    a = areas[3 * i:3 * i + 3, :3].astype(t)
+    offset = p[:, 0:1] * a[0] + p[:, 1:2] * a[1] + p[:, 2:3] * a[2]
+    return centre + offset
+
+
+def area_light_terms(rs, lights: Lights, areas, Ng, shape, draw, shadows: bool, record=None):
+    """The area_light callable of lighting.py for hits with outward geometric normals Ng on
+    analytic shapes `shape` (the GLSL's has_area and area_light_term): for point light i with
+    an area (row 3i's w not NO_AREA), the mean of point_term_at(q_m) over its M points q_m =
+    area_light_point(u_m), u_m = draw(i, m), each times the visibility of q_m (`shadows`; a
+    shadow ray only where the term is not 0), summed in m order; None for a light without an
+    area. `record` hears each shadow ray's outcome (the event of light l's m-th point:
+    SHADOW, l + m * (number of lights))."""
+    t = Ng.dtype.type
+    M = draw.light_samples
+    n_lights = len(lights.u_directional_direction) + len(lights.u_point_position)
+
+    def area_light(i, P, N, V, material):
+        if areas[3 * i, 3] == NO_AREA:
+            return None
+        total = np.zeros(P.shape, t)
+        for m in range(M):
+            Q = area_light_point(areas, i, lights.u_point_position[i], draw(i, m))
+            term = point_term_at(P, N, V, Q, lights.u_point_intensity[i], lights.u_point_attenuation[i],
+                                 material)
+            if shadows:
+                needed = (term != 0).any(-1)
+                blocked = np.zeros(len(P), bool)
+                blocked[needed] = blocked_towards(rs, Q[needed], P[needed], Ng[needed], shape[needed])
+                if record is not None:
+                    light = len(lights.u_directional_direction) + i
+                    record(blocked, ray_tree_event(SHADOW, light + m * n_lights))
+                term = np.where(blocked, t(0), t(1))[:, None] * term
+            total += term
+        return total / t(M)
+    return area_light
 
 
 # -- the ray tree's hash ------------------------------------------------------------------------
@@ -225,8 +294,21 @@ def ray_tree_event(kind, index):
     return (kind << np.uint64(32)) | (np.asarray(index, np.int64) & 0xFFFFFFFF).astype(np.uint64)
 
 
+class _AreaDraw:
+    """draw(i, m): the u of point m of light i's area at each hit of the camera rays `owner`,
+    rays `key` (distributed_2d at slot 1 + key, dimension LIGHT_DIMENSION + i, m of M)."""
+
+    def __init__(self, samples, owner, key):
+        self.samples, self.owner, self.light_samples = samples, owner, samples.sampling.light_samples
+        with np.errstate(over="ignore"):                 # slots wrap modulo 2^32, as the GLSL's
+            self.slot = np.uint32(1) + key
+
+    def __call__(self, i: int, m: int) -> np.ndarray:
+        return self.samples.point_2d(self.owner, self.slot, LIGHT_DIMENSION + i, m, self.light_samples)
+
+
 def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
-          ray_trees=None, samples=None):
+          ray_trees=None, samples=None, areas=None):
     """Trace rays O, D (R, 3): (colour (R, 3), hit (R,), s (R,)) with hit and s of each ray's
     first hit (primary rays between s_min and s_max; secondary rays from 0 to inf). float32 as
     the GLSL, or float64 for float64 rays (and then `lights` in float64). shadows=False lights
@@ -234,7 +316,9 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
     (R,) uint64 array, has each ray tree's hash added to it (the comment above). `samples`, a
     sampling.RaySamples of the R camera rays, says whose numbers each hit draws (the
     distributed effects); each ray of a tree carries its key (the GLSL's g_ray_key: the camera
-    ray 0, the reflected child of r 2r + 1, the transmitted 2r + 2, as uint32).
+    ray 0, the reflected child of r 2r + 1, the transmitted 2r + 2, as uint32). `areas`, the
+    u_point_area rows of renderer/core/light_areas.py (None: no light declares an area), makes
+    the point lights with an area area lights (area_light_terms; `samples` then required).
     A secondary ray is spawned only when some channel of its weight is at least
     RAY_WEIGHT_CUTOFF (renderer/core/ray_depth.py)."""
     t = np.asarray(O).dtype.type if np.asarray(O).dtype == np.float64 else F32
@@ -272,8 +356,11 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         Du = normalize(D)
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
+        area_light = None if areas is None else area_light_terms(
+            rs, lights, areas, Ng, shape, _AreaDraw(samples, owner, key), shadows, record)
         local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
-                         shadow_visibility(rs, lights, Ng, shape, record) if shadows else None)
+                         shadow_visibility(rs, lights, Ng, shape, record) if shadows else None,
+                         area_light)
         np.add.at(colour, owner, weight * local)
         if depth == max_depth:
             break

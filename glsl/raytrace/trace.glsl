@@ -34,7 +34,7 @@ uniform int u_sphere_object[NUM_SPHERES];
 uniform vec4 u_planes[NUM_PLANES];              // (unit N, d): P.N + d = 0
 uniform int u_plane_object[NUM_PLANES];
 #endif
-uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, 0), (kt, 0)
+uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, gloss), (kt, 0)
 uniform vec3 u_background;
 
 #include "lighting.glsl"

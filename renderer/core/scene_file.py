@@ -47,7 +47,7 @@ LIGHT_TYPES = ("directional", "point")
 TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials", "lights",
             "objects")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z")
-MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior")
+MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 LIGHT_KEYS = {
     "directional": ("type", "direction", "intensity", *SHADOW_KEYS),
@@ -462,6 +462,8 @@ class _Reader:
                 setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
         if "ior" in raw:
             mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
+        if "gloss" in raw:
+            mat.gloss = self.gloss(raw["gloss"], _join(path, "gloss"))
         channel = energy_excess(mat.kr, mat.kt)
         if channel is not None:
             where = _join(path, "kt" if "kt" in raw else "kr")
@@ -470,6 +472,15 @@ class _Reader:
                              f"(the reflected and refracted rays together carry at most the "
                              f"light that arrives)")
         return mat
+
+    def gloss(self, value: Any, path: str) -> float:
+        """A Phong-lobe exponent: a number >= 0, or inf (TOML's `inf`), the mirror."""
+        x = self.to_float(value, path) if _is_number(value) else 0.0
+        if x == math.inf:
+            return x
+        if math.isnan(x) or x < 0:
+            self.fail(path, f"must be a number >= 0 or inf (a mirror), got {show_number(x)}")
+        return self.number(value, path)
 
     def light(self, raw: dict, path: str) -> DirectionalLight | PointLight:
         if "type" not in raw:

@@ -8,8 +8,9 @@ hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, n
 
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
-MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, and the sample
-pattern's constants from renderer/core/ray_sampling.py); the uniforms (camera rays from
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, GLOSSY when such a material
+has a finite gloss, MAX_DEPTH, and the sample pattern's constants from
+renderer/core/ray_sampling.py); the uniforms (camera rays from
 renderer/core/camera_rays.py, lights from renderer/core/uniforms.py, shapes, the pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
 renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
@@ -19,9 +20,9 @@ changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
-`shadows`), SECONDARY (where max_depth > 0) and MESHES (the BVH walk; a scene without triangles
-gets a one-triangle BVH of a degenerate triangle, which no ray hits). The light, sphere and
-plane counts stay compile-time constants. The image is the same.
+`shadows`), SECONDARY and GLOSSY (where max_depth > 0) and MESHES (the BVH walk; a scene
+without triangles gets a one-triangle BVH of a degenerate triangle, which no ray hits). The
+light, sphere and plane counts stay compile-time constants. The image is the same.
 """
 
 from __future__ import annotations
@@ -108,6 +109,7 @@ class RayTracer:
             "NUM_PLANES": len(rs.plane_offset),
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
+            "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
             **self.sampling.defines(),
         }
@@ -157,7 +159,7 @@ class RayTracer:
         zero = np.zeros((len(rs.n), 1))
         materials = np.stack([np.concatenate(part, 1) for part in (
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
-            (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
+            (rs.ks, rs.ior[:, None]), (rs.kr, rs.gloss[:, None]), (rs.kt, zero))], 1)  # (M, 5, 4)
         arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object

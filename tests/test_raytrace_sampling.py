@@ -5,10 +5,10 @@ progressive frames (first_sample), adaptive refinement exactly where the first s
 disagree, and the GPU against the reference with each pattern."""
 
 from fractions import Fraction
-from pathlib import Path
 
 import numpy as np
 import pytest
+from glsl_harness import ShaderProbe
 
 from reference.raytrace.camera import camera_ray
 from reference.raytrace.pipeline import DECISION_MARGIN, render as reference_raytrace
@@ -24,9 +24,7 @@ from renderer.core.ray_sampling import (DEFAULT_ADAPTIVE_THRESHOLD, MAX_SAMPLES,
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import poisson_disk, regular_grid
 from renderer.core.scene_file import scene_from_dict
-from renderer.gpu.shaders import shader_source
 
-GLSL = Path(__file__).parent / "glsl"
 F32 = np.float32
 Y, X = np.mgrid[0:6, 0:8].astype(np.uint32)          # a few pixels (x, y), row 0 at the bottom
 
@@ -106,7 +104,6 @@ def test_regular_and_poisson_are_tables_the_same_everywhere():
 def test_glsl_sample_offsets_are_the_twin_bit_for_bit(gl_contexts):
     width, height = 37, 23
     y, x = np.mgrid[0:height, 0:width].astype(np.uint32)
-    vertex = shader_source("fullscreen.vert", directory=GLSL).text
     cases = [(ray_sampling("random", 3, seed=0), [0, 2], [0, 2 ** 32 - 3]),
              (ray_sampling("jittered", 6, seed=0xFFFFFFFF), [0, 4, 5], [0, 77]),
              (ray_sampling("adaptive", 16), [0, 3, 4, 15], [0, 16]),
@@ -115,29 +112,13 @@ def test_glsl_sample_offsets_are_the_twin_bit_for_bit(gl_contexts):
              (ray_sampling("poisson", 5), [1, 4], [0])]
     for kind, ctx in gl_contexts.items():
         for sampling, ks, firsts in cases:
-            fragment = shader_source("raytrace_sampling.frag", sampling.defines(), directory=GLSL).text
-            program = ctx.program(vertex_shader=vertex, fragment_shader=fragment)
-            texture = ctx.texture((width, height), 2, dtype="u4")
-            framebuffer = ctx.framebuffer([texture])
-            vao = ctx.vertex_array(program, [])
-            try:
-                for name, value in sampling.uniforms().items():
-                    if name in program:
-                        program[name].write(value.tobytes())
+            with ShaderProbe(ctx, "raytrace_sampling.frag", sampling.defines(), (width, height), 2) as shader:
+                shader.write(sampling.uniforms())
                 for k in ks:
                     for first in firsts:
-                        program["u_k"].value = k
-                        if "u_first_sample" in program:
-                            program["u_first_sample"].value = first
-                        framebuffer.use()
-                        framebuffer.clear()
-                        vao.render(vertices=3)
-                        got = np.frombuffer(texture.read(), np.uint32).reshape(height, width, 2)
+                        got = shader.run(u_k=k, u_first_sample=first)
                         expected = sample_offset(x, y, k, first, sampling).view(np.uint32)
                         assert np.array_equal(got, expected), (kind, sampling.pattern, k, first)
-            finally:
-                for thing in (vao, framebuffer, texture, program):
-                    thing.release()
 
 
 def test_ray_sampling_refuses_what_it_cannot_do():

@@ -32,6 +32,8 @@ void main() {
     for (int k = 0; k < count; ++k) {   // one call site of trace: it is inlined where called
         vec3 O, D;
         camera_ray(gl_FragCoord.xy + sample_offset(pixel, k), O, D);
+        g_pixel = pixel;
+        g_sample = k;
         bool hit;
         float s;
         vec3 colour = trace(O, D, u_near, u_far, hit, s);

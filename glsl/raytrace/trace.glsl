@@ -165,6 +165,12 @@ bool occluded(vec3 O, vec3 D, float s_max, int from_shape) {
 
 vec3 g_geometric_normal;             // the outward Ng of the point being lit
 int g_shape;                         // its analytic shape (scene_hit's from_shape), or -1
+// Whose numbers a hit draws (sampling.glsl's distributed_2d at slot 1 + g_ray_key): the pixel
+// and sample k being traced (set by raytrace.frag) and the key of the ray being shaded: the
+// camera ray 0, the reflected child of ray r 2r + 1, the transmitted 2r + 2 (mod 2^32).
+uvec2 g_pixel;
+int g_sample;
+uint g_ray_key;
 
 // Where a secondary or shadow ray leaving P on the side of n starts: P itself on an analytic
 // shape (scene_hit and occluded never meet it there again), else Waechter and Binder's offset.
@@ -219,41 +225,46 @@ vec3 stack_D[TRACE_STACK];
 vec3 stack_w[TRACE_STACK];
 int stack_depth[TRACE_STACK];
 int stack_from[TRACE_STACK];            // the analytic shape a ray starts on, or -1
+uint stack_key[TRACE_STACK];            // the ray's key (g_ray_key)
 
-void trace_store(int i, vec3 O, vec3 D, vec3 w, int depth, int from_shape) {
+void trace_store(int i, vec3 O, vec3 D, vec3 w, int depth, int from_shape, uint key) {
     stack_O[i] = O;
     stack_D[i] = D;
     stack_w[i] = w;
     stack_depth[i] = depth;
     stack_from[i] = from_shape;
+    stack_key[i] = key;
 }
 
-void trace_load(int i, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape) {
+void trace_load(int i, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape,
+                out uint key) {
     O = stack_O[i];
     D = stack_D[i];
     w = stack_w[i];
     depth = stack_depth[i];
     from_shape = stack_from[i];
+    key = stack_key[i];
 }
 
-void trace_push(int top, vec3 O, vec3 D, vec3 w, int depth, int from_shape) {
+void trace_push(int top, vec3 O, vec3 D, vec3 w, int depth, int from_shape, uint key) {
 #ifdef TRACE_STACK_SELECT
     for (int i = 0; i < TRACE_STACK; ++i) {
-        if (i == top) trace_store(i, O, D, w, depth, from_shape);
+        if (i == top) trace_store(i, O, D, w, depth, from_shape, key);
     }
 #else
-    trace_store(top, O, D, w, depth, from_shape);
+    trace_store(top, O, D, w, depth, from_shape, key);
 #endif
 }
 
-void trace_pop(int top, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape) {
+void trace_pop(int top, out vec3 O, out vec3 D, out vec3 w, out int depth, out int from_shape,
+               out uint key) {
 #ifdef TRACE_STACK_SELECT
-    trace_load(0, O, D, w, depth, from_shape);
+    trace_load(0, O, D, w, depth, from_shape, key);
     for (int i = 1; i < TRACE_STACK; ++i) {
-        if (i == top) trace_load(i, O, D, w, depth, from_shape);
+        if (i == top) trace_load(i, O, D, w, depth, from_shape, key);
     }
 #else
-    trace_load(top, O, D, w, depth, from_shape);
+    trace_load(top, O, D, w, depth, from_shape, key);
 #endif
 }
 #endif
@@ -267,6 +278,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
     vec3 w = vec3(1.0);
     int depth = 0;
     int from_shape = -1;
+    uint key = 0u;
 #ifdef SECONDARY
     int top = 0;
 #endif
@@ -307,6 +319,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
             vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
             g_geometric_normal = Ng;
             g_shape = kind == TRACE_SPHERE ? index : kind == TRACE_PLANE ? NUM_SPHERES + index : -1;
+            g_ray_key = key;
             colour += w * lighting(P, N);
 #ifdef SECONDARY
             if (depth < MAX_DEPTH) {
@@ -324,17 +337,19 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 bool reflect = any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)));
                 vec3 O_t = ray_origin(P, -Ng_in, g_shape);
                 if (transmit && reflect) {      // the reflected ray first, then this one
-                    trace_push(top, O_t, T, w_t, depth + 1, g_shape);
+                    trace_push(top, O_t, T, w_t, depth + 1, g_shape, 2u * key + 2u);
                     ++top;
                 }
                 if (reflect) {
                     O = ray_origin(P, Ng_in, g_shape);
                     D = ray_reflect(Du, N_in);
                     w = w_r;
+                    key = 2u * key + 1u;
                 } else if (transmit) {
                     O = O_t;
                     D = T;
                     w = w_t;
+                    key = 2u * key + 2u;
                 }
                 depth += 1;
                 from_shape = g_shape;
@@ -346,7 +361,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
         if (!next && top == 0) break;
         if (!next) {
             --top;
-            trace_pop(top, O, D, w, depth, from_shape);
+            trace_pop(top, O, D, w, depth, from_shape, key);
         }
 #else
         break;

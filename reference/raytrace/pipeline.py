@@ -30,7 +30,7 @@ import numpy as np
 from reference.lighting import Lights
 from reference.output import flip_rows
 from reference.raytrace.camera import camera_ray
-from reference.raytrace.sampling import sample_offset
+from reference.raytrace.sampling import RaySamples, sample_offset
 from reference.raytrace.trace import mix64, trace
 from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame
@@ -76,9 +76,13 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
         centres = np.stack([px, py], -1).astype(t) + t(0.5)
         windows = np.stack([centres + sample_offset(px, py, k, first_sample, sampling).astype(t) for k in ks])
         O, D = camera_ray(windows.reshape(-1, 2), uniforms)
+        owners = RaySamples(np.tile(px, len(ks)), np.tile(py, len(ks)),
+                            np.repeat(np.asarray(ks, np.int64), len(pixels)), first_sample, sampling)
         trees = np.zeros(len(O), np.uint64)
         parts = [trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near, cam.far,
-                       scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS])
+                       scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS],
+                       RaySamples(*(a[i:i + CHUNK_RAYS] for a in (owners.x, owners.y, owners.k)),
+                                  first_sample, sampling))
                  for i in range(0, len(O), CHUNK_RAYS)]
         colour, hit, s = (np.concatenate(part) for part in zip(*parts))
         trees = mix64(trees.reshape(len(ks), -1) + np.asarray(ks, np.uint64)[:, None])

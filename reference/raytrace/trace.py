@@ -226,12 +226,15 @@ def ray_tree_event(kind, index):
 
 
 def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
-          ray_trees=None):
+          ray_trees=None, samples=None):
     """Trace rays O, D (R, 3): (colour (R, 3), hit (R,), s (R,)) with hit and s of each ray's
     first hit (primary rays between s_min and s_max; secondary rays from 0 to inf). float32 as
     the GLSL, or float64 for float64 rays (and then `lights` in float64). shadows=False lights
     every point by every light (no shadow rays; the GLSL without SHADOWS). `ray_trees`, an
-    (R,) uint64 array, has each ray tree's hash added to it (the comment above).
+    (R,) uint64 array, has each ray tree's hash added to it (the comment above). `samples`, a
+    sampling.RaySamples of the R camera rays, says whose numbers each hit draws (the
+    distributed effects); each ray of a tree carries its key (the GLSL's g_ray_key: the camera
+    ray 0, the reflected child of r 2r + 1, the transmitted 2r + 2, as uint32).
     A secondary ray is spawned only when some channel of its weight is at least
     RAY_WEIGHT_CUTOFF (renderer/core/ray_depth.py)."""
     t = np.asarray(O).dtype.type if np.asarray(O).dtype == np.float64 else F32
@@ -244,6 +247,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
     owner = np.arange(R)
     from_shape = np.full(R, -1)
     path = np.full(R, ROOT_PATH, np.uint64)
+    key = np.zeros(R, np.uint32)
     weight = np.ones((R, 3), t)
     first_hit, first_s = None, None
     lo, hi = t(s_min), t(s_max)
@@ -261,8 +265,8 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         if depth == 0:
             first_hit, first_s = hit.copy(), s.copy()
         np.add.at(colour, owner[~hit], weight[~hit] * background)
-        O, D, kind, index, s, uv, owner, path, weight = (
-            a[hit] for a in (O, D, kind, index, s, uv, owner, path, weight))
+        O, D, kind, index, s, uv, owner, path, key, weight = (
+            a[hit] for a in (O, D, kind, index, s, uv, owner, path, key, weight))
         P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv)
         shape = shape_id(rs, kind, index)
         Du = normalize(D)
@@ -291,6 +295,9 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         owner = np.concatenate([owner[go_r], owner[go_t]])
         from_shape = np.concatenate([shape[go_r], shape[go_t]])
         path = np.concatenate([mix64(path[go_r] ^ np.uint64(1)), mix64(path[go_t] ^ np.uint64(2))])
+        with np.errstate(over="ignore"):                 # keys wrap modulo 2^32, as the GLSL's
+            key = np.concatenate([np.uint32(2) * key[go_r] + np.uint32(1),
+                                  np.uint32(2) * key[go_t] + np.uint32(2)])
         weight = np.concatenate([w_r[go_r], w_t[go_t]])
         lo, hi = leaving_s_min(O), t(np.inf)
     return colour, first_hit, first_s

@@ -15,6 +15,19 @@ random numbers (glsl/raytrace/random.glsl), so successive frames draw new sample
 
 with u0, u1 the random numbers of dimensions 0 and 1 of random_stream(pixel x, pixel y,
 first_sample + k, bounce 0, seed). N is at most MAX_SAMPLES (the GLSL's uniform array).
+
+Distributed dimensions (docs/conventions.md, "Distributed sampling"; Cook, Porter and Carpenter
+1984): besides its pixel position, sample k carries a point of each other dimension it needs
+(the lens, the time; at a hit, the glossy lobe and M = light_samples points of each area light),
+drawn by glsl/raytrace/sampling.glsl's `distributed_2d` / `distributed_1d` (twin:
+reference/raytrace/sampling.py). Each dimension's points over a pixel's samples follow the
+pixel's pattern (stratified over the n * per_sample points of a set: the strata grid of
+`dimension_grid`), shuffled by a hash permutation keyed per pixel, frame, ray and dimension, so
+that the dimensions are stratified each and decorrelated from one another. The numbers come from
+the stream of slot 0 (camera-level dimensions) or slot 1 + r (at the hit of ray r of the
+sample's tree: the camera ray is r = 0, the reflected child of r is 2r + 1, the transmitted
+2r + 2), dimension d's m-th point from that stream's numbers 2 (DIMENSION_STRIDE d + m) and
+2 (DIMENSION_STRIDE d + m) + 1.
 """
 
 from __future__ import annotations
@@ -36,6 +49,16 @@ FIRST_SET = 4                # adaptive: the samples every pixel gets, a 2 x 2 g
 # their range. One step refines 1.7 to 2.5 times as many pixels (smooth shading's gradients)
 # for an RMS error 1 to 3 % lower (benchmarks/bench_adaptive.py, docs/conventions.md).
 DEFAULT_ADAPTIVE_THRESHOLD = 2.0 / 255.0
+# Distributed dimensions: camera-level (slot 0) and at a hit (slot 1 + the ray's key).
+PIXEL_DIMENSION, LENS_DIMENSION, TIME_DIMENSION = 0, 1, 2
+GLOSSY_DIMENSION = 0
+LIGHT_DIMENSION = 1          # point light i's area samples: dimension LIGHT_DIMENSION + i
+DIMENSION_STRIDE = 64        # numbers 2 (stride d + m), +1: a dimension's m-th point
+MAX_LIGHT_SAMPLES = DIMENSION_STRIDE   # area-light points per hit and light
+MAX_STRATA_SIDE = 256        # a strata grid's columns (stratum_offset's 32-bit numerators)
+# The permutations' streams are those of seed ^ PERMUTATION_SALT (sampling.glsl), so that a
+# permutation key is never one of the numbers that place the points.
+PERMUTATION_SALT = 0x5BD1E995
 
 
 @dataclass(frozen=True)
@@ -49,6 +72,27 @@ class RaySampling:
     rest_strata: tuple[int, int]             # of samples first_set .. N - 1 (adaptive)
     table: np.ndarray | None                 # (N, 2) float32 offsets: regular, poisson
     threshold: float | None                  # adaptive: the refinement threshold
+    light_samples: int = 1                   # M: each area light's points per hit
+
+    @property
+    def set_sizes(self) -> tuple[int, int]:
+        """The samples of the first set and of the rest (adaptive: 4 and N - 4; else N, 0)."""
+        return self.first_set, self.samples - self.first_set
+
+    def dimension_grid(self, which_set: int, per_sample: int = 1) -> tuple[int, int]:
+        """(columns, rows) of the strata grid of a distributed dimension's n * per_sample
+        points of set `which_set` (n its samples): strata(n * per_sample), (1, 1) when empty."""
+        n = self.set_sizes[which_set] * per_sample
+        return strata(n) if n > 0 else (1, 1)
+
+    @property
+    def dimension_mode(self) -> str:
+        """How a distributed dimension places its points: "random" (the stream's numbers),
+        "jittered" (jittered, adaptive: uniform in a cell), "centres" (regular: the cells'
+        centres) or "table" (poisson: the pixel's table at the permuted index when
+        per_sample is 1; jittered cells otherwise, and in 1D)."""
+        return {"random": "random", "jittered": "jittered", "adaptive": "jittered",
+                "regular": "centres", "poisson": "table"}[self.pattern]
 
     @property
     def adaptive(self) -> bool:
@@ -59,7 +103,20 @@ class RaySampling:
         return {"NUM_SAMPLES": self.samples, "FIRST_SAMPLES": self.first_set,
                 "SAMPLE_TABLE": self.table is not None, "ADAPTIVE": self.adaptive,
                 "FIRST_COLUMNS": self.first_strata[0], "FIRST_ROWS": self.first_strata[1],
-                "REST_COLUMNS": self.rest_strata[0], "REST_ROWS": self.rest_strata[1]}
+                "REST_COLUMNS": self.rest_strata[0], "REST_ROWS": self.rest_strata[1],
+                **self.dimension_defines()}
+
+    def dimension_defines(self) -> dict[str, object]:
+        """distributed_2d's and distributed_1d's constants: the mode and the strata grids of
+        one point per sample (DIMENSION_*) and, with light_samples M > 1, of M (LIGHT_*)."""
+        mode = self.dimension_mode
+        defines = {"DIMENSION_RANDOM": mode == "random", "DIMENSION_CENTRES": mode == "centres",
+                   "DIMENSION_TABLE": mode == "table", "LIGHT_SAMPLES": self.light_samples}
+        for prefix, per_sample in (("DIMENSION", 1), ("LIGHT", self.light_samples)):
+            for name, which in (("FIRST", 0), ("REST", 1)):
+                columns, rows = self.dimension_grid(which, per_sample)
+                defines[f"{prefix}_{name}_COLUMNS"], defines[f"{prefix}_{name}_ROWS"] = columns, rows
+        return defines
 
     def uniforms(self) -> dict[str, np.ndarray]:
         """The per-tracer uniforms (u_first_sample is per frame)."""
@@ -72,11 +129,13 @@ class RaySampling:
 
 
 def ray_sampling(pattern: str = "regular", samples: int = 1, seed: int = DEFAULT_SEED,
-                 adaptive_threshold: float | None = None) -> RaySampling:
-    """The rule of `pattern` with N = `samples`; ValueError (its reason in one line) for an
-    unknown pattern, N outside 1..MAX_SAMPLES, a regular N that is not a perfect square,
-    adaptive N < FIRST_SET, a seed that is not a uint32, or a threshold with another pattern
-    (adaptive: default DEFAULT_ADAPTIVE_THRESHOLD, finite and >= 0)."""
+                 adaptive_threshold: float | None = None, light_samples: int = 1) -> RaySampling:
+    """The rule of `pattern` with N = `samples` and M = `light_samples` points per area light
+    and hit; ValueError (its reason in one line) for an unknown pattern, N outside
+    1..MAX_SAMPLES, a regular N that is not a perfect square, adaptive N < FIRST_SET, a seed
+    that is not a uint32, a threshold with another pattern (adaptive: default
+    DEFAULT_ADAPTIVE_THRESHOLD, finite and >= 0), M outside 1..MAX_LIGHT_SAMPLES, or an N * M
+    whose strata grid is wider than MAX_STRATA_SIDE."""
     if pattern not in RAY_PATTERNS:
         raise ValueError(f"sample pattern must be one of {', '.join(RAY_PATTERNS)}, got {pattern!r}")
     n = int(samples)
@@ -101,7 +160,18 @@ def ray_sampling(pattern: str = "regular", samples: int = 1, seed: int = DEFAULT
             raise ValueError(f"the adaptive threshold must be a finite number >= 0, got {adaptive_threshold!r}")
         first, first_strata = FIRST_SET, strata(FIRST_SET)
         rest_strata = strata(n - FIRST_SET) if n > FIRST_SET else (1, 1)
-    return RaySampling(pattern, n, int(seed), first, first_strata, rest_strata, table, threshold)
+    if not (isinstance(light_samples, (int, np.integer)) and 1 <= light_samples <= MAX_LIGHT_SAMPLES):
+        raise ValueError(f"light samples per hit must be a whole number from 1 to {MAX_LIGHT_SAMPLES}, "
+                         f"got {light_samples!r}")
+    rule = RaySampling(pattern, n, int(seed), first, first_strata, rest_strata, table, threshold,
+                       int(light_samples))
+    for which in (0, 1):
+        columns = rule.dimension_grid(which, rule.light_samples)[0]
+        if columns > MAX_STRATA_SIDE:
+            raise ValueError(f"{n} samples per pixel times {light_samples} light samples make a "
+                             f"strata grid {columns} cells wide, more than {MAX_STRATA_SIDE}; "
+                             "choose counts with a common factor")
+    return rule
 
 
 def check_first_sample(first_sample: int, samples: int) -> int:

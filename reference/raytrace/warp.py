@@ -1,0 +1,91 @@
+"""# Twin: glsl/raytrace/warp.glsl
+
+Warps of uniform points u in [0, 1)^2 (distributed_2d's, sampling.py) onto the domains the
+distributed effects sample (docs/conventions.md, "Distributed sampling"), vectorised over
+(..., 2) points, in the dtype of u (float32 as the GLSL, in its order of operations; float64
+for the ground truth): the unit disc, the unit sphere, a Phong lobe; an orthonormal basis
+about a direction; and each warp's density, for the chi-square tests. sin, cos and pow differ
+from the GPU's by a few ulps, so warped points agree within that, not bit for bit.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+PI = np.pi
+
+
+def _t(u):
+    u = np.asarray(u)
+    return u.dtype.type if u.dtype.kind == "f" else np.float64
+
+
+def square_to_disc(u) -> np.ndarray:
+    """Shirley and Chiu's concentric map of the square onto the unit disc (density 1/pi);
+    u = (0.5, 0.5) is the centre exactly."""
+    t = _t(u)
+    u = np.asarray(u, t)
+    o = t(2) * u - t(1)
+    x, y = o[..., 0], o[..., 1]
+    wide = np.abs(x) > np.abs(y)
+    quarter = t(PI / 4)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = np.where(wide, x, y)
+        theta = np.where(wide, quarter * (y / x), t(2) * quarter - quarter * (x / y))
+    centre = (x == 0) & (y == 0)
+    r = np.where(centre, t(0), r)
+    theta = np.where(centre, t(0), theta)
+    return np.stack([r * np.cos(theta), r * np.sin(theta)], -1).astype(t)
+
+
+def square_to_sphere(u) -> np.ndarray:
+    """Uniform on the unit sphere (density 1/(4 pi)): z = 1 - 2 u0, phi = 2 pi u1."""
+    t = _t(u)
+    u = np.asarray(u, t)
+    z = t(1) - t(2) * u[..., 0]
+    r = np.sqrt(np.maximum(t(0), t(1) - z * z))
+    phi = t(2 * PI) * u[..., 1]
+    return np.stack([r * np.cos(phi), r * np.sin(phi), z], -1).astype(t)
+
+
+def square_to_phong_lobe(u, exponent) -> np.ndarray:
+    """Directions about +z with density (e + 1)/(2 pi) cos^e(alpha): cos alpha =
+    (1 - u0)^(1/(e + 1)), phi = 2 pi u1; `exponent` broadcasts against u's points."""
+    t = _t(u)
+    u = np.asarray(u, t)
+    e = np.asarray(exponent, t)
+    cos_alpha = np.power(t(1) - u[..., 0], t(1) / (e + t(1)))
+    sin_alpha = np.sqrt(np.maximum(t(0), t(1) - cos_alpha * cos_alpha))
+    phi = t(2 * PI) * u[..., 1]
+    return np.stack([sin_alpha * np.cos(phi), sin_alpha * np.sin(phi), cos_alpha], -1).astype(t)
+
+
+def orthonormal_basis(n):
+    """(b1, b2) with (b1, b2, n) a right-handed orthonormal basis for unit n (..., 3): Duff et
+    al., JCGT 6(1) 2017, as the GLSL (n.z = 0 counts as positive)."""
+    n = np.asarray(n)
+    t = _t(n)
+    x, y, z = n[..., 0], n[..., 1], n[..., 2]
+    s = np.where(z >= 0, t(1), t(-1))
+    a = t(-1) / (s + z)
+    b = x * y * a
+    b1 = np.stack([t(1) + s * x * x * a, s * b, -s * x], -1)
+    b2 = np.stack([b, s + y * y * a, -y], -1)
+    return b1.astype(t), b2.astype(t)
+
+
+def disc_density(p) -> np.ndarray:
+    """square_to_disc's density at points p (..., 2): 1/pi inside the unit disc, else 0."""
+    p = np.asarray(p, np.float64)
+    return np.where((p ** 2).sum(-1) <= 1.0, 1.0 / PI, 0.0)
+
+
+def sphere_density(d) -> np.ndarray:
+    """square_to_sphere's density (per steradian) at unit directions d (..., 3)."""
+    return np.full(np.shape(d)[:-1], 1.0 / (4.0 * PI))
+
+
+def phong_lobe_density(d, exponent) -> np.ndarray:
+    """square_to_phong_lobe's density (per steradian) at unit directions d (..., 3)."""
+    cos_alpha = np.asarray(d, np.float64)[..., 2]
+    return np.where(cos_alpha > 0, (exponent + 1.0) / (2.0 * PI) * np.maximum(cos_alpha, 0.0) ** exponent, 0.0)

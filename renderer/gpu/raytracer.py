@@ -37,7 +37,7 @@ from renderer.core.camera_rays import camera_ray_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import check_first_sample, ray_sampling
+from renderer.core.ray_sampling import GLOSSY_DIMENSION, check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
@@ -110,6 +110,7 @@ class RayTracer:
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
+            "GLOSSY_DIMENSION": GLOSSY_DIMENSION,
             "MAX_DEPTH": self.max_depth,
             **self.sampling.defines(),
         }

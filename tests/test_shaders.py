@@ -18,6 +18,7 @@ RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
                   "raytrace/optics.glsl": "reference/raytrace/optics.py",
                   "raytrace/bvh.glsl": "reference/raytrace/bvh.py",
                   "raytrace/sampling.glsl": "reference/raytrace/sampling.py",
+                  "raytrace/warp.glsl": "reference/raytrace/warp.py",
                   "raytrace/trace.glsl": "reference/raytrace/trace.py"}
 
 

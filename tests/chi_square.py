@@ -80,10 +80,7 @@ def pooled_statistic(observed, expected) -> tuple[float, int]:
     statistic = float((((observed - expected) ** 2) / np.where(alone, expected, 1))[alone].sum())
     terms = int(alone.sum())
     low = ~alone & ((observed != 0) | (expected != 0))
-    # the pools: the running sum of expected counts crosses a multiple of the threshold
-    # at most once per cell (each < threshold), so a pool closes where the sum, restarted at
-    # each close, exceeds it; a loop over the few pooled cells, not over samples
-    pool_o = pool_e = 0.0
+    pool_o = pool_e = 0.0                  # a loop over the low cells (few), not the samples
     for o, e in zip(observed[low], expected[low]):
         pool_o, pool_e = pool_o + o, pool_e + e
         if pool_e > POOL_THRESHOLD:

@@ -21,7 +21,11 @@ bounce (every ray of one depth at once), no Python loop over pixels or rays.
   reflected weight k_r + k_t F along ray_reflect(Du, N) from offset_ray_origin(P, Ng);
   transmitted weight k_t (1 - F) along ray_refract(Du, N, eta) from offset_ray_origin(P, -Ng)
   (none under total internal reflection, where F = 1). A ray's colour is
-  local + w_r reflected + w_t transmitted; a ray that misses brings the background colour.
+  local + w_r reflected + w_t transmitted; a ray that misses brings the background colour;
+- glossy reflection (docs/conventions.md, "Glossy reflection"): where some material sets
+  `gloss`, each reflected ray goes through glossy_reflection: drawn from the Phong lobe of
+  its material's exponent about the mirror direction with the hit's GLOSSY_DIMENSION point,
+  absorbed below the surface; gloss inf keeps the mirror direction.
 """
 
 from __future__ import annotations

@@ -49,20 +49,26 @@ def square_to_sphere(u) -> np.ndarray:
 
 
 def minus_log_1m(u) -> np.ndarray:
-    """-log(1 - u) for u in [0, 1) in u's dtype, as the GLSL's warp_minus_log_1m: below 1/16
-    the Taylor series u (1 + u/2 + ... + u^5/6), above it -log(1 - u)."""
+    """-log(1 - u) for u in [0, 1) in u's dtype: float32 as the GLSL's warp_minus_log_1m (below
+    1/16 the Taylor series u (1 + u/2 + ... + u^5/6), above it -log(1 - u)); float64 (the
+    ground truth) -log1p(-u)."""
     t = _t(u)
     u = np.asarray(u, t)
+    if t is np.float64:
+        return -np.log1p(-u)
     series = u * (t(1) + u * (t(1 / 2) + u * (t(1 / 3) + u * (t(1 / 4) + u * (t(1 / 5) + u / t(6))))))
     with np.errstate(divide="ignore"):
         return np.where(u >= t(0.0625), -np.log(t(1) - u), series)
 
 
 def one_minus_exp(x) -> np.ndarray:
-    """1 - exp(-x) for x >= 0 in x's dtype, as the GLSL's warp_one_minus_exp: below ln 2 the
-    series x (1 - x/2 (1 - x/3 (... (1 - x/9)))), above it 1 - exp(-x)."""
+    """1 - exp(-x) for x >= 0 in x's dtype: float32 as the GLSL's warp_one_minus_exp (below
+    ln 2 the series x (1 - x/2 (1 - x/3 (... (1 - x/9)))), above it 1 - exp(-x)); float64 (the
+    ground truth) -expm1(-x)."""
     t = _t(x)
     x = np.asarray(x, t)
+    if t is np.float64:
+        return -np.expm1(-x)
     s = t(1) - x / t(9)
     for n in range(8, 1, -1):
         s = t(1) - x / t(n) * s

@@ -121,6 +121,15 @@ def build_parser() -> argparse.ArgumentParser:
                             f"{MAX_DEPTH_LIMIT} (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
                        help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
+        lens_options(p)
+
+    def lens_options(p):
+        p.add_argument("--aperture", type=float, default=None, metavar="A",
+                       help="ray tracer: the thin lens's radius in scene units, >= 0, instead of "
+                            "the scene's camera.aperture (depth of field; 0: a pinhole)")
+        p.add_argument("--focus-distance", type=float, default=None, metavar="F",
+                       help="ray tracer: the view depth in focus, > 0, instead of the scene's "
+                            "camera.focus_distance")
 
     render = sub.add_parser("render", help="render a scene to PNG")
     common(render)
@@ -292,6 +301,7 @@ def check_raytrace_options(args) -> None:
         args.parser.error(f"--max-depth must be between 0 and {MAX_DEPTH_LIMIT}, got {args.max_depth}")
     if args.adaptive_threshold is not None and args.pattern != "adaptive":
         args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
+    check_lens_options(args, traced)
     if traced:
         from renderer.core.ray_sampling import ray_sampling
         options = _raytrace_options(args)
@@ -302,6 +312,35 @@ def check_raytrace_options(args) -> None:
             given += [] if args.seed is None else [f"--seed {args.seed}"]
             given += [] if args.adaptive_threshold is None else [f"--adaptive-threshold {args.adaptive_threshold:g}"]
             args.parser.error(f"{' '.join(given)}: {error}")
+
+
+LENS_OPTIONS = {"aperture": "--aperture", "focus_distance": "--focus-distance"}
+
+
+def check_lens_options(args, traced: bool) -> None:
+    """The thin lens's options are the ray tracer's (the rasteriser's camera is a pinhole)."""
+    given = [option for key, option in LENS_OPTIONS.items() if getattr(args, key, None) is not None]
+    if given and not traced:
+        also = " or --methods" if hasattr(args, "methods") else ""
+        args.parser.error(f"{' and '.join(given)} {'is' if len(given) == 1 else 'are'} for "
+                          f"--method raytrace{also}")
+
+
+def _load_traced(args):
+    """The scene, its camera's lens set by --aperture and --focus-distance where given, each
+    checked as the scene file's key is: one line naming the option, status 2."""
+    from renderer.core.scene_file import with_lens
+    from renderer.errors import SceneError, show_number
+    scene = _load(args.scene)
+    values = {key: getattr(args, key) for key in LENS_OPTIONS if getattr(args, key, None) is not None}
+    if not values:
+        return scene
+    try:
+        camera = with_lens(scene.camera, values, source=scene.source or scene.name)
+    except SceneError as error:
+        raise UserError(f"{LENS_OPTIONS[error.key]} {show_number(values[error.key])}: "
+                        f"{error.reason}") from None
+    return replace(scene, camera=camera)
 
 
 def _raytrace_options(args) -> dict:
@@ -366,7 +405,7 @@ def cmd_render(args) -> int:
                         file=str(args.depth))
     check_outputs(args.output, args.depth)   # a folder, a file as parent, the same file twice
     check_raytrace_options(args)
-    scene = _load(args.scene)
+    scene = _load_traced(args)
     if args.method == "raytrace":
         check_raytrace_memory(scene, args.size, [args.backend], args.spp)
     else:
@@ -450,7 +489,7 @@ def cmd_compare_methods(args) -> int:
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.jsonio import json_text
     from renderer.core.paths import output_stem
-    scene = _load(args.scene)
+    scene = _load_traced(args)
     check_memory(scene, args.size, ["gpu"])
     check_raytrace_memory(scene, args.size, ["gpu"], args.spp)
     out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
@@ -516,7 +555,7 @@ def cmd_compare(args) -> int:
     check_raytrace_options(args)
     if args.methods:
         return cmd_compare_methods(args)
-    scene = _load(args.scene)
+    scene = _load_traced(args)
     if args.method == "raytrace":
         check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)
     else:

@@ -21,8 +21,8 @@ from renderer.core import transforms as tf
 from renderer.checks.compare import compare_frames, depth_tie_pixels
 from renderer.gpu.context import activate, gl_function
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.study.extremes import (RAYTRACE_DEPTHS, STABILITY, extreme_scenes, is_finite_frame,
-                                     is_ray_traced, measure_ray_traced)
+from renderer.study.extremes import (RAYTRACE_DEPTHS, RAYTRACE_SAMPLING, STABILITY, extreme_scenes,
+                                     is_finite_frame, is_ray_traced, measure_ray_traced)
 from renderer.core.gl_rules import GL_NEGATIVE_ONE_TO_ONE
 from renderer.gpu import GpuRenderer
 from renderer.core.primitives import plane
@@ -221,14 +221,18 @@ def test_every_case_is_documented_and_there_are_at_least_14():
 def test_the_ray_tracers_extreme_cases_are_the_issues():
     """Issue 14's list: a ray grazing a sphere; spheres of radius 1e-4 and 1e4; a scene 1e6
     from the origin; a light on a surface; a camera inside a glass sphere; total internal
-    reflection; a coplanar plane and triangle; max depth 0 and 64."""
-    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_grazing_sphere", "rt_huge_sphere",
-                          "rt_inside_glass", "rt_light_on_surface", "rt_mirrors", "rt_tiny_sphere",
-                          "rt_total_internal_reflection"]
+    reflection; a coplanar plane and triangle; max depth 0 and 64. Issue 16's: an aperture
+    larger than the scene (4 samples, each its own lens point)."""
+    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_grazing_sphere", "rt_huge_aperture",
+                          "rt_huge_sphere", "rt_inside_glass", "rt_light_on_surface", "rt_mirrors",
+                          "rt_tiny_sphere", "rt_total_internal_reflection"]
     radii = {name: [s.radius for s in extreme_scene(name).world_shapes() if hasattr(s, "radius")]
              for name in ("rt_tiny_sphere", "rt_huge_sphere")}
     assert min(radii["rt_tiny_sphere"]) == pytest.approx(1e-4) and max(radii["rt_huge_sphere"]) == pytest.approx(1e4)
     assert RAYTRACE_DEPTHS == {"rt_mirrors": (0, 64)}
+    huge = extreme_scene("rt_huge_aperture")
+    span = np.ptp([s.centre for s in huge.world_shapes() if hasattr(s, "radius")], axis=0).max() + 1.0
+    assert huge.camera.aperture > 10 * span and RAYTRACE_SAMPLING == {"rt_huge_aperture": (4, "jittered")}
 
 
 def ray_traced_cases() -> list:
@@ -244,7 +248,8 @@ def ray_traced_cases() -> list:
 @pytest.mark.parametrize("name, max_depth", ray_traced_cases())
 def test_ray_traced_extreme_case_is_finite_and_within_tolerance_of_float64(name, max_depth, gl_contexts):
     size = (64, 48) if name == "rt_grazing_sphere" else SIZE
-    case = measure_ray_traced(extreme_scene(name), size, gl_contexts, max_depth)
+    case = measure_ray_traced(extreme_scene(name), size, gl_contexts, max_depth,
+                              *RAYTRACE_SAMPLING.get(name, (1, "regular")))
     assert set(case["finite"]) == {"egl", "osmesa", "reference"} and all(case["finite"].values())
     for kind, figures in case["contexts"].items():
         assert PIPELINE_TOLERANCE.passes(figures), (kind, PIPELINE_TOLERANCE.failures(figures))

@@ -25,8 +25,8 @@ from renderer.core.shadow_settings import RESOLUTIONS, BiasRule, Shadow, auto_bi
 REPO = Path(__file__).resolve().parent.parent
 BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_plane",
                  "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
-                 "hierarchy", "classic", "cornell_box", "glossy", "mesh_shadow", "tir_bubble",
-                 "shadow_plane", "shadow_room", "shadow_curved"}
+                 "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble",
+                 "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "glossy"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera), or a backdrop (tir_bubble's checkerboard) filling the view.
 PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room"}
@@ -467,7 +467,8 @@ BAD_SCENES = [
     ("unknown top-level key", "objcts = []\n", "objcts: unknown key; did you mean 'objects'?"),
     ("unknown camera key", "[camera]\nfovy = 40\n", "camera.fovy: unknown key; did you mean 'fov_y'?"),
     ("unknown key, no close match", "[camera]\nzoom = 2\n",
-     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far, reversed_z"),
+     "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far, reversed_z, "
+     "aperture, focus_distance"),
     ("unknown inline material key", OBJECT + 'material = { kdd = [1, 0, 0] }\n',
      "objects[0].material.kdd: unknown key; did you mean 'kd'?"),
     ("unknown light key for its type", '[[lights]]\ntype = "directional"\nposition = [0, 1, 0]\n',
@@ -547,6 +548,21 @@ BAD_SCENES = [
      "camera.fov_y: must be between 0 and 180 degrees (both excluded), got -45"),
     ("unknown projection", '[camera]\nprojection = "orthographic"\n',
      "camera.projection: unknown projection 'orthographic'; expected one of: perspective, parallel"),
+    # the thin lens (docs/scene-format.md, [camera])
+    ("negative aperture", "[camera]\naperture = -0.1\n", "camera.aperture: must be >= 0, got -0.1"),
+    ("nan aperture", "[camera]\naperture = nan\n", "camera.aperture: expected a finite number, got nan"),
+    ("infinite aperture", "[camera]\naperture = inf\n", "camera.aperture: expected a finite number, got inf"),
+    ("aperture as a string", '[camera]\naperture = "f/2"\n',
+     "camera.aperture: expected a number, got a string ('f/2')"),
+    ("parallel camera with a lens", '[camera]\nprojection = "parallel"\naperture = 0.2\n',
+     "camera.aperture: must be 0 with a parallel camera, got 0.2: a lens focuses rays from one "
+     "eye, and a parallel camera has none"),
+    ("zero focus distance", "[camera]\nfocus_distance = 0\n", "camera.focus_distance: must be > 0, got 0"),
+    ("negative focus distance", "[camera]\nfocus_distance = -3\n",
+     "camera.focus_distance: must be > 0, got -3"),
+    ("focus distance below float32's inverse", "[camera]\nfocus_distance = 1e-30\n",
+     "camera.focus_distance: must be >= 1e-18 (its inverse must fit the GPU's float32 "
+     "arithmetic), got 1e-30"),
     # transforms
     ("negative scale", OBJECT + "scale = [-1, 1, 1]\n",
      "objects[0].scale: must be >= 0 in every component, got [-1, 1, 1]: a negative scale turns "

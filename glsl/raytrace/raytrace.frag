@@ -1,8 +1,8 @@
 #version 330 core
 // The ray tracer's full-screen pass (renderer/gpu/raytracer.py; twin: reference/raytrace/
 // pipeline.py): per pixel, camera rays through gl_FragCoord.xy + sample_offset(pixel, k)
-// (sampling.glsl) traced from near to far (trace.glsl), their colours summed in sample order
-// and averaged. Every pixel traces FIRST_SAMPLES samples (NUM_SAMPLES but for ADAPTIVE); with
+// (sampling.glsl), with LENS through lens_point(pixel, k) of the thin lens (camera.glsl),
+// traced from near to far (trace.glsl), their colours summed in sample order and averaged. Every pixel traces FIRST_SAMPLES samples (NUM_SAMPLES but for ADAPTIVE); with
 // ADAPTIVE, a pixel whose first samples' clamped colours differ by more than
 // u_adaptive_threshold in some channel (max - min over the samples) traces all NUM_SAMPLES.
 // out_color: (average linear colour, 1 where some camera ray hit, else 0); out_depth: the
@@ -32,6 +32,9 @@ void main() {
     for (int k = 0; k < count; ++k) {   // one call site of trace: it is inlined where called
         vec3 O, D;
         camera_ray(gl_FragCoord.xy + sample_offset(pixel, k), O, D);
+#ifdef LENS
+        thin_lens_ray(lens_point(pixel, k), O, D);
+#endif
         g_pixel = pixel;
         g_sample = k;
         bool hit;

@@ -18,6 +18,12 @@
 #ifndef FIRST_SAMPLES
 #define FIRST_SAMPLES NUM_SAMPLES
 #endif
+#ifndef FIRST_COLUMNS                  // one sample in one 1 x 1 cell (a shader that only
+#define FIRST_COLUMNS 1                 // includes this file, e.g. through camera.glsl)
+#define FIRST_ROWS 1
+#define REST_COLUMNS 1
+#define REST_ROWS 1
+#endif
 uniform uint u_seed;
 #ifdef SAMPLE_TABLE
 uniform vec2 u_sample_offsets[NUM_SAMPLES];

@@ -3,7 +3,8 @@
 The reference ray tracer's frame (docs/conventions.md, "Rays", "Sample positions"): per pixel
 (i, j) and sample k a camera ray through the window point (i + 0.5) + dx, (j + 0.5) + dy
 (float32, as gl_FragCoord.xy + offset), the offset sampling.py's for sample index
-first_sample + k; each traced by trace.py from near to far; the samples' linear colours summed
+first_sample + k, through its lens point where the camera has an aperture (camera.py's
+thin_lens_ray; an aperture of 0 too, which must leave the ray as it is); each traced by trace.py from near to far; the samples' linear colours summed
 in sample order and averaged; rgba8 = to_unorm8 of the clamped average with alpha 255 where
 some sample's camera ray hit; depth = the nearest first hit's view depth (camera rays have
 s = -z_eye), +inf where none hit; samples = the samples traced per pixel. Row 0 at the top, as
@@ -29,10 +30,10 @@ import numpy as np
 
 from reference.lighting import Lights
 from reference.output import flip_rows
-from reference.raytrace.camera import camera_ray
+from reference.raytrace.camera import camera_ray, lens_point, thin_lens_ray
 from reference.raytrace.sampling import RaySamples, sample_offset
 from reference.raytrace.trace import mix64, trace
-from renderer.core.camera_rays import camera_ray_uniforms
+from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
 from renderer.core.ray_sampling import check_first_sample, ray_sampling
@@ -64,6 +65,7 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
     uniforms = {k: v.astype(t) for k, v in uniforms.items()}
     lights = Lights.from_scene(scene, t, origin=matrices.origin)
     cam = scene.camera
+    lens = _lens(cam, matrices.view, t)
     y, x = np.divmod(np.arange(width * height, dtype=np.uint32), np.uint32(width))  # row 0 at the bottom
 
     def traced(pixels, ks):
@@ -78,6 +80,9 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
         O, D = camera_ray(windows.reshape(-1, 2), uniforms)
         owners = RaySamples(np.tile(px, len(ks)), np.tile(py, len(ks)),
                             np.repeat(np.asarray(ks, np.int64), len(pixels)), first_sample, sampling)
+        if lens is not None:
+            O, D = thin_lens_ray(lens_point(owners.x, owners.y, owners.k, first_sample, sampling, t),
+                                 O, D, lens)
         trees = np.zeros(len(O), np.uint64)
         parts = [trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near, cam.far,
                        scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS],
@@ -127,6 +132,14 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
     frame.rgba8_tie = None if other is None else _frame(*other, width, height, t).rgba8
     frame.milliseconds = (time.perf_counter() - start) * 1000.0
     return frame
+
+
+def _lens(camera, view, t) -> dict | None:
+    """The thin lens's uniforms in dtype `t` when the camera has an aperture at all (a radius
+    of 0 too: its code then runs and must give the pinhole's rays exactly), else None."""
+    if camera.aperture is None:
+        return None
+    return {k: np.asarray(v).astype(t) for k, v in lens_uniforms(view, camera.aperture, camera.focus).items()}
 
 
 def _frame(state, count, width: int, height: int, t=F32) -> Frame:

@@ -67,3 +67,27 @@ def camera_ray_uniforms(view, projection, width: int, height: int) -> dict[str, 
         direction = np.zeros((3, 3))
         direction[:, 2] = forward
     return {"u_ray_origin": origin, "u_ray_direction": direction}
+
+
+# -- the thin lens (docs/conventions.md, "Depth of field") ---------------------------------------
+
+# name -> GLSL type
+LENS_UNIFORMS = {
+    "u_lens_right": "vec3",          # a * the camera's unit right vector (camera-relative world)
+    "u_lens_up": "vec3",             # a * its unit up vector
+    "u_inverse_focus": "float",      # 1 / f, f the view depth in focus
+}
+
+
+def lens_uniforms(view, aperture: float, focus: float) -> dict[str, np.ndarray]:
+    """{"u_lens_right", "u_lens_up", "u_inverse_focus"} in float64 for a lens of radius
+    `aperture` focused at view depth `focus`, from the camera-relative `view` (a rotation: its
+    rows 0 and 1 are the unit right and up vectors in world coordinates). The lens point
+    l in the unit disc moves a camera ray P = O + s D to O' = O + offset, D' = D - offset / f,
+    offset = l.x u_lens_right + l.y u_lens_up: across the view axis, so D' keeps D's
+    component 1 along it (s stays the view depth), and O' + f D' = O + f D (the focus plane's
+    point is the pinhole ray's). Aperture 0 gives zero vectors: O', D' = O, D exactly."""
+    view = np.asarray(view, dtype=np.float64)
+    return {"u_lens_right": float(aperture) * view[0, :3],
+            "u_lens_up": float(aperture) * view[1, :3],
+            "u_inverse_focus": np.float64(1.0 / float(focus))}

@@ -37,6 +37,12 @@ class Camera:
     near: float = 0.1            # scene units along the viewing axis
     far: float = 100.0
     reversed_z: bool = False     # depth 1 at near, 0 at far (glClipControl ZERO_TO_ONE, GL_GREATER)
+    # The ray tracer's thin lens (docs/conventions.md, "Depth of field"; the rasteriser is a
+    # pinhole): the lens radius in scene units, None for no lens at all (0 is a lens of radius
+    # 0, the pinhole exactly, whose code the reference still runs), and the view depth in
+    # focus, None for |look - eye|.
+    aperture: float | None = None
+    focus_distance: float | None = None
 
     def view(self) -> np.ndarray:
         return transforms.look_at(self.eye, self.look, self.up)
@@ -46,6 +52,18 @@ class Camera:
             return transforms.perspective(math.radians(self.fov_y), aspect, self.near, self.far,
                                           self.reversed_z)
         return transforms.orthographic(self.height, aspect, self.near, self.far, self.reversed_z)
+
+    @property
+    def focus(self) -> float:
+        """The view depth in focus: focus_distance, or the look point's |look - eye|."""
+        if self.focus_distance is not None:
+            return float(self.focus_distance)
+        return float(np.linalg.norm(np.subtract(self.look, self.eye, dtype=np.float64)))
+
+    @property
+    def has_lens(self) -> bool:
+        """Whether the ray tracer defocuses: an aperture above 0."""
+        return self.aperture is not None and self.aperture > 0.0
 
 
 @dataclass

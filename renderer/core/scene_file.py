@@ -46,7 +46,9 @@ LIGHT_TYPES = ("directional", "point")
 
 TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials", "lights",
             "objects")
-CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z")
+LENS_KEYS = ("aperture", "focus_distance")
+CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
+               *LENS_KEYS)
 MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 LIGHT_KEYS = {
@@ -147,6 +149,15 @@ def scene_from_dict(data: dict, source: str = "<dict>", base_dir=None) -> Scene:
     reader = _Reader(source, Path.cwd() if base_dir is None else Path(base_dir))
     _check_nesting(data, reader)
     return reader.scene(data)
+
+
+def with_lens(camera: Camera, values: dict, source: str) -> Camera:
+    """A copy of `camera` with the thin-lens keys in `values` ("aperture", "focus_distance")
+    set and checked as a scene file's [camera] keys are (a SceneError naming the key): the
+    command line's --aperture and --focus-distance."""
+    camera = dataclasses.replace(camera)
+    _Reader(source, Path.cwd()).lens(values, camera, "")
+    return camera
 
 
 def _check_nesting(data: Any, reader: "_Reader") -> None:
@@ -436,7 +447,26 @@ class _Reader:
             self.fail(key("near"), f"must be > 0 for a perspective camera, got {cam.near:g}")
         if cam.far <= cam.near:
             self.fail(key("far"), f"must be greater than near ({cam.near:g}), got {cam.far:g}")
+        self.lens(raw, cam, path)
         return cam
+
+    def lens(self, raw: dict, cam: Camera, path: str) -> None:
+        """The thin lens's keys (docs/scene-format.md, "Depth of field") onto `cam`. The
+        focus distance's inverse is a float32 uniform: it must be at least 1 / MAX_NUMBER."""
+        key = lambda k: _join(path, k)   # noqa: E731
+        if "aperture" in raw:
+            cam.aperture = self.number(raw["aperture"], key("aperture"), minimum=0.0)
+            if cam.projection == "parallel" and cam.aperture > 0.0:
+                self.fail(key("aperture"), f"must be 0 with a parallel camera, got "
+                                           f"{cam.aperture:g}: a lens focuses rays from one "
+                                           f"eye, and a parallel camera has none")
+        if "focus_distance" in raw:
+            cam.focus_distance = self.number(raw["focus_distance"], key("focus_distance"),
+                                             above=0.0)
+            if cam.focus_distance < 1.0 / MAX_NUMBER:
+                self.fail(key("focus_distance"), f"must be >= {1.0 / MAX_NUMBER:g} (its inverse "
+                                                 f"must fit the GPU's float32 arithmetic), got "
+                                                 f"{cam.focus_distance:g}")
 
     def materials(self, raw: Any, path: str) -> dict[str, Material]:
         if not isinstance(raw, dict):

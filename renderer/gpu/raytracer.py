@@ -9,9 +9,10 @@ hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, n
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
 MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, GLOSSY when such a material
-has a finite gloss, MAX_DEPTH, and the sample pattern's constants from
-renderer/core/ray_sampling.py); the uniforms (camera rays from
-renderer/core/camera_rays.py, lights from renderer/core/uniforms.py, shapes, the pattern's); the
+has a finite gloss, MAX_DEPTH, LENS when the camera's aperture is above 0, and the sample
+pattern's constants from renderer/core/ray_sampling.py); the uniforms (camera rays and the thin
+lens from renderer/core/camera_rays.py, lights from renderer/core/uniforms.py, shapes, the
+pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
 renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
 the camera calls update() (and resize()), which keeps all of them and writes new contents: the
@@ -20,9 +21,10 @@ changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
-`shadows`), SECONDARY and GLOSSY (where max_depth > 0) and MESHES (the BVH walk; a scene
-without triangles gets a one-triangle BVH of a degenerate triangle, which no ray hits). The
-light, sphere and plane counts stay compile-time constants. The image is the same.
+`shadows`), SECONDARY and GLOSSY (where max_depth > 0), LENS (a lens of radius 0 without an
+aperture) and MESHES (the BVH walk; a scene without triangles gets a one-triangle BVH of a
+degenerate triangle, which no ray hits). The light, sphere and plane counts stay compile-time
+constants. The image is the same.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ import moderngl
 import numpy as np
 
 from renderer.core.bvh import build_bvh, texels
-from renderer.core.camera_rays import camera_ray_uniforms
+from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
@@ -112,6 +114,7 @@ class RayTracer:
             "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
             "GLOSSY_DIMENSION": GLOSSY_DIMENSION,
             "MAX_DEPTH": self.max_depth,
+            "LENS": scene.camera.has_lens or every,
             **self.sampling.defines(),
         }
 
@@ -135,6 +138,7 @@ class RayTracer:
         matrices = scene.matrices(self.width, self.height)
         rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
         values = {name: to_glsl(value) for name, value in rays.items()}
+        values.update(self._lens_values(matrices))
         for name, value in light_uniforms(scene, matrices.origin).items():
             if value.size:
                 values[name] = np.asarray(value, np.float32).tobytes()
@@ -154,6 +158,14 @@ class RayTracer:
         for name, unit in self._units.items():
             if name in program:
                 program[name].value = unit
+
+    def _lens_values(self, matrices) -> dict:
+        """The thin lens's uniforms (renderer/core/camera_rays.py, lens_uniforms) as float32
+        bytes; a camera without an aperture has a lens of radius 0 (the specialise=False
+        build runs it: the pinhole exactly)."""
+        cam = self.scene.camera
+        lens = lens_uniforms(matrices.view, cam.aperture or 0.0, cam.focus)
+        return {name: np.asarray(value, np.float32).tobytes() for name, value in lens.items()}
 
     def _texture_arrays(self, rs) -> dict:
         """The float textures' contents by sampler name (`texels` lays them out)."""

@@ -12,8 +12,8 @@ reversed-Z is measured a second time with it off, to show the depth error it rem
 scene whose file is refused (a NaN vertex) is listed with the one-line error a user sees.
 
 A scene file whose name starts with `rt_` is ray traced instead (RayTracer on each context
-against reference/raytrace in float64, 1 sample per pixel, at each of its RAYTRACE_DEPTHS,
-the default depth otherwise): where the float32 and float64 references disagree on a grazing
+against reference/raytrace in float64, 1 sample per pixel or its RAYTRACE_SAMPLING, at each of
+its RAYTRACE_DEPTHS, the default depth otherwise): where the float32 and float64 references disagree on a grazing
 ray (renderer/checks/compare.py, grazing_ray_pixels) either one's colour and depth is
 accepted, as at the rasteriser's depth ties. Ray-traced cases are not rasterised: the
 rasteriser draws their spheres and planes as tessellations, whose extremes are the rasteriser
@@ -102,6 +102,10 @@ STABILITY = {
                    "in it; rays leaving it start at s > 2^-18 |O| and skip it",
     "rt_far_from_origin": "camera-relative coordinates: the shapes and lights relative to the "
                           "eye in float64 before the float32 upload",
+    "rt_huge_aperture": "the lens offset lies across the view axis and every lens ray passes "
+                        "its pinhole ray's point on the focus plane (O' = O + offset, D' = D - "
+                        "offset / f: nothing divides by the aperture), so rays starting 50 units "
+                        "off the axis stay finite and s stays the view depth",
     "rt_grazing_sphere": "the robust discriminant (Ray Tracing Gems ch. 7); where float32 "
                          "cannot tell a tangent ray from a miss the float64 reference decides "
                          "otherwise, and those grazing pixels accept either",
@@ -126,6 +130,9 @@ STABILITY = {
 
 # Ray-traced cases measured at other maximum depths than the default.
 RAYTRACE_DEPTHS = {"rt_mirrors": (0, 64)}
+# Ray-traced cases whose effect needs several samples per pixel (each sample its own lens
+# point): (samples, pattern); one regular sample otherwise, whose lens point is the lens's centre.
+RAYTRACE_SAMPLING = {"rt_huge_aperture": (4, "jittered")}
 RAY_TRACED_PREFIX = "rt_"
 
 
@@ -177,18 +184,20 @@ def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
 
 
 def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
-                       max_depth: int = DEFAULT_MAX_DEPTH) -> dict:
+                       max_depth: int = DEFAULT_MAX_DEPTH, samples: int = 1,
+                       pattern: str = "regular") -> dict:
     """Figures of one ray-traced scene, as measure_scene: each GPU frame against the float64
     reference, which accepts the float32 reference's colour and depth at grazing pixels
     (`grazing_pixels`: where the two references' ray trees differ); `truth` without that."""
     width, height = size
+    options = {"max_depth": max_depth, "samples": samples, "pattern": pattern}
     gpu_frames = {}
     for kind, ctx in contexts.items():
-        with RayTracer(scene, width, height, context=ctx, max_depth=max_depth) as tracer:
+        with RayTracer(scene, width, height, context=ctx, **options) as tracer:
             gpu_frames[kind] = tracer.render()
     rs = ray_scene(scene)                        # the BVH built once, for both precisions
-    truth = reference_raytrace(scene, width, height, max_depth=max_depth, dtype=np.float64, rs=rs)
-    twin = reference_raytrace(scene, width, height, max_depth=max_depth, rs=rs)
+    truth = reference_raytrace(scene, width, height, dtype=np.float64, rs=rs, **options)
+    twin = reference_raytrace(scene, width, height, rs=rs, **options)
     tie, tie_depth, grazing = either_precision(truth, twin)
     finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
     finite["reference"] = is_finite_frame(truth) and is_finite_frame(twin)
@@ -228,10 +237,12 @@ def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: d
         description = scene_description(path)
         if method == "raytrace":
             depths = RAYTRACE_DEPTHS.get(name, (DEFAULT_MAX_DEPTH,))
+            samples, pattern = RAYTRACE_SAMPLING.get(name, (1, "regular"))
             for depth in depths:
                 case = name if len(depths) == 1 else f"{name} (max depth {depth})"
-                cases.append(base | {"case": case, "tests": description, "max_depth": depth}
-                             | measure_ray_traced(scene, size, contexts, depth))
+                cases.append(base | {"case": case, "tests": description, "max_depth": depth,
+                                     "samples": samples, "pattern": pattern}
+                             | measure_ray_traced(scene, size, contexts, depth, samples, pattern))
             continue
         cases.append(base | {"tests": description, "reversed_z": scene.camera.reversed_z}
                      | measure_scene(scene, size, contexts))
@@ -265,8 +276,8 @@ def markdown_table(cases: list[dict], size: tuple[int, int]) -> str:
     lines = [f"# Extreme cases ({size[0]}x{size[1]})", "",
              "GPU against the float64 reference (the ground truth here: the same pipeline in "
              "float64 at the same size; for `raytrace` cases the ray tracer, 1 sample per "
-             "pixel). Mismatched: pixels failing the threshold-2 compare "
-             "with ±1 px allowed, both ways; raw: fraction off by more than 2 in place; both "
+             f"pixel but where the case needs more: {_sampled(cases)}). Mismatched: pixels "
+             "failing the threshold-2 compare with ±1 px allowed, both ways; raw: fraction off by more than 2 in place; both "
              "accept either surface at the reference's depth ties (tie px: pixels where two "
              "surfaces are closer than GL's float32 depth can order, that is z-fighting) and, "
              "ray traced, either precision's result where the float32 and float64 references "
@@ -296,6 +307,12 @@ def markdown_table(cases: list[dict], size: tuple[int, int]) -> str:
             f"| {truth['rmse']:.3f} / {truth['max_abs']} "
             f"| {worst['depth_max_rel']:.2e} | {verdict} | {case['stability']} |")
     return "\n".join(lines) + "\n"
+
+
+def _sampled(cases: list[dict]) -> str:
+    """'rt_huge_aperture 4 jittered' for each case measured with more than one sample."""
+    return ", ".join(f"{case['case']} {case['samples']} {case['pattern']}" for case in cases
+                     if case.get("samples", 1) > 1) or "none here"
 
 
 def _backends(cases: list[dict]) -> list[str]:

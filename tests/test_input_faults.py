@@ -339,7 +339,12 @@ ENERGY_RULE = ("the energy rule is kr + kt <= 1 in each channel (the reflected a
     ('{ type = "sphere" }', "{ kt = 0.5, ior = -1.33 }", "objects[0].material.ior", "must be > 0, got -1.33"),
     ('{ type = "sphere" }', "{ kr = 0.6, kt = [0.3, 0.5, 0.3] }", "objects[0].material.kt",
      f"kr + kt is 1.1 in channel g; {ENERGY_RULE}"),
-], ids=["negative radius", "zero normal", "ior 0", "ior negative", "kr + kt > 1"])
+    ('{ type = "sphere" }', "{ kr = 0.5, gloss = -10 }", "objects[0].material.gloss",
+     "must be a number >= 0 or inf (a mirror), got -10"),
+    ('{ type = "sphere" }', "{ kr = 0.5, gloss = nan }", "objects[0].material.gloss",
+     "must be a number >= 0 or inf (a mirror), got nan"),
+], ids=["negative radius", "zero normal", "ior 0", "ior negative", "kr + kt > 1", "gloss negative",
+        "gloss nan"])
 def test_a_bad_ray_traced_scene_is_one_line_naming_file_key_and_reason(capsys, work, shape, material,
                                                                       key, reason):
     (work / "rt.toml").write_text(f"[[objects]]\nshape = {shape}\nmaterial = {material}\n")

@@ -26,7 +26,8 @@ REPO = Path(__file__).resolve().parent.parent
 BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_plane",
                  "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
                  "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble",
-                 "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "soft_shadows"}
+                 "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "soft_shadows",
+                 "glossy"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera), or a backdrop (tir_bubble's checkerboard) filling the view.
 PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room"}
@@ -743,7 +744,7 @@ BAD_SCENES = [
      "objects[0].cast_shadows: unknown key; did you mean 'casts_shadows'?"),
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
-     "two_sided, shading, kr, kt, ior"),
+     "two_sided, shading, kr, kt, ior, gloss"),
 ]
 
 

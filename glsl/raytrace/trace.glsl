@@ -6,9 +6,10 @@
 // and down to a weight cut-off, depth first (the reflected ray first, the transmitted one
 // waiting on a fixed-size stack) in a loop of bounded length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
-// SECONDARY (some k_r or k_t > 0), MAX_DEPTH, and lighting.glsl's light counts and SPECULAR;
-// AREA_LIGHTS (some point light has an area of size > 0: LIGHT_SAMPLES shadow rays to points
-// of it per hit, area_light_term).
+// SECONDARY (some k_r or k_t > 0), GLOSSY (such a material has a finite gloss: reflected rays
+// drawn from a lobe; GLOSSY_DIMENSION its dimension), MAX_DEPTH, and lighting.glsl's light
+// counts and SPECULAR; AREA_LIGHTS (some point light has an area of size > 0: LIGHT_SAMPLES
+// shadow rays to points of it per hit, area_light_term).
 
 #include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
 #include "raytrace/optics.glsl"
@@ -38,7 +39,7 @@ uniform int u_sphere_object[NUM_SPHERES];
 uniform vec4 u_planes[NUM_PLANES];              // (unit N, d): P.N + d = 0
 uniform int u_plane_object[NUM_PLANES];
 #endif
-uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, 0), (kt, 0)
+uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, gloss), (kt, 0)
 uniform vec3 u_background;
 
 #include "lighting.glsl"
@@ -252,6 +253,26 @@ vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
 }
 #endif
 
+#ifdef GLOSSY
+#include "raytrace/sampling.glsl"
+#include "raytrace/warp.glsl"
+// Glossy reflection (docs/conventions.md, "Glossy reflection"): the direction D of the ray
+// reflected at the hit being shaded, with mirror direction R, outward geometric normal Ng_in
+// on the incoming side and lobe exponent `gloss`: square_to_phong_lobe of the hit's
+// GLOSSY_DIMENSION point in the basis (orthonormal_basis(R), R). False where D lies below the
+// surface (D.Ng_in <= 0): the ray is absorbed. A mirror (gloss inf) takes R exactly.
+bool glossy_direction(vec3 R, vec3 Ng_in, float gloss, out vec3 D) {
+    D = R;
+    if (isinf(gloss)) return true;
+    vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, uint(GLOSSY_DIMENSION), 0u, 1u);
+    vec3 lobe = square_to_phong_lobe(u, gloss);
+    vec3 b1, b2;
+    orthonormal_basis(R, b1, b2);
+    D = lobe.x * b1 + lobe.y * b2 + lobe.z * R;
+    return dot(D, Ng_in) > 0.0;
+}
+#endif
+
 // Hall and Greenberg's adaptive tree depth (1983): a secondary ray whose weight is below
 // TRACE_WEIGHT_CUTOFF in every channel is not spawned (renderer/core/ray_depth.py: the rule,
 // its RAY_WEIGHT_CUTOFF and max_rays, which these mirror). The energy rule kr + kt <= 1 makes
@@ -391,6 +412,11 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 bool refracted = ray_refract(Du, N_in, eta, T);
                 bool transmit = any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted;
                 bool reflect = any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)));
+                vec3 R = ray_reflect(Du, N_in);
+#ifdef GLOSSY
+                if (reflect)
+                    reflect = glossy_direction(R, Ng_in, trace_texel(u_materials, 5 * obj + 3).w, R);
+#endif
                 vec3 O_t = ray_origin(P, -Ng_in, g_shape);
                 if (transmit && reflect) {      // the reflected ray first, then this one
                     trace_push(top, O_t, T, w_t, depth + 1, g_shape, 2u * key + 2u);
@@ -398,7 +424,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 }
                 if (reflect) {
                     O = ray_origin(P, Ng_in, g_shape);
-                    D = ray_reflect(Du, N_in);
+                    D = R;
                     w = w_r;
                     key = 2u * key + 1u;
                 } else if (transmit) {

@@ -23,7 +23,11 @@ bounce (every ray of one depth at once), no Python loop over pixels or rays.
   reflected weight k_r + k_t F along ray_reflect(Du, N) from offset_ray_origin(P, Ng);
   transmitted weight k_t (1 - F) along ray_refract(Du, N, eta) from offset_ray_origin(P, -Ng)
   (none under total internal reflection, where F = 1). A ray's colour is
-  local + w_r reflected + w_t transmitted; a ray that misses brings the background colour.
+  local + w_r reflected + w_t transmitted; a ray that misses brings the background colour;
+- glossy reflection (docs/conventions.md, "Glossy reflection"): where some material sets
+  `gloss`, each reflected ray goes through glossy_reflection: drawn from the Phong lobe of
+  its material's exponent about the mirror direction with the hit's GLOSSY_DIMENSION point,
+  absorbed below the surface; gloss inf keeps the mirror direction.
 """
 
 from __future__ import annotations
@@ -36,10 +40,11 @@ from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_cl
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
                                           triangle_normal)
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
-from reference.raytrace.warp import square_to_disc, square_to_sphere
+from reference.raytrace.warp import (orthonormal_basis, square_to_disc, square_to_phong_lobe,
+                                     square_to_sphere)
 from renderer.core.light_areas import AREA_SHAPE_CODES, NO_AREA
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
-from renderer.core.ray_sampling import LIGHT_DIMENSION
+from renderer.core.ray_sampling import GLOSSY_DIMENSION, LIGHT_DIMENSION
 
 F32 = np.float32
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
@@ -264,6 +269,35 @@ def area_light_terms(rs, lights: Lights, areas, Ng, shape, draw, shadows: bool, 
         return total / t(M)
     return area_light
 
+# -- glossy reflection ---------------------------------------------------------------------------
+def glossy_reflection(R, Ng_in, gloss, u):
+    """The GLSL's glossy_direction (docs/conventions.md, "Glossy reflection"): (D, kept) for
+    reflected rays with mirror directions R (n, 3), outward geometric normals Ng_in (n, 3) on
+    their incoming side, lobe exponents `gloss` (n,) and points u (n, 2) (GLOSSY_DIMENSION at
+    the hit): D is square_to_phong_lobe(u, gloss) in the basis (orthonormal_basis(R), R);
+    where it lies below the surface (D.Ng_in <= 0) the ray is absorbed (kept False). A mirror
+    (gloss inf) takes R exactly and is always kept."""
+    t = R.dtype.type
+    mirror = np.isinf(gloss)
+    lobe = square_to_phong_lobe(np.asarray(u, t), np.asarray(gloss, t))
+    b1, b2 = orthonormal_basis(R)
+    D = lobe[:, 0:1] * b1 + lobe[:, 1:2] * b2 + lobe[:, 2:3] * R
+    return np.where(mirror[:, None], R, D), mirror | (_dot(D, Ng_in) > 0)
+
+
+def _glossy_rays(rs, samples, D_r, go_r, Ng_in, obj, owner, key):
+    """trace's reflected rays D_r (those of go_r) through glossy_reflection, each with the
+    point of its hit (slot 1 + the ray's key); the absorbed ones dropped from D_r and go_r."""
+    if samples is None:
+        raise ValueError("a scene that sets gloss needs the camera rays' samples (trace(samples=))")
+    with np.errstate(over="ignore"):                 # slots wrap modulo 2^32, as the GLSL's
+        slot = np.uint32(1) + key[go_r]
+    u = samples.point_2d(owner[go_r], slot, GLOSSY_DIMENSION)
+    D_r, kept = glossy_reflection(D_r, Ng_in[go_r], rs.gloss[obj[go_r]], u)
+    go_r = go_r.copy()
+    go_r[np.flatnonzero(go_r)[~kept]] = False
+    return D_r[kept], go_r
+
 
 # -- the ray tree's hash ------------------------------------------------------------------------
 # Which surface each ray of a camera ray's tree hit (or none), and which shadow rays were
@@ -376,9 +410,12 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         refracted, T = ray_refract(Du, N_in, eta)
         go_r = w_r.max(-1) >= RAY_WEIGHT_CUTOFF
         go_t = (w_t.max(-1) >= RAY_WEIGHT_CUTOFF) & refracted
+        D_r = ray_reflect(Du[go_r], N_in[go_r])
+        if rs.gloss_set:        # the lobe's code wherever a material sets gloss, inf included
+            D_r, go_r = _glossy_rays(rs, samples, D_r, go_r, Ng_in, obj, owner, key)
         O = np.concatenate([ray_origin(P[go_r], Ng_in[go_r], shape[go_r]),
                             ray_origin(P[go_t], -Ng_in[go_t], shape[go_t])])
-        D = np.concatenate([ray_reflect(Du[go_r], N_in[go_r]), T[go_t]]).astype(t)
+        D = np.concatenate([D_r, T[go_t]]).astype(t)
         owner = np.concatenate([owner[go_r], owner[go_t]])
         from_shape = np.concatenate([shape[go_r], shape[go_t]])
         path = np.concatenate([mix64(path[go_r] ^ np.uint64(1)), mix64(path[go_t] ^ np.uint64(2))])

@@ -10,7 +10,8 @@ renderer/gpu/raytracer.py, reference/raytrace/trace.py): made once per scene, ca
   relative to their bounds' centre, then its boxes fitted to the camera-relative triangles
   (`refit`), so that a new eye needs only a refit (`ray_scene(scene, tree=...)`: the bytes a
   build for that eye gives);
-- the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided.
+- the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided, gloss (the
+  reflected rays' lobe exponent, inf for a mirror).
 """
 
 from __future__ import annotations
@@ -43,6 +44,8 @@ class RayScene:
     kt: np.ndarray                   # (M, 3)
     ior: np.ndarray                  # (M,)
     two_sided: np.ndarray            # (M,) bool
+    gloss: np.ndarray                # (M,) lobe exponent, inf: a mirror (Material.gloss_exponent)
+    gloss_set: bool = False          # some material sets `gloss` (inf included)
 
     @property
     def specular(self) -> bool:
@@ -52,6 +55,13 @@ class RayScene:
     def secondary(self) -> bool:
         """Whether any material reflects or transmits (secondary rays exist)."""
         return bool((self.kr > 0).any() or (self.kt > 0).any())
+
+    @property
+    def glossy(self) -> bool:
+        """Whether some material that reflects (k_r or k_t > 0) has a finite gloss: the
+        reflected rays' lobe is sampled somewhere (the GLSL's GLOSSY)."""
+        reflects = (self.kr > 0).any(-1) | (self.kt > 0).any(-1)
+        return bool((reflects & np.isfinite(self.gloss)).any())
 
 
 def _normalize_or_zero(v):
@@ -106,4 +116,6 @@ def ray_scene(scene: Scene, tree: Bvh | None = None) -> RayScene:
         bvh=refit(tree, triangles) if len(triangles) else None,
         ka=rows("ka"), kd=rows("kd"), ks=rows("ks"), n=rows("n", 1), kr=rows("kr"), kt=rows("kt"),
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
+        gloss=np.array([m.gloss_exponent for m in mats], np.float64),
+        gloss_set=any(m.gloss is not None for m in mats),
     )

@@ -82,12 +82,22 @@ class Material:
     kr: tuple = (0.0, 0.0, 0.0)
     kt: tuple = (0.0, 0.0, 0.0)
     ior: float = 1.5
+    # Glossy reflection (ray tracer only): the Phong-lobe exponent (>= 0) about the mirror
+    # direction from which the reflected ray is drawn (docs/conventions.md, "Glossy
+    # reflection"). None, not set, is a mirror as inf is; the reference traces the lobe's code
+    # wherever some material sets it, inf included, so that inf = mirror is tested, not assumed.
+    gloss: float | None = None
 
     @property
     def has_specular(self) -> bool:
         """Whether the lighting has a specular term at all (some k_s not 0). Both pipelines
         leave the term out otherwise (renderer/gpu/shaders.py, reference/lighting.py)."""
         return any(float(k) != 0.0 for k in self.ks)
+
+    @property
+    def gloss_exponent(self) -> float:
+        """The reflected rays' lobe exponent: `gloss`, or inf (a mirror) where it is not set."""
+        return math.inf if self.gloss is None else float(self.gloss)
 
 
 ENERGY_SLACK = 1e-9

@@ -49,7 +49,7 @@ TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials
 LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
                *LENS_KEYS)
-MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior")
+MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 AREA_KEYS = ("area", "size", "radius", "normal")   # a point light's area (LightArea), `area` first
 AREA_SHAPE_KEYS = {"rectangle": ("size", "normal"), "disc": ("radius", "normal"),
@@ -500,6 +500,8 @@ class _Reader:
                 setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
         if "ior" in raw:
             mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
+        if "gloss" in raw:
+            mat.gloss = self.gloss(raw["gloss"], _join(path, "gloss"))
         channel = energy_excess(mat.kr, mat.kt)
         if channel is not None:
             where = _join(path, "kt" if "kt" in raw else "kr")
@@ -508,6 +510,15 @@ class _Reader:
                              f"(the reflected and refracted rays together carry at most the "
                              f"light that arrives)")
         return mat
+
+    def gloss(self, value: Any, path: str) -> float:
+        """A Phong-lobe exponent: a number >= 0, or inf (TOML's `inf`), the mirror."""
+        x = self.to_float(value, path) if _is_number(value) else 0.0
+        if x == math.inf:
+            return x
+        if math.isnan(x) or x < 0:
+            self.fail(path, f"must be a number >= 0 or inf (a mirror), got {show_number(x)}")
+        return self.number(value, path)
 
     def light(self, raw: dict, path: str) -> DirectionalLight | PointLight:
         if "type" not in raw:

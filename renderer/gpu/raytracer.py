@@ -8,11 +8,12 @@ hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, n
 
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
-MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, LENS when the
-camera's aperture is above 0, AREA_LIGHTS when some point light has an area of size > 0, and
-the sample pattern's constants from renderer/core/ray_sampling.py, LIGHT_SAMPLES among them);
-the uniforms (camera rays and the thin lens from renderer/core/camera_rays.py, lights from
-renderer/core/uniforms.py and their areas from renderer/core/light_areas.py, shapes, the
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, GLOSSY when such a material
+has a finite gloss, MAX_DEPTH, LENS when the camera's aperture is above 0, AREA_LIGHTS when some
+point light has an area of size > 0, and the sample pattern's constants from
+renderer/core/ray_sampling.py, LIGHT_SAMPLES among them); the uniforms (camera rays and the thin
+lens from renderer/core/camera_rays.py, lights from renderer/core/uniforms.py and their areas
+from renderer/core/light_areas.py, shapes, the
 pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
 renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
@@ -22,11 +23,11 @@ changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
-`shadows`), SECONDARY (where max_depth > 0), LENS (a lens of radius 0 without an aperture),
-MESHES (the BVH walk; a scene without triangles gets a one-triangle BVH of a degenerate
-triangle, which no ray hits) and AREA_LIGHTS (where there are point lights;
-renderer/core/light_areas.py). The light, sphere and
-plane counts stay compile-time constants. The image is the same.
+`shadows`), SECONDARY and GLOSSY (where max_depth > 0), LENS (a lens of radius 0 without an
+aperture), MESHES (the BVH walk; a scene without triangles gets a one-triangle BVH of a
+degenerate triangle, which no ray hits) and AREA_LIGHTS (where there are point lights;
+renderer/core/light_areas.py). The light, sphere and plane counts stay compile-time
+constants. The image is the same.
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.light_areas import area_light_defines, area_light_uniforms
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import check_first_sample, ray_sampling
+from renderer.core.ray_sampling import GLOSSY_DIMENSION, check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
@@ -114,6 +115,8 @@ class RayTracer:
             "NUM_PLANES": len(rs.plane_offset),
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
+            "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
+            "GLOSSY_DIMENSION": GLOSSY_DIMENSION,
             "MAX_DEPTH": self.max_depth,
             "LENS": scene.camera.has_lens or every,
             **self.sampling.defines(),
@@ -174,7 +177,7 @@ class RayTracer:
         zero = np.zeros((len(rs.n), 1))
         materials = np.stack([np.concatenate(part, 1) for part in (
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
-            (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
+            (rs.ks, rs.ior[:, None]), (rs.kr, rs.gloss[:, None]), (rs.kt, zero))], 1)  # (M, 5, 4)
         arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object

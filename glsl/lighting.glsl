@@ -15,7 +15,10 @@
 //     including shader defines (shadow rays); a point in shadow keeps only the ambient term.
 //     A light whose terms are 0 at P (behind the surface, or a material with k_d = k_s = 0)
 //     casts no shadow ray: its visibility could change nothing. The rasteriser's fragment
-//     stage defines SHADOWS too, answered by shadow maps (glsl/shadow/lookup.glsl).
+//     stage defines SHADOWS too, answered by shadow maps (glsl/shadow/lookup.glsl);
+//   AREA_LIGHTS: a point light with an area (has_area(i)) lights by area_light_term(i, P, N,
+//     V); the including shader defines both (its samples on the area, each point_term_at a
+//     sampled point, shadowed, averaged); the others light as without it.
 // Each light's term is a function of its own (directional_term, point_term), which flat and
 // Gouraud receivers of shadows also call to keep the terms apart (glsl/vertex.glsl).
 
@@ -71,6 +74,10 @@ uniform vec3 u_point_attenuation[NUM_POINT_LIGHTS];             // (c, l, q)
 float light_visibility_directional(int i, vec3 P, vec3 N);
 float light_visibility_point(int i, vec3 P, vec3 N);
 #endif
+#if defined(AREA_LIGHTS) && NUM_POINT_LIGHTS > 0
+bool has_area(int i);
+vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V);
+#endif
 
 // normalize(v), except that a zero vector stays zero (GLSL's normalize(0) is NaN): a normal
 // that vanishes (singular normal matrix, opposite normals interpolated) lights as ambient.
@@ -124,13 +131,18 @@ vec3 directional_term(int i, vec3 N, vec3 V) {
 }
 #endif
 #if NUM_POINT_LIGHTS > 0
-vec3 point_term(int i, vec3 P, vec3 N, vec3 V) {
-    vec3 to_light = u_point_position[i] - P;
+// Light i's term as if it shone from Q (its position, or a point of its area).
+vec3 point_term_at(int i, vec3 Q, vec3 P, vec3 N, vec3 V) {
+    vec3 to_light = Q - P;
     float d = length(to_light);
     vec3 L = d > 0.0 ? to_light / d : N;             // a light on the surface: fully incident
     vec3 c_l_q = u_point_attenuation[i];
     float att = 1.0 / (c_l_q.x + c_l_q.y * d + c_l_q.z * d * d);
     return light_contribution(N, L, V, att * u_point_intensity[i]);
+}
+
+vec3 point_term(int i, vec3 P, vec3 N, vec3 V) {
+    return point_term_at(i, u_point_position[i], P, N, V);
 }
 #endif
 
@@ -148,6 +160,20 @@ vec3 shadowed_point(int i, vec3 P, vec3 N, vec3 term) {
 #endif
 #endif
 
+#if NUM_POINT_LIGHTS > 0
+// What point light i adds at P: its term, shadowed where SHADOWS; an area light's samples.
+vec3 lit_point(int i, vec3 P, vec3 N, vec3 V) {
+#ifdef AREA_LIGHTS
+    if (has_area(i)) return area_light_term(i, P, N, V);
+#endif
+#ifdef SHADOWS
+    return shadowed_point(i, P, N, point_term(i, P, N, V));
+#else
+    return point_term(i, P, N, V);
+#endif
+}
+#endif
+
 // The colour I at world point P with unit normal N (already flipped for a two-sided back face).
 vec3 lighting(vec3 P, vec3 N) {
     vec3 V = view_vector(P);
@@ -163,11 +189,7 @@ vec3 lighting(vec3 P, vec3 N) {
 #endif
 #if NUM_POINT_LIGHTS > 0
     for (int i = 0; i < POINT_LIGHTS; ++i) {
-#ifdef SHADOWS
-        I += shadowed_point(i, P, N, point_term(i, P, N, V));
-#else
-        I += point_term(i, P, N, V);
-#endif
+        I += lit_point(i, P, N, V);
     }
 #endif
     return I;

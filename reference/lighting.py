@@ -161,10 +161,11 @@ class LightTerms:
 def shade_terms(ambient: np.ndarray, terms, P: np.ndarray, N: np.ndarray, visibility=None) -> np.ndarray:
     """I = ambient + sum_l term_l over (kind, i, term) `terms` in order, each term times
     visibility(kind, i, P, N, needed) when given (lighting()'s `visibility`; `needed`: where
-    the term is not 0)."""
+    the term is not 0), but an "area" term, which comes shadowed (lighting()'s `area_light`)."""
     I = ambient.astype(ambient.dtype, copy=True)
     for kind, i, term in terms:
-        I += term if visibility is None else visibility(kind, i, P, N, (term != 0).any(-1)) * term
+        shadowed = visibility is None or kind == "area"
+        I += term if shadowed else visibility(kind, i, P, N, (term != 0).any(-1)) * term
     return I
 
 
@@ -174,10 +175,18 @@ def ambient_term(P: np.ndarray, N: np.ndarray, material: MaterialUniforms, light
     return np.broadcast_to(ambient, np.broadcast_shapes(ambient.shape, P.shape, N.shape))
 
 
+def point_term_at(P, N, V, position, intensity, attenuation, material: MaterialUniforms) -> np.ndarray:
+    """A point light's term at P as if it shone from `position` (its position, or a point of
+    its area; (3,) or one per point): the GLSL's point_term_at."""
+    L, att = point_light_vector(P, N, position, attenuation)
+    return light_contribution(N, L, V, att, intensity, material)
+
+
 def each_light_term(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
-                    lights: Lights):
+                    lights: Lights, area_light=None):
     """(kind, i, term) for each light, one at a time, in lighting()'s order (glsl/lighting.glsl:
-    directional_term, point_term)."""
+    directional_term, point_term; lit_point: ("area", i, area_light's term) for a point light
+    with an area, when `area_light` is given)."""
     V = normalize_or_zero(E - P)
     for i, (direction, intensity) in enumerate(zip(lights.u_directional_direction,
                                                    lights.u_directional_intensity)):
@@ -185,8 +194,11 @@ def each_light_term(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: Mater
         yield "directional", i, light_contribution(N, L, V, 1.0, intensity, material)
     for i, (position, intensity, attenuation) in enumerate(zip(
             lights.u_point_position, lights.u_point_intensity, lights.u_point_attenuation)):
-        L, att = point_light_vector(P, N, position, attenuation)
-        yield "point", i, light_contribution(N, L, V, att, intensity, material)
+        area = None if area_light is None else area_light(i, P, N, V, material)
+        if area is not None:
+            yield "area", i, area
+        else:
+            yield "point", i, point_term_at(P, N, V, position, intensity, attenuation, material)
 
 
 def light_terms(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
@@ -203,7 +215,7 @@ def light_terms(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialU
 
 
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
-             lights: Lights, visibility=None) -> np.ndarray:
+             lights: Lights, visibility=None, area_light=None) -> np.ndarray:
     """The notes' lighting equation at points P (..., 3) with unit normals N (..., 3): the sum
     of light_terms.
 
@@ -214,7 +226,11 @@ def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUnif
     GLSL's light_visibility_directional / light_visibility_point): in shadow, ambient only.
     `needed` (...,) is where the light's terms are not 0: elsewhere visibility can change
     nothing, and the GLSL casts no shadow ray (the callable may answer anything there).
+    `area_light` (the ray tracer's AREA_LIGHTS): None, or a callable
+    area_light(i, P, N, V, material) -> (..., 3) giving point light i's whole term where it
+    has an area (its samples, each shadowed, averaged: trace.py's area_light_terms) and None
+    for a light without one, which then lights as above.
     E and the material's arrays may vary per point (broadcast against P). One light's term
     at a time (the terms are not kept)."""
-    return shade_terms(ambient_term(P, N, material, lights), each_light_term(P, N, E, material, lights),
-                       P, N, visibility)
+    return shade_terms(ambient_term(P, N, material, lights),
+                       each_light_term(P, N, E, material, lights, area_light), P, N, visibility)

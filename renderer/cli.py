@@ -26,7 +26,7 @@ from renderer import __version__
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import RAY_PATTERNS
+from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -121,6 +121,9 @@ def build_parser() -> argparse.ArgumentParser:
                             f"{MAX_DEPTH_LIMIT} (default 4)")
         p.add_argument("--seed", type=int, default=None, metavar="S",
                        help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
+        p.add_argument("--light-samples", type=int, default=None, metavar="M",
+                       help=f"ray tracer: points sampled on each area light per hit, 1 to "
+                            f"{MAX_LIGHT_SAMPLES} (default 1; docs/conventions.md, \"Area lights\")")
         lens_options(p)
 
     def lens_options(p):
@@ -299,6 +302,7 @@ def check_raytrace_options(args) -> None:
                           f"--method raytrace{also}")
     if not 0 <= args.max_depth <= MAX_DEPTH_LIMIT:
         args.parser.error(f"--max-depth must be between 0 and {MAX_DEPTH_LIMIT}, got {args.max_depth}")
+    check_light_samples_option(args, traced)
     if args.adaptive_threshold is not None and args.pattern != "adaptive":
         args.parser.error(f"--adaptive-threshold is for --pattern adaptive, not {args.pattern}")
     check_lens_options(args, traced)
@@ -306,12 +310,25 @@ def check_raytrace_options(args) -> None:
         from renderer.core.ray_sampling import ray_sampling
         options = _raytrace_options(args)
         try:
-            ray_sampling(options["pattern"], options["samples"], options["seed"], options["adaptive_threshold"])
+            ray_sampling(options["pattern"], options["samples"], options["seed"], options["adaptive_threshold"],
+                         options["light_samples"])
         except ValueError as error:
             given = [f"--spp {args.spp}", f"--pattern {args.pattern}"]
             given += [] if args.seed is None else [f"--seed {args.seed}"]
             given += [] if args.adaptive_threshold is None else [f"--adaptive-threshold {args.adaptive_threshold:g}"]
+            given += [] if args.light_samples is None else [f"--light-samples {args.light_samples}"]
             args.parser.error(f"{' '.join(given)}: {error}")
+
+
+def check_light_samples_option(args, traced: bool) -> None:
+    """--light-samples: for the ray tracer only, 1 to MAX_LIGHT_SAMPLES."""
+    if args.light_samples is None:
+        return
+    if not traced:
+        also = " or --methods" if hasattr(args, "methods") else ""
+        args.parser.error(f"--light-samples is for --method raytrace{also}")
+    if not 1 <= args.light_samples <= MAX_LIGHT_SAMPLES:
+        args.parser.error(f"--light-samples must be between 1 and {MAX_LIGHT_SAMPLES}, got {args.light_samples}")
 
 
 LENS_OPTIONS = {"aperture": "--aperture", "focus_distance": "--focus-distance"}
@@ -347,7 +364,8 @@ def _raytrace_options(args) -> dict:
     from renderer.core.sampling import DEFAULT_SEED
     return {"samples": args.spp, "pattern": args.pattern, "max_depth": args.max_depth,
             "seed": DEFAULT_SEED if args.seed is None else args.seed,
-            "adaptive_threshold": args.adaptive_threshold}
+            "adaptive_threshold": args.adaptive_threshold,
+            "light_samples": 1 if args.light_samples is None else args.light_samples}
 
 
 def samples_fired(frame) -> str:

@@ -339,7 +339,12 @@ ENERGY_RULE = ("the energy rule is kr + kt <= 1 in each channel (the reflected a
     ('{ type = "sphere" }', "{ kt = 0.5, ior = -1.33 }", "objects[0].material.ior", "must be > 0, got -1.33"),
     ('{ type = "sphere" }', "{ kr = 0.6, kt = [0.3, 0.5, 0.3] }", "objects[0].material.kt",
      f"kr + kt is 1.1 in channel g; {ENERGY_RULE}"),
-], ids=["negative radius", "zero normal", "ior 0", "ior negative", "kr + kt > 1"])
+    ('{ type = "sphere" }', "{ kr = 0.5, gloss = -10 }", "objects[0].material.gloss",
+     "must be a number >= 0 or inf (a mirror), got -10"),
+    ('{ type = "sphere" }', "{ kr = 0.5, gloss = nan }", "objects[0].material.gloss",
+     "must be a number >= 0 or inf (a mirror), got nan"),
+], ids=["negative radius", "zero normal", "ior 0", "ior negative", "kr + kt > 1", "gloss negative",
+        "gloss nan"])
 def test_a_bad_ray_traced_scene_is_one_line_naming_file_key_and_reason(capsys, work, shape, material,
                                                                       key, reason):
     (work / "rt.toml").write_text(f"[[objects]]\nshape = {shape}\nmaterial = {material}\n")
@@ -352,7 +357,11 @@ def test_a_bad_ray_traced_scene_is_one_line_naming_file_key_and_reason(capsys, w
     (["--max-depth", "-1"], "--max-depth must be between 0 and 64, got -1"),
     (["--max-depth", "65"], "--max-depth must be between 0 and 64, got 65"),
     (["--pattern", "hexagonal"], "argument --pattern: invalid choice: 'hexagonal' (choose from"),
-], ids=["spp 0", "max depth -1", "max depth 65", "unknown pattern"])
+    (["--light-samples", "0"], "--light-samples must be between 1 and 64, got 0"),
+    (["--light-samples", "65"], "--light-samples must be between 1 and 64, got 65"),
+    (["--light-samples", "two"], "argument --light-samples: invalid int value: 'two'"),
+], ids=["spp 0", "max depth -1", "max depth 65", "unknown pattern", "light samples 0",
+        "light samples 65", "light samples not a number"])
 def test_a_bad_ray_tracer_option_is_its_reason_then_the_usage(capsys, work, command, option, reason):
     """Argument errors print the reason on one line (the option named), then the usage line
     (tests/test_cli.py); status 2, nothing written. 65 is absurd: renderer/core/ray_depth.py's
@@ -362,4 +371,16 @@ def test_a_bad_ray_tracer_option_is_its_reason_then_the_usage(capsys, work, comm
     assert main(args) == 2
     first, usage = capsys.readouterr().err.splitlines()
     assert first.startswith(f"renderer {command}: {reason}") and usage.startswith(f"usage: renderer {command}")
+    assert sorted(p.name for p in work.iterdir()) == before
+
+
+@pytest.mark.parametrize("command", ["render", "compare"])
+def test_light_samples_are_for_the_ray_tracer(capsys, work, command):
+    """--light-samples without --method raytrace (the rasteriser lights from each area light's
+    centre): its reason, then the usage; status 2, nothing written."""
+    before = sorted(p.name for p in work.iterdir())
+    assert main([command, "sphere", "--size", "16x12", "--light-samples", "4"]) == 2
+    first, usage = capsys.readouterr().err.splitlines()
+    assert first.startswith(f"renderer {command}: --light-samples is for --method raytrace")
+    assert usage.startswith(f"usage: renderer {command}")
     assert sorted(p.name for p in work.iterdir()) == before

@@ -14,9 +14,12 @@ from renderer.core.builtin import builtin_scenes, made_for_raytracing
 from renderer.study.ground_truth import RAY_TRUTH_DEPTH, ground_truth
 from renderer.study.ray_report import (RAY_QUICK, RayStudy, RaySceneRun, RaySetting,
                                        ray_settings)
+from renderer.core.sampling import PATTERNS
+from renderer.study.distributed_report import (LIGHT_CARRIER_SAMPLES, distributed_sections,
+                                               scene_effects)
 from renderer.core.shadow_settings import BIAS_RULES, DEFAULT_FILTER, FILTERS, named_bias
 from renderer.study.report import FULL, QUICK, RasterStudy, ReportResult, metrics, run_report, settings
-from renderer.study.report_settings import (CSV_COLUMNS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS,
+from renderer.study.report_settings import (CSV_COLUMNS, DISTRIBUTED_KNOBS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS,
                                             SHADOW_COLUMNS, SHADOW_TARGETS, ShadowTarget)
 from renderer.study.shadow_report import cheapest_shadow, shadow_sections, with_shadow_setting
 from renderer.study.report_output import convergence_slopes, pareto_front, series_name
@@ -266,7 +269,15 @@ def test_ray_settings_cover_each_knob_on_its_backends():
     plan = ray_settings(RAY_QUICK)
     assert {(s.knob, s.backend) for s in plan} == {
         ("antialiasing", "gpu"), ("antialiasing", "reference"), ("max_depth", "gpu"),
-        ("max_depth", "reference"), ("precision", "reference")}
+        ("max_depth", "reference"), ("precision", "reference"),
+        *((knob, backend) for knob in DISTRIBUTED_KNOBS for backend in ("gpu", "reference"))}
+    lights = [s for s in plan if s.knob == "light_samples" and s.backend == "gpu"]
+    assert {(s.pattern, s.samples, s.light_samples) for s in lights} == {
+        (p, LIGHT_CARRIER_SAMPLES, m) for p in PATTERNS for m in RAY_QUICK.light_counts}
+    lens = {s.setting for s in plan if s.knob == "lens" and s.backend == "gpu"}
+    assert lens == {s.setting for s in plan if s.knob == "antialiasing" and s.backend == "gpu"
+                    and s.pattern != "adaptive"}           # the same pattern series, lens spent
+    assert all(s.light_samples == 1 for s in plan if s.knob != "light_samples")
     sampled = [s for s in plan if s.knob == "antialiasing"]
     assert {s.max_depth for s in sampled} == {RAY_TRUTH_DEPTH}      # the sampling error alone
     assert {s.setting for s in sampled if s.pattern == "regular"} == {"regular 1", "regular 4",
@@ -293,6 +304,53 @@ def test_adaptive_thresholds_are_series_of_their_own_fitted_in_samples_and_in_ti
     assert in_samples[("adaptive @1/255", "gpu")].slope == pytest.approx(-1.0)
     assert in_time[("adaptive @1/255", "gpu")].slope == pytest.approx(-2.0)     # t ~ N^0.5
     assert in_time[("adaptive @16/255", "gpu")].samples == (4, 36)
+
+
+def test_distributed_knobs_go_to_the_scenes_that_use_their_effect():
+    """soft_shadows: light samples per hit beside the pixel samples that carry them;
+    depth_of_field: its pattern series is the lens knob (the same frames antialiasing would
+    trace); classic: none of them."""
+    plan = ray_settings(RAY_QUICK)
+    study = RayStudy()
+    knobs = {name: {s.knob for s in study.scene_settings(plan, load_scene(builtin_scenes()[name]), 8, 6)}
+             for name in ("soft_shadows", "depth_of_field", "classic")}
+    assert knobs["soft_shadows"] == {"antialiasing", "max_depth", "precision", "light_samples"}
+    assert knobs["depth_of_field"] == {"max_depth", "precision", "lens"}
+    assert knobs["classic"] == {"antialiasing", "max_depth", "precision"}
+    assert scene_effects(load_scene(builtin_scenes()["depth_of_field"])) == {"lens"}
+
+
+@pytest.mark.slow                       # the truth of 4096 shadow rays per pixel
+def test_a_tiny_light_samples_sweep_gpu_and_reference(tmp_path, gl_contexts):
+    """soft_shadows at 8x6: more light samples per hit, less error (the penumbrae's; the 4
+    pixel samples' error at edges stays); the GPU's error that of the reference, which traces
+    the same rays."""
+    scene = load_scene(builtin_scenes()["soft_shadows"])
+    truth, _ = ground_truth(scene, 8, 6, tmp_path, method="raytrace")
+    run = RaySceneRun(scene, 8, 6, gl_contexts["egl"])
+    error = {}
+    for backend, m in (("reference", 1), ("reference", 64), ("gpu", 64)):
+        setting = RaySetting("light_samples", f"jittered 4x{m}", backend, "jittered", 4,
+                             RAY_TRUTH_DEPTH, light_samples=m)
+        image, _, _ = run.timed(setting, 1)
+        error[(backend, m)] = metrics(image, truth)["rmse"]
+    assert error[("reference", 64)] < 0.8 * error[("reference", 1)]       # measured 0.72
+    assert error[("gpu", 64)] == pytest.approx(error[("reference", 64)], abs=1e-5)
+
+
+def test_distributed_section_fits_each_knob_in_its_own_samples():
+    rows = [{"scene": "s", "knob": "light_samples", "setting": f"{p} 4x{m}", "pattern": p,
+             "backend": "gpu", "threshold": None, "samples": 4, "light_samples": m,
+             "median_ms": float(m), "rmse": m ** slope}
+            for p, slope in (("random", -0.5), ("jittered", -0.75)) for m in (1, 4, 16)]
+    rows += [{**rows[0], "knob": "lens", "setting": f"jittered {n}", "pattern": "jittered",
+              "samples": n, "light_samples": 1, "median_ms": float(n), "rmse": n ** -0.6}
+             for n in (1, 4, 16)]
+    text = "\n".join(distributed_sections(rows))
+    assert "| light_samples | random | gpu | -0.50 |" in text
+    assert "| light_samples | jittered | gpu | -0.75 |" in text
+    assert "| lens | jittered | gpu | -0.60 |" in text
+    assert distributed_sections([r for r in rows if r["knob"] == "antialiasing"]) == []
 
 
 def test_the_scenes_made_for_the_ray_tracer(tmp_path):
@@ -352,7 +410,8 @@ def test_ray_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
         reader = csv.DictReader(handle)
         assert tuple(reader.fieldnames) == RAY_CSV_COLUMNS
         rows = list(reader)
-    assert len(rows) == len(ray_settings(RAY_QUICK))
+    classic = load_scene(builtin_scenes()["classic"])
+    assert len(rows) == len(RayStudy().scene_settings(ray_settings(RAY_QUICK), classic, 16, 12))
     error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in rows}
     samples = {(row["setting"], row["backend"]): float(row["samples"]) for row in rows}
     for backend in ("gpu", "reference"):

@@ -26,8 +26,8 @@ REPO = Path(__file__).resolve().parent.parent
 BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_plane",
                  "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
                  "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble",
-                 "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field",
-                 "motion_blur"}
+                 "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "soft_shadows",
+                 "glossy", "motion_blur"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera), or a backdrop (tir_bubble's checkerboard) filling the view.
 PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room"}
@@ -461,6 +461,7 @@ def test_scene_from_dict_accepts_tuples_and_names_its_source():
 
 OBJECT = '[[objects]]\nname = "ball"\nmesh = { primitive = "uv_sphere" }\n'
 LIGHT = '[[lights]]\ntype = "directional"\n'
+POINT = '[[lights]]\ntype = "point"\n'
 
 # (test id, scene text, expected "KEY.PATH: reason" after "FILE: ")
 BAD_SCENES = [
@@ -672,6 +673,36 @@ BAD_SCENES = [
      "lights[0].attenuation: must not be all zero: the light is divided by c + l d + q d^2"),
     ("negative intensity", '[[lights]]\ntype = "point"\nintensity = [1, 1, -1]\n',
      "lights[0].intensity: must be >= 0 in every component, item 2 is -1"),
+    # area lights
+    ("unknown area shape", POINT + 'area = "square"\nsize = [1, 1]\n',
+     "lights[0].area: unknown area shape 'square'; expected one of: rectangle, disc, sphere"),
+    ("area as a number", POINT + "area = 1\n", "lights[0].area: expected a string, got an integer (1)"),
+    ("rectangle without size", POINT + 'area = "rectangle"\n',
+     "lights[0].size: missing; a rectangle light needs size = [w, h]"),
+    ("disc without radius", POINT + 'area = "disc"\n',
+     "lights[0].radius: missing; a disc light needs radius = r"),
+    ("negative size", POINT + 'area = "rectangle"\nsize = [1, -0.5]\n',
+     "lights[0].size: must be >= 0 in every component, item 1 is -0.5"),
+    ("infinite size", POINT + 'area = "rectangle"\nsize = [inf, 1]\n',
+     "lights[0].size: expected finite numbers, item 0 is inf"),
+    ("size of three", POINT + 'area = "rectangle"\nsize = [1, 1, 1]\n',
+     "lights[0].size: expected a list of 2 numbers, got a list of 3 items"),
+    ("negative radius", POINT + 'area = "sphere"\nradius = -1\n', "lights[0].radius: must be >= 0, got -1"),
+    ("nan radius", POINT + 'area = "disc"\nradius = nan\n', "lights[0].radius: expected a finite number, got nan"),
+    ("size given for a disc", POINT + 'area = "disc"\nradius = 1\nsize = [1, 1]\n',
+     "lights[0].size: is for rectangle lights, not a disc; a disc light takes radius and normal"),
+    ("radius given for a rectangle", POINT + 'area = "rectangle"\nsize = [1, 1]\nradius = 1\n',
+     "lights[0].radius: is for disc and sphere lights, not a rectangle; a rectangle light takes "
+     "size and normal"),
+    ("normal given for a sphere", POINT + 'area = "sphere"\nradius = 1\nnormal = [0, 1, 0]\n',
+     "lights[0].normal: is for rectangle and disc lights, not a sphere; a sphere light takes radius"),
+    ("zero area normal", POINT + 'area = "disc"\nradius = 1\nnormal = [0, 0, 0]\n',
+     "lights[0].normal: must not be zero length: it says which way the disc faces"),
+    ("size without area", POINT + "size = [1, 1]\n",
+     "lights[0].size: is for area lights; add area = one of 'rectangle', 'disc', 'sphere'"),
+    ("area on a directional light", '[[lights]]\ntype = "directional"\narea = "disc"\n',
+     "lights[0].area: belongs to point lights, not directional ones; keys here: type, direction, "
+     "intensity, shadows, shadow_resolution, shadow_filter, shadow_bias"),
     # shadows
     ("shadows as a string", LIGHT + 'shadows = "off"\n',
      "lights[0].shadows: expected true or false, got a string ('off')"),
@@ -733,7 +764,7 @@ BAD_SCENES = [
      "objects[0].angular_speed: unknown key; did you mean 'angular_velocity'?"),
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
-     "two_sided, shading, kr, kt, ior"),
+     "two_sided, shading, kr, kt, ior, gloss"),
 ]
 
 

@@ -70,6 +70,15 @@ def test_material_ray_tracer_keys():
     load(one_object(mesh={"primitive": "cube"}, material={"kr": 0.7, "kt": 0.3}))
 
 
+def test_gloss_is_a_lobe_exponent_from_0_to_inf_and_unset_is_the_mirror():
+    """gloss 0 (the cosine lobe) and TOML's inf (the mirror) are both taken; an unset gloss
+    is None, which the ray tracer reads as inf (Material.gloss_exponent)."""
+    for gloss in (0, 10, 1e6, math.inf):
+        mat = load(one_object(shape=SPHERE, material={"kr": 0.5, "gloss": gloss})).objects[0].material
+        assert mat.gloss == gloss and mat.gloss_exponent == gloss
+    assert Material().gloss is None and Material().gloss_exponent == math.inf
+
+
 def test_only_the_ray_tracing_and_shadow_builtin_scenes_use_shapes_and_ray_tracer_terms():
     """conftest.RAYTRACE_SCENES is the set of built-in scenes made for the ray tracer: each uses
     an analytic shape or k_r, k_t, ior and says `--method raytrace` in its description. The
@@ -142,6 +151,14 @@ BAD = [
      "in each channel"),
     ("energy kr only", {"materials": {"m": {"kr": 1.5}}, "objects": []},
      "materials.m.kr: kr + kt is 1.5 in channel r"),
+    ("gloss negative", one_object(shape=SPHERE, material={"kr": 0.5, "gloss": -1}),
+     "objects[0].material.gloss: must be a number >= 0 or inf (a mirror), got -1"),
+    ("gloss -inf", one_object(shape=SPHERE, material={"gloss": -math.inf}),
+     "objects[0].material.gloss: must be a number >= 0 or inf (a mirror), got -inf"),
+    ("gloss nan", one_object(shape=SPHERE, material={"gloss": math.nan}),
+     "objects[0].material.gloss: must be a number >= 0 or inf (a mirror), got nan"),
+    ("gloss string", one_object(shape=SPHERE, material={"gloss": "inf"}),
+     "objects[0].material.gloss: expected a number, got a string ('inf')"),
 ]
 
 

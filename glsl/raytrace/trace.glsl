@@ -6,11 +6,15 @@
 // and down to a weight cut-off, depth first (the reflected ray first, the transmitted one
 // waiting on a fixed-size stack) in a loop of bounded length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
-// SECONDARY (some k_r or k_t > 0), MAX_DEPTH, MOTION and NUM_MOVING_MESHES (motion blur), and
-// lighting.glsl's light counts and SPECULAR.
+// SECONDARY (some k_r or k_t > 0), GLOSSY (such a material has a finite gloss: reflected rays
+// drawn from a lobe; GLOSSY_DIMENSION its dimension), MAX_DEPTH, MOTION and NUM_MOVING_MESHES
+// (motion blur), and lighting.glsl's light counts and SPECULAR; AREA_LIGHTS (some point light
+// has an area of size > 0: LIGHT_SAMPLES shadow rays to points of it per hit, area_light_term).
 
 #include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
 #include "raytrace/optics.glsl"
+#include "raytrace/sampling.glsl"     // distributed_2d: the numbers a hit draws
+#include "raytrace/warp.glsl"
 #ifdef MESHES
 uniform sampler2D u_nodes;           // renderer/core/bvh.py's layout
 uniform sampler2D u_triangles;
@@ -35,7 +39,7 @@ uniform int u_sphere_object[NUM_SPHERES];
 uniform vec4 u_planes[NUM_PLANES];              // (unit N, d): P.N + d = 0
 uniform int u_plane_object[NUM_PLANES];
 #endif
-uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, 0), (kt, 0)
+uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, gloss), (kt, 0)
 
 #ifndef NUM_MOVING_MESHES
 #define NUM_MOVING_MESHES 0
@@ -286,13 +290,85 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
 }
 #endif
 #if NUM_POINT_LIGHTS > 0
-float light_visibility_point(int i, vec3 P, vec3 N) {
-    vec3 Q = u_point_position[i];
+// 0 where the shadow ray from P to the point Q (a point light, or a point of an area light) is
+// blocked, else 1. It ends short of Q by the hit tie (s_max = d (1 - TRACE_HIT_TIE)): a surface
+// through Q itself (a light lying in a plane) ties with the light, which keeps it.
+float light_visibility_at(vec3 Q, vec3 P) {
     vec3 n = dot(g_geometric_normal, Q - P) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
     vec3 O = ray_origin(P, n, g_shape);
     vec3 to_light = Q - O;
     float d = sqrt(dot(to_light, to_light));
-    return (d > 0.0 && occluded(O, to_light / d, d, g_shape)) ? 0.0 : 1.0;
+    return (d > 0.0 && occluded(O, to_light / d, d * (1.0 - TRACE_HIT_TIE), g_shape)) ? 0.0 : 1.0;
+}
+
+float light_visibility_point(int i, vec3 P, vec3 N) {
+    return light_visibility_at(u_point_position[i], P);
+}
+#endif
+
+#if defined(AREA_LIGHTS) && NUM_POINT_LIGHTS > 0
+// Area lights (docs/conventions.md, "Area lights"; the uniform: renderer/core/light_areas.py).
+// Point light i's area is u_point_position[i] + p.x a_0 + p.y a_1 + p.z a_2, the axes a_j in
+// rows 3i .. 3i + 2 of u_point_area and p a point of the unit shape named by row 3i's w
+// (AREA_NONE: no area, the point light's own code).
+uniform vec4 u_point_area[3 * NUM_POINT_LIGHTS];
+const uint LIGHT_DIMENSION = 1u;     // renderer/core/ray_sampling.py: light i's points, LIGHT_DIMENSION + i
+const float AREA_NONE = 0.0;
+const float AREA_RECTANGLE = 1.0;
+const float AREA_DISC = 2.0;
+
+bool has_area(int i) {
+    return u_point_area[3 * i].w != AREA_NONE;
+}
+
+// The point of light i's area at u in [0, 1)^2: p = (2u - 1, 0) on the rectangle, the
+// concentric map's (x, y, 0) on the disc, square_to_sphere(u) on the sphere. An area of size
+// 0 has zero axes: the light's position exactly.
+vec3 area_light_point(int i, vec2 u) {
+    float shape = u_point_area[3 * i].w;
+    vec3 p = shape == AREA_RECTANGLE ? vec3(2.0 * u - 1.0, 0.0)
+           : shape == AREA_DISC ? vec3(square_to_disc(u), 0.0) : square_to_sphere(u);
+    vec3 offset = p.x * u_point_area[3 * i].xyz + p.y * u_point_area[3 * i + 1].xyz
+                + p.z * u_point_area[3 * i + 2].xyz;
+    return u_point_position[i] + offset;
+}
+
+// Light i's term at P: the mean over its LIGHT_SAMPLES points q_m (the numbers of dimension
+// LIGHT + i at this ray's slot, m of LIGHT_SAMPLES) of point_term_at(q_m), each times the
+// visibility of q_m (SHADOWS; no shadow ray where the term is 0), summed in m order.
+vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
+    vec3 sum = vec3(0.0);
+    for (int m = 0; m < LIGHT_SAMPLES; ++m) {
+        vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, LIGHT_DIMENSION + uint(i),
+                                uint(m), uint(LIGHT_SAMPLES));
+        vec3 Q = area_light_point(i, u);
+        vec3 term = point_term_at(i, Q, P, N, V);
+#ifdef SHADOWS
+        term = term != vec3(0.0) ? light_visibility_at(Q, P) * term : vec3(0.0);
+#endif
+        sum += term;
+    }
+    return sum / float(LIGHT_SAMPLES);
+}
+#endif
+
+#ifdef GLOSSY
+#include "raytrace/sampling.glsl"
+#include "raytrace/warp.glsl"
+// Glossy reflection (docs/conventions.md, "Glossy reflection"): the direction D of the ray
+// reflected at the hit being shaded, with mirror direction R, outward geometric normal Ng_in
+// on the incoming side and lobe exponent `gloss`: square_to_phong_lobe of the hit's
+// GLOSSY_DIMENSION point in the basis (orthonormal_basis(R), R). False where D lies below the
+// surface (D.Ng_in <= 0): the ray is absorbed. A mirror (gloss inf) takes R exactly.
+bool glossy_direction(vec3 R, vec3 Ng_in, float gloss, out vec3 D) {
+    D = R;
+    if (isinf(gloss)) return true;
+    vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, uint(GLOSSY_DIMENSION), 0u, 1u);
+    vec3 lobe = square_to_phong_lobe(u, gloss);
+    vec3 b1, b2;
+    orthonormal_basis(R, b1, b2);
+    D = lobe.x * b1 + lobe.y * b2 + lobe.z * R;
+    return dot(D, Ng_in) > 0.0;
 }
 #endif
 
@@ -445,6 +521,11 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 bool refracted = ray_refract(Du, N_in, eta, T);
                 bool transmit = any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted;
                 bool reflect = any(greaterThanEqual(w_r, vec3(TRACE_WEIGHT_CUTOFF)));
+                vec3 R = ray_reflect(Du, N_in);
+#ifdef GLOSSY
+                if (reflect)
+                    reflect = glossy_direction(R, Ng_in, trace_texel(u_materials, 5 * obj + 3).w, R);
+#endif
                 vec3 O_t = ray_origin(P, -Ng_in, g_shape);
                 if (transmit && reflect) {      // the reflected ray first, then this one
                     trace_push(top, O_t, T, w_t, depth + 1, g_shape, 2u * key + 2u);
@@ -452,7 +533,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 }
                 if (reflect) {
                     O = ray_origin(P, Ng_in, g_shape);
-                    D = ray_reflect(Du, N_in);
+                    D = R;
                     w = w_r;
                     key = 2u * key + 1u;
                 } else if (transmit) {

@@ -34,12 +34,42 @@ vec3 square_to_sphere(vec2 u) {
     return vec3(r * cos(phi), r * sin(phi), z);
 }
 
+// -log(1 - u) for u in [0, 1), accurate relative to itself for small u too: llvmpipe's log
+// has an absolute error of about 1e-7 near 1, which log(1 - u) would make a large relative one
+// where u is small. Below 1/16 the Taylor series u (1 + u/2 + ... + u^5/6) (truncation below
+// (1/16)^6 / 7 < 2^-26 relative), above it log.
+float warp_minus_log_1m(float u) {
+    if (u >= 0.0625) return -log(1.0 - u);
+    return u * (1.0 + u * (1.0 / 2.0 + u * (1.0 / 3.0 + u * (1.0 / 4.0 + u * (1.0 / 5.0 + u / 6.0)))));
+}
+
+// 1 - exp(-t) for t >= 0, accurate relative to itself for small t too (1 - exp(-t) cancels
+// there): below ln 2 the series t (1 - t/2 (1 - t/3 (... (1 - t/9)))) (truncation below
+// (ln 2)^9 / 10! < 2^-26 relative), above it 1 - exp(-t) (which loses at most a factor 2).
+float warp_one_minus_exp(float t) {
+    if (t >= 0.693147180559945) return 1.0 - exp(-t);
+    float s = 1.0 - t / 9.0;
+    s = 1.0 - t / 8.0 * s;
+    s = 1.0 - t / 7.0 * s;
+    s = 1.0 - t / 6.0 * s;
+    s = 1.0 - t / 5.0 * s;
+    s = 1.0 - t / 4.0 * s;
+    s = 1.0 - t / 3.0 * s;
+    s = 1.0 - t / 2.0 * s;
+    return t * s;
+}
+
 // A direction about +z with the normalised Phong lobe's density (e + 1)/(2 pi) cos^e(alpha)
-// (e = 0: the uniform hemisphere): cos alpha = (1 - u0)^(1/(e + 1)) (1 - u0 in (0, 1], so pow
-// never sees 0), phi = 2 pi u1.
+// (e = 0: the uniform hemisphere): cos alpha = (1 - u0)^(1/(e + 1)), phi = 2 pi u1. Computed as
+// 1 - cos alpha = 1 - exp(-t), t = -log(1 - u0) / (e + 1), and sin alpha = sqrt((1 - cos)
+// (1 + cos)), so that a narrow lobe (cos alpha near 1) keeps its angle's relative precision:
+// sqrt(1 - cos^2) of a rounded cos would quantise it (e = 1e6: by 6 %) and turn pow's few
+// ulps into a thousand (docs/conventions.md, "Glossy reflection").
 vec3 square_to_phong_lobe(vec2 u, float exponent) {
-    float cos_alpha = pow(1.0 - u.x, 1.0 / (exponent + 1.0));
-    float sin_alpha = sqrt(max(0.0, 1.0 - cos_alpha * cos_alpha));
+    float t = warp_minus_log_1m(u.x) / (exponent + 1.0);
+    float one_minus_cos = warp_one_minus_exp(t);
+    float cos_alpha = 1.0 - one_minus_cos;
+    float sin_alpha = sqrt(one_minus_cos * (2.0 - one_minus_cos));
     float phi = WARP_TWO_PI * u.y;
     return vec3(sin_alpha * cos(phi), sin_alpha * sin(phi), cos_alpha);
 }

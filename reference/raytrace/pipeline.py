@@ -17,6 +17,9 @@ which may differ from these in the last bits: a pixel whose spread lies within D
 of the threshold is traced both ways, and the frame's rgba8_tie holds the other decision's
 colour there (comparisons accept either, as at a depth tie).
 
+Area lights (a point light with an area, of any size): `light_samples` M points on each per
+hit (renderer/core/light_areas.py's uniform, trace.py's area_light_terms).
+
 In float32 as the GPU, or in float64 (dtype=np.float64: the uniforms, offsets and lights in
 float64 too), the ground truth; the frame's ray_tree holds each pixel's hash of its samples'
 ray trees (trace.py), which tells where the two precisions disagree on a grazing ray.
@@ -36,6 +39,7 @@ from reference.raytrace.trace import mix64, trace
 from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import to_unorm8
+from renderer.core.light_areas import AREA_UNIFORM, area_light_uniforms, declares_area_lights
 from renderer.core.ray_sampling import check_first_sample, ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
@@ -51,19 +55,20 @@ DECISION_MARGIN = 2.0 ** -12
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
            max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
            rs=None, first_sample: int = 0, adaptive_threshold: float | None = None,
-           dtype=F32) -> Frame:
+           dtype=F32, light_samples: int = 1) -> Frame:
     """The frame (module docstring) of sample indices first_sample .. first_sample + N - 1;
     `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays; `dtype`
     float32 (the GPU's twin) or float64."""
     start = time.perf_counter()
     t = np.dtype(dtype).type
     rs = rs if rs is not None else ray_scene(scene)
-    sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
+    sampling = ray_sampling(pattern, samples, seed, adaptive_threshold, light_samples)
     first_sample = check_first_sample(first_sample, sampling.samples)
     matrices = scene.matrices(width, height)
     uniforms = camera_ray_uniforms(matrices.view, matrices.projection, width, height)
     uniforms = {k: v.astype(t) for k, v in uniforms.items()}
     lights = Lights.from_scene(scene, t, origin=matrices.origin)
+    areas = area_light_uniforms(scene)[AREA_UNIFORM] if declares_area_lights(scene) else None
     cam = scene.camera
     lens = _lens(cam, matrices.view, t)
     y, x = np.divmod(np.arange(width * height, dtype=np.uint32), np.uint32(width))  # row 0 at the bottom
@@ -87,7 +92,7 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
         parts = [trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near, cam.far,
                        scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS],
                        RaySamples(*(a[i:i + CHUNK_RAYS] for a in (owners.x, owners.y, owners.k)),
-                                  first_sample, sampling))
+                                  first_sample, sampling), areas)
                  for i in range(0, len(O), CHUNK_RAYS)]
         colour, hit, s = (np.concatenate(part) for part in zip(*parts))
         trees = mix64(trees.reshape(len(ks), -1) + np.asarray(ks, np.uint64)[:, None])

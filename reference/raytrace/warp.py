@@ -48,14 +48,44 @@ def square_to_sphere(u) -> np.ndarray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], -1).astype(t)
 
 
+def minus_log_1m(u) -> np.ndarray:
+    """-log(1 - u) for u in [0, 1) in u's dtype: float32 as the GLSL's warp_minus_log_1m (below
+    1/16 the Taylor series u (1 + u/2 + ... + u^5/6), above it -log(1 - u)); float64 (the
+    ground truth) -log1p(-u)."""
+    t = _t(u)
+    u = np.asarray(u, t)
+    if t is np.float64:
+        return -np.log1p(-u)
+    series = u * (t(1) + u * (t(1 / 2) + u * (t(1 / 3) + u * (t(1 / 4) + u * (t(1 / 5) + u / t(6))))))
+    with np.errstate(divide="ignore"):
+        return np.where(u >= t(0.0625), -np.log(t(1) - u), series)
+
+
+def one_minus_exp(x) -> np.ndarray:
+    """1 - exp(-x) for x >= 0 in x's dtype: float32 as the GLSL's warp_one_minus_exp (below
+    ln 2 the series x (1 - x/2 (1 - x/3 (... (1 - x/9)))), above it 1 - exp(-x)); float64 (the
+    ground truth) -expm1(-x)."""
+    t = _t(x)
+    x = np.asarray(x, t)
+    if t is np.float64:
+        return -np.expm1(-x)
+    s = t(1) - x / t(9)
+    for n in range(8, 1, -1):
+        s = t(1) - x / t(n) * s
+    return np.where(x >= t(np.log(2.0)), t(1) - np.exp(-x), x * s)
+
+
 def square_to_phong_lobe(u, exponent) -> np.ndarray:
     """Directions about +z with density (e + 1)/(2 pi) cos^e(alpha): cos alpha =
-    (1 - u0)^(1/(e + 1)), phi = 2 pi u1; `exponent` broadcasts against u's points."""
+    (1 - u0)^(1/(e + 1)), phi = 2 pi u1, computed as the GLSL: 1 - cos alpha = one_minus_exp(
+    minus_log_1m(u0) / (e + 1)), sin alpha = sqrt((1 - cos)(1 + cos)), which keeps a narrow
+    lobe's angles precise; `exponent` broadcasts against u's points."""
     t = _t(u)
     u = np.asarray(u, t)
     e = np.asarray(exponent, t)
-    cos_alpha = np.power(t(1) - u[..., 0], t(1) / (e + t(1)))
-    sin_alpha = np.sqrt(np.maximum(t(0), t(1) - cos_alpha * cos_alpha))
+    one_minus_cos = one_minus_exp(minus_log_1m(u[..., 0]) / (e + t(1)))
+    cos_alpha = t(1) - one_minus_cos
+    sin_alpha = np.sqrt(one_minus_cos * (t(2) - one_minus_cos))
     phi = t(2 * PI) * u[..., 1]
     return np.stack([sin_alpha * np.cos(phi), sin_alpha * np.sin(phi), cos_alpha], -1).astype(t)
 

@@ -190,12 +190,12 @@ class MethodComparison:
 def compare_methods(scene: Scene, width: int, height: int, *, context=None, context_kind: str = "auto",
                     samples: int = 1, pattern: str = "regular", max_depth: int | None = None,
                     seed: int = DEFAULT_SEED, adaptive_threshold: float | None = None,
-                    threshold: int = DEFAULT_THRESHOLD,
+                    light_samples: int = 1, threshold: int = DEFAULT_THRESHOLD,
                     deviation: int = DEFAULT_DEVIATION) -> MethodComparison:
     """Render CHAIN on the GPU in one GL context (`context`, else a new one of
     `context_kind`) and explain where the rasteriser and the ray tracer (samples, pattern,
-    max_depth (default the ray tracer's), seed, adaptive_threshold as RayTracer takes them)
-    differ."""
+    max_depth (default the ray tracer's), seed, adaptive_threshold, light_samples as RayTracer
+    takes them) differ."""
     from renderer.gpu.context import make_context, release_context
     from renderer.gpu.pipeline import GpuRenderer
     from renderer.gpu.raytracer import DEFAULT_MAX_DEPTH, RayTracer
@@ -232,7 +232,8 @@ def compare_methods(scene: Scene, width: int, height: int, *, context=None, cont
             if key != last:
                 with RayTracer(scene, width, height, context=ctx, samples=n, pattern=kind,
                                max_depth=depth, seed=seed, shadows=shadows,
-                               adaptive_threshold=None if centre else adaptive_threshold) as tracer:
+                               adaptive_threshold=None if centre else adaptive_threshold,
+                               light_samples=light_samples) as tracer:
                     frame = tracer.render()
                 renders += 1
             frames[name], last = frame, key

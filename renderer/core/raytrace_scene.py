@@ -10,7 +10,8 @@ renderer/gpu/raytracer.py, reference/raytrace/trace.py): made once per scene, ca
   relative to their bounds' centre, then its boxes fitted to the camera-relative triangles
   (`refit`), so that a new eye needs only a refit (`ray_scene(scene, tree=...)`: the bytes a
   build for that eye gives);
-- the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided;
+- the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided, gloss (the
+  reflected rays' lobe exponent, inf for a mirror).
 - motion blur (`motion=True`; renderer/core/motion.py): every object's motion, and the BVH is
   a `forest`: the static triangles' tree first (if there are any), then one tree per moving
   mesh object over its time-0 triangles (each built eye-free and refitted as above), which the
@@ -49,6 +50,8 @@ class RayScene:
     kt: np.ndarray                   # (M, 3)
     ior: np.ndarray                  # (M,)
     two_sided: np.ndarray            # (M,) bool
+    gloss: np.ndarray                # (M,) lobe exponent, inf: a mirror (Material.gloss_exponent)
+    gloss_set: bool = False          # some material sets `gloss` (inf included)
     motion: SceneMotion | None = None    # per object; None: no motion code (the still scene)
     mesh_object: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     # (K,) per tree of `bvh`: the object it moves with, -1 for the static triangles' tree
@@ -71,6 +74,13 @@ class RayScene:
     def secondary(self) -> bool:
         """Whether any material reflects or transmits (secondary rays exist)."""
         return bool((self.kr > 0).any() or (self.kt > 0).any())
+
+    @property
+    def glossy(self) -> bool:
+        """Whether some material that reflects (k_r or k_t > 0) has a finite gloss: the
+        reflected rays' lobe is sampled somewhere (the GLSL's GLOSSY)."""
+        reflects = (self.kr > 0).any(-1) | (self.kt > 0).any(-1)
+        return bool((reflects & np.isfinite(self.gloss)).any())
 
 
 def _normalize_or_zero(v):
@@ -127,6 +137,8 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         bvh=refit(tree, triangles) if len(triangles) else None,
         ka=rows("ka"), kd=rows("kd"), ks=rows("ks"), n=rows("n", 1), kr=rows("kr"), kt=rows("kt"),
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
+        gloss=np.array([m.gloss_exponent for m in mats], np.float64),
+        gloss_set=any(m.gloss is not None for m in mats),
         motion=scene_motion(scene) if motion else None, mesh_object=mesh_object,
     )
 

@@ -86,12 +86,22 @@ class Material:
     kr: tuple = (0.0, 0.0, 0.0)
     kt: tuple = (0.0, 0.0, 0.0)
     ior: float = 1.5
+    # Glossy reflection (ray tracer only): the Phong-lobe exponent (>= 0) about the mirror
+    # direction from which the reflected ray is drawn (docs/conventions.md, "Glossy
+    # reflection"). None, not set, is a mirror as inf is; the reference traces the lobe's code
+    # wherever some material sets it, inf included, so that inf = mirror is tested, not assumed.
+    gloss: float | None = None
 
     @property
     def has_specular(self) -> bool:
         """Whether the lighting has a specular term at all (some k_s not 0). Both pipelines
         leave the term out otherwise (renderer/gpu/shaders.py, reference/lighting.py)."""
         return any(float(k) != 0.0 for k in self.ks)
+
+    @property
+    def gloss_exponent(self) -> float:
+        """The reflected rays' lobe exponent: `gloss`, or inf (a mirror) where it is not set."""
+        return math.inf if self.gloss is None else float(self.gloss)
 
 
 ENERGY_SLACK = 1e-9
@@ -242,13 +252,40 @@ class DirectionalLight:
     shadow: Shadow = field(default_factory=Shadow)   # its shadow map (renderer/core/shadows.py)
 
 
+AreaShape = Literal["rectangle", "disc", "sphere"]
+AREA_SHAPES = ("rectangle", "disc", "sphere")
+
+
+@dataclass(frozen=True)
+class LightArea:
+    """The area a point light emits from, centred on its position, for the ray tracer's soft
+    shadows (docs/conventions.md, "Area lights"; the rasteriser lights from the centre):
+    "rectangle" of `size` (w, h) along b1, b2 of the orthonormal basis of `normal`
+    (renderer/core/light_areas.py), "disc" of `radius` across `normal`, or "sphere" of
+    `radius`. Every point of it is an isotropic point emitter with the light's intensity and
+    attenuation (the normal says where the shape lies, not where it shines); size 0 is the
+    point light."""
+    shape: AreaShape = "rectangle"
+    size: tuple = (0.0, 0.0)             # rectangle: (w, h), scene units, each >= 0
+    radius: float = 0.0                  # disc, sphere: scene units, >= 0
+    normal: tuple = (0.0, -1.0, 0.0)     # rectangle, disc: the plane's normal, not zero
+
+    @property
+    def has_size(self) -> bool:
+        """Whether the area is more than its centre (some extent > 0)."""
+        extents = self.size if self.shape == "rectangle" else (self.radius,)
+        return any(float(x) > 0.0 for x in extents)
+
+
 @dataclass
 class PointLight:
-    """A local light at `position`, attenuated by 1 / (c + l d + q d^2)."""
+    """A local light at `position`, attenuated by 1 / (c + l d + q d^2); with an `area`, the
+    ray tracer's area light centred there (LightArea)."""
     position: tuple = (0.0, 0.0, 5.0)
     intensity: tuple = (1.0, 1.0, 1.0)
     attenuation: tuple = (1.0, 0.0, 0.0)
     shadow: Shadow = field(default_factory=Shadow)   # its shadow map: six cube faces
+    area: LightArea | None = None
 
 
 @dataclass

@@ -36,9 +36,9 @@ from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core import shapes
 from renderer.core.shadow_settings import (FILTERS, MAX_BIAS_TEXELS, RESOLUTIONS, BiasRule, Shadow,
                                            auto_bias)
-from renderer.core.scene import (SHADING_MODES, Camera, DirectionalLight, Material, Mesh, Plane,
-                            PointLight, Scene, SceneObject, Sphere, Transform, energy_excess,
-                            world_shape)
+from renderer.core.scene import (AREA_SHAPES, SHADING_MODES, Camera, DirectionalLight, LightArea,
+                            Material, Mesh, Plane, PointLight, Scene, SceneObject, Sphere,
+                            Transform, energy_excess, world_shape)
 
 PROJECTIONS = ("perspective", "parallel")
 CULL_MODES = ("none", "back", "front")
@@ -49,11 +49,14 @@ TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials
 LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
                *LENS_KEYS, "shutter")
-MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior")
+MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
+AREA_KEYS = ("area", "size", "radius", "normal")   # a point light's area (LightArea), `area` first
+AREA_SHAPE_KEYS = {"rectangle": ("size", "normal"), "disc": ("radius", "normal"),
+                   "sphere": ("radius",)}
 LIGHT_KEYS = {
     "directional": ("type", "direction", "intensity", *SHADOW_KEYS),
-    "point": ("type", "position", "intensity", "attenuation", *SHADOW_KEYS),
+    "point": ("type", "position", "intensity", "attenuation", *SHADOW_KEYS, *AREA_KEYS),
 }
 BIAS_KEYS = tuple(f.name for f in dataclasses.fields(BiasRule))   # normal, constant, slope
 OBJECT_KEYS = ("name", "mesh", "shape", "material", "scale", "shear", "rotate", "translate", "parent",
@@ -313,10 +316,15 @@ class _Reader:
     def vec3(self, value: Any, path: str, *, minimum: float | None = None,
              scalar_ok: bool = False) -> tuple[float, float, float]:
         """A list of 3 finite numbers (or, where scalar_ok, one number meaning all three)."""
-        expected = "a number or a list of 3 numbers" if scalar_ok else "a list of 3 numbers"
+        return self.numbers(value, path, 3, minimum=minimum, scalar_ok=scalar_ok)
+
+    def numbers(self, value: Any, path: str, count: int, *, minimum: float | None = None,
+                scalar_ok: bool = False) -> tuple[float, ...]:
+        """A list of `count` finite numbers (or, where scalar_ok, one number meaning all)."""
+        expected = f"a number or a list of {count} numbers" if scalar_ok else f"a list of {count} numbers"
         if scalar_ok and _is_number(value):
-            value = [value] * 3
-        if not isinstance(value, (list, tuple)) or len(value) != 3:
+            value = [value] * count
+        if not isinstance(value, (list, tuple)) or len(value) != count:
             self.fail(path, f"expected {expected}, got {describe_value(value)}")
         components = []
         for i, item in enumerate(value):
@@ -503,6 +511,8 @@ class _Reader:
                 setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
         if "ior" in raw:
             mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
+        if "gloss" in raw:
+            mat.gloss = self.gloss(raw["gloss"], _join(path, "gloss"))
         channel = energy_excess(mat.kr, mat.kt)
         if channel is not None:
             where = _join(path, "kt" if "kt" in raw else "kr")
@@ -511,6 +521,15 @@ class _Reader:
                              f"(the reflected and refracted rays together carry at most the "
                              f"light that arrives)")
         return mat
+
+    def gloss(self, value: Any, path: str) -> float:
+        """A Phong-lobe exponent: a number >= 0, or inf (TOML's `inf`), the mirror."""
+        x = self.to_float(value, path) if _is_number(value) else 0.0
+        if x == math.inf:
+            return x
+        if math.isnan(x) or x < 0:
+            self.fail(path, f"must be a number >= 0 or inf (a mirror), got {show_number(x)}")
+        return self.number(value, path)
 
     def light(self, raw: dict, path: str) -> DirectionalLight | PointLight:
         if "type" not in raw:
@@ -538,10 +557,45 @@ class _Reader:
                 if not any(light.attenuation):
                     self.fail(key("attenuation"), "must not be all zero: the light is divided "
                                                   "by c + l d + q d^2")
+            light.area = self.light_area(raw, path)
         if "intensity" in raw:
             light.intensity = self.colour(raw["intensity"], key("intensity"))
         light.shadow = self.shadow(raw, path)
         return light
+
+    def light_area(self, raw: dict, path: str) -> LightArea | None:
+        """A point light's area (scene.LightArea) from its area keys: `area` names the shape,
+        which then needs its extent (`size` for a rectangle, `radius` for a disc or a sphere)
+        and takes nothing of another shape's; `normal` (rectangle, disc) defaults to [0, -1, 0]."""
+        key = lambda k: _join(path, k)   # noqa: E731
+        if "area" not in raw:
+            given = next((k for k in AREA_KEYS if k in raw), None)
+            if given:
+                self.fail(key(given), f"is for area lights; add area = one of "
+                                      f"{', '.join(map(repr, AREA_SHAPES))}")
+            return None
+        shape = self.choice(raw["area"], key("area"), "area shape", AREA_SHAPES)
+        extent = "size" if shape == "rectangle" else "radius"
+        for k in AREA_KEYS[1:]:
+            if k in raw and k not in AREA_SHAPE_KEYS[shape]:
+                owners = " and ".join(s for s in AREA_SHAPES if k in AREA_SHAPE_KEYS[s])
+                self.fail(key(k), f"is for {owners} lights, not a {shape}; a {shape} light "
+                                  f"takes {' and '.join(AREA_SHAPE_KEYS[shape])}")
+        if extent not in raw:
+            self.fail(key(extent), f"missing; a {shape} light needs "
+                                   f"{'size = [w, h]' if shape == 'rectangle' else 'radius = r'}")
+        area = LightArea(shape)
+        if shape == "rectangle":
+            area = dataclasses.replace(area, size=self.numbers(raw["size"], key("size"), 2, minimum=0.0))
+        else:
+            area = dataclasses.replace(area, radius=self.number(raw["radius"], key("radius"), minimum=0.0))
+        if "normal" in raw:
+            normal = self.vec3(raw["normal"], key("normal"))
+            if not any(normal):
+                self.fail(key("normal"), "must not be zero length: it says which way the "
+                                         f"{shape} faces")
+            area = dataclasses.replace(area, normal=normal)
+        return area
 
     def shadow(self, raw: dict, path: str) -> Shadow:
         """A light's shadow-map settings (shadow_settings.Shadow) from its shadow keys. A

@@ -8,11 +8,14 @@ hit. `render(first_sample=F)` traces sample indices F .. F + N - 1 (a uniform, n
 
 GL resources are made once in the constructor: the program, specialised by #defines for what
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
-MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, MAX_DEPTH, LENS when the
-camera's aperture is above 0, MOTION and NUM_MOVING_MESHES where something moves during the
-shutter (docs/conventions.md, "Motion blur"), and the sample pattern's constants from
-renderer/core/ray_sampling.py); the uniforms (camera rays and the thin lens from renderer/core/
-camera_rays.py, lights from renderer/core/uniforms.py, shapes, the pattern's); the
+MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, GLOSSY when such a material
+has a finite gloss, MAX_DEPTH, LENS when the camera's aperture is above 0, AREA_LIGHTS when some
+point light has an area of size > 0, MOTION and NUM_MOVING_MESHES where something moves during
+the shutter (docs/conventions.md, "Motion blur"), and the sample pattern's constants from
+renderer/core/ray_sampling.py, LIGHT_SAMPLES among them); the uniforms (camera rays and the thin
+lens from renderer/core/camera_rays.py, lights from renderer/core/uniforms.py and their areas
+from renderer/core/light_areas.py, shapes, the objects' motions from renderer/core/motion.py,
+the pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
 renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
 the camera calls update() (and resize()), which keeps all of them and writes new contents: the
@@ -21,11 +24,12 @@ changed) the compile.
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
-`shadows`), SECONDARY (where max_depth > 0), LENS (a lens of radius 0 without an aperture),
-MOTION (each moving mesh in its own tree wherever an object declares a motion) and MESHES (the
-BVH walk; a scene without static triangles gets a one-triangle tree of a degenerate triangle
-at root 0, which no ray hits). The light, sphere and
-plane counts stay compile-time constants. The image is the same.
+`shadows`), SECONDARY and GLOSSY (where max_depth > 0), LENS (a lens of radius 0 without an
+aperture), MOTION (each moving mesh in its own tree wherever an object declares a motion),
+MESHES (the BVH walk; a scene without static triangles gets a one-triangle tree of a degenerate
+triangle at root 0, which no ray hits) and AREA_LIGHTS (where there are point lights;
+renderer/core/light_areas.py). The light, sphere and plane counts stay compile-time
+constants. The image is the same.
 """
 
 from __future__ import annotations
@@ -40,8 +44,10 @@ from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.motion import declares_motion, moves, scene_motion
 from renderer.core.gl_rules import check_light_count, to_unorm8
+from renderer.core.light_areas import area_light_defines, area_light_uniforms
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import TIME_DIMENSION, check_first_sample, ray_sampling
+from renderer.core.ray_sampling import (GLOSSY_DIMENSION, TIME_DIMENSION, check_first_sample,
+                                         ray_sampling)
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
@@ -61,14 +67,14 @@ class RayTracer:
                  context: moderngl.Context | None = None, context_kind: str = "auto",
                  samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
                  seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True,
-                 adaptive_threshold: float | None = None):
+                 adaptive_threshold: float | None = None, light_samples: int = 1):
         width, height = image_size(width, height)
         if not 0 <= int(max_depth) <= MAX_DEPTH_LIMIT:
             raise ValueError(f"max_depth must be between 0 and {MAX_DEPTH_LIMIT}, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
         self.width, self.height = width, height
-        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold)
+        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold, light_samples)
         self.max_depth = int(max_depth)
         self.shadows = bool(shadows)
         self.specialise = bool(specialise)
@@ -114,9 +120,12 @@ class RayTracer:
             "NUM_PLANES": len(rs.plane_offset),
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
+            "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
+            "GLOSSY_DIMENSION": GLOSSY_DIMENSION,
             "MAX_DEPTH": self.max_depth,
             "LENS": scene.camera.has_lens or every,
             **self.sampling.defines(),
+            **area_light_defines(scene, every),
             **self._motion_defines(rs),
         }
 
@@ -141,7 +150,7 @@ class RayTracer:
         rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
         values = {name: to_glsl(value) for name, value in rays.items()}
         values.update(self._lens_values(matrices))
-        for name, value in light_uniforms(scene, matrices.origin).items():
+        for name, value in (light_uniforms(scene, matrices.origin) | area_light_uniforms(scene)).items():
             if value.size:
                 values[name] = np.asarray(value, np.float32).tobytes()
         values["u_background"] = np.asarray(scene.background, np.float32).tobytes()
@@ -175,7 +184,7 @@ class RayTracer:
         zero = np.zeros((len(rs.n), 1))
         materials = np.stack([np.concatenate(part, 1) for part in (
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
-            (rs.ks, rs.ior[:, None]), (rs.kr, zero), (rs.kt, zero))], 1)     # (M, 5, 4)
+            (rs.ks, rs.ior[:, None]), (rs.kr, rs.gloss[:, None]), (rs.kt, zero))], 1)  # (M, 5, 4)
         arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object

@@ -10,7 +10,8 @@ curved primitive at the finest tessellation (renderer/study/tessellation.py FINE
 The ray tracer's truth is the reference ray tracer (reference/raytrace/pipeline.py) in float64
 at up to RAY_TRUTH_DEPTH bounces, RAY_TRUTH_PASSES frames of RAY_TRUTH_SAMPLES jittered samples per
 pixel (1024 in all), the frames' sample indices following one another (first_sample), so each
-frame draws new, independent strata; its seed is not the sweep's. The frames' average linear
+frame draws new, independent strata; its seed is not the sweep's; a scene with area lights
+takes RAY_TRUTH_LIGHT_SAMPLES points on each per hit. The frames' average linear
 colour, clamped to [0, 1], is the truth: what the tracer shows of a pixel, as the frames it is
 compared with. A frame at a time bounds the memory (the reference holds a frame's rays at once).
 
@@ -28,6 +29,7 @@ import numpy as np
 
 import reference
 from renderer.core.imageio import write_npy
+from renderer.core.light_areas import uses_area_lights
 from renderer.core.paths import output_stem
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.raytrace_scene import ray_scene
@@ -45,6 +47,9 @@ RAY_TRUTH_DEPTH = MAX_DEPTH_LIMIT      # as deep as the tracer goes (its weight 
                                        # a ray tree before that: renderer/core/ray_depth.py)
 RAY_TRUTH_SEED = DEFAULT_SEED + 1      # not the seed of the swept patterns' samples
 RAY_TRUTH_VERSION = 1                  # bump when the ray truth's recipe changes
+RAY_TRUTH_LIGHT_SAMPLES = 4            # per area light and hit, where the scene has area lights:
+                                       # 4096 shadow rays per pixel and light, 16 times the
+                                       # light_samples knob's most (renderer/study/distributed_report.py)
 
 
 def default_cache_dir() -> Path:
@@ -83,6 +88,8 @@ def cache_path(scene: Scene, width: int, height: int, cache_dir, method: str = "
         drawn, stem = scene, f"{output_stem(scene)}-raytrace"
         recipe = (f"jittered={RAY_TRUTH_SAMPLES}x{RAY_TRUTH_PASSES} depth={RAY_TRUTH_DEPTH} "
                   f"seed={RAY_TRUTH_SEED} v{RAY_TRUTH_VERSION}")
+        if truth_light_samples(scene) > 1:          # (other scenes keep their cached truths)
+            recipe += f" light_samples={truth_light_samples(scene)}"
     key = hashlib.sha256(f"{scene_digest(drawn)} {width}x{height} {recipe}".encode()).hexdigest()[:24]
     return Path(cache_dir) / f"{stem}-{width}x{height}-{key}.npy"
 
@@ -99,6 +106,12 @@ def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     return blocks.mean(axis=(1, 3))
 
 
+def truth_light_samples(scene: Scene) -> int:
+    """The light samples per hit of the ray tracer's truth: RAY_TRUTH_LIGHT_SAMPLES where some
+    point light has an area, else 1 (more would change nothing)."""
+    return RAY_TRUTH_LIGHT_SAMPLES if uses_area_lights(scene) else 1
+
+
 def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     """(H, W, 3) float64: the ray tracer's truth rendered now (see the module docstring)."""
     from reference.raytrace.pipeline import render
@@ -107,7 +120,8 @@ def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     for frame in range(RAY_TRUTH_PASSES):
         total += render(scene, width, height, samples=RAY_TRUTH_SAMPLES, pattern="jittered",
                         max_depth=RAY_TRUTH_DEPTH, seed=RAY_TRUTH_SEED, rs=rs, dtype=np.float64,
-                        first_sample=frame * RAY_TRUTH_SAMPLES).linear[..., :3]
+                        first_sample=frame * RAY_TRUTH_SAMPLES,
+                        light_samples=truth_light_samples(scene)).linear[..., :3]
     return clamped(total / RAY_TRUTH_PASSES)
 
 

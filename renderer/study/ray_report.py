@@ -13,6 +13,8 @@ RAY_TRUTH_DEPTH) make one row of results.csv, with report.py's metrics.
     max_depth       0 .. RAY_TRUTH_DEPTH bounces                        jittered, RAY_BASE_SAMPLES
     precision       float32, float64 (reference only)                   jittered, RAY_BASE_SAMPLES,
                                                                         the truth's depth
+    light_samples, lens, time, glossy: the distributed effects' knobs, on the scenes that use
+                    them (renderer/study/distributed_report.py)
 
 A setting is one frame of the tracer: its N samples per pixel are looped in the shader (in the
 reference, traced as one wavefront), so its time grows with the rays it traces, and the
@@ -34,6 +36,8 @@ from renderer.core.ray_sampling import FIRST_SET
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED, PATTERNS
 from renderer.core.scene import Plane, Sphere
+from renderer.study.distributed_report import (distributed_settings,
+                                               settings_for_scene)
 from renderer.study.metrics import metrics
 from renderer.study.ground_truth import (RAY_TRUTH_DEPTH, RAY_TRUTH_SAMPLES, ground_truth)
 from renderer.study.report_settings import (RAY_BASE_SAMPLES, RAY_CSV_COLUMNS, RAY_DEFAULT_SIZE,
@@ -51,11 +55,13 @@ class RaySweep:
     thresholds: tuple = (1, 4, 16)                   # adaptive, in levels of 255: a series each
     depths: tuple = (0, 1, 2, 3, 4, 8, 16, RAY_TRUTH_DEPTH)
     patterns: tuple = tuple(PATTERNS)
+    light_counts: tuple = (1, 4, 16, 64)             # light samples per hit (light_samples)
     runs: int = 5                                    # as the rasteriser's: GPU times are noisy
 
 
 RAY_FULL = RaySweep()
-RAY_QUICK = RaySweep(sample_counts=(1, 4, 16), thresholds=(4,), depths=(0, 1, 4, RAY_TRUTH_DEPTH))
+RAY_QUICK = RaySweep(sample_counts=(1, 4, 16), thresholds=(4,), depths=(0, 1, 4, RAY_TRUTH_DEPTH),
+                     light_counts=(1, 4, 16))
 
 
 @dataclass(frozen=True)
@@ -69,16 +75,19 @@ class RaySetting:
     max_depth: int
     threshold: float | None = None   # adaptive: the spread that refines a pixel
     dtype: str = "float32"           # the reference's (the GPU's is float32)
+    light_samples: int = 1           # M per area light and hit
 
     def columns(self) -> dict:
         """The columns of results.csv that name this setting."""
         return {"knob": self.knob, "setting": self.setting, "backend": self.backend,
-                "pattern": self.pattern, "max_depth": self.max_depth, "threshold": self.threshold}
+                "pattern": self.pattern, "light_samples": self.light_samples,
+                "max_depth": self.max_depth, "threshold": self.threshold}
 
     def options(self) -> dict:
         """The keyword arguments of RayTracer and of the reference's render."""
         return {"samples": self.samples, "pattern": self.pattern, "max_depth": self.max_depth,
-                "seed": DEFAULT_SEED, "adaptive_threshold": self.threshold}
+                "seed": DEFAULT_SEED, "adaptive_threshold": self.threshold,
+                "light_samples": self.light_samples}
 
 
 def ray_settings(sweep: RaySweep) -> list[RaySetting]:
@@ -98,7 +107,7 @@ def ray_settings(sweep: RaySweep) -> list[RaySetting]:
                 for b in BACKENDS]
     out += [RaySetting("precision", dtype, "reference", "jittered", RAY_BASE_SAMPLES,
                        RAY_TRUTH_DEPTH, dtype=dtype) for dtype in ("float32", "float64")]
-    return out
+    return out + distributed_settings(RaySetting, sweep, RAY_TRUTH_DEPTH)
 
 
 class RaySceneRun:
@@ -135,7 +144,7 @@ class RayStudy:
     """The ray tracer's sweep (module docstring), as report.py's run_report drives it."""
     method = "raytrace"
     columns = RAY_CSV_COLUMNS
-    knobs = ("antialiasing", "max_depth", "precision")
+    knobs = ("antialiasing", "max_depth", "precision", "light_samples", "lens", "time", "glossy")
 
     def sweep(self, quick: bool) -> RaySweep:
         return RAY_QUICK if quick else RAY_FULL
@@ -162,7 +171,8 @@ class RayStudy:
         return ray_settings(sweep)
 
     def scene_settings(self, plan: list[RaySetting], scene, width: int, height: int) -> list[RaySetting]:
-        return plan                                      # every scene gets every setting
+        """Each distributed knob only where the scene uses its effect (distributed_report.py)."""
+        return settings_for_scene(plan, scene)
 
     def needs_truth(self, plan: list[RaySetting]) -> bool:
         return bool(plan)

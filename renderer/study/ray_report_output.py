@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from renderer.study.ground_truth import (RAY_TRUTH_DEPTH, RAY_TRUTH_PASSES, RAY_TRUTH_SAMPLES,
                                          RAY_TRUTH_SEED)
+from renderer.study.distributed_report import distributed_sections
 from renderer.study.report_output import (cheapest_sections, convergence_slopes, errors_bullet,
                                           generated_line, plots_section, series_name, spread)
 from renderer.study.report_settings import RAY_BASE_SAMPLES, RAY_TEXTBOOK_SLOPES
@@ -87,6 +88,7 @@ def ray_report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "of its pattern (fixed seeds).",
         "",
         *_slope_lines(rows),
+        *distributed_sections(rows),
     ]
     lines += cheapest_sections(rows, scenes, "which trace at the truth's depth")
     lines += plots_section(scenes, plots)

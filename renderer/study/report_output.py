@@ -16,8 +16,8 @@ import numpy as np
 
 from renderer.core import sampling
 from renderer.study.ground_truth import TRUTH_GRID
-from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, MISMATCH_LEVELS, TARGETS_RMSE,
-                                            TEXTBOOK_SLOPES)
+from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, MISMATCH_LEVELS,
+                                            PATTERN_KNOBS, TARGETS_RMSE, TEXTBOOK_SLOPES)
 from renderer.study.shadow_report import method_bullet, shadow_sections
 
 BACKENDS = ("gpu", "reference")
@@ -56,8 +56,9 @@ def series_name(row: dict) -> str:
 
 
 def series_key(row: dict) -> str:
-    """The plot series a row belongs to: series_name and backend for anti-aliasing, else backend."""
-    return f"{series_name(row)} ({row['backend']})" if row["knob"] == "antialiasing" else row["backend"]
+    """The plot series a row belongs to: series_name and backend for anti-aliasing (and the
+    distributed knobs, whose series are patterns too), else backend."""
+    return f"{series_name(row)} ({row['backend']})" if row["knob"] in PATTERN_KNOBS else row["backend"]
 
 
 def _colour(name: str, names: list[str]) -> str:
@@ -87,11 +88,11 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
         members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         first = members[0]
         marker, line = STYLES[first["backend"]]
-        colour = (_colour(series_name(first), names) if first["knob"] == "antialiasing"
+        colour = (_colour(series_name(first), names) if first["knob"] in PATTERN_KNOBS
                   else f"C{index}")
         axes.plot([r["median_ms"] for r in members], [r[error] for r in members], marker=marker,
                   linestyle=line, markersize=4, linewidth=1, color=colour, label=name)
-        if first["knob"] != "antialiasing":              # few points: name each one
+        if first["knob"] not in PATTERN_KNOBS:          # few points: name each one
             for r in members:
                 acne = f" (acne {r['acne_pixels']})" if r.get("acne_pixels") else ""
                 axes.annotate(r["setting"] + acne, (r["median_ms"], r[error]), fontsize=6,
@@ -103,7 +104,7 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
                   color="black", linestyle="--", linewidth=0.8)
         axes.scatter([r["median_ms"] for r in front], [r[error] for r in front], s=90,
                      facecolors="none", edgecolors="black", label="Pareto front", zorder=3)
-        for r in front if front[0]["knob"] == "antialiasing" else ():
+        for r in front if front[0]["knob"] in PATTERN_KNOBS else ():
             axes.annotate(f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r[error]),
                           fontsize=6, xytext=(4, 3), textcoords="offset points")
     axes.set_xscale("log")
@@ -136,15 +137,17 @@ def _fit(x: np.ndarray, y: np.ndarray) -> float:
     return float(np.sum(x * y) / np.sum(x * x))
 
 
-def convergence_slopes(rows: list[dict], series=tuple(sampling.PATTERNS), x: str = "samples") -> dict:
-    """(series, backend) -> Slope of log RMSE against log `x` ("samples" or "median_ms"), for
-    the anti-aliasing rows of each of `series` (series_name)."""
+def convergence_slopes(rows: list[dict], series=tuple(sampling.PATTERNS), x: str = "samples",
+                       knob: str = "antialiasing") -> dict:
+    """(series, backend) -> Slope of log RMSE against log `x` ("samples", "light_samples" or
+    "median_ms"), for the rows of `knob` (the anti-aliasing rows by default) of each of
+    `series` (series_name)."""
     slopes = {}
     for name in series:
         for backend in BACKENDS:
             by_scene = defaultdict(list)
             for row in rows:
-                if row["knob"] == "antialiasing" and series_name(row) == name \
+                if row["knob"] == knob and series_name(row) == name \
                         and row["backend"] == backend and row["rmse"] > 0:
                     by_scene[row["scene"]].append((row[x], math.log(row["rmse"]), row["samples"]))
             centred = []

@@ -56,11 +56,17 @@ RAY_QUICK_SIZE = (64, 48)
 RAY_QUICK_SCENES = ("classic",)
 RAY_MAX_SIZE = (320, 240)            # its ground truth traces 1024 rays per pixel in float64
 RAY_BASE_SAMPLES = 16                # jittered, for the knobs other than antialiasing
-RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "max_depth",
-                   "threshold", "runs", "median_ms", "rmse", "max_abs", "psnr", "flip_mean",
+RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "light_samples",
+                   "max_depth", "threshold", "runs", "median_ms", "rmse", "max_abs", "psnr", "flip_mean",
                    "mismatched_fraction")
 RAY_TEXTBOOK_SLOPES = TEXTBOOK_SLOPES | {
     "adaptive": ("none", "N is the mean traced: samples 5..N only where the first 4 disagree "
                  "(edges, shadow boundaries), so the error falls faster in N than jittered's, "
                  "until what the first 4 miss sets a floor"),
 }
+
+# The ray tracer's distributed effects (renderer/study/distributed_report.py): a knob per
+# dimension; with antialiasing, the knobs whose series are sampling patterns.
+EFFECT_KNOBS = ("lens", "time", "glossy")
+DISTRIBUTED_KNOBS = ("light_samples", *EFFECT_KNOBS)
+PATTERN_KNOBS = ("antialiasing", *DISTRIBUTED_KNOBS)

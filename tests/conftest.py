@@ -94,7 +94,8 @@ def pytest_terminal_summary(terminalreporter, exitstatus, config):
 # (measured at load average 3, 2026-12-01) for no rasteriser feature the other scenes lack.
 # Their ray-tracing tests are tests/test_raytrace_scenes.py.
 RAYTRACE_SCENES = frozenset({"classic", "cornell_box", "mesh_shadow", "tir_bubble",
-                             "depth_of_field", "soft_shadows", "glossy"})
+                             "depth_of_field", "soft_shadows", "glossy",
+                             "motion_blur"})
 # The built-in scenes made for shadow maps (issue 15): rasteriser scenes, held in the default
 # run like the others; their spheres and floors are analytic shapes so that the ray tracer's
 # shadow rays, their truth, see exact surfaces (tests/test_scene_shapes.py).

@@ -222,17 +222,21 @@ def test_the_ray_tracers_extreme_cases_are_the_issues():
     """Issue 14's list: a ray grazing a sphere; spheres of radius 1e-4 and 1e4; a scene 1e6
     from the origin; a light on a surface; a camera inside a glass sphere; total internal
     reflection; a coplanar plane and triangle; max depth 0 and 64. Issue 16's: an aperture
-    larger than the scene (4 samples, each its own lens point)."""
-    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_grazing_sphere", "rt_huge_aperture",
-                          "rt_huge_sphere", "rt_inside_glass", "rt_light_on_surface", "rt_mirrors",
-                          "rt_tiny_sphere", "rt_total_internal_reflection"]
+    larger than the scene (4 samples, each its own lens point); an object moving 100 scene units
+    during the shutter (4 samples, each its own time)."""
+    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_fast_motion", "rt_grazing_sphere",
+                          "rt_huge_aperture", "rt_huge_sphere", "rt_inside_glass", "rt_light_on_surface",
+                          "rt_mirrors", "rt_tiny_sphere", "rt_total_internal_reflection"]
+    fast = extreme_scene("rt_fast_motion")
+    assert [float(np.linalg.norm(o.velocity)) for o in fast.objects] == [100.0] * 3
+    assert fast.camera.shutter == (0.0, 1.0) and RAYTRACE_SAMPLING["rt_fast_motion"] == (4, "regular")
     radii = {name: [s.radius for s in extreme_scene(name).world_shapes() if hasattr(s, "radius")]
              for name in ("rt_tiny_sphere", "rt_huge_sphere")}
     assert min(radii["rt_tiny_sphere"]) == pytest.approx(1e-4) and max(radii["rt_huge_sphere"]) == pytest.approx(1e4)
     assert RAYTRACE_DEPTHS == {"rt_mirrors": (0, 64)}
     huge = extreme_scene("rt_huge_aperture")
     span = np.ptp([s.centre for s in huge.world_shapes() if hasattr(s, "radius")], axis=0).max() + 1.0
-    assert huge.camera.aperture > 10 * span and RAYTRACE_SAMPLING == {"rt_huge_aperture": (4, "jittered")}
+    assert huge.camera.aperture > 10 * span and RAYTRACE_SAMPLING["rt_huge_aperture"] == (4, "jittered")
 
 
 def ray_traced_cases() -> list:

@@ -16,7 +16,7 @@ import pytest
 
 from reference.raytrace.bvh import any_hit, closest_hit, closest_hit_brute_force, inverse_direction, ray_box
 from reference.raytrace.intersect import ray_triangle
-from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, mesh_vertices, refit, texels
+from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, forest, mesh_vertices, refit, roots, texels
 from renderer.core.primitives import icosphere
 
 GLSL = Path(__file__).parent / "glsl"
@@ -243,6 +243,31 @@ def test_twin_equals_brute_force_on_a_soup():
     assert assert_same_closest_hit(V, O, D, answer, closest_hit_brute_force(V, O, D)) == 0
 
 
+def test_a_forest_walks_each_tree_from_its_root(gl_contexts):
+    """A forest (motion blur's layout: several trees in one pair of textures, each tree's node
+    and triangle indices offset by those before it): the walk from each tree's root answers as
+    that tree alone, closest hit and any hit, in the twin and in the GLSL (bit for bit the
+    GPU's walk of the tree alone); triangles keep the numbering their trees were given."""
+    A, B = soup(400, 20), soup(300, 21)
+    second = build_bvh(B)
+    numbered = second.triangles.copy()
+    numbered[:, 0, 3] += len(A)                        # B's triangles after A's
+    trees = [build_bvh(A), Bvh(second.nodes, numbered, second.depth)]
+    both = forest(trees)
+    assert roots(both).tolist() == [0, len(trees[0].nodes)] and roots(trees[1]).tolist() == [0]
+    assert len(both.triangles) == 700 and refit(both, np.concatenate([A, B])).nodes.tolist() == both.nodes.tolist()
+    O, D = random_rays(32 * 32, 22, spread=1.2)
+    for root, tree in zip(roots(both), trees):
+        alone, walked = closest_hit(tree, O, D), closest_hit(both, O, D, root=root)
+        assert 0.1 < alone[0].mean() < 0.9, alone[0].mean()
+        for a, b in zip(alone, walked):
+            assert np.array_equal(a, b)
+        assert np.array_equal(any_hit(both, O, D, root=root), alone[0])
+        ctx = gl_contexts["egl"]
+        rays = O.reshape(32, 32, 3), D.reshape(32, 32, 3)
+        assert np.array_equal(gpu_closest_hits(ctx, both, *rays, root=root), gpu_closest_hits(ctx, tree, *rays))
+
+
 def test_any_hit_answers_as_closest_hit_does(sphere):
     """The shadow rays' walk stops at its first hit: whether something is hit is closest_hit's
     answer, ray for ray, whatever s_max (here from 0.5 to 4, and infinite)."""
@@ -269,11 +294,13 @@ def test_twin_equals_brute_force_on_the_icosphere(sphere):
 WIDTH, HEIGHT = 64, 64
 
 
-def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30, any_hit=False):
+def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30, any_hit=False, root=0):
     """(s, triangle, u, v) per ray from bvh_closest_hit; any_hit: (1 or 0, 0, 0, 0) from
-    bvh_any_hit."""
+    bvh_any_hit; both walking the tree whose root node is `root`."""
     from renderer.gpu.bvh import bvh_textures
+    from renderer.gpu.context import activate
     from renderer.gpu.shaders import shader_source
+    activate(ctx)               # a test run before (the command line's) may leave another current
     fragment = shader_source("raytrace_bvh.frag", {"ANY_HIT": any_hit}, directory=GLSL).text
     program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
                           fragment_shader=fragment)
@@ -290,6 +317,7 @@ def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30, any_hit=False):
             program[name].value = unit
         program["u_s_min"].value = s_min
         program["u_s_max"].value = s_max
+        program["u_root"].value = root
         framebuffer.use()
         vao.render(vertices=3)
         ctx.finish()

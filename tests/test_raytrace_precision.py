@@ -142,10 +142,10 @@ def test_a_branching_tree_stays_within_the_bound():
     sizes = []
     scene_hit = trace_module.scene_hit
 
-    def counting(rs, O, D, s_min, s_max, from_shape=None):
+    def counting(rs, O, D, s_min, s_max, *rest):
         if np.ndim(s_max) == 0:                   # a wavefront (shadow rays pass an array)
             sizes.append(len(O))
-        return scene_hit(rs, O, D, s_min, s_max, from_shape)
+        return scene_hit(rs, O, D, s_min, s_max, *rest)
 
     trace_module.scene_hit = counting
     try:

@@ -318,6 +318,8 @@ def test_distributed_knobs_go_to_the_scenes_that_use_their_effect():
     assert knobs["depth_of_field"] == {"max_depth", "precision", "lens"}
     assert knobs["classic"] == {"antialiasing", "max_depth", "precision"}
     assert scene_effects(load_scene(builtin_scenes()["depth_of_field"])) == {"lens"}
+    assert scene_effects(load_scene(builtin_scenes()["motion_blur"])) == {"time"}
+    assert scene_effects(load_scene(builtin_scenes()["glossy"])) == {"glossy"}
 
 
 @pytest.mark.slow                       # the truth of 4096 shadow rays per pixel

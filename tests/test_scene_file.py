@@ -27,7 +27,7 @@ BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_p
                  "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
                  "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble",
                  "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "soft_shadows",
-                 "glossy"}
+                 "glossy", "motion_blur"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera), or a backdrop (tir_bubble's checkerboard) filling the view.
 PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room"}
@@ -470,7 +470,7 @@ BAD_SCENES = [
     ("unknown camera key", "[camera]\nfovy = 40\n", "camera.fovy: unknown key; did you mean 'fov_y'?"),
     ("unknown key, no close match", "[camera]\nzoom = 2\n",
      "camera.zoom: unknown key; known keys here: eye, look, up, projection, fov_y, height, near, far, reversed_z, "
-     "aperture, focus_distance"),
+     "aperture, focus_distance, shutter"),
     ("unknown inline material key", OBJECT + 'material = { kdd = [1, 0, 0] }\n',
      "objects[0].material.kdd: unknown key; did you mean 'kd'?"),
     ("unknown light key for its type", '[[lights]]\ntype = "directional"\nposition = [0, 1, 0]\n',
@@ -742,6 +742,26 @@ BAD_SCENES = [
      "objects[0].receives_shadows: expected true or false, got a string ('no')"),
     ("misspelt casts_shadows", OBJECT + "cast_shadows = false\n",
      "objects[0].cast_shadows: unknown key; did you mean 'casts_shadows'?"),
+    # motion blur (the ray tracer's)
+    ("negative shutter interval", "[camera]\nshutter = [1.0, 0.5]\n",
+     "camera.shutter: negative shutter interval: close 0.5 is before open 1; the shutter is "
+     "[open, close] with open <= close"),
+    ("shutter as a number", "[camera]\nshutter = 1.0\n",
+     "camera.shutter: expected a list of 2 numbers [open, close], got a number (1)"),
+    ("shutter of three", "[camera]\nshutter = [0, 1, 2]\n",
+     "camera.shutter: expected a list of 2 numbers [open, close], got a list of 3 items"),
+    ("nan shutter", "[camera]\nshutter = [0, nan]\n",
+     "camera.shutter[1]: expected a finite number, got nan"),
+    ("infinite shutter", "[camera]\nshutter = [-inf, 0]\n",
+     "camera.shutter[0]: expected a finite number, got -inf"),
+    ("velocity with a string", OBJECT + 'velocity = [1, "fast", 0]\n',
+     "objects[0].velocity: expected a list of 3 numbers, item 1 is a string ('fast')"),
+    ("infinite velocity", OBJECT + "velocity = [inf, 0, 0]\n",
+     "objects[0].velocity: expected finite numbers, item 0 is inf"),
+    ("nan angular velocity", OBJECT + "angular_velocity = [0, nan, 0]\n",
+     "objects[0].angular_velocity: expected finite numbers, item 1 is nan"),
+    ("misspelt angular velocity", OBJECT + "angular_speed = [0, 1, 0]\n",
+     "objects[0].angular_speed: unknown key; did you mean 'angular_velocity'?"),
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
      "two_sided, shading, kr, kt, ior, gloss"),

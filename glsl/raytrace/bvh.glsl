@@ -1,7 +1,8 @@
 // Twin: reference/raytrace/bvh.py
 // The closest hit of a ray P = O + s D against the triangles of a BVH (docs/conventions.md,
 // "Rays"), traversed depth first with a fixed stack, the nearer child first; and whether any
-// triangle is hit (shadow rays), which stops at the first hit it finds. The BVH is two
+// triangle is hit (shadow rays), which stops at the first hit it finds. Both walk the tree whose
+// root node is `root`: 0, or one of the trees of a forest (renderer/core/bvh.py, motion blur). The BVH is two
 // RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width),
 // the width a power of two):
 //   nodes:     texel 2i = [min.xyz, a], texel 2i + 1 = [max.xyz, count]; count > 0: a leaf of
@@ -56,10 +57,10 @@ int bvh_node(sampler2D nodes, int node, out int a) {
 }
 
 // Whether the ray meets the root's box in [s_min, s_max].
-bool bvh_meets_root(sampler2D nodes, vec3 O, vec3 inv_D, float s_min, float s_max) {
+bool bvh_meets_root(sampler2D nodes, int root, vec3 O, vec3 inv_D, float s_min, float s_max) {
     float near;
-    return bvh_ray_box(O, inv_D, bvh_texel(nodes, 0).xyz, bvh_texel(nodes, 1).xyz, s_min, s_max,
-                       near);
+    return bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * root).xyz, bvh_texel(nodes, 2 * root + 1).xyz,
+                       s_min, s_max, near);
 }
 
 // Triangle j of the triangles texture: its vertices A, B, C and its original index.
@@ -86,8 +87,8 @@ void bvh_children(sampler2D nodes, int node, int a, vec3 O, vec3 inv_D, float s_
 
 // Whether a triangle is hit with s_min < s < s_max; s the nearest hit's parameter (s_max on a
 // miss), uv its barycentric (u, v), triangle its original index (-1 on a miss).
-bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float s_min,
-                     float s_max, out float s, out vec2 uv, out int triangle) {
+bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec3 D,
+                     float s_min, float s_max, out float s, out vec2 uv, out int triangle) {
     vec3 inv_D = 1.0 / D;
     s = s_max;
     uv = vec2(0.0);
@@ -95,8 +96,8 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
     int stack[BVH_STACK_SIZE];
     float stack_near[BVH_STACK_SIZE];
     int top = 0;
-    if (!bvh_meets_root(nodes, O, inv_D, s_min, s)) return false;
-    int node = 0;
+    if (!bvh_meets_root(nodes, root, O, inv_D, s_min, s)) return false;
+    int node = root;
     while (true) {
         int a;
         int count = bvh_node(nodes, node, a);
@@ -158,13 +159,13 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float
 // Whether any triangle is hit with s_min < s < s_max (a shadow ray): the same walk, but it stops
 // at the first hit it finds and takes the children in stored order (no nearest-first ordering,
 // no distances on the stack, s_max fixed), so it answers as bvh_closest_hit's return value.
-bool bvh_any_hit(sampler2D nodes, sampler2D triangles, vec3 O, vec3 D, float s_min,
+bool bvh_any_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec3 D, float s_min,
                  float s_max) {
     vec3 inv_D = 1.0 / D;
     int stack[BVH_STACK_SIZE];
     int top = 0;
-    if (!bvh_meets_root(nodes, O, inv_D, s_min, s_max)) return false;
-    int node = 0;
+    if (!bvh_meets_root(nodes, root, O, inv_D, s_min, s_max)) return false;
+    int node = root;
     bool hit = false;
     while (true) {
         int a;

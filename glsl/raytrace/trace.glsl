@@ -7,9 +7,9 @@
 // waiting on a fixed-size stack) in a loop of bounded length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
 // SECONDARY (some k_r or k_t > 0), GLOSSY (such a material has a finite gloss: reflected rays
-// drawn from a lobe; GLOSSY_DIMENSION its dimension), MAX_DEPTH, and lighting.glsl's light
-// counts and SPECULAR; AREA_LIGHTS (some point light has an area of size > 0: LIGHT_SAMPLES
-// shadow rays to points of it per hit, area_light_term).
+// drawn from a lobe; GLOSSY_DIMENSION its dimension), MAX_DEPTH, MOTION and NUM_MOVING_MESHES
+// (motion blur), and lighting.glsl's light counts and SPECULAR; AREA_LIGHTS (some point light
+// has an area of size > 0: LIGHT_SAMPLES shadow rays to points of it per hit, area_light_term).
 
 #include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
 #include "raytrace/optics.glsl"
@@ -40,6 +40,80 @@ uniform vec4 u_planes[NUM_PLANES];              // (unit N, d): P.N + d = 0
 uniform int u_plane_object[NUM_PLANES];
 #endif
 uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, gloss), (kt, 0)
+
+#ifndef NUM_MOVING_MESHES
+#define NUM_MOVING_MESHES 0
+#endif
+#ifdef MOTION
+// Motion blur (docs/conventions.md, "Motion blur"): each sphere's, plane's and moving mesh's
+// motion as rows (c, rate), (v, 0), (axis, 0) (renderer/core/motion.py); trace_motion_at puts
+// the spheres and planes where they are at the camera sample's time (g_spheres, g_planes) and
+// takes each moving mesh's motion at that time (g_mesh_motion), once per camera sample: its
+// reflected, transmitted and shadow rays see the scene at the same time. A moving mesh has its
+// own tree in u_nodes (root u_mesh_root), walked with the ray moved into its time-0 frame.
+#include "raytrace/motion.glsl"
+uniform vec2 u_shutter;
+#if NUM_SPHERES > 0
+uniform vec4 u_sphere_motion[3 * NUM_SPHERES];
+vec4 g_spheres[NUM_SPHERES];
+#endif
+#if NUM_PLANES > 0
+uniform vec4 u_plane_motion[3 * NUM_PLANES];
+vec4 g_planes[NUM_PLANES];
+#endif
+#if NUM_MOVING_MESHES > 0
+uniform vec4 u_mesh_motion[3 * NUM_MOVING_MESHES];
+uniform int u_mesh_root[NUM_MOVING_MESHES];
+uniform int u_mesh_object[NUM_MOVING_MESHES];
+Motion g_mesh_motion[NUM_MOVING_MESHES];
+#endif
+
+void trace_motion_at(float t) {
+#if NUM_SPHERES > 0
+    for (int k = 0; k < NUM_SPHERES; ++k) {
+        Motion m = motion_at(u_sphere_motion[3 * k], u_sphere_motion[3 * k + 1],
+                             u_sphere_motion[3 * k + 2], t);
+        g_spheres[k] = vec4(motion_point(m, u_spheres[k].xyz), u_spheres[k].w);
+    }
+#endif
+#if NUM_PLANES > 0
+    for (int k = 0; k < NUM_PLANES; ++k) {
+        Motion m = motion_at(u_plane_motion[3 * k], u_plane_motion[3 * k + 1],
+                             u_plane_motion[3 * k + 2], t);
+        vec3 N;
+        float d;
+        motion_plane(m, u_planes[k].xyz, u_planes[k].w, N, d);
+        g_planes[k] = vec4(N, d);
+    }
+#endif
+#if NUM_MOVING_MESHES > 0
+    for (int k = 0; k < NUM_MOVING_MESHES; ++k) {
+        g_mesh_motion[k] = motion_at(u_mesh_motion[3 * k], u_mesh_motion[3 * k + 1],
+                                     u_mesh_motion[3 * k + 2], t);
+    }
+#endif
+}
+#endif
+
+// Sphere k (centre, radius) and plane k (unit N at time 0, d) at this camera sample's time.
+#if NUM_SPHERES > 0
+vec4 trace_sphere(int k) {
+#ifdef MOTION
+    return g_spheres[k];
+#else
+    return u_spheres[k];
+#endif
+}
+#endif
+#if NUM_PLANES > 0
+vec4 trace_plane(int k) {
+#ifdef MOTION
+    return g_planes[k];
+#else
+    return u_planes[k];
+#endif
+}
+#endif
 uniform vec3 u_background;
 
 #include "lighting.glsl"
@@ -80,8 +154,8 @@ int scene_hit(vec3 O, vec3 D, float s_min, float s_max, int from_shape,
     float s_k;
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        vec3 C = u_spheres[k].xyz;
-        float r = u_spheres[k].w;
+        vec3 C = trace_sphere(k).xyz;
+        float r = trace_sphere(k).w;
         if (ray_sphere_from(O, D, C, r, k == from_shape, s_min, s_limit, s_k)) {
             s = s_k; s_limit = s_k * (1.0 - TRACE_HIT_TIE); kind = TRACE_SPHERE; index = k;
         }
@@ -90,7 +164,7 @@ int scene_hit(vec3 O, vec3 D, float s_min, float s_max, int from_shape,
 #if NUM_PLANES > 0
     for (int k = 0; k < NUM_PLANES; ++k) {
         if (NUM_SPHERES + k != from_shape
-                && ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s_limit, s_k)) {
+                && ray_plane(O, D, trace_plane(k).xyz, trace_plane(k).w, s_min, s_limit, s_k)) {
             s = s_k; s_limit = s_k * (1.0 - TRACE_HIT_TIE); kind = TRACE_PLANE; index = k;
         }
     }
@@ -98,9 +172,19 @@ int scene_hit(vec3 O, vec3 D, float s_min, float s_max, int from_shape,
 #ifdef MESHES
     vec2 uv_t;
     int triangle;
-    if (bvh_closest_hit(u_nodes, u_triangles, O, D, s_min, s_limit, s_k, uv_t, triangle)) {
-        s = s_k; kind = TRACE_TRIANGLE; index = triangle; uv = uv_t;
+    if (bvh_closest_hit(u_nodes, u_triangles, 0, O, D, s_min, s_limit, s_k, uv_t, triangle)) {
+        s = s_k; s_limit = s_k; kind = TRACE_TRIANGLE; index = triangle; uv = uv_t;
     }
+#if NUM_MOVING_MESHES > 0
+    for (int m = 0; m < NUM_MOVING_MESHES; ++m) {
+        if (bvh_closest_hit(u_nodes, u_triangles, u_mesh_root[m],
+                            motion_point_back(g_mesh_motion[m], O),
+                            motion_direction_back(g_mesh_motion[m], D), s_min, s_limit, s_k, uv_t,
+                            triangle)) {
+            s = s_k; s_limit = s_k; kind = TRACE_TRIANGLE; index = triangle; uv = uv_t;
+        }
+    }
+#endif
 #endif
     return kind;
 }
@@ -114,14 +198,14 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
     obj = 0;
 #if NUM_SPHERES > 0
     if (kind == TRACE_SPHERE) {
-        Ng = sphere_normal(P, u_spheres[index].xyz, u_spheres[index].w);
+        Ng = sphere_normal(P, trace_sphere(index).xyz, trace_sphere(index).w);
         Ns = Ng;
         obj = u_sphere_object[index];
     }
 #endif
 #if NUM_PLANES > 0
     if (kind == TRACE_PLANE) {
-        Ng = plane_normal(u_planes[index].xyz);
+        Ng = plane_normal(trace_plane(index).xyz);
         Ns = Ng;
         obj = u_plane_object[index];
     }
@@ -137,6 +221,14 @@ void surface(vec3 O, vec3 D, int kind, int index, float s, vec2 uv,
         vec3 nC = trace_texel(u_triangle_data, 6 * index + 5).xyz;
         Ns = normalize_or_zero((1.0 - uv.x - uv.y) * nA.xyz + uv.x * nB + uv.y * nC);
         obj = int(nA.w);
+#if NUM_MOVING_MESHES > 0
+        for (int m = 0; m < NUM_MOVING_MESHES; ++m) {   // a moving mesh's normals, turned
+            if (u_mesh_object[m] == obj) {
+                Ng = motion_direction(g_mesh_motion[m], Ng);
+                Ns = motion_direction(g_mesh_motion[m], Ns);
+            }
+        }
+#endif
     }
 #endif
 }
@@ -151,19 +243,26 @@ bool occluded(vec3 O, vec3 D, float s_max, int from_shape) {
     bool hit = false;
 #if NUM_SPHERES > 0
     for (int k = 0; k < NUM_SPHERES; ++k) {
-        bool hit_k = ray_sphere_from(O, D, u_spheres[k].xyz, u_spheres[k].w, k == from_shape,
+        bool hit_k = ray_sphere_from(O, D, trace_sphere(k).xyz, trace_sphere(k).w, k == from_shape,
                                      s_min, s_max, s_k);
         hit = hit || hit_k;
     }
 #endif
 #if NUM_PLANES > 0
     for (int k = 0; k < NUM_PLANES; ++k) {
-        bool hit_k = ray_plane(O, D, u_planes[k].xyz, u_planes[k].w, s_min, s_max, s_k);
+        bool hit_k = ray_plane(O, D, trace_plane(k).xyz, trace_plane(k).w, s_min, s_max, s_k);
         hit = hit || (hit_k && NUM_SPHERES + k != from_shape);
     }
 #endif
 #ifdef MESHES
-    if (!hit) hit = bvh_any_hit(u_nodes, u_triangles, O, D, s_min, s_max);
+    if (!hit) hit = bvh_any_hit(u_nodes, u_triangles, 0, O, D, s_min, s_max);
+#if NUM_MOVING_MESHES > 0
+    for (int m = 0; m < NUM_MOVING_MESHES; ++m) {
+        if (!hit) hit = bvh_any_hit(u_nodes, u_triangles, u_mesh_root[m],
+                                    motion_point_back(g_mesh_motion[m], O),
+                                    motion_direction_back(g_mesh_motion[m], D), s_min, s_max);
+    }
+#endif
 #endif
     return hit;
 }
@@ -346,6 +445,13 @@ void trace_pop(int top, out vec3 O, out vec3 D, out vec3 w, out int depth, out i
 }
 #endif
 
+#ifdef MOTION
+// The camera sample's time in the shutter: its TIME_DIMENSION number at slot 0 (the camera's).
+float trace_sample_time() {
+    return motion_time(u_shutter, distributed_1d(g_pixel, g_sample, 0u, uint(TIME_DIMENSION)));
+}
+#endif
+
 // The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
 // from 0 to infinity); hit and s: the first ray's hit.
 vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s_hit) {
@@ -361,6 +467,9 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
 #endif
     hit = false;
     s_hit = s_max;
+#ifdef MOTION
+    trace_motion_at(trace_sample_time());
+#endif
     // Whether to go on is tested at the end of the body, not at the top, and no `continue`:
     // llvmpipe runs a loop's body with lanes masked off until every lane of its SIMD group has
     // left, so a test at the top costs one more whole body, masked, per group.

@@ -8,7 +8,8 @@ intersect.py), so each pair decides as the GLSL does; the order differs (the GLS
 first, nearer child first), which changes the answer only where two triangles are hit at the
 same s (an edge or vertex they share): either is the closest hit then. `any_hit` (shadow rays)
 answers whether closest_hit would hit, dropping each ray from the wavefront at its first hit,
-as the GLSL's bvh_any_hit stops at its first.
+as the GLSL's bvh_any_hit stops at its first. Both walk the tree whose root node is `root`: 0,
+or one of the trees of a forest (renderer/core/bvh.py, motion blur).
 
 Ray-box (slab) test with 1/D precomputed, IEEE: 1/(+-0) = +-inf. An axis whose 1/D is
 infinite (D's component 0, or so small that 1/D overflows) is parallel to its slab: it admits
@@ -120,7 +121,7 @@ def _children(ray, node, n0, inner):
     return np.repeat(ray[inner], 2), children
 
 
-def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
+def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None, root=0):
     """(hit, s, uv, triangle) for rays O, D (R, 3): whether a triangle is hit with
     s_min < s < s_max (scalars or per ray), the nearest such s (s_max on a miss), its (u, v),
     and the triangle's original index (-1 on a miss). float32 as the GLSL, or float64 for float64 rays;
@@ -132,7 +133,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     best_uv = np.zeros((R, 2), dtype)
     best_tri = np.full(R, -1, np.int64)
     ray = np.arange(R)
-    node = np.zeros(R, np.int64)
+    node = np.full(R, root, np.int64)
     while ray.size:
         ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min[ray], best_s[ray])
         # leaves: every (ray, triangle) pair, then the nearest hit per ray
@@ -154,7 +155,7 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     return hit, best_s, best_uv, original
 
 
-def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
+def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None, root=0):
     """Whether each ray O, D (R, 3) hits a triangle with s_min < s < s_max (scalars or per
     ray): closest_hit's `hit`, found as the GLSL's bvh_any_hit finds it, a ray leaving the walk
     at its first hit. Dtypes and `vertices` as closest_hit."""
@@ -163,7 +164,7 @@ def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None):
     s_max = np.broadcast_to(np.asarray(s_max, dtype), (R,))
     blocked = np.zeros(R, bool)
     ray = np.arange(R)
-    node = np.zeros(R, np.int64)
+    node = np.full(R, root, np.int64)
     while ray.size:
         ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min[ray], s_max[ray])
         r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])

@@ -39,6 +39,9 @@ from reference.lighting import (Lights, MaterialUniforms, lighting, normalize, n
 from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
                                           triangle_normal)
+from reference.raytrace.motion import (motion_at, motion_direction, motion_direction_back,
+                                       motion_plane, motion_point, motion_point_back, motion_time)
+from renderer.core.ray_sampling import TIME_DIMENSION
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from reference.raytrace.warp import (orthonormal_basis, square_to_disc, square_to_phong_lobe,
                                      square_to_sphere)
@@ -65,13 +68,14 @@ def leaving_s_min(O):
     return O.dtype.type(HIT_TIE) * np.sqrt(_dot(O, O))
 
 
-def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
+def scene_hit(rs, O, D, s_min, s_max, from_shape=None, time=None):
     """(kind, index, s, uv) of the nearest hit with s_min < s < s_max of rays O, D (R, 3):
     kind MISS/SPHERE/PLANE/TRIANGLE, index the sphere's, plane's or original triangle's, s the
     hit (s_max on a miss). In the dtype of O: float32, or float64 with the scene's float64
     surfaces. `from_shape` (R,): the analytic shape each ray starts on (shape_id; -1 for none),
     met again only at a sphere's far side (ray_sphere_from, on_surface). Ties (HIT_TIE): a surface
-    replaces the nearest found so far only when nearer by more than HIT_TIE relative."""
+    replaces the nearest found so far only when nearer by more than HIT_TIE relative. `time`
+    (R,): each ray's time, where the motion code runs (shapes_at, mesh_trees)."""
     R, t = len(O), O.dtype.type
     s = np.broadcast_to(np.asarray(s_max, t), (R,)).astype(t)
     s_min = np.broadcast_to(np.asarray(s_min, t), (R,))
@@ -88,19 +92,76 @@ def scene_hit(rs, O, D, s_min, s_max, from_shape=None):
         limit = np.where(hit, s_k * keep, limit)
         kind[hit], index[hit] = what, k
 
+    centres, planes = shapes_at(rs, time, t)
     for k in range(len(rs.sphere_radius)):
-        C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
+        C, r = centres[k], t(rs.sphere_radius[k])
         hit, s_k = ray_sphere_from(O, D, C, r, from_shape == k, s_min, limit)
         found(hit, s_k, SPHERE, k)
     for k in range(len(rs.plane_offset)):
-        hit, s_k = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, limit)
+        hit, s_k = ray_plane(O, D, *planes[k], s_min, limit)
         found(hit & (from_shape != len(rs.sphere_radius) + k), s_k, PLANE, k)
-    if rs.bvh is not None:
-        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O, D, s_min, limit,
-                                              vertices=None if t is F32 else rs.triangles)
+    for root, O_k, D_k in mesh_trees(rs, O, D, time):
+        hit, s_t, uv_t, tri = bvh_closest_hit(rs.bvh, O_k, D_k, s_min, limit,
+                                              vertices=None if t is F32 else rs.triangles, root=root)
         s = np.where(hit, s_t, s)
+        limit = np.where(hit, s_t, limit)
         kind[hit], index[hit], uv[hit] = TRIANGLE, tri[hit], uv_t[hit]
     return kind, index, s, uv
+
+
+# -- motion blur --------------------------------------------------------------------------------
+# Where the scene has motion (rs.motion; renderer/core/raytrace_scene.py) each ray carries its
+# camera sample's time: the spheres and planes move (motion_point, motion_plane) and the rays
+# move into each moving mesh's time-0 frame (motion_point_back), the GLSL's trace_motion_at.
+# Without a time (a caller tracing the still scene) everything stays at time 0.
+
+def sample_times(rs, samples, R: int, t):
+    """The times (R,) of camera rays 0 .. R-1 of `samples` (a sampling.RaySamples), in dtype
+    t: open + u (close - open) with u their TIME_DIMENSION number at slot 0 (the GLSL's
+    trace_sample_time); None where the scene has no motion or no samples are given."""
+    if rs.motion is None or samples is None:
+        return None
+    u = samples.point_1d(np.arange(R), 0, TIME_DIMENSION)
+    return motion_time(rs.motion.shutter, u.astype(t))
+
+
+def shapes_at(rs, time, t):
+    """(centres, planes): each sphere's centre and each plane's (N, d) in dtype t, (3,) and ()
+    or, where the motion code runs, one per ray (R, 3) and (R,) at the rays' times."""
+    centres = [rs.sphere_centre[k].astype(t) for k in range(len(rs.sphere_radius))]
+    planes = [(rs.plane_normal[k].astype(t), t(rs.plane_offset[k])) for k in range(len(rs.plane_offset))]
+    if rs.motion is None or time is None:
+        return centres, planes
+    spheres, flat = rs.motion.rows(rs.sphere_object), rs.motion.rows(rs.plane_object)
+    return ([motion_point(motion_at(spheres[k], time), C) for k, C in enumerate(centres)],
+            [motion_plane(motion_at(flat[k], time), N, d) for k, (N, d) in enumerate(planes)])
+
+
+def mesh_trees(rs, O, D, time):
+    """(root, O, D) for each tree of the scene's BVH: the static triangles' with the rays as
+    they are, each moving mesh object's with the rays moved into its time-0 frame."""
+    if rs.bvh is None:
+        return []
+    trees = []
+    for root, obj in zip(rs.mesh_roots, rs.mesh_object):
+        if obj < 0 or time is None:
+            trees.append((root, O, D))
+        else:
+            m = motion_at(rs.motion.rows([obj])[0], time)
+            trees.append((root, motion_point_back(m, O), motion_direction_back(m, D)))
+    return trees
+
+
+def _at(time, rays):
+    """The times of `rays` (an index or mask), or None where no time is given."""
+    return None if time is None else time[rays]
+
+
+def _per_hit(values, k, rays):
+    """values[k] at each hit (shape k, ray `rays`): one vector per shape (S of (3,)) or one per
+    shape and ray (S of (R, 3))."""
+    stacked = np.stack(values)
+    return stacked[k, rays] if stacked.ndim == 3 else stacked[k]
 
 
 def shape_id(rs, kind, index):
@@ -115,48 +176,50 @@ def ray_origin(P, n, shape):
     return np.where((shape >= 0)[:, None], P, offset_ray_origin(P, n))
 
 
-def occluded(rs, O, D, s_max, from_shape=None):
+def occluded(rs, O, D, s_max, from_shape=None, time=None):
     """Whether anything is hit with leaving_s_min(O) < s < s_max (a shadow ray from a point of
     from_shape; s_max a number or one per ray): any hit, not the nearest, as the GLSL: the
-    spheres, the planes, then the BVH's any-hit walk for the rays none of them blocks. The
-    answer is scene_hit's (kind != MISS), found with less work."""
+    spheres, the planes, then the BVH's any-hit walks for the rays none of them blocks. The
+    answer is scene_hit's (kind != MISS) at the same `time`, found with less work."""
     R, t = len(O), O.dtype.type
     s_min = leaving_s_min(O)
     s_max = np.broadcast_to(np.asarray(s_max, t), (R,))
     from_shape = np.full(R, -1) if from_shape is None else from_shape
     blocked = np.zeros(R, bool)
+    centres, planes = shapes_at(rs, time, t)
     for k in range(len(rs.sphere_radius)):
-        C, r = rs.sphere_centre[k].astype(t), t(rs.sphere_radius[k])
+        C, r = centres[k], t(rs.sphere_radius[k])
         blocked |= ray_sphere_from(O, D, C, r, from_shape == k, s_min, s_max)[0]
     for k in range(len(rs.plane_offset)):
-        hit = ray_plane(O, D, rs.plane_normal[k].astype(t), t(rs.plane_offset[k]), s_min, s_max)[0]
+        hit = ray_plane(O, D, *planes[k], s_min, s_max)[0]
         blocked |= hit & (from_shape != len(rs.sphere_radius) + k)
-    if rs.bvh is not None:
+    for root, O_k, D_k in mesh_trees(rs, O, D, time):
         rest = ~blocked
-        blocked[rest] = bvh_any_hit(rs.bvh, O[rest], D[rest], s_min[rest], s_max[rest],
-                                    vertices=None if t is F32 else rs.triangles)
+        blocked[rest] = bvh_any_hit(rs.bvh, O_k[rest], D_k[rest], s_min[rest], s_max[rest],
+                                    vertices=None if t is F32 else rs.triangles, root=root)
     return blocked
 
 
-def surface(rs, O, D, kind, index, s, uv):
+def surface(rs, O, D, kind, index, s, uv, time=None):
     """(P, Ng, Ns, obj) at hits (no misses): the hit point, the outward geometric and shading
-    unit normals, the object index."""
+    unit normals, the object index; the surfaces at each hit's `time` (scene_hit's)."""
     P = O + s[:, None] * D
     t = P.dtype.type
     Ng = np.zeros_like(P)
     Ns = np.zeros_like(P)
     obj = np.zeros(len(P), np.int64)
+    centres, planes = shapes_at(rs, time, t)
     m = kind == SPHERE
     if m.any():
         k = index[m]
-        Ng[m] = sphere_normal(P[m], rs.sphere_centre[k].astype(t),
+        Ng[m] = sphere_normal(P[m], _per_hit(centres, k, m),
                               rs.sphere_radius[k].astype(t)[:, None])
         Ns[m] = Ng[m]
         obj[m] = rs.sphere_object[k]
     m = kind == PLANE
     if m.any():
         k = index[m]
-        Ng[m] = plane_normal(rs.plane_normal[k].astype(t))
+        Ng[m] = plane_normal(_per_hit([N for N, _ in planes], k, m))
         Ns[m] = Ng[m]
         obj[m] = rs.plane_object[k]
     m = kind == TRIANGLE
@@ -168,7 +231,19 @@ def surface(rs, O, D, kind, index, s, uv):
         u, v = uv[m, 0:1], uv[m, 1:2]
         Ns[m] = normalize_or_zero((t(1) - u - v) * n[:, 0] + u * n[:, 1] + v * n[:, 2])
         obj[m] = rs.triangle_object[k]
+        _turn_normals(rs, m, obj, time, Ng, Ns)
     return P, Ng, Ns, obj
+
+
+def _turn_normals(rs, hits, obj, time, Ng, Ns):
+    """Turn the time-0 normals of the hits on moving meshes (in place) to their hits' times."""
+    if time is None or rs.bvh is None:
+        return
+    for o in rs.mesh_object[rs.mesh_object >= 0]:
+        on = hits & (obj == o)
+        if on.any():
+            m = motion_at(rs.motion.rows([o])[0], time[on])
+            Ng[on], Ns[on] = motion_direction(m, Ng[on]), motion_direction(m, Ns[on])
 
 
 def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
@@ -176,26 +251,27 @@ def materials(rs, obj, specular: bool, dtype=F32) -> MaterialUniforms:
                             rs.n[obj].astype(dtype)[:, None], specular=specular)
 
 
-def blocked_towards(rs, Q, P, Ng, shape):
+def blocked_towards(rs, Q, P, Ng, shape, time=None):
     """Whether the shadow ray from each hit P (outward geometric normal Ng, on analytic shape
     `shape`) to the point Q (a point light, or a point of an area light; (3,) or one per hit)
     is blocked: from ray_origin(P, Ng on Q's side), towards Q (unit direction), s_max the
     distance less the hit tie, d (1 - HIT_TIE) (a surface through Q ties with the light, which
-    keeps it); a light at the origin (d = 0) is not blocked (the GLSL's light_visibility_at)."""
+    keeps it); a light at the origin (d = 0) is not blocked (the GLSL's light_visibility_at).
+    The scene at the hits' `time` (motion blur)."""
     n = np.where((_dot(Ng, Q - P) >= 0)[:, None], Ng, -Ng)
     O = ray_origin(P, n, shape)
     to_light = Q - O
     d = np.sqrt(_dot(to_light, to_light))
     with np.errstate(divide="ignore", invalid="ignore"):
         L = to_light / d[:, None]
-    return occluded(rs, O, L, d * (d.dtype.type(1) - d.dtype.type(HIT_TIE)), shape) & (d > 0)
+    return occluded(rs, O, L, d * (d.dtype.type(1) - d.dtype.type(HIT_TIE)), shape, time) & (d > 0)
 
 
-def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
+def shadow_visibility(rs, lights: Lights, Ng, shape, record=None, time=None):
     """The visibility callable of lighting.py for hits with outward geometric normals Ng on
     analytic shapes `shape` (shape_id): one shadow ray per point and light (the GLSL's
-    light_visibility_directional / _point). `record(needed, event)`, if given, hears each
-    shadow ray's outcome (ray_tree_event)."""
+    light_visibility_directional / _point), at the hits' `time`. `record(needed, event)`, if
+    given, hears each shadow ray's outcome (ray_tree_event)."""
     t = Ng.dtype.type
 
     def visibility(kind, i, P, N, needed):
@@ -205,9 +281,10 @@ def shadow_visibility(rs, lights: Lights, Ng, shape, record=None):
             L = normalize(-lights.u_directional_direction[i])
             n = np.where((_dot(n, L) >= 0)[:, None], n, -n)
             O = ray_origin(P, n, on)
-            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on)
+            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on,
+                                       _at(time, needed))
         else:
-            blocked[needed] = blocked_towards(rs, lights.u_point_position[i], P, n, on)
+            blocked[needed] = blocked_towards(rs, lights.u_point_position[i], P, n, on, _at(time, needed))
         if record is not None:
             light = i if kind == "directional" else len(lights.u_directional_direction) + i
             record(blocked, ray_tree_event(SHADOW, light))
@@ -237,14 +314,15 @@ def area_light_point(areas, i: int, centre, u) -> np.ndarray:
     return centre + offset
 
 
-def area_light_terms(rs, lights: Lights, areas, Ng, shape, draw, shadows: bool, record=None):
+def area_light_terms(rs, lights: Lights, areas, Ng, shape, draw, shadows: bool, record=None,
+                     time=None):
     """The area_light callable of lighting.py for hits with outward geometric normals Ng on
     analytic shapes `shape` (the GLSL's has_area and area_light_term): for point light i with
     an area (row 3i's w not NO_AREA), the mean of point_term_at(q_m) over its M points q_m =
     area_light_point(u_m), u_m = draw(i, m), each times the visibility of q_m (`shadows`; a
     shadow ray only where the term is not 0), summed in m order; None for a light without an
     area. `record` hears each shadow ray's outcome (the event of light l's m-th point:
-    SHADOW, l + m * (number of lights))."""
+    SHADOW, l + m * (number of lights)). The scene at the hits' `time` (motion blur)."""
     t = Ng.dtype.type
     M = draw.light_samples
     n_lights = len(lights.u_directional_direction) + len(lights.u_point_position)
@@ -260,7 +338,8 @@ def area_light_terms(rs, lights: Lights, areas, Ng, shape, draw, shadows: bool, 
             if shadows:
                 needed = (term != 0).any(-1)
                 blocked = np.zeros(len(P), bool)
-                blocked[needed] = blocked_towards(rs, Q[needed], P[needed], Ng[needed], shape[needed])
+                blocked[needed] = blocked_towards(rs, Q[needed], P[needed], Ng[needed], shape[needed],
+                                                  _at(time, needed))
                 if record is not None:
                     light = len(lights.u_directional_direction) + i
                     record(blocked, ray_tree_event(SHADOW, light + m * n_lights))
@@ -342,7 +421,7 @@ class _AreaDraw:
 
 
 def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
-          ray_trees=None, samples=None, areas=None):
+          ray_trees=None, samples=None, areas=None, time=None):
     """Trace rays O, D (R, 3): (colour (R, 3), hit (R,), s (R,)) with hit and s of each ray's
     first hit (primary rays between s_min and s_max; secondary rays from 0 to inf). float32 as
     the GLSL, or float64 for float64 rays (and then `lights` in float64). shadows=False lights
@@ -353,12 +432,15 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
     ray 0, the reflected child of r 2r + 1, the transmitted 2r + 2, as uint32). `areas`, the
     u_point_area rows of renderer/core/light_areas.py (None: no light declares an area), makes
     the point lights with an area area lights (area_light_terms; `samples` then required).
+    Motion blur: each camera ray's time (`time` (R,), else drawn from `samples`: sample_times),
+    which its secondary and shadow rays share.
     A secondary ray is spawned only when some channel of its weight is at least
     RAY_WEIGHT_CUTOFF (renderer/core/ray_depth.py)."""
     t = np.asarray(O).dtype.type if np.asarray(O).dtype == np.float64 else F32
     O = np.asarray(O, t)
     D = np.asarray(D, t)
     R = len(O)
+    time = sample_times(rs, samples, R, t) if time is None else np.asarray(time, t)
     colour = np.zeros((R, 3), t)
     background = np.asarray(background, t)
     specular = rs.specular
@@ -377,7 +459,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
     for depth in range(max_depth + 1):
         if not len(O):
             break
-        kind, index, s, uv = scene_hit(rs, O, D, lo, hi, from_shape)
+        kind, index, s, uv = scene_hit(rs, O, D, lo, hi, from_shape, _at(time, owner))
         record(slice(None), ray_tree_event(kind, index))
         hit = kind != MISS
         if depth == 0:
@@ -385,15 +467,17 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         np.add.at(colour, owner[~hit], weight[~hit] * background)
         O, D, kind, index, s, uv, owner, path, key, weight = (
             a[hit] for a in (O, D, kind, index, s, uv, owner, path, key, weight))
-        P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv)
+        P, Ng, Ns, obj = surface(rs, O, D, kind, index, s, uv, _at(time, owner))
         shape = shape_id(rs, kind, index)
         Du = normalize(D)
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
         area_light = None if areas is None else area_light_terms(
-            rs, lights, areas, Ng, shape, _AreaDraw(samples, owner, key), shadows, record)
+            rs, lights, areas, Ng, shape, _AreaDraw(samples, owner, key), shadows, record,
+            _at(time, owner))
         local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
-                         shadow_visibility(rs, lights, Ng, shape, record) if shadows else None,
+                         shadow_visibility(rs, lights, Ng, shape, record, _at(time, owner))
+                         if shadows else None,
                          area_light)
         np.add.at(colour, owner, weight * local)
         if depth == max_depth:

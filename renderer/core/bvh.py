@@ -211,6 +211,37 @@ def refit(bvh: Bvh, vertices) -> Bvh:
     return Bvh(nodes, triangles, bvh.depth)
 
 
+def forest(trees: list[Bvh]) -> Bvh:
+    """Several BVHs in one layout (motion blur: the static triangles' tree, then one per moving
+    mesh object; docs/conventions.md, "Motion blur"): their nodes and triangles concatenated in
+    order, each tree's node and triangle indices offset by the nodes and triangles before it,
+    so that a walk from a tree's root (`roots`) sees that tree alone. Triangles keep their
+    original indices (the caller's numbering across all trees); depth is the deepest tree's."""
+    nodes, triangles, node_base, triangle_base = [], [], 0, 0
+    for tree in trees:
+        part = tree.nodes.copy()
+        leaf = part[:, 1, 3] > 0
+        part[:, 0, 3] += np.where(leaf, triangle_base, node_base).astype(np.float32)
+        nodes.append(part)
+        triangles.append(tree.triangles)
+        node_base += len(part)
+        triangle_base += len(tree.triangles)
+    if 2 * triangle_base >= MAX_EXACT_INDEX or 2 * node_base >= MAX_EXACT_INDEX:
+        raise ValueError(f"{triangle_base} triangles in {node_base} nodes: the float32 layout "
+                         f"indexes at most {MAX_EXACT_INDEX // 2 - 1}")
+    return Bvh(np.concatenate(nodes), np.concatenate(triangles), max(t.depth for t in trees))
+
+
+def roots(bvh: Bvh) -> np.ndarray:
+    """The root node of each tree of a `forest` (of a single BVH: [0]), in order: the nodes no
+    interior node names as a child (left i + 1, right a)."""
+    inner = np.flatnonzero(~bvh.is_leaf)
+    child = np.zeros(len(bvh.nodes), bool)
+    child[inner + 1] = True
+    child[bvh.nodes[inner, 0, 3].astype(np.int64)] = True
+    return np.flatnonzero(~child)
+
+
 def mesh_vertices(positions, faces) -> np.ndarray:
     """(F, 3, 3) float32 triangle vertices of a mesh (positions (V, 3), faces (F, 3))."""
     return np.asarray(positions, np.float32)[np.asarray(faces)]

@@ -12,15 +12,21 @@ renderer/gpu/raytracer.py, reference/raytrace/trace.py): made once per scene, ca
   build for that eye gives);
 - the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided, gloss (the
   reflected rays' lobe exponent, inf for a mirror).
+- motion blur (`motion=True`; renderer/core/motion.py): every object's motion, and the BVH is
+  a `forest`: the static triangles' tree first (if there are any), then one tree per moving
+  mesh object over its time-0 triangles (each built eye-free and refitted as above), which the
+  twins walk with the ray moved into that object's time-0 frame (`mesh_object`: the object
+  each tree moves with, -1 for the static one). Without it, every triangle is in one tree.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from renderer.core.bvh import Bvh, build_bvh, refit
+from renderer.core.bvh import Bvh, build_bvh, forest, refit, roots
+from renderer.core.motion import SceneMotion, declares_motion, has_motion, scene_motion
 from renderer.core.scene import Scene, WorldPlane, WorldSphere
 
 
@@ -46,6 +52,19 @@ class RayScene:
     two_sided: np.ndarray            # (M,) bool
     gloss: np.ndarray                # (M,) lobe exponent, inf: a mirror (Material.gloss_exponent)
     gloss_set: bool = False          # some material sets `gloss` (inf included)
+    motion: SceneMotion | None = None    # per object; None: no motion code (the still scene)
+    mesh_object: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    # (K,) per tree of `bvh`: the object it moves with, -1 for the static triangles' tree
+
+    @property
+    def mesh_roots(self) -> np.ndarray:
+        """(K,) each tree's root node in `bvh`."""
+        return roots(self.bvh) if self.bvh is not None else np.zeros(0, np.int64)
+
+    @property
+    def static_tree(self) -> bool:
+        """Whether `bvh` starts with a tree of static triangles (walked as it is)."""
+        return bool(len(self.mesh_object)) and self.mesh_object[0] < 0
 
     @property
     def specular(self) -> bool:
@@ -69,10 +88,12 @@ def _normalize_or_zero(v):
     return v / np.where(length > 0, length, 1.0)
 
 
-def ray_scene(scene: Scene, tree: Bvh | None = None) -> RayScene:
+def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None) -> RayScene:
     """The scene's surfaces and materials for the ray tracer. `tree`: the BVH of an earlier
-    ray_scene of this scene's very triangles (another camera, other materials or lights),
-    refitted instead of built again."""
+    ray_scene of this scene's very triangles (another camera, other materials or lights; the
+    same `motion`), refitted instead of built again. `motion`: with motion blur's data and
+    trees (module docstring); default: where some object declares a motion (the twin's rule)."""
+    motion = declares_motion(scene) if motion is None else bool(motion)
     shapes = scene.world_shapes()
     matrices = scene.matrices(1, 1)
     world_matrices = scene.world_matrices()
@@ -93,10 +114,10 @@ def ray_scene(scene: Scene, tree: Bvh | None = None) -> RayScene:
         normals.append(vertex_normals[faces])
         owner.append(np.full(len(faces), k, np.int64))
     triangles = np.concatenate(tris) if tris else np.zeros((0, 3, 3))
+    owners = np.concatenate(owner) if owner else np.zeros(0, np.int64)
+    mesh_object = _tree_objects(scene, owners, motion)
     if len(triangles) and tree is None:
-        absolute = np.concatenate(world_tris)
-        centre = (absolute.min((0, 1)) + absolute.max((0, 1))) / 2
-        tree = build_bvh(absolute - centre)
+        tree = _build_trees(np.concatenate(world_tris), owners, mesh_object)
     mats = [obj.material for obj in scene.objects]
 
     def rows(name, width=3):
@@ -118,4 +139,28 @@ def ray_scene(scene: Scene, tree: Bvh | None = None) -> RayScene:
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
         gloss=np.array([m.gloss_exponent for m in mats], np.float64),
         gloss_set=any(m.gloss is not None for m in mats),
+        motion=scene_motion(scene) if motion else None, mesh_object=mesh_object,
     )
+
+
+def _tree_objects(scene: Scene, owners: np.ndarray, motion: bool) -> np.ndarray:
+    """The object each tree of the BVH moves with (-1: the static triangles' tree, first)."""
+    present = np.unique(owners)
+    moving = [k for k in present if motion and has_motion(scene.objects[k])]
+    static = [-1] if len(present) > len(moving) else []
+    return np.array(static + moving, np.int64)
+
+
+def _build_trees(absolute: np.ndarray, owners: np.ndarray, mesh_object: np.ndarray) -> Bvh:
+    """The BVH (a `forest` where some mesh moves) over world-space triangles, each tree built
+    relative to its triangles' bounds' centre (independent of the eye; refitted after)."""
+    trees = []
+    for k in mesh_object:
+        ids = np.flatnonzero(~np.isin(owners, mesh_object[mesh_object >= 0]) if k < 0 else owners == k)
+        group = absolute[ids]
+        centre = (group.min((0, 1)) + group.max((0, 1))) / 2
+        built = build_bvh(group - centre)
+        triangles = built.triangles.copy()
+        triangles[:, 0, 3] = ids[built.original_index]           # the scene's numbering
+        trees.append(Bvh(built.nodes, triangles, built.depth))
+    return trees[0] if len(trees) == 1 else forest(trees)

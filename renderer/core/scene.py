@@ -43,6 +43,10 @@ class Camera:
     # focus, None for |look - eye|.
     aperture: float | None = None
     focus_distance: float | None = None
+    # The ray tracer's shutter (open, close), open <= close, in the units of time that object
+    # velocities are given in; a sample's time lies in [open, close] (renderer/core/motion.py).
+    # The rasteriser draws time 0.
+    shutter: tuple = (0.0, 0.0)
 
     def view(self) -> np.ndarray:
         return transforms.look_at(self.eye, self.look, self.up)
@@ -233,6 +237,11 @@ class SceneObject:
     shape: Shape | None = None   # an analytic shape the ray tracer intersects; None: triangles
     casts_shadows: bool = True   # drawn into the lights' shadow maps (renderer/core/shadows.py)
     receives_shadows: bool = True  # looks itself up in them: lit only where a light reaches it
+    # Motion blur (the ray tracer; renderer/core/motion.py): scene units per unit time, and
+    # degrees per unit time about that axis through the object's world origin. None: the
+    # object declares no motion (a zero vector declares it, still). Children do not follow.
+    velocity: tuple | None = None
+    angular_velocity: tuple | None = None
 
 
 @dataclass

@@ -48,7 +48,7 @@ TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials
             "objects")
 LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
-               *LENS_KEYS)
+               *LENS_KEYS, "shutter")
 MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 AREA_KEYS = ("area", "size", "radius", "normal")   # a point light's area (LightArea), `area` first
@@ -60,7 +60,7 @@ LIGHT_KEYS = {
 }
 BIAS_KEYS = tuple(f.name for f in dataclasses.fields(BiasRule))   # normal, constant, slope
 OBJECT_KEYS = ("name", "mesh", "shape", "material", "scale", "shear", "rotate", "translate", "parent",
-               "cull", "casts_shadows", "receives_shadows")
+               "cull", "casts_shadows", "receives_shadows", "velocity", "angular_velocity")
 MESH_FILE_KEYS = ("file", "crease_angle")
 SHAPE_TYPES = ("sphere", "plane")
 SHAPE_KEYS = {
@@ -443,6 +443,8 @@ class _Reader:
             cam.far = self.number(raw["far"], key("far"))
         if "reversed_z" in raw:
             cam.reversed_z = self.boolean(raw["reversed_z"], key("reversed_z"))
+        if "shutter" in raw:
+            cam.shutter = self.shutter(raw["shutter"], key("shutter"))
 
         view = np.subtract(cam.eye, cam.look)
         if not np.any(view):
@@ -475,6 +477,15 @@ class _Reader:
                 self.fail(key("focus_distance"), f"must be >= {1.0 / MAX_NUMBER:g} (its inverse "
                                                  f"must fit the GPU's float32 arithmetic), got "
                                                  f"{cam.focus_distance:g}")
+    def shutter(self, value: Any, path: str) -> tuple[float, float]:
+        """The ray tracer's shutter [open, close] (motion blur): two finite numbers, open <= close."""
+        if not isinstance(value, (list, tuple)) or len(value) != 2:
+            self.fail(path, f"expected a list of 2 numbers [open, close], got {describe_value(value)}")
+        open_, close = (self.number(x, f"{path}[{i}]") for i, x in enumerate(value))
+        if close < open_:
+            self.fail(path, f"negative shutter interval: close {show_number(close)} is before open "
+                            f"{show_number(open_)}; the shutter is [open, close] with open <= close")
+        return open_, close
 
     def materials(self, raw: Any, path: str) -> dict[str, Material]:
         if not isinstance(raw, dict):
@@ -654,6 +665,9 @@ class _Reader:
         for flag in ("casts_shadows", "receives_shadows"):
             if flag in raw:
                 setattr(obj, flag, self.boolean(raw[flag], key(flag)))
+        for motion in ("velocity", "angular_velocity"):          # motion blur, the ray tracer's
+            if motion in raw:
+                setattr(obj, motion, self.vec3(raw[motion], key(motion)))
         return obj
 
     def object_material(self, raw: Any, path: str, materials: dict[str, Material]) -> Material:

@@ -10,11 +10,12 @@ GL resources are made once in the constructor: the program, specialised by #defi
 the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHERES, NUM_PLANES,
 MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, GLOSSY when such a material
 has a finite gloss, MAX_DEPTH, LENS when the camera's aperture is above 0, AREA_LIGHTS when some
-point light has an area of size > 0, and the sample pattern's constants from
+point light has an area of size > 0, MOTION and NUM_MOVING_MESHES where something moves during
+the shutter (docs/conventions.md, "Motion blur"), and the sample pattern's constants from
 renderer/core/ray_sampling.py, LIGHT_SAMPLES among them); the uniforms (camera rays and the thin
 lens from renderer/core/camera_rays.py, lights from renderer/core/uniforms.py and their areas
-from renderer/core/light_areas.py, shapes, the
-pattern's); the
+from renderer/core/light_areas.py, shapes, the objects' motions from renderer/core/motion.py,
+the pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
 renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
 the camera calls update() (and resize()), which keeps all of them and writes new contents: the
@@ -24,8 +25,9 @@ changed) the compile.
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
 `shadows`), SECONDARY and GLOSSY (where max_depth > 0), LENS (a lens of radius 0 without an
-aperture), MESHES (the BVH walk; a scene without triangles gets a one-triangle BVH of a
-degenerate triangle, which no ray hits) and AREA_LIGHTS (where there are point lights;
+aperture), MOTION (each moving mesh in its own tree wherever an object declares a motion),
+MESHES (the BVH walk; a scene without static triangles gets a one-triangle tree of a degenerate
+triangle at root 0, which no ray hits) and AREA_LIGHTS (where there are point lights;
 renderer/core/light_areas.py). The light, sphere and plane counts stay compile-time
 constants. The image is the same.
 """
@@ -37,13 +39,15 @@ import time
 import moderngl
 import numpy as np
 
-from renderer.core.bvh import build_bvh, texels
+from renderer.core.bvh import build_bvh, forest, roots, texels
 from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame, image_size
+from renderer.core.motion import declares_motion, moves, scene_motion
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.light_areas import area_light_defines, area_light_uniforms
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import GLOSSY_DIMENSION, check_first_sample, ray_sampling
+from renderer.core.ray_sampling import (GLOSSY_DIMENSION, TIME_DIMENSION, check_first_sample,
+                                         ray_sampling)
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
@@ -87,7 +91,8 @@ class RayTracer:
 
     def _build(self) -> None:
         ctx = self.ctx
-        rs = self.ray_scene = ray_scene(self.scene)
+        self._motion_layout = self._motion_now()
+        rs = self.ray_scene = ray_scene(self.scene, motion=self._motion_layout)
         self._surfaces = self._surfaces_now()
         self.defines = self._defines(rs)
         self._compile()
@@ -121,6 +126,7 @@ class RayTracer:
             "LENS": scene.camera.has_lens or every,
             **self.sampling.defines(),
             **area_light_defines(scene, every),
+            **self._motion_defines(rs),
         }
 
     def _compile(self) -> None:
@@ -157,6 +163,7 @@ class RayTracer:
         if len(rs.plane_offset):
             values["u_planes"] = np.concatenate([rs.plane_normal, rs.plane_offset[:, None]], 1).astype(np.float32).tobytes()
             values["u_plane_object"] = rs.plane_object.astype(np.int32).tobytes()
+        values.update(self._motion_uniforms(rs))
         for name, value in values.items():
             if name in program:
                 program[name].write(value)
@@ -181,10 +188,9 @@ class RayTracer:
         arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object
-            bvh = rs.bvh
-            if bvh is None:                           # all features, no triangles: a placeholder
+            bvh = self._bvh(rs)
+            if rs.bvh is None:                        # all features, no triangles: a placeholder
                 triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
-                bvh = build_bvh(triangles)
             arrays["u_nodes"], arrays["u_triangles"] = bvh.nodes, bvh.triangles
             data = np.zeros((len(triangles), 6, 4))
             data[:, :3, :3] = triangles
@@ -192,6 +198,46 @@ class RayTracer:
             data[:, 3, 3] = owner
             arrays["u_triangle_data"] = data
         return arrays
+
+    # -- motion blur (docs/conventions.md, "Motion blur") ------------------------------------
+    def _motion_now(self) -> bool:
+        """Whether the ray scene takes motion blur's data and trees (ray_scene's `motion`): where
+        something moves in the image, or, compiling every feature, wherever an object declares
+        a motion (as the twin)."""
+        return moves(self.scene) or (not self.specialise and declares_motion(self.scene))
+
+    def _motion_defines(self, rs) -> dict:
+        """MOTION where something moves (every feature: always) and NUM_MOVING_MESHES, the
+        moving mesh objects with their own trees."""
+        if not (moves(self.scene) or not self.specialise):
+            return {}
+        return {"MOTION": True, "NUM_MOVING_MESHES": int((rs.mesh_object >= 0).sum()),
+                "TIME_DIMENSION": TIME_DIMENSION}
+
+    def _bvh(self, rs):
+        """The BVH the GPU walks: the scene's, with a placeholder tree at root 0 where MESHES
+        walks one and the scene has no static triangles (no triangles at all, or only moving
+        meshes): one degenerate triangle, which no ray hits."""
+        if rs.bvh is not None and rs.static_tree:
+            return rs.bvh
+        placeholder = build_bvh(np.zeros((1, 3, 3)))
+        return placeholder if rs.bvh is None else forest([placeholder, rs.bvh])
+
+    def _motion_uniforms(self, rs) -> dict:
+        """The shutter and every sphere's, plane's and moving mesh's motion rows (renderer/
+        core/motion.py), the moving meshes' roots in u_nodes and their objects."""
+        if "MOTION" not in self.defines:
+            return {}
+        motion = rs.motion if rs.motion is not None else scene_motion(self.scene)
+        moving = rs.mesh_object[rs.mesh_object >= 0]
+        rows = {"u_shutter": motion.shutter, "u_sphere_motion": motion.rows(rs.sphere_object),
+                "u_plane_motion": motion.rows(rs.plane_object), "u_mesh_motion": motion.rows(moving)}
+        values = {name: np.asarray(value, np.float32).tobytes() for name, value in rows.items()
+                  if np.size(value)}
+        if len(moving):                   # the moving meshes' trees are the last ones
+            values["u_mesh_root"] = roots(self._bvh(rs))[-len(moving):].astype(np.int32).tobytes()
+            values["u_mesh_object"] = moving.astype(np.int32).tobytes()
+        return values
 
     def _build_targets(self) -> None:
         """The framebuffer at the image size and its float targets (self._targets)."""
@@ -220,9 +266,12 @@ class RayTracer:
                 a is not b for old, new in zip(self._surfaces, now) for a, b in zip(old, new)):
             raise ValueError("the scene's objects changed since this RayTracer was made; "
                              "make a new one")
+        if self._motion_now() != self._motion_layout:
+            raise ValueError("the scene's motion blur switched on or off since this RayTracer "
+                             "was made; make a new one")
         check_light_count(self.scene)
         activate(self.ctx)
-        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh)
+        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh, motion=self._motion_layout)
         defines = self._defines(rs)
         if defines != self.defines:
             self.defines = defines

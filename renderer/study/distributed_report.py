@@ -25,6 +25,7 @@ from __future__ import annotations
 import math
 
 from renderer.core.light_areas import uses_area_lights
+from renderer.core.motion import moves
 from renderer.core.sampling import PATTERNS
 from renderer.study.report_output import convergence_slopes, spread
 from renderer.study.report_settings import DISTRIBUTED_KNOBS, EFFECT_KNOBS
@@ -58,12 +59,9 @@ def scene_effects(scene) -> set[str]:
     camera = scene.camera
     if camera.has_lens:
         effects.add("lens")
-    shutter = getattr(camera, "shutter", (0.0, 0.0))
-    if shutter[1] > shutter[0] and any(any(getattr(obj, "velocity", (0, 0, 0))) or
-                                       any(getattr(obj, "angular_velocity", (0, 0, 0)))
-                                       for obj in scene.objects):
+    if camera.shutter[0] < camera.shutter[1] and moves(scene):    # an open shutter, a motion
         effects.add("time")
-    if any(math.isfinite(getattr(obj.material, "gloss", math.inf)) and max(obj.material.kr + obj.material.kt) > 0
+    if any(math.isfinite(obj.material.gloss_exponent) and max(obj.material.kr + obj.material.kt) > 0
            for obj in scene.objects):
         effects.add("glossy")
     return effects

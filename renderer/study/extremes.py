@@ -100,6 +100,9 @@ STABILITY = {
     "rt_coplanar": "hit ties: a surface replaces the nearest hit only when nearer by more than "
                    "2^-18 relative, so the plane, found first, shows wherever the triangle lies "
                    "in it; rays leaving it start at s > 2^-18 |O| and skip it",
+    "rt_fast_motion": "motion in the displacement form about camera-relative centres (X + (R - I)(X - c) "
+                      "+ t v), rays moved into a mesh's time-0 frame and its normals turned back: "
+                      "rounding relative to the distance moved, whatever the speed or the turns",
     "rt_far_from_origin": "camera-relative coordinates: the shapes and lights relative to the "
                           "eye in float64 before the float32 upload",
     "rt_huge_aperture": "the lens offset lies across the view axis and every lens ray passes "
@@ -128,11 +131,13 @@ STABILITY = {
                                     "from Waechter and Binder's offset",
 }
 
-# Ray-traced cases measured at other maximum depths than the default.
+# Ray-traced cases measured at other maximum depths than the default, and with more samples
+# per pixel than 1 (regular pattern; motion blur: each sample its own time).
 RAYTRACE_DEPTHS = {"rt_mirrors": (0, 64)}
 # Ray-traced cases whose effect needs several samples per pixel (each sample its own lens
-# point): (samples, pattern); one regular sample otherwise, whose lens point is the lens's centre.
-RAYTRACE_SAMPLING = {"rt_huge_aperture": (4, "jittered")}
+# point, or its own time): (samples, pattern); one regular sample otherwise, whose lens point is
+# the lens's centre and whose time the middle of the shutter.
+RAYTRACE_SAMPLING = {"rt_huge_aperture": (4, "jittered"), "rt_fast_motion": (4, "regular")}
 RAY_TRACED_PREFIX = "rt_"
 
 
@@ -188,7 +193,8 @@ def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
                        pattern: str = "regular") -> dict:
     """Figures of one ray-traced scene, as measure_scene: each GPU frame against the float64
     reference, which accepts the float32 reference's colour and depth at grazing pixels
-    (`grazing_pixels`: where the two references' ray trees differ); `truth` without that."""
+    (`grazing_pixels`: where the two references' ray trees differ); `truth` without that.
+    `samples` per pixel, regular pattern."""
     width, height = size
     options = {"max_depth": max_depth, "samples": samples, "pattern": pattern}
     gpu_frames = {}

@@ -10,6 +10,7 @@ uniform sampler2D u_nodes;
 uniform sampler2D u_triangles;
 uniform float u_s_min;
 uniform float u_s_max;
+uniform int u_root;                 // the tree walked (a forest's; 0 unless set)
 layout(location = 0) out vec4 out_hit;
 
 void main() {
@@ -17,12 +18,12 @@ void main() {
     vec3 O = texelFetch(u_origins, pixel, 0).xyz;
     vec3 D = texelFetch(u_directions, pixel, 0).xyz;
 #ifdef ANY_HIT
-    out_hit = vec4(bvh_any_hit(u_nodes, u_triangles, O, D, u_s_min, u_s_max) ? 1.0 : 0.0, 0.0, 0.0, 0.0);
+    out_hit = vec4(bvh_any_hit(u_nodes, u_triangles, u_root, O, D, u_s_min, u_s_max) ? 1.0 : 0.0, 0.0, 0.0, 0.0);
 #else
     float s;
     vec2 uv;
     int triangle;
-    bvh_closest_hit(u_nodes, u_triangles, O, D, u_s_min, u_s_max, s, uv, triangle);
+    bvh_closest_hit(u_nodes, u_triangles, u_root, O, D, u_s_min, u_s_max, s, uv, triangle);
     out_hit = vec4(s, float(triangle), uv);
 #endif
 }

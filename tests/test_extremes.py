@@ -223,9 +223,11 @@ def test_the_ray_tracers_extreme_cases_are_the_issues():
     from the origin; a light on a surface; a camera inside a glass sphere; total internal
     reflection; a coplanar plane and triangle; max depth 0 and 64. Issue 16's: an aperture
     larger than the scene (4 samples, each its own lens point); an object moving 100 scene units
-    during the shutter (4 samples, each its own time)."""
-    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_fast_motion", "rt_grazing_sphere",
-                          "rt_huge_aperture", "rt_huge_sphere", "rt_inside_glass", "rt_light_on_surface",
+    during the shutter (4 samples, each its own time); a huge area light touching its receiver;
+    glossy exponents 1 and 1e6 (4 samples each, each its own light point and lobe direction)."""
+    assert RAY_TRACED == ["rt_coplanar", "rt_far_from_origin", "rt_fast_motion", "rt_glossy_exponents",
+                          "rt_grazing_sphere", "rt_huge_aperture", "rt_huge_area_light", "rt_huge_sphere",
+                          "rt_inside_glass", "rt_light_on_surface",
                           "rt_mirrors", "rt_tiny_sphere", "rt_total_internal_reflection"]
     fast = extreme_scene("rt_fast_motion")
     assert [float(np.linalg.norm(o.velocity)) for o in fast.objects] == [100.0] * 3
@@ -237,6 +239,10 @@ def test_the_ray_tracers_extreme_cases_are_the_issues():
     huge = extreme_scene("rt_huge_aperture")
     span = np.ptp([s.centre for s in huge.world_shapes() if hasattr(s, "radius")], axis=0).max() + 1.0
     assert huge.camera.aperture > 10 * span and RAYTRACE_SAMPLING["rt_huge_aperture"] == (4, "jittered")
+    light = extreme_scene("rt_huge_area_light").point_lights[0]
+    assert light.area.size == (100.0, 100.0) and light.position[1] == 0.0       # in the floor
+    assert sorted(o.material.gloss for o in extreme_scene("rt_glossy_exponents").objects
+                  if o.material.gloss is not None) == [1.0, 1.0, 1e6]
 
 
 def ray_traced_cases() -> list:

@@ -25,7 +25,7 @@ from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.light_areas import (AREA_SHAPE_CODES, AREA_UNIFORM, NO_AREA, area_axes,
                                        area_light_defines, area_light_uniforms, orthonormal_basis)
-from renderer.core.ray_sampling import LIGHT_DIMENSION, ray_sampling
+from renderer.core.ray_sampling import ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene import LightArea
 from renderer.core.scene_file import load_scene, scene_from_dict
@@ -92,10 +92,10 @@ def test_the_scene_file_keys_make_the_area():
 
 
 def test_the_glsl_constants_are_the_twins():
-    """trace.glsl's LIGHT_DIMENSION and shape codes are renderer/core's (the twin reads those)."""
+    """trace.glsl's area shape codes are renderer/core's (the twin reads those; the light's
+    dimension: tests/test_raytrace_distributed.py)."""
     text = (Path(__file__).resolve().parent.parent / "glsl" / "raytrace" / "trace.glsl").read_text()
-    constants = dict(re.findall(r"const (?:uint|float) (LIGHT_DIMENSION|AREA_[A-Z]+) = ([0-9.]+)u?;", text))
-    assert int(constants.pop("LIGHT_DIMENSION")) == LIGHT_DIMENSION
+    constants = dict(re.findall(r"const (?:uint|float) (AREA_[A-Z]+) = ([0-9.]+)u?;", text))
     assert {name: float(value) for name, value in constants.items()} == {
         "AREA_NONE": NO_AREA, **{f"AREA_{shape.upper()}": code for shape, code in AREA_SHAPE_CODES.items()
                                  if shape != "sphere"}}      # the sphere: the one left

@@ -7,11 +7,15 @@ dimensions are decorrelated (another dimension or slot gives another permutation
 patterns repeat from frame to frame and the others do not; the GLSL draws the twin's points bit
 for bit on EGL and OSMesa."""
 
+import re
+from pathlib import Path
+
 import numpy as np
 import pytest
 from glsl_harness import ShaderProbe
 
 from reference.raytrace.sampling import distributed_1d, distributed_2d, permute
+import renderer.core.ray_sampling as ray_sampling_module
 from renderer.core.ray_sampling import (LENS_DIMENSION, MAX_LIGHT_SAMPLES, TIME_DIMENSION,
                                         ray_sampling)
 
@@ -88,6 +92,16 @@ def test_table_patterns_repeat_each_frame_and_the_others_draw_new_points():
         frame0 = distributed_2d(3, 3, np.arange(4), 0, sampling, 0, LENS_DIMENSION)
         frame1 = distributed_2d(3, 3, np.arange(4), 4, sampling, 0, LENS_DIMENSION)
         assert np.array_equal(frame0, frame1) == repeats, pattern
+
+
+def test_the_glsl_dimensions_and_stream_layout_are_the_pythons():
+    """sampling.glsl's constants, each the one renderer/core/ray_sampling.py names."""
+    text = (Path(__file__).resolve().parents[1] / "glsl" / "raytrace" / "sampling.glsl").read_text()
+    found = {name: int(value, 0) for name, value in
+             re.findall(r"const uint ([A-Z_]+) = (0x[0-9A-Fa-f]+|\d+)u;", text)}
+    names = ["PIXEL_DIMENSION", "LENS_DIMENSION", "TIME_DIMENSION", "GLOSSY_DIMENSION",
+             "LIGHT_DIMENSION", "DIMENSION_STRIDE", "PERMUTATION_SALT"]
+    assert {name: found[name] for name in names} == {name: getattr(ray_sampling_module, name) for name in names}
 
 
 def test_light_samples_are_refused_outside_their_range():

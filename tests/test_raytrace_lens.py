@@ -8,7 +8,6 @@ compiled in); and the GPU against the twin within PIPELINE_TOLERANCE (small fram
 depth_of_field scene at 320x240, 4 and 16 samples, EGL and OSMesa in the full run)."""
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -17,7 +16,7 @@ import pytest
 from reference.raytrace.camera import camera_ray, lens_point, pixel_windows, thin_lens_ray
 from reference.raytrace.pipeline import render as reference_raytrace
 from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
-from renderer.core.ray_sampling import LENS_DIMENSION, ray_sampling
+from renderer.core.ray_sampling import ray_sampling
 from renderer.core.scene import Camera
 from renderer.core.scene_file import scene_from_dict
 
@@ -74,11 +73,6 @@ def lens_rays(k, dtype=np.float64, aperture=0.3, focus=4.0, pattern="jittered", 
     uniforms = lens_uniforms(m.view, aperture, focus)
     O2, D2 = thin_lens_ray(points, O, D, uniforms)
     return O, D, O2, D2, -m.view[2, :3], points, uniforms
-
-
-def test_the_glsl_lens_dimension_is_the_sampling_layers():
-    text = (Path(__file__).resolve().parents[1] / "glsl" / "raytrace" / "camera.glsl").read_text()
-    assert int(re.search(r"const uint LENS_DIMENSION = (\d+)u;", text)[1]) == LENS_DIMENSION
 
 
 def test_lens_points_lie_inside_the_unit_disc_and_the_offsets_inside_the_aperture():

@@ -32,7 +32,6 @@ void thin_lens_ray(vec2 l, inout vec3 O, inout vec3 D) {
 
 // The lens point of sample k: the concentric map of the sampling layer's point of the lens
 // dimension at slot 0 (the camera's).
-const uint LENS_DIMENSION = 1u;      // renderer/core/ray_sampling.py's LENS_DIMENSION
 
 vec2 lens_point(uvec2 pixel, int k) {
     return square_to_disc(distributed_2d(pixel, k, 0u, LENS_DIMENSION, 0u, 1u));

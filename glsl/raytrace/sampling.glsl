@@ -73,7 +73,15 @@ vec2 sample_offset(uvec2 pixel, int k) {
 #ifndef LIGHT_SAMPLES
 #define LIGHT_SAMPLES 1
 #endif
-// renderer/core/ray_sampling.py: the streams' layout.
+// renderer/core/ray_sampling.py: the dimensions and the streams' layout (tests/
+// test_raytrace_distributed.py holds each equal to its Python name). Camera-level dimensions
+// (slot 0): the pixel, the lens, the time; at a hit (slot 1 + g_ray_key): the glossy lobe and
+// point light i's area, LIGHT_DIMENSION + i.
+const uint PIXEL_DIMENSION = 0u;
+const uint LENS_DIMENSION = 1u;
+const uint TIME_DIMENSION = 2u;
+const uint GLOSSY_DIMENSION = 0u;
+const uint LIGHT_DIMENSION = 1u;
 const uint DIMENSION_STRIDE = 64u;
 const uint PERMUTATION_SALT = 0x5BD1E995u;
 const uint CELL_CENTRE = 0x80000000u;           // stratum_coordinate's h of a cell's centre

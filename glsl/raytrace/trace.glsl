@@ -7,7 +7,7 @@
 // waiting on a fixed-size stack) in a loop of bounded length (no recursion in GLSL).
 // Compile-time constants (renderer/gpu/raytracer.py): NUM_SPHERES, NUM_PLANES, MESHES,
 // SECONDARY (some k_r or k_t > 0), GLOSSY (such a material has a finite gloss: reflected rays
-// drawn from a lobe; GLOSSY_DIMENSION its dimension), MAX_DEPTH, MOTION and NUM_MOVING_MESHES
+// drawn from a lobe), MAX_DEPTH, MOTION and NUM_MOVING_MESHES
 // (motion blur), and lighting.glsl's light counts and SPECULAR; AREA_LIGHTS (some point light
 // has an area of size > 0: LIGHT_SAMPLES shadow rays to points of it per hit, area_light_term).
 
@@ -312,7 +312,6 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
 // rows 3i .. 3i + 2 of u_point_area and p a point of the unit shape named by row 3i's w
 // (AREA_NONE: no area, the point light's own code).
 uniform vec4 u_point_area[3 * NUM_POINT_LIGHTS];
-const uint LIGHT_DIMENSION = 1u;     // renderer/core/ray_sampling.py: light i's points, LIGHT_DIMENSION + i
 const float AREA_NONE = 0.0;
 const float AREA_RECTANGLE = 1.0;
 const float AREA_DISC = 2.0;
@@ -363,7 +362,7 @@ vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
 bool glossy_direction(vec3 R, vec3 Ng_in, float gloss, out vec3 D) {
     D = R;
     if (isinf(gloss)) return true;
-    vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, uint(GLOSSY_DIMENSION), 0u, 1u);
+    vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, GLOSSY_DIMENSION, 0u, 1u);
     vec3 lobe = square_to_phong_lobe(u, gloss);
     vec3 b1, b2;
     orthonormal_basis(R, b1, b2);
@@ -448,7 +447,7 @@ void trace_pop(int top, out vec3 O, out vec3 D, out vec3 w, out int depth, out i
 #ifdef MOTION
 // The camera sample's time in the shutter: its TIME_DIMENSION number at slot 0 (the camera's).
 float trace_sample_time() {
-    return motion_time(u_shutter, distributed_1d(g_pixel, g_sample, 0u, uint(TIME_DIMENSION)));
+    return motion_time(u_shutter, distributed_1d(g_pixel, g_sample, 0u, TIME_DIMENSION));
 }
 #endif
 

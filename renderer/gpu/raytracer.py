@@ -46,7 +46,7 @@ from renderer.core.motion import declares_motion, moves, scene_motion
 from renderer.core.gl_rules import check_light_count, to_unorm8
 from renderer.core.light_areas import area_light_defines, area_light_uniforms
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import (GLOSSY_DIMENSION, TIME_DIMENSION, check_first_sample,
+from renderer.core.ray_sampling import (check_first_sample,
                                          ray_sampling)
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED
@@ -121,7 +121,6 @@ class RayTracer:
             "MESHES": rs.bvh is not None or every,
             "SECONDARY": (rs.secondary or every) and self.max_depth > 0,
             "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
-            "GLOSSY_DIMENSION": GLOSSY_DIMENSION,
             "MAX_DEPTH": self.max_depth,
             "LENS": scene.camera.has_lens or every,
             **self.sampling.defines(),
@@ -211,8 +210,7 @@ class RayTracer:
         moving mesh objects with their own trees."""
         if not (moves(self.scene) or not self.specialise):
             return {}
-        return {"MOTION": True, "NUM_MOVING_MESHES": int((rs.mesh_object >= 0).sum()),
-                "TIME_DIMENSION": TIME_DIMENSION}
+        return {"MOTION": True, "NUM_MOVING_MESHES": int((rs.mesh_object >= 0).sum())}
 
     def _bvh(self, rs):
         """The BVH the GPU walks: the scene's, with a placeholder tree at root 0 where MESHES

@@ -109,9 +109,17 @@ STABILITY = {
                         "its pinhole ray's point on the focus plane (O' = O + offset, D' = D - "
                         "offset / f: nothing divides by the aperture), so rays starting 50 units "
                         "off the axis stay finite and s stays the view depth",
+    "rt_glossy_exponents": "a lobe below the surface is absorbed, not reflected back; "
+                           "square_to_phong_lobe computes 1 - cos alpha from log and exp (series "
+                           "where they would cancel), so an exponent of 1e6 keeps its angles "
+                           "where sqrt(1 - cos^2) would round them away",
     "rt_grazing_sphere": "the robust discriminant (Ray Tracing Gems ch. 7); where float32 "
                          "cannot tell a tangent ray from a miss the float64 reference decides "
                          "otherwise, and those grazing pixels accept either",
+    "rt_huge_area_light": "shadow rays to a light's point end a hit tie short of it (s_max = "
+                          "d (1 - 2^-18)), so the floor the point lies in does not decide them "
+                          "by float32's rounding; points behind a receiver's horizon add nothing "
+                          "and cast no shadow ray",
     "rt_huge_sphere": "rays leaving a sphere never meet it again but at the far root q/a "
                       "(convexity), so the cancellation of f.f - r^2 at radius 1e4 casts no "
                       "false shadow; camera rays' depth keeps it within 5e-4",
@@ -137,7 +145,8 @@ RAYTRACE_DEPTHS = {"rt_mirrors": (0, 64)}
 # Ray-traced cases whose effect needs several samples per pixel (each sample its own lens
 # point, or its own time): (samples, pattern); one regular sample otherwise, whose lens point is
 # the lens's centre and whose time the middle of the shutter.
-RAYTRACE_SAMPLING = {"rt_huge_aperture": (4, "jittered"), "rt_fast_motion": (4, "regular")}
+RAYTRACE_SAMPLING = {"rt_huge_aperture": (4, "jittered"), "rt_fast_motion": (4, "regular"),
+                     "rt_huge_area_light": (4, "jittered"), "rt_glossy_exponents": (4, "jittered")}
 RAY_TRACED_PREFIX = "rt_"
 
 

@@ -63,13 +63,15 @@ def truth_scene(scene: Scene) -> Scene:
 
 def scene_digest(scene: Scene) -> str:
     """SHA-256 of everything that decides the image: camera, lights, ambient, background,
-    and per object its name, material, transform, parent, culling and mesh arrays."""
+    and per object its name, material, transform, parent, culling, motion and mesh arrays."""
     digest = hashlib.sha256()
     for part in (scene.camera, scene.directional_lights, scene.point_lights, scene.ambient,
                  scene.background):
         digest.update(repr(part).encode())
     for obj in scene.objects:
         digest.update(repr((obj.name, obj.material, obj.transform, obj.parent, obj.cull)).encode())
+        if obj.velocity is not None or obj.angular_velocity is not None:   # (still objects keep
+            digest.update(repr((obj.velocity, obj.angular_velocity)).encode())  # their keys)
         if obj.shape is not None:             # what the ray tracer intersects instead of the mesh
             digest.update(repr(obj.shape).encode())
         for array, dtype in ((obj.mesh.positions, np.float64), (obj.mesh.normals, np.float64),

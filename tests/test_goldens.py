@@ -9,8 +9,8 @@ golden can never drift from the reference unnoticed, not even by `--update-golde
 Goldens are tests/goldens/SCENE-MODE.png (+ .json): MODE is flat, gouraud or phong (every
 material drawn that way) and, for scenes whose materials mix modes, "as-authored" (the scene
 as its file has it); "raytrace" for the GPU ray tracer (renderer/gpu/raytracer.py, 1 sample
-per pixel, max depth 4), held the same two ways, against the NumPy ray tracer
-(reference/raytrace/).
+per pixel, max depth 4; the distributed effects' scenes with TRACE_OPTIONS, samples that show
+their effect), held the same two ways, against the NumPy ray tracer (reference/raytrace/).
 """
 
 import functools
@@ -66,6 +66,11 @@ REFERENCE_CHECKED = [pytest.param(*p.values, id=p.id, marks=[*p.marks, *(
     [] if p.values[1] == "phong" else [pytest.mark.slow])]) for p in RENDERED]
 TRACED = sorted(RAYTRACE_SCENES)
 TRACED_IDS = [f"{name}-{RAYTRACE}" for name in TRACED]
+# One regular sample is a pinhole, a still, a mirror and a point light: the effects' scenes are
+# traced with 4 jittered samples (soft_shadows: and 4 points per area light and hit).
+EFFECT_SAMPLES = {"samples": 4, "pattern": "jittered"}
+TRACE_OPTIONS = {"soft_shadows": {**EFFECT_SAMPLES, "light_samples": 4},
+                 "depth_of_field": EFFECT_SAMPLES, "motion_blur": EFFECT_SAMPLES, "glossy": EFFECT_SAMPLES}
 
 
 def assert_exact_where_made(name, frame):
@@ -126,7 +131,7 @@ def test_golden_matches_reference(name, mode, reference_frames):
 def test_ray_tracer_matches_golden(name, context_kind, gl_contexts, golden):
     frame = golden.check_scene(scene_variant(name, AS_AUTHORED), f"{name}-{RAYTRACE}",
                                size=RAYTRACE_SIZE, context=gl_contexts[context_kind],
-                               method=RAYTRACE)
+                               method=RAYTRACE, **TRACE_OPTIONS.get(name, {}))
     assert (frame.rgba8[..., 3] == 255).mean() > 0.5
     assert_exact_where_made(f"{name}-{RAYTRACE}", frame)
 
@@ -134,7 +139,8 @@ def test_ray_tracer_matches_golden(name, context_kind, gl_contexts, golden):
 @pytest.mark.parametrize("name", TRACED, ids=TRACED_IDS)
 def test_ray_traced_golden_matches_reference(name, traced_references):
     png = golden_png(f"{name}-{RAYTRACE}")
-    assert_matches_reference(png, traced_references.frame(name, *RAYTRACE_SIZE).rgba8)
+    assert_matches_reference(png, traced_references.frame(name, *RAYTRACE_SIZE,
+                                                          **TRACE_OPTIONS.get(name, {})).rgba8)
 
 
 def test_every_golden_belongs_to_a_scene_and_mode():

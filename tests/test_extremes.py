@@ -305,9 +305,9 @@ def test_is_finite_frame_sees_nan_and_inf(reference_frames):
 
 # -- the command line -----------------------------------------------------------------------------
 
-def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli):
+def test_a_mesh_with_a_nan_vertex_is_refused_in_one_line(tmp_path, cli_here):
     out = tmp_path / "x.png"
-    result = cli("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
+    result = cli_here("render", str(extreme_scenes()["nan_mesh"]), "-o", str(out))
     assert result.returncode == 2 and not out.exists()
     [line] = result.stderr.strip().splitlines()
     assert "nan_mesh.toml: objects[0].mesh.file:" in line

@@ -64,6 +64,7 @@ def test_a_corrupt_mesh_file_is_refused_in_words(cli, tmp_path, name, content, r
     assert line == f"renderer: scene.toml: objects[0].mesh.file: {name}: {reason}"
 
 
+@pytest.mark.slow                  # a process each (library noise shows only in a real one)
 @pytest.mark.parametrize("coordinate, reason", [
     ("inf", "vertex 3 is not finite (inf, 0, 0); 1 of 4 vertices are NaN or Inf"),
     ("1e300", "vertex 3 (1e+300, 0, 0) is too large for the GPU's float32 arithmetic; "
@@ -77,6 +78,7 @@ def test_huge_or_infinite_mesh_coordinates_are_refused_without_library_warnings(
     assert line == f"renderer: scene.toml: objects[0].mesh.file: big.obj: {reason}"
 
 
+@pytest.mark.slow                  # a process of its own, as the cases above
 def test_a_ply_index_beyond_int32_is_reported_as_written(cli, tmp_path):
     ply = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
            "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"

@@ -176,11 +176,11 @@ def test_a_parent_scale_breaks_a_child_sphere():
     assert refusal(data).startswith("s.toml: objects[1].shape: a sphere's transform")
 
 
-def test_shape_refusal_through_the_command_line(tmp_path, cli):
+def test_shape_refusal_through_the_command_line(tmp_path, cli_here):
     bad = tmp_path / "bad.toml"
     bad.write_text('[[objects]]\nshape = { type = "sphere", radius = -2.0 }\n')
     out = tmp_path / "out.png"
-    result = cli("render", bad, "-o", out, "--backend", "reference", "--size", "32x24")
+    result = cli_here("render", bad, "-o", out, "--backend", "reference", "--size", "32x24")
     assert result.returncode == 2, result.stderr
     assert result.stderr.strip().splitlines() == [
         f"renderer: {bad}: objects[0].shape.radius: must be > 0, got -2"]

@@ -96,3 +96,25 @@ def test_one_sample_frames_add_up_to_the_frame_of_all_their_samples(gl_contexts)
     assert np.abs(acc.rgba8.astype(int) - whole.rgba8).max() <= 1
     with pytest.raises(ValueError):
         Accumulator(cap=0)
+
+
+@pytest.mark.slow                       # a tracer compiled per scene; 80 frames each
+@pytest.mark.parametrize("name", ["soft_shadows", "depth_of_field", "motion_blur", "glossy"])
+def test_the_viewer_converges_on_each_distributed_effect(name, gl_contexts):
+    """Issue 16: each one-sample frame draws a new light point, lens point, time and lobe
+    direction (the sample index is the frame's), so the viewer's mean converges on the
+    effect: its RMSE against the mean of 64 later frames (samples 16 to 79) falls from 1 to 4
+    to 16 frames."""
+    from renderer.core.scene_file import load_scene
+    size = (32, 24)
+    with RayTracer(load_scene(name), *size, context=gl_contexts["egl"], samples=SAMPLES_PER_FRAME,
+                   pattern=PATTERN) as tracer:
+        acc, means = Accumulator(), {}
+        for frames in range(1, 17):
+            acc.trace(tracer)
+            if frames in (1, 4, 16):
+                means[frames] = np.clip(acc.linear[..., :3], 0, 1)
+        truth = np.clip(np.mean([tracer.render(first_sample=k).linear[..., :3]
+                                 for k in range(16, 80)], axis=0), 0, 1)
+    rmse = {n: float(np.sqrt(((image - truth) ** 2).mean())) for n, image in means.items()}
+    assert rmse[1] > rmse[4] > rmse[16], rmse

@@ -36,7 +36,8 @@ def ray_report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "# Error against run time: the ray tracer",
         "",
         generated_line(result, size, sweep.runs,
-                       f"renderer report --method raytrace{' --quick' if quick else ''}"),
+                       f"renderer report --method raytrace{' --quick' if quick else ''}"
+                       + (f" --knobs {','.join(result.knobs)}" if result.knobs else "")),
         "",
         "## Scenes",
         "",

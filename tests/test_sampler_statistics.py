@@ -30,7 +30,10 @@ import pytest
 from chi_square import Grid, expected_counts, histogram, p_value, significance
 from glsl_harness import ShaderProbe
 from reference.raytrace import warp
+from reference.raytrace.motion import motion_time
 from reference.raytrace.sampling import distributed_1d, distributed_2d
+from reference.raytrace.trace import area_light_point
+from renderer.core.light_areas import AREA_SHAPE_CODES
 from renderer.core.ray_sampling import LENS_DIMENSION, LIGHT_DIMENSION, TIME_DIMENSION, ray_sampling
 
 PI = np.pi
@@ -136,6 +139,38 @@ def lobe_case(exponent: float):
                 lambda phi, alpha: lobe(phi, alpha, wrong_exponent), f"exponent {wrong_exponent:g}")
 
 
+def rectangle_light_case():
+    """A 3 x 2 rectangle light's points (trace.py's area_light_point: centre + (2u - 1) of its
+    half-edges, u its LIGHT_DIMENSION points, 4 per hit), uniform over the rectangle."""
+    half = (1.5, 1.0)
+
+    def sample():
+        areas = np.zeros((3, 4), np.float32)
+        areas[0, 0], areas[1, 1] = half
+        areas[0, 3] = AREA_SHAPE_CODES["rectangle"]
+        centre = np.float32([0.5, -2.0, 3.0])
+        q = area_light_point(areas, 0, centre, points_2d("jittered", LIGHT_DIMENSION, 3, 4)).astype(np.float64)
+        return (q[:, 0] - 0.5) / half[0], (q[:, 1] + 2.0) / half[1]
+
+    def rectangle(x, y):                                # on [-1, 1]^2: 1/4
+        return uniform(x, y) / 4
+    return Case("area_light_point rectangle", sample, lambda: Grid.even((-1, 1), (-1, 1), 48, 32),
+                rectangle, tilted(rectangle, lambda x, y: y), "5 % more towards +y")
+
+
+def time_case():
+    """The sample times of a shutter [0.25, 2.25] (motion.py's motion_time of distributed_1d's
+    TIME points, jittered), uniform over it."""
+    def sample():
+        t = motion_time((0.25, 2.25), points_1d("jittered")).astype(np.float64)
+        return t, np.zeros_like(t)
+
+    def shutter(t, _):
+        return uniform(t, _) / 2
+    return Case("motion_time", sample, lambda: Grid(np.linspace(0.25, 2.25, 1001), np.array([-0.5, 0.5])),
+                shutter, tilted(shutter, lambda t, _: t - 1.25), "5 % more towards the close")
+
+
 # -- distributed_2d and distributed_1d ---------------------------------------------------------
 
 def uniform(x, y):
@@ -172,6 +207,7 @@ def line_case(pattern: str):
 
 PATTERNS = ("random", "jittered", "regular", "adaptive")
 CASES = [disc_case(), sphere_case(), *(lobe_case(e) for e in (1.0, 10.0, 1000.0)),
+         rectangle_light_case(), time_case(),
          *(square_case(p) for p in PATTERNS), square_case("jittered", 4), square_case("poisson", 4),
          *(line_case(p) for p in (*PATTERNS, "poisson"))]
 TESTS = len(CASES) + 1                       # and the poisson table's

@@ -228,7 +228,7 @@ def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUnif
     nothing, and the GLSL casts no shadow ray (the callable may answer anything there).
     `area_light` (the ray tracer's AREA_LIGHTS): None, or a callable
     area_light(i, P, N, V, material) -> (..., 3) giving point light i's whole term where it
-    has an area (its samples, each shadowed, averaged: trace.py's area_light_terms) and None
+    has an area (its samples, each shadowed, averaged: raytrace/area_lights.py's area_light_terms) and None
     for a light without one, which then lights as above.
     E and the material's arrays may vary per point (broadcast against P). One light's term
     at a time (the terms are not kept)."""

@@ -19,7 +19,8 @@ import pytest
 from reference.lighting import Lights
 from reference.raytrace.pipeline import render as reference_raytrace
 from reference.raytrace.sampling import RaySamples
-from reference.raytrace.trace import area_light_point, trace
+from reference.raytrace.area_lights import area_light_point
+from reference.raytrace.trace import trace
 from reference.raytrace.warp import orthonormal_basis as warp_basis
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
@@ -92,9 +93,9 @@ def test_the_scene_file_keys_make_the_area():
 
 
 def test_the_glsl_constants_are_the_twins():
-    """trace.glsl's area shape codes are renderer/core's (the twin reads those; the light's
+    """area_lights.glsl's shape codes are renderer/core's (the twin reads those; the light's
     dimension: tests/test_raytrace_distributed.py)."""
-    text = (Path(__file__).resolve().parent.parent / "glsl" / "raytrace" / "trace.glsl").read_text()
+    text = (Path(__file__).resolve().parent.parent / "glsl" / "raytrace" / "area_lights.glsl").read_text()
     constants = dict(re.findall(r"const (?:uint|float) (AREA_[A-Z]+) = ([0-9.]+)u?;", text))
     assert {name: float(value) for name, value in constants.items()} == {
         "AREA_NONE": NO_AREA, **{f"AREA_{shape.upper()}": code for shape, code in AREA_SHAPE_CODES.items()

@@ -1,5 +1,5 @@
 """Glossy reflection (docs/conventions.md, "Glossy reflection"; glsl/raytrace/trace.glsl's
-glossy_direction, reference/raytrace/trace.py's glossy_reflection): the reflected ray drawn
+glossy_direction, reference/raytrace/glossy.py's glossy_reflection): the reflected ray drawn
 from the Phong lobe about the mirror direction, absorbed below the surface, gloss = inf the
 mirror exactly. Hand-checked cases first (the lobe's mean cosine, the half of a lobe that lies
 under a surface, a glossy floor's reflection of a white sky), then the limit (gloss = inf
@@ -14,9 +14,9 @@ import math
 import numpy as np
 import pytest
 
-from reference.raytrace import trace as twin_trace
+from reference.raytrace import glossy as twin_glossy
 from reference.raytrace.pipeline import render as reference_raytrace
-from reference.raytrace.trace import glossy_reflection
+from reference.raytrace.glossy import glossy_reflection
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.scene_file import load_scene, scene_from_dict
@@ -149,7 +149,7 @@ def test_gloss_inf_is_the_mirror_bit_for_bit(gl_contexts, monkeypatch):
     assert np.array_equal(every.linear, expected.linear)
 
     calls = []
-    monkeypatch.setattr(twin_trace, "glossy_reflection",
+    monkeypatch.setattr(twin_glossy, "glossy_reflection",
                         lambda *a: calls.append(len(a[0])) or glossy_reflection(*a))
     twin_plain = reference_raytrace(plain, 48, 36, **options)
     assert not calls

@@ -32,7 +32,7 @@ from glsl_harness import ShaderProbe
 from reference.raytrace import warp
 from reference.raytrace.motion import motion_time
 from reference.raytrace.sampling import distributed_1d, distributed_2d
-from reference.raytrace.trace import area_light_point
+from reference.raytrace.area_lights import area_light_point
 from renderer.core.light_areas import AREA_SHAPE_CODES
 from renderer.core.ray_sampling import LENS_DIMENSION, LIGHT_DIMENSION, TIME_DIMENSION, ray_sampling
 
@@ -140,7 +140,7 @@ def lobe_case(exponent: float):
 
 
 def rectangle_light_case():
-    """A 3 x 2 rectangle light's points (trace.py's area_light_point: centre + (2u - 1) of its
+    """A 3 x 2 rectangle light's points (area_lights.py's area_light_point: centre + (2u - 1) of its
     half-edges, u its LIGHT_DIMENSION points, 4 per hit), uniform over the rectangle."""
     half = (1.5, 1.0)
 

@@ -19,6 +19,8 @@ RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
                   "raytrace/bvh.glsl": "reference/raytrace/bvh.py",
                   "raytrace/sampling.glsl": "reference/raytrace/sampling.py",
                   "raytrace/warp.glsl": "reference/raytrace/warp.py",
+                  "raytrace/area_lights.glsl": "reference/raytrace/area_lights.py",
+                  "raytrace/glossy.glsl": "reference/raytrace/glossy.py",
                   "raytrace/motion.glsl": "reference/raytrace/motion.py",
                   "raytrace/trace.glsl": "reference/raytrace/trace.py"}
 

@@ -306,70 +306,9 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
 }
 #endif
 
-#if defined(AREA_LIGHTS) && NUM_POINT_LIGHTS > 0
-// Area lights (docs/conventions.md, "Area lights"; the uniform: renderer/core/light_areas.py).
-// Point light i's area is u_point_position[i] + p.x a_0 + p.y a_1 + p.z a_2, the axes a_j in
-// rows 3i .. 3i + 2 of u_point_area and p a point of the unit shape named by row 3i's w
-// (AREA_NONE: no area, the point light's own code).
-uniform vec4 u_point_area[3 * NUM_POINT_LIGHTS];
-const float AREA_NONE = 0.0;
-const float AREA_RECTANGLE = 1.0;
-const float AREA_DISC = 2.0;
+#include "raytrace/area_lights.glsl"     // after light_visibility_at, which it calls
 
-bool has_area(int i) {
-    return u_point_area[3 * i].w != AREA_NONE;
-}
-
-// The point of light i's area at u in [0, 1)^2: p = (2u - 1, 0) on the rectangle, the
-// concentric map's (x, y, 0) on the disc, square_to_sphere(u) on the sphere. An area of size
-// 0 has zero axes: the light's position exactly.
-vec3 area_light_point(int i, vec2 u) {
-    float shape = u_point_area[3 * i].w;
-    vec3 p = shape == AREA_RECTANGLE ? vec3(2.0 * u - 1.0, 0.0)
-           : shape == AREA_DISC ? vec3(square_to_disc(u), 0.0) : square_to_sphere(u);
-    vec3 offset = p.x * u_point_area[3 * i].xyz + p.y * u_point_area[3 * i + 1].xyz
-                + p.z * u_point_area[3 * i + 2].xyz;
-    return u_point_position[i] + offset;
-}
-
-// Light i's term at P: the mean over its LIGHT_SAMPLES points q_m (the numbers of dimension
-// LIGHT + i at this ray's slot, m of LIGHT_SAMPLES) of point_term_at(q_m), each times the
-// visibility of q_m (SHADOWS; no shadow ray where the term is 0), summed in m order.
-vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
-    vec3 sum = vec3(0.0);
-    for (int m = 0; m < LIGHT_SAMPLES; ++m) {
-        vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, LIGHT_DIMENSION + uint(i),
-                                uint(m), uint(LIGHT_SAMPLES));
-        vec3 Q = area_light_point(i, u);
-        vec3 term = point_term_at(i, Q, P, N, V);
-#ifdef SHADOWS
-        term = term != vec3(0.0) ? light_visibility_at(Q, P) * term : vec3(0.0);
-#endif
-        sum += term;
-    }
-    return sum / float(LIGHT_SAMPLES);
-}
-#endif
-
-#ifdef GLOSSY
-#include "raytrace/sampling.glsl"
-#include "raytrace/warp.glsl"
-// Glossy reflection (docs/conventions.md, "Glossy reflection"): the direction D of the ray
-// reflected at the hit being shaded, with mirror direction R, outward geometric normal Ng_in
-// on the incoming side and lobe exponent `gloss`: square_to_phong_lobe of the hit's
-// GLOSSY_DIMENSION point in the basis (orthonormal_basis(R), R). False where D lies below the
-// surface (D.Ng_in <= 0): the ray is absorbed. A mirror (gloss inf) takes R exactly.
-bool glossy_direction(vec3 R, vec3 Ng_in, float gloss, out vec3 D) {
-    D = R;
-    if (isinf(gloss)) return true;
-    vec2 u = distributed_2d(g_pixel, g_sample, 1u + g_ray_key, GLOSSY_DIMENSION, 0u, 1u);
-    vec3 lobe = square_to_phong_lobe(u, gloss);
-    vec3 b1, b2;
-    orthonormal_basis(R, b1, b2);
-    D = lobe.x * b1 + lobe.y * b2 + lobe.z * R;
-    return dot(D, Ng_in) > 0.0;
-}
-#endif
+#include "raytrace/glossy.glsl"
 
 // Hall and Greenberg's adaptive tree depth (1983): a secondary ray whose weight is below
 // TRACE_WEIGHT_CUTOFF in every channel is not spawned (renderer/core/ray_depth.py: the rule,

@@ -18,7 +18,7 @@ of the threshold is traced both ways, and the frame's rgba8_tie holds the other 
 colour there (comparisons accept either, as at a depth tie).
 
 Area lights (a point light with an area, of any size): `light_samples` M points on each per
-hit (renderer/core/light_areas.py's uniform, trace.py's area_light_terms).
+hit (renderer/core/light_areas.py's uniform, area_lights.py's area_light_terms).
 
 In float32 as the GPU, or in float64 (dtype=np.float64: the uniforms, offsets and lights in
 float64 too), the ground truth; the frame's ray_tree holds each pixel's hash of its samples'

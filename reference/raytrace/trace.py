@@ -17,25 +17,24 @@ bounce (every ray of one depth at once), no Python loop over pixels or rays.
   is opaque to shadow rays); in shadow a light adds nothing but its ambient share; a light
   whose terms are 0 at P (behind it; k_d = k_s = 0) casts no shadow ray, as the GLSL; an area
   light (a point light with an area) is M = light_samples point lights at points of its area,
-  each with its shadow ray, averaged (area_light_terms);
+  each with its shadow ray, averaged (area_lights.py, with area_light_shadow's rays);
 - secondary rays (depth < max_depth): with Du = normalize(D), N and Ng flipped to the incoming
   side, eta = 1/ior entering (front seen), ior leaving, F = fresnel_schlick(Du, N, eta):
   reflected weight k_r + k_t F along ray_reflect(Du, N) from offset_ray_origin(P, Ng);
   transmitted weight k_t (1 - F) along ray_refract(Du, N, eta) from offset_ray_origin(P, -Ng)
   (none under total internal reflection, where F = 1). A ray's colour is
   local + w_r reflected + w_t transmitted; a ray that misses brings the background colour;
-- glossy reflection (docs/conventions.md, "Glossy reflection"): where some material sets
-  `gloss`, each reflected ray goes through glossy_reflection: drawn from the Phong lobe of
-  its material's exponent about the mirror direction with the hit's GLOSSY_DIMENSION point,
-  absorbed below the surface; gloss inf keeps the mirror direction.
+- glossy reflection (docs/conventions.md, "Glossy reflection"; glossy.py): where some material
+  sets `gloss`, each reflected ray is drawn from the Phong lobe of its material's exponent
+  about the mirror direction with the hit's GLOSSY_DIMENSION point, absorbed below the
+  surface; gloss inf keeps the mirror direction.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from reference.lighting import (Lights, MaterialUniforms, lighting, normalize, normalize_or_zero,
-                                point_term_at)
+from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
                                           triangle_normal)
@@ -43,11 +42,9 @@ from reference.raytrace.motion import (motion_at, motion_direction, motion_direc
                                        motion_plane, motion_point, motion_point_back, motion_time)
 from renderer.core.ray_sampling import TIME_DIMENSION
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
-from reference.raytrace.warp import (orthonormal_basis, square_to_disc, square_to_phong_lobe,
-                                     square_to_sphere)
-from renderer.core.light_areas import AREA_SHAPE_CODES, NO_AREA
+from reference.raytrace.area_lights import AreaDraw, area_light_terms
+from reference.raytrace.glossy import glossy_rays
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
-from renderer.core.ray_sampling import GLOSSY_DIMENSION, LIGHT_DIMENSION
 
 F32 = np.float32
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
@@ -292,90 +289,23 @@ def shadow_visibility(rs, lights: Lights, Ng, shape, record=None, time=None):
     return visibility
 
 
-# -- area lights ---------------------------------------------------------------------------------
-# docs/conventions.md, "Area lights"; the uniform's layout: renderer/core/light_areas.py.
-
-def area_light_point(areas, i: int, centre, u) -> np.ndarray:
-    """(R, 3) points of point light i's area at u (R, 2) in [0, 1)^2, in centre's dtype (the
-    GLSL's area_light_point): centre + p.x a_0 + p.y a_1 + p.z a_2 with p = (2u - 1, 0) on a
-    rectangle, (square_to_disc(u), 0) on a disc, square_to_sphere(u) on a sphere; `areas` the
-    (3 Lp, 4) u_point_area rows, `centre` the light's position (3,)."""
-    t = centre.dtype.type
-    u = np.asarray(u).astype(t)
-    shape = areas[3 * i, 3]
-    if shape == AREA_SHAPE_CODES["rectangle"]:
-        p = np.concatenate([t(2) * u - t(1), np.zeros((len(u), 1), t)], -1)
-    elif shape == AREA_SHAPE_CODES["disc"]:
-        p = np.concatenate([square_to_disc(u), np.zeros((len(u), 1), t)], -1)
-    else:
-        p = square_to_sphere(u)
-    a = areas[3 * i:3 * i + 3, :3].astype(t)
-    offset = p[:, 0:1] * a[0] + p[:, 1:2] * a[1] + p[:, 2:3] * a[2]
-    return centre + offset
-
-
-def area_light_terms(rs, lights: Lights, areas, Ng, shape, draw, shadows: bool, record=None,
-                     time=None):
-    """The area_light callable of lighting.py for hits with outward geometric normals Ng on
-    analytic shapes `shape` (the GLSL's has_area and area_light_term): for point light i with
-    an area (row 3i's w not NO_AREA), the mean of point_term_at(q_m) over its M points q_m =
-    area_light_point(u_m), u_m = draw(i, m), each times the visibility of q_m (`shadows`; a
-    shadow ray only where the term is not 0), summed in m order; None for a light without an
-    area. `record` hears each shadow ray's outcome (the event of light l's m-th point:
-    SHADOW, l + m * (number of lights)). The scene at the hits' `time` (motion blur)."""
-    t = Ng.dtype.type
-    M = draw.light_samples
+def area_light_shadow(rs, lights: Lights, Ng, shape, record=None, time=None):
+    """The `shadow` of area_lights.area_light_terms for hits with outward geometric normals
+    Ng on analytic shapes `shape`, at the hits' `time`: shadow(i, m, Q, P, needed) -> whether
+    the shadow ray from each hit (where `needed`) to point Q of light i's area is blocked
+    (blocked_towards); `record` hears each (the event of light l's m-th point: SHADOW,
+    l + m * (number of lights))."""
     n_lights = len(lights.u_directional_direction) + len(lights.u_point_position)
 
-    def area_light(i, P, N, V, material):
-        if areas[3 * i, 3] == NO_AREA:
-            return None
-        total = np.zeros(P.shape, t)
-        for m in range(M):
-            Q = area_light_point(areas, i, lights.u_point_position[i], draw(i, m))
-            term = point_term_at(P, N, V, Q, lights.u_point_intensity[i], lights.u_point_attenuation[i],
-                                 material)
-            if shadows:
-                needed = (term != 0).any(-1)
-                blocked = np.zeros(len(P), bool)
-                blocked[needed] = blocked_towards(rs, Q[needed], P[needed], Ng[needed], shape[needed],
-                                                  _at(time, needed))
-                if record is not None:
-                    light = len(lights.u_directional_direction) + i
-                    record(blocked, ray_tree_event(SHADOW, light + m * n_lights))
-                term = np.where(blocked, t(0), t(1))[:, None] * term
-            total += term
-        return total / t(M)
-    return area_light
-
-# -- glossy reflection ---------------------------------------------------------------------------
-def glossy_reflection(R, Ng_in, gloss, u):
-    """The GLSL's glossy_direction (docs/conventions.md, "Glossy reflection"): (D, kept) for
-    reflected rays with mirror directions R (n, 3), outward geometric normals Ng_in (n, 3) on
-    their incoming side, lobe exponents `gloss` (n,) and points u (n, 2) (GLOSSY_DIMENSION at
-    the hit): D is square_to_phong_lobe(u, gloss) in the basis (orthonormal_basis(R), R);
-    where it lies below the surface (D.Ng_in <= 0) the ray is absorbed (kept False). A mirror
-    (gloss inf) takes R exactly and is always kept."""
-    t = R.dtype.type
-    mirror = np.isinf(gloss)
-    lobe = square_to_phong_lobe(np.asarray(u, t), np.asarray(gloss, t))
-    b1, b2 = orthonormal_basis(R)
-    D = lobe[:, 0:1] * b1 + lobe[:, 1:2] * b2 + lobe[:, 2:3] * R
-    return np.where(mirror[:, None], R, D), mirror | (_dot(D, Ng_in) > 0)
-
-
-def _glossy_rays(rs, samples, D_r, go_r, Ng_in, obj, owner, key):
-    """trace's reflected rays D_r (those of go_r) through glossy_reflection, each with the
-    point of its hit (slot 1 + the ray's key); the absorbed ones dropped from D_r and go_r."""
-    if samples is None:
-        raise ValueError("a scene that sets gloss needs the camera rays' samples (trace(samples=))")
-    with np.errstate(over="ignore"):                 # slots wrap modulo 2^32, as the GLSL's
-        slot = np.uint32(1) + key[go_r]
-    u = samples.point_2d(owner[go_r], slot, GLOSSY_DIMENSION)
-    D_r, kept = glossy_reflection(D_r, Ng_in[go_r], rs.gloss[obj[go_r]], u)
-    go_r = go_r.copy()
-    go_r[np.flatnonzero(go_r)[~kept]] = False
-    return D_r[kept], go_r
+    def shadow(i, m, Q, P, needed):
+        blocked = np.zeros(len(P), bool)
+        blocked[needed] = blocked_towards(rs, Q[needed], P[needed], Ng[needed], shape[needed],
+                                          _at(time, needed))
+        if record is not None:
+            light = len(lights.u_directional_direction) + i
+            record(blocked, ray_tree_event(SHADOW, light + m * n_lights))
+        return blocked
+    return shadow
 
 
 # -- the ray tree's hash ------------------------------------------------------------------------
@@ -405,19 +335,6 @@ def ray_tree_event(kind, index):
     """The uint64 event of a ray that hit surface (kind, index), or of a shadow ray."""
     kind = np.asarray(kind, np.uint64)
     return (kind << np.uint64(32)) | (np.asarray(index, np.int64) & 0xFFFFFFFF).astype(np.uint64)
-
-
-class _AreaDraw:
-    """draw(i, m): the u of point m of light i's area at each hit of the camera rays `owner`,
-    rays `key` (distributed_2d at slot 1 + key, dimension LIGHT_DIMENSION + i, m of M)."""
-
-    def __init__(self, samples, owner, key):
-        self.samples, self.owner, self.light_samples = samples, owner, samples.sampling.light_samples
-        with np.errstate(over="ignore"):                 # slots wrap modulo 2^32, as the GLSL's
-            self.slot = np.uint32(1) + key
-
-    def __call__(self, i: int, m: int) -> np.ndarray:
-        return self.samples.point_2d(self.owner, self.slot, LIGHT_DIMENSION + i, m, self.light_samples)
 
 
 def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, shadows: bool = True,
@@ -473,8 +390,8 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         back = _dot(Du, Ng) > 0
         N = np.where((back & rs.two_sided[obj])[:, None], -Ns, Ns)
         area_light = None if areas is None else area_light_terms(
-            rs, lights, areas, Ng, shape, _AreaDraw(samples, owner, key), shadows, record,
-            _at(time, owner))
+            lights, areas, AreaDraw(samples, owner, key),
+            area_light_shadow(rs, lights, Ng, shape, record, _at(time, owner)) if shadows else None)
         local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
                          shadow_visibility(rs, lights, Ng, shape, record, _at(time, owner))
                          if shadows else None,
@@ -496,7 +413,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         go_t = (w_t.max(-1) >= RAY_WEIGHT_CUTOFF) & refracted
         D_r = ray_reflect(Du[go_r], N_in[go_r])
         if rs.gloss_set:        # the lobe's code wherever a material sets gloss, inf included
-            D_r, go_r = _glossy_rays(rs, samples, D_r, go_r, Ng_in, obj, owner, key)
+            D_r, go_r = glossy_rays(rs.gloss, samples, D_r, go_r, Ng_in, obj, owner, key)
         O = np.concatenate([ray_origin(P[go_r], Ng_in[go_r], shape[go_r]),
                             ray_origin(P[go_t], -Ng_in[go_t], shape[go_t])])
         D = np.concatenate([D_r, T[go_t]]).astype(t)

@@ -16,8 +16,8 @@ from glsl_harness import ShaderProbe
 
 from reference.raytrace.sampling import distributed_1d, distributed_2d, permute
 import renderer.core.ray_sampling as ray_sampling_module
-from renderer.core.ray_sampling import (LENS_DIMENSION, MAX_LIGHT_SAMPLES, TIME_DIMENSION,
-                                        ray_sampling)
+from renderer.core.ray_sampling import (FIRST_SET, LENS_DIMENSION, MAX_LIGHT_SAMPLES, MAX_SAMPLES,
+                                        MAX_STRATA_SIDE, TIME_DIMENSION, ray_sampling)
 
 
 def test_permute_is_a_bijection_of_every_length():
@@ -102,6 +102,20 @@ def test_the_glsl_dimensions_and_stream_layout_are_the_pythons():
     names = ["PIXEL_DIMENSION", "LENS_DIMENSION", "TIME_DIMENSION", "GLOSSY_DIMENSION",
              "LIGHT_DIMENSION", "DIMENSION_STRIDE", "PERMUTATION_SALT"]
     assert {name: found[name] for name in names} == {name: getattr(ray_sampling_module, name) for name in names}
+
+
+def test_every_allowed_count_makes_strata_grids_stratum_offset_can_hold():
+    """stratum_coordinate needs at most MAX_STRATA_SIDE columns and rows (its numerators stay
+    below 2^32): every N and M ray_sampling accepts, in every set, keeps to it."""
+    widest = 0
+    for pattern in ("jittered", "adaptive"):
+        for n in range(FIRST_SET if pattern == "adaptive" else 1, MAX_SAMPLES + 1):
+            for m in range(1, MAX_LIGHT_SAMPLES + 1):
+                sampling = ray_sampling(pattern, n, light_samples=m)
+                for which in (0, 1):
+                    for per_sample in (1, m):
+                        widest = max(widest, *sampling.dimension_grid(which, per_sample))
+    assert 0 < widest <= MAX_STRATA_SIDE
 
 
 def test_light_samples_are_refused_outside_their_range():

@@ -134,8 +134,7 @@ def ray_sampling(pattern: str = "regular", samples: int = 1, seed: int = DEFAULT
     and hit; ValueError (its reason in one line) for an unknown pattern, N outside
     1..MAX_SAMPLES, a regular N that is not a perfect square, adaptive N < FIRST_SET, a seed
     that is not a uint32, a threshold with another pattern (adaptive: default
-    DEFAULT_ADAPTIVE_THRESHOLD, finite and >= 0), M outside 1..MAX_LIGHT_SAMPLES, or an N * M
-    whose strata grid is wider than MAX_STRATA_SIDE."""
+    DEFAULT_ADAPTIVE_THRESHOLD, finite and >= 0) or M outside 1..MAX_LIGHT_SAMPLES."""
     if pattern not in RAY_PATTERNS:
         raise ValueError(f"sample pattern must be one of {', '.join(RAY_PATTERNS)}, got {pattern!r}")
     n = int(samples)
@@ -163,15 +162,10 @@ def ray_sampling(pattern: str = "regular", samples: int = 1, seed: int = DEFAULT
     if not (isinstance(light_samples, (int, np.integer)) and 1 <= light_samples <= MAX_LIGHT_SAMPLES):
         raise ValueError(f"light samples per hit must be a whole number from 1 to {MAX_LIGHT_SAMPLES}, "
                          f"got {light_samples!r}")
-    rule = RaySampling(pattern, n, int(seed), first, first_strata, rest_strata, table, threshold,
+    # Every N <= MAX_SAMPLES and M <= MAX_LIGHT_SAMPLES makes strata grids at most
+    # MAX_STRATA_SIDE wide (tests/test_raytrace_distributed.py tries them all).
+    return RaySampling(pattern, n, int(seed), first, first_strata, rest_strata, table, threshold,
                        int(light_samples))
-    for which in (0, 1):
-        columns = rule.dimension_grid(which, rule.light_samples)[0]
-        if columns > MAX_STRATA_SIDE:
-            raise ValueError(f"{n} samples per pixel times {light_samples} light samples make a "
-                             f"strata grid {columns} cells wide, more than {MAX_STRATA_SIDE}; "
-                             "choose counts with a common factor")
-    return rule
 
 
 def check_first_sample(first_sample: int, samples: int) -> int:

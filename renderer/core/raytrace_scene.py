@@ -52,6 +52,7 @@ class RayScene:
     two_sided: np.ndarray            # (M,) bool
     gloss: np.ndarray                # (M,) lobe exponent, inf: a mirror (Material.gloss_exponent)
     gloss_set: bool = False          # some material sets `gloss` (inf included)
+    glossy: bool = False             # some material is glossy (Material.is_glossy: the GLSL's GLOSSY)
     motion: SceneMotion | None = None    # per object; None: no motion code (the still scene)
     mesh_object: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     # (K,) per tree of `bvh`: the object it moves with, -1 for the static triangles' tree
@@ -75,12 +76,6 @@ class RayScene:
         """Whether any material reflects or transmits (secondary rays exist)."""
         return bool((self.kr > 0).any() or (self.kt > 0).any())
 
-    @property
-    def glossy(self) -> bool:
-        """Whether some material that reflects (k_r or k_t > 0) has a finite gloss: the
-        reflected rays' lobe is sampled somewhere (the GLSL's GLOSSY)."""
-        reflects = (self.kr > 0).any(-1) | (self.kt > 0).any(-1)
-        return bool((reflects & np.isfinite(self.gloss)).any())
 
 
 def _normalize_or_zero(v):
@@ -139,6 +134,7 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
         gloss=np.array([m.gloss_exponent for m in mats], np.float64),
         gloss_set=any(m.gloss is not None for m in mats),
+        glossy=any(m.is_glossy for m in mats),
         motion=scene_motion(scene) if motion else None, mesh_object=mesh_object,
     )
 

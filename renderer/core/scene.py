@@ -103,6 +103,13 @@ class Material:
         """The reflected rays' lobe exponent: `gloss`, or inf (a mirror) where it is not set."""
         return math.inf if self.gloss is None else float(self.gloss)
 
+    @property
+    def is_glossy(self) -> bool:
+        """Whether the ray tracer draws this material's reflected rays from a lobe: it
+        reflects (some k_r or k_t > 0) and its gloss is finite (the GLSL's GLOSSY)."""
+        reflects = any(float(k) > 0.0 for k in (*self.kr, *self.kt))
+        return reflects and math.isfinite(self.gloss_exponent)
+
 
 ENERGY_SLACK = 1e-9
 

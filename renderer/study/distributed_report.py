@@ -61,8 +61,7 @@ def scene_effects(scene) -> set[str]:
         effects.add("lens")
     if camera.shutter[0] < camera.shutter[1] and moves(scene):    # an open shutter, a motion
         effects.add("time")
-    if any(math.isfinite(obj.material.gloss_exponent) and max(obj.material.kr + obj.material.kt) > 0
-           for obj in scene.objects):
+    if any(obj.material.is_glossy for obj in scene.objects):
         effects.add("glossy")
     return effects
 

@@ -1,0 +1,49 @@
+"""The texture-coordinate rules of the analytic shapes, written once (docs/conventions.md,
+"Texture coordinates"): the primitives apply them to their vertices, the ray tracer and its
+twin to their hits, so that a sphere or plane gets the same UVs both ways.
+
+- Sphere, for the unit direction d from the centre (object space): longitude
+  lambda = atan2(d.x, d.z), u = 1/2 + lambda / (2 pi) (u = 1/2 faces +z and grows to the
+  right seen from +z), v = 1/2 + asin(d.y) / pi (1 at the north pole +y). The seam is
+  lambda = +-pi, the -z side.
+- Plane with normal n: T = the object x axis projected into the plane, normalised (the
+  -z axis where |n.x| > PLANE_AXIS_SWITCH), B = n x T for unit n; u = p.T, v = p.B for the
+  object-space point p (one unit, one repeat before uv_scale). For n = +y: T = +x, B = -z.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+# Where the normal is this close to the x axis, T comes from the -z axis instead.
+PLANE_AXIS_SWITCH = 0.999
+
+
+def longitude_u(x, z) -> np.ndarray:
+    """u of the longitude rule around the y axis: 1/2 + atan2(x, z) / (2 pi), in [0, 1]."""
+    return 0.5 + np.arctan2(x, z) / (2.0 * np.pi)
+
+
+def sphere_uv(directions) -> np.ndarray:
+    """(N, 2) UVs of unit directions (N, 3) from a sphere's centre (the module's rule)."""
+    d = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+    u = longitude_u(d[:, 0], d[:, 2])
+    v = 0.5 + np.arcsin(np.clip(d[:, 1], -1.0, 1.0)) / np.pi
+    return np.stack([u, v], axis=1)
+
+
+def plane_uv_axes(normal) -> tuple[np.ndarray, np.ndarray]:
+    """(T, B), unit, of a plane with `normal` (any length but zero): u = p.T, v = p.B."""
+    n = np.asarray(normal, dtype=np.float64)
+    n = n / np.linalg.norm(n)
+    axis = np.array([0.0, 0.0, -1.0]) if abs(n[0]) > PLANE_AXIS_SWITCH else np.array([1.0, 0.0, 0.0])
+    t = axis - (axis @ n) * n
+    t /= np.linalg.norm(t)
+    return t, np.cross(n, t)
+
+
+def plane_uv(points, normal) -> np.ndarray:
+    """(N, 2) UVs of object-space points (N, 3) on a plane with `normal`."""
+    t, b = plane_uv_axes(normal)
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    return np.stack([p @ t, p @ b], axis=1)

@@ -14,7 +14,7 @@ import numpy as np
 import trimesh
 
 from renderer.core.scene import Mesh
-from renderer.core.uv_rules import plane_uv, sphere_uv
+from renderer.core.uv_rules import plane_uv, sphere_uv, weld_corners
 
 
 def _grid_faces(rows: int, cols: int, wrap_cols: bool) -> np.ndarray:
@@ -101,7 +101,7 @@ def icosphere(radius: float = 1.0, subdivisions: int = 2) -> Mesh:
     normals = np.asarray(ico.vertices, dtype=float)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     faces = np.asarray(ico.faces, dtype=np.int64)
-    vertex, faces, uvs = _weld_corners(faces, _sphere_corner_uvs(normals, faces))
+    vertex, faces, uvs = weld_corners(faces, _sphere_corner_uvs(normals, faces))
     return Mesh(normals[vertex] * radius, normals[vertex], faces, f"icosphere({subdivisions})",
                 uvs=uvs)
 
@@ -123,20 +123,6 @@ def _sphere_corner_uvs(directions: np.ndarray, faces: np.ndarray) -> np.ndarray:
     count = (~pole).sum(axis=1, keepdims=True)
     uv[..., 0] = np.where(pole, others / np.maximum(count, 1), u)
     return uv
-
-
-def _weld_corners(faces: np.ndarray, corner_uvs: np.ndarray):
-    """One vertex per distinct (vertex, UV) among the faces' corners: (source vertex of each
-    new vertex, new faces, new UVs). A vertex keeps its place in order; its copies with
-    other UVs follow it, in the order faces first use them."""
-    corner_vertex = faces.reshape(-1)
-    key = np.column_stack([corner_vertex, corner_uvs.reshape(-1, 2)])
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    order = np.lexsort((first, corner_vertex[first]))                # by vertex, then use
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    new_faces = rank[np.asarray(inverse).reshape(-1)].reshape(faces.shape)
-    return corner_vertex[first][order], new_faces, corner_uvs.reshape(-1, 2)[first][order]
 
 
 def plane(size: float = 2.0, segments: int = 1) -> Mesh:

@@ -19,6 +19,7 @@ neither makes a level of its own. Conventions (docs/conventions.md, "Texture coo
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -163,13 +164,15 @@ def mip_chain(level0: np.ndarray) -> tuple:
 
 # --------------------------------------------------------------------------- sources
 
-def texture_from_image(rgb: np.ndarray, source: str, colorspace: str = "srgb") -> Texture:
+def texture_from_image(rgb: np.ndarray, source: str, colorspace: str = "srgb",
+                       tint=(1.0, 1.0, 1.0)) -> Texture:
     """A Texture from float RGB (H, W, 3) in [0, 1], row 0 at the top, decoded by
-    `colorspace` ("srgb": srgb_to_linear; "linear": as it is); alpha 1."""
+    `colorspace` ("srgb": srgb_to_linear; "linear": as it is), then multiplied by the linear
+    `tint` (glTF's baseColorFactor); alpha 1."""
     if colorspace not in COLORSPACES:
         raise ValueError(f"colorspace must be one of {', '.join(COLORSPACES)}, got {colorspace!r}")
     rgb = np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0)
-    linear = srgb_to_linear(rgb) if colorspace == "srgb" else rgb
+    linear = (srgb_to_linear(rgb) if colorspace == "srgb" else rgb) * np.asarray(tint, dtype=np.float64)
     rgba = np.concatenate([linear, np.ones((*linear.shape[:2], 1))], axis=2)
     return Texture(mip_chain(rgba), source, colorspace)
 
@@ -195,40 +198,52 @@ def load_texture(path, colorspace: str = "srgb", *, source: str | None = None,
 
     8-bit images are read as c / 255 per channel (greyscale and palettes expanded to RGB);
     16-bit greyscale as c / 65535; alpha is dropped."""
+    path = Path(path)
+    if not path.exists():
+        _image_problem("image file not found", path, source, key)
+    if not path.is_file():
+        _image_problem("is not a file", path, source, key)
+    with open(path, "rb") as handle:
+        data = handle.read()
+    return texture_from_bytes(data, str(path), colorspace, source=source, key=key)
+
+
+def texture_from_bytes(data: bytes, name: str, colorspace: str = "srgb", *, tint=(1.0, 1.0, 1.0),
+                       source: str | None = None, key: str | None = None) -> Texture:
+    """An encoded image (PNG or JPEG bytes) as a Texture named `name`, with load_texture's
+    checks and errors (`name` stands for the file in them)."""
     from PIL import Image, UnidentifiedImageError
 
-    path = Path(path)
-
-    def fail(reason: str):
-        if source is not None:
-            raise SceneError(f"{path}: {reason}", file=source, key=key)
-        raise SceneError(reason, file=str(path), key=key)
-
-    if not path.exists():
-        fail("image file not found")
-    if not path.is_file():
-        fail("is not a file")
-    if path.stat().st_size == 0:
-        fail("image file is empty (0 bytes)")
+    if len(data) == 0:
+        _image_problem("image is empty (0 bytes)", name, source, key)
     try:
-        with Image.open(path) as image:
+        with Image.open(io.BytesIO(data)) as image:
             width, height = image.size
             if width == 0 or height == 0:
-                fail(f"image has no texels ({width} x {height})")
+                _image_problem(f"image has no texels ({width} x {height})", name, source, key)
             largest = gl_rules.GL_MIN_MAX_TEXTURE_SIZE
             if max(width, height) > largest:
-                fail(f"image is {width} x {height}; a texture is at most {largest} texels on a "
-                     f"side (GL_MAX_TEXTURE_SIZE)")
+                _image_problem(f"image is {width} x {height}; a texture is at most {largest} "
+                               f"texels on a side (GL_MAX_TEXTURE_SIZE)", name, source, key)
             too_much = memory.over_limit(width * height * TEXTURE_BYTES_PER_TEXEL)
             if too_much:
-                fail(f"a {width} x {height} texture {too_much}")
+                _image_problem(f"a {width} x {height} texture {too_much}", name, source, key)
             image.load()
             rgb = _rgb(image)
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError, Image.DecompressionBombError) \
-            as exc:
+    except UnidentifiedImageError:
+        _image_problem("could not be read as an image: not a format Pillow knows (PNG, JPEG)",
+                       name, source, key)
+    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as exc:
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
-        fail(f"could not be read as an image (PNG or JPEG): {reason}")
-    return texture_from_image(rgb, str(path), colorspace)
+        _image_problem(f"could not be read as an image (PNG or JPEG): {reason}", name, source, key)
+    return texture_from_image(rgb, name, colorspace, tint)
+
+
+def _image_problem(reason: str, name, source: str | None, key: str | None):
+    """The one-line SceneError: "SOURCE: KEY: NAME: reason", or "NAME: KEY: reason" alone."""
+    if source is not None:
+        raise SceneError(f"{name}: {reason}", file=source, key=key)
+    raise SceneError(reason, file=str(name), key=key)
 
 
 def _rgb(image) -> np.ndarray:
@@ -237,4 +252,3 @@ def _rgb(image) -> np.ndarray:
         grey = np.asarray(image, dtype=np.float64) / 65535.0
         return np.repeat(grey[:, :, None], 3, axis=2)
     return np.asarray(image.convert("RGB"), dtype=np.float64) / 255.0
-

@@ -9,6 +9,9 @@ twin to their hits, so that a sphere or plane gets the same UVs both ways.
 - Plane with normal n: T = the object x axis projected into the plane, normalised (the
   -z axis where |n.x| > PLANE_AXIS_SWITCH), B = n x T for unit n; u = p.T, v = p.B for the
   object-space point p (one unit, one repeat before uv_scale). For n = +y: T = +x, B = -z.
+
+`weld_corners` is the seam rule for meshes: a vertex whose faces give it different UVs
+becomes one vertex per UV (primitives, mesh files).
 """
 
 from __future__ import annotations
@@ -47,3 +50,19 @@ def plane_uv(points, normal) -> np.ndarray:
     t, b = plane_uv_axes(normal)
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     return np.stack([p @ t, p @ b], axis=1)
+
+
+def weld_corners(faces: np.ndarray, corner_uvs: np.ndarray):
+    """Vertices from per-corner UVs (F, 3, 2): one vertex per distinct (vertex, UV) among the
+    faces' corners, so that a vertex splits where its corners' UVs differ (a seam). Returns
+    (the source vertex of each new vertex, new faces, new UVs). Vertices keep their order
+    (those no face uses are left out); a vertex's copies follow it, in the order faces first
+    use them."""
+    corner_vertex = faces.reshape(-1)
+    key = np.column_stack([corner_vertex, corner_uvs.reshape(-1, 2)])
+    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    order = np.lexsort((first, corner_vertex[first]))                # by vertex, then use
+    rank = np.empty_like(order)
+    rank[order] = np.arange(len(order))
+    new_faces = rank[np.asarray(inverse).reshape(-1)].reshape(faces.shape)
+    return corner_vertex[first][order], new_faces, corner_uvs.reshape(-1, 2)[first][order]

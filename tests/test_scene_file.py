@@ -764,7 +764,7 @@ BAD_SCENES = [
      "objects[0].angular_speed: unknown key; did you mean 'angular_velocity'?"),
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
-     "two_sided, shading, kr, kt, ior, gloss"),
+     "two_sided, shading, kr, kt, ior, gloss, texture"),
 ]
 
 

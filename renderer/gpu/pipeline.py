@@ -299,7 +299,7 @@ class GpuRenderer:
                 content = [(item.vbo, "3f 3f", "in_position", "in_normal")]
             else:                                    # flat: the normal is the face's, not read
                 content = [(item.vbo, "3f 3x4", "in_position")]
-            if variant.texture:
+            if program.get("in_uv", None) is not None:   # textured, and the texel is used
                 content.append((item.uv_vbo, "2f", "in_uv"))
             vao = self.ctx.vertex_array(program, content, index_buffer=item.ibo,
                                         index_element_size=4)

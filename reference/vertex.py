@@ -78,9 +78,9 @@ def modulated(material) -> tuple:
     return () if material.texture is None else tuple(material.texture.modulate)
 
 
-def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, *, u_model: np.ndarray,
-                   u_normal_matrix: np.ndarray, u_view: np.ndarray, u_projection: np.ndarray,
-                   u_eye: np.ndarray, material, lights: Lights, in_uv: np.ndarray | None = None,
+def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, in_uv: np.ndarray | None = None,
+                   *, u_model: np.ndarray, u_normal_matrix: np.ndarray, u_view: np.ndarray,
+                   u_projection: np.ndarray, u_eye: np.ndarray, material, lights: Lights,
                    dtype=np.float64) -> VertexOutputs:
     """Run the vertex stage over all of an object's vertices at once."""
     in_position = np.asarray(in_position, dtype=dtype)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from renderer.core.scene import FrameMatrices, Material, ObjectMatrices, Scene, SceneObject
+from renderer.core.textures import MaterialTexture
 
 # name -> GLSL type; "vec3[]" is an array with one row per light of that kind.
 LIGHT_UNIFORMS = {
@@ -105,13 +106,13 @@ def material_uniforms(material: Material) -> dict[str, np.ndarray]:
             "u_n": np.asarray(material.n, dtype=np.float64)}
 
 
-def texture_uniforms(material: Material) -> dict[str, np.ndarray]:
-    """A textured material's UV transform (TEXTURE_UNIFORMS but the texture unit), float64;
+def texture_uniforms(texture: MaterialTexture | None) -> dict[str, np.ndarray]:
+    """A material's texture's UV transform (TEXTURE_UNIFORMS but the texture unit), float64;
     empty for a material without a texture."""
-    if material.texture is None:
+    if texture is None:
         return {}
-    return {"u_uv_scale": np.asarray(material.texture.uv_scale, dtype=np.float64),
-            "u_uv_offset": np.asarray(material.texture.uv_offset, dtype=np.float64)}
+    return {"u_uv_scale": np.asarray(texture.uv_scale, dtype=np.float64),
+            "u_uv_offset": np.asarray(texture.uv_offset, dtype=np.float64)}
 
 
 def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.ndarray]:
@@ -120,4 +121,4 @@ def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.
     return {"u_model": matrices.model, "u_normal_matrix": matrices.normal,
             **material_uniforms(obj.material),
             "u_two_sided": np.asarray(int(bool(obj.material.two_sided))),
-            **texture_uniforms(obj.material)}
+            **texture_uniforms(obj.material.texture)}

@@ -72,13 +72,17 @@ class Sampler:
         return self.filter in MIPMAPPED_FILTERS
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class Texture:
     """A texture's mip levels, (H_k, W_k, 4) uint8, row 0 at the top, linear values (module
     docstring). Compared by identity: each Texture object is uploaded once."""
     levels: tuple
     source: str                            # file path or "checker 8x8 at 256", for messages
     colorspace: str = "srgb"               # what the file held: "srgb" (decoded) or "linear"
+
+    def __repr__(self) -> str:             # short: materials are printed and hashed by repr
+        return (f"Texture({self.source!r}, {self.colorspace}, {self.width}x{self.height}, "
+                f"{len(self.levels)} levels)")
 
     @property
     def width(self) -> int:

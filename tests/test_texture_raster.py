@@ -31,9 +31,9 @@ from renderer.core.scene_file import load_scene
 from renderer.core.shadow_settings import Shadow
 from renderer.core.textures import MaterialTexture, Sampler, Texture, mip_chain
 from renderer.gpu import GpuRenderer
-from renderer.gpu.shaders import ShaderVariant, program_sources
 
-TEXTURED_SCENES = ("textured_mesh", "checker_horizon", "globe")
+from conftest import TEXTURE_SCENES
+
 SCENE_SIZE = (320, 240)
 IMAGE_FILTERS = ("nearest", "bilinear", "mip-nearest", "trilinear")
 FLAT_WHITE = (1.0, 1.0, 1.0)
@@ -250,7 +250,7 @@ HORIZON_ANISOTROPY = pytest.mark.xfail(strict=True, reason="anisotropic EWA at t
                                        "pixels 3/255 from the twin (GL's float32 UVs)")
 SCENE_FILTERS = [pytest.param(name, filter, id=f"{name}-{filter}",
                               marks=[HORIZON_ANISOTROPY] if (name, filter) == ("checker_horizon", "anisotropic") else [])
-                 for name in TEXTURED_SCENES for filter in (*IMAGE_FILTERS, "anisotropic")]
+                 for name in sorted(TEXTURE_SCENES) for filter in (*IMAGE_FILTERS, "anisotropic")]
 
 
 @pytest.mark.slow                   # 3 scenes x 5 filters x 2 contexts at 320x240: about 20 s

@@ -275,8 +275,7 @@ def test_only_a_textured_material_gets_texture_code_and_uvs(gl_contexts):
     """A textured and an untextured quad in one scene: the textured material's program has the
     material sampler, the UV transform and in_uv, and only its object's vertex array binds UVs;
     the other program has none of them (no TEXTURED define: the code is not compiled)."""
-    texture = MaterialTexture(texture_of(np.full((2, 2, 4), 255, np.uint8), "white"),
-                              uv_offset=(0.5, 0.0))
+    texture = MaterialTexture(texture_of(np.full((2, 2, 4), 255, np.uint8), "white"))
     scene = Scene(camera=Camera(eye=(0.0, 0.0, 4.0)), directional_lights=[DirectionalLight()], objects=[
         SceneObject("textured", quad(1.0, 1.0), Material(texture=texture), Transform(translate=(-1, 0, 0))),
         SceneObject("plain", quad(1.0, 1.0), Material(), Transform(translate=(1, 0, 0)))])

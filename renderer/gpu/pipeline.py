@@ -273,8 +273,9 @@ class GpuRenderer:
             vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
             item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
-            if item.obj.material.texture is not None:
-                item.uv_vbo = self.ctx.buffer(_texture_coordinates(item.obj).tobytes())
+            uvs = item.obj.texture_coordinates()
+            if uvs is not None:                      # in_uv: float32 (V, 2)
+                item.uv_vbo = self.ctx.buffer(np.ascontiguousarray(uvs, dtype=np.float32).tobytes())
 
     @staticmethod
     def _release_buffers(item: _ObjectBuffers) -> None:
@@ -634,14 +635,6 @@ class GpuRenderer:
     def __repr__(self) -> str:
         state = "released" if self._released else context_kind(self.ctx)
         return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
-
-
-def _texture_coordinates(obj: SceneObject) -> np.ndarray:
-    """The object's vertex UVs as its textured material's in_uv takes them: float32 (V, 2)."""
-    if obj.mesh.uvs is None:
-        raise ValueError(f"object {obj.name!r}: its material has a texture but its mesh "
-                         f"({obj.mesh.source or 'made in code'}) has no texture coordinates")
-    return np.ascontiguousarray(obj.mesh.uvs, dtype=np.float32)
 
 
 def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:

@@ -295,3 +295,28 @@ def test_only_a_textured_material_gets_texture_code_and_uvs(gl_contexts):
     assert set(members) == {("kd",), ()}
     assert texture_names <= members[("kd",)] and not texture_names & members[()]
     assert bound == [{"in_position", "in_normal", "in_uv"}, {"in_position", "in_normal"}]
+
+
+def test_a_texture_is_uploaded_once_however_many_materials_and_frames_use_it(gl_contexts):
+    """Two materials share one texture, a third has its own: two uploads, none again when
+    update() recomputes the frame."""
+    shared, own = (texture_of(np.full((4, 4, 4), c, np.uint8), f"grey {c}") for c in (90, 200))
+    objects = [SceneObject(f"quad{i}", quad(0.8, 0.8), Material(texture=MaterialTexture(texture)),
+                           Transform(translate=(i - 1.0, 0, 0)))
+               for i, texture in enumerate((shared, shared, own))]
+    scene = Scene(camera=Camera(eye=(0.0, 0.0, 4.0)), directional_lights=[DirectionalLight()],
+                  objects=objects)
+    uploads = []
+    original = moderngl.Context.texture
+
+    def counting(self, size, components, *args, **kwargs):
+        uploads.append(size)
+        return original(self, size, components, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(moderngl.Context, "texture", counting)
+        with GpuRenderer(scene, 16, 12, context=gl_contexts["egl"]) as gpu:
+            gpu.render()
+            gpu.update()
+            gpu.render()
+    assert uploads == [(4, 4), (4, 4)]

@@ -320,3 +320,19 @@ def test_a_texture_is_uploaded_once_however_many_materials_and_frames_use_it(gl_
             gpu.update()
             gpu.render()
     assert uploads == [(4, 4), (4, 4)]
+
+
+def test_a_material_given_a_texture_after_the_renderer_was_made(gl_contexts):
+    """update() after an object's material gains a texture uploads its UVs and draws it
+    textured: its texels, as a new renderer draws them."""
+    texels = np.random.default_rng(3).integers(0, 256, (8, 8, 4), dtype=np.uint8)
+    camera = Camera(eye=(0.0, 0.0, 5.0), projection="parallel", height=2.0)
+    scene = texels_out_scene(texture_of(texels, "random"), Sampler(filter="nearest"), "gouraud",
+                             quad(2.0, 2.0), camera)
+    textured = scene.objects[0].material
+    scene.objects[0].material = replace(textured, texture=None)
+    with GpuRenderer(scene, 8, 8, context=gl_contexts["egl"]) as gpu:
+        assert (gpu.render().rgba8[..., :3] == 255).all()           # k_a = I_a = 1, untextured
+        scene.objects[0].material = textured
+        gpu.update()
+        assert np.array_equal(gpu.render().rgba8[..., :3], texels[..., :3])

@@ -273,9 +273,14 @@ class GpuRenderer:
             vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
             item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
-            uvs = item.obj.texture_coordinates()
-            if uvs is not None:                      # in_uv: float32 (V, 2)
-                item.uv_vbo = self.ctx.buffer(np.ascontiguousarray(uvs, dtype=np.float32).tobytes())
+        self._upload_uvs(item)
+
+    def _upload_uvs(self, item: _ObjectBuffers) -> None:
+        """The mesh's UVs (in_uv, float32) once the object's material is textured: when it is
+        made, or at the update() after a material gains a texture."""
+        uvs = item.obj.texture_coordinates()
+        if uvs is not None and item.uv_vbo is None and item.vbo is not None:
+            item.uv_vbo = self.ctx.buffer(np.ascontiguousarray(uvs, dtype=np.float32).tobytes())
 
     @staticmethod
     def _release_buffers(item: _ObjectBuffers) -> None:
@@ -320,6 +325,7 @@ class GpuRenderer:
             if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
                 self._release_buffers(item)
                 self._upload(item)
+            self._upload_uvs(item)
         matrices = scene.matrices(self.width, self.height)
         visible = visible_objects(scene, matrices)
         shadows = self._update_shadows(matrices, visible)

@@ -150,6 +150,13 @@ def to_unorm8(c: np.ndarray) -> np.ndarray:
     return np.floor(scaled, out=scaled).astype(np.uint8)
 
 
+
+# --- textures ----------------------------------------------------------------------------------
+
+# GL 4.5's minimum of GL_MAX_TEXTURE_SIZE (llvmpipe's own is 16384 too): a texture's largest
+# side. The guaranteed minimum, as for uniforms below, so the reference holds the same rule.
+GL_MIN_MAX_TEXTURE_SIZE = 16384
+
 # --- uniform storage: how many lights a scene may have ---------------------------------------
 #
 # The light arrays are uniforms (renderer/core/uniforms.py, glsl/lighting.glsl) sized at

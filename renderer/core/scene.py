@@ -18,6 +18,7 @@ import numpy as np
 
 from renderer.core import transforms
 from renderer.core.shadow_settings import Shadow
+from renderer.core.textures import MaterialTexture
 
 Projection = Literal["perspective", "parallel"]
 ShadingMode = Literal["flat", "gouraud", "phong"]
@@ -91,6 +92,14 @@ class Material:
     # reflection"). None, not set, is a mirror as inf is; the reference traces the lobe's code
     # wherever some material sets it, inf included, so that inf = mirror is tested, not assumed.
     gloss: float | None = None
+    # A texture (renderer/core/textures.py): its texel multiplies the coefficients it names
+    # (texture.modulate) before lighting; None: untextured. The object's mesh needs UVs.
+    texture: MaterialTexture | None = None
+
+    @property
+    def textured(self) -> bool:
+        """Whether a texture modulates this material's coefficients."""
+        return self.texture is not None
 
     @property
     def has_specular(self) -> bool:
@@ -124,9 +133,12 @@ def energy_excess(kr, kt) -> int | None:
 
 @dataclass
 class Mesh:
-    """A triangle mesh: positions (V, 3) float64, unit normals (V, 3) float64, faces (F, 3) int64.
+    """A triangle mesh: positions (V, 3) float64, unit normals (V, 3) float64, faces (F, 3) int64,
+    and texture coordinates `uvs` (V, 2) float64, or None where it has none.
 
-    Faces are counter-clockwise seen from the side their normals point to.
+    Faces are counter-clockwise seen from the side their normals point to. UVs follow GL
+    (docs/conventions.md, "Texture coordinates"): u along the image left to right, v from its
+    bottom row (0) to its top row (1); a seam has its vertices duplicated.
     """
     positions: np.ndarray
     normals: np.ndarray
@@ -136,6 +148,7 @@ class Mesh:
     # that it can be rebuilt at another tessellation (renderer/study/tessellation.py); None for
     # mesh files.
     recipe: tuple[str, dict] | None = None
+    uvs: np.ndarray | None = None
 
     @property
     def triangle_count(self) -> int:

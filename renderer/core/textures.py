@@ -36,7 +36,7 @@ FILTERS = ("nearest", "bilinear", "mip-nearest", "trilinear", "anisotropic")
 MIPMAPPED_FILTERS = ("mip-nearest", "trilinear", "anisotropic")
 COLORSPACES = ("srgb", "linear")           # what an image file's values are
 MODULATED = ("ka", "kd", "ks")             # the coefficients a texel may multiply
-ANISOTROPY_RANGE = (2, 16)                 # llvmpipe's GL_MAX_TEXTURE_MAX_ANISOTROPY is 16
+ANISOTROPY_RANGE = (2, gl_rules.MAX_TEXTURE_MAX_ANISOTROPY)
 DEFAULT_ANISOTROPY = 16                    # "anisotropic" without a degree: the most there is
 
 # Decoding an image: float64 RGBA level 0 (32 bytes a texel), the mip chain's half-width

@@ -15,6 +15,11 @@ the mesh, that scene file and its key). What it checks:
   edge where the two faces' normals differ by up to the angle, split into one vertex per side
   where they differ by more, as modelling tools do. `crease_angle=180` is smooth everywhere
   (`smooth_vertex_normals`).
+- texture coordinates (`Mesh.uvs`, docs/conventions.md "Texture coordinates"): OBJ `vt`,
+  PLY `texture_u texture_v` / `u v` / `s t`, glTF TEXCOORD_0 (trimesh turns glTF's v, which
+  points down the image, into ours: v = 1 - v_gltf). Kept only when every part of the file
+  has them, and they must be finite. Merging and crease splitting keep them: positions merge
+  for the normals' sake, then a vertex splits where its corners' UVs differ (a seam).
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from renderer.core import memory
 from renderer.core.paths import checked_path
 from renderer.errors import SceneError, show_number
 from renderer.core.scene import Mesh
+from renderer.core.uv_rules import weld_corners
 
 # Suffixes we hand to trimesh; the first three are the ones the tests cover.
 MESH_SUFFIXES = (".obj", ".ply", ".stl", ".off", ".glb", ".gltf")
@@ -98,14 +104,21 @@ def _load_checked(path: Path, crease_angle: float) -> Mesh:
         _check_obj_face_indices(path)
     if suffix == ".ply":
         _check_ascii_ply_face_indices(path)
-    positions, faces, file_normals = _read_with_trimesh(path)
+    positions, faces, file_normals, uvs = _read_with_trimesh(path)
     _check_geometry(positions, faces)
-    if file_normals is None:
-        positions, faces = merge_coincident_vertices(positions, faces)
-        positions, normals, faces = crease_vertex_normals(positions, faces, crease_angle)
-    else:
+    _check_uvs(uvs)
+    if file_normals is not None:
         normals = _repair_normals(file_normals, smooth_vertex_normals(positions, faces))
-    return Mesh(positions, normals, faces, str(path))
+        return Mesh(positions, normals, faces, str(path), uvs=uvs)
+    # The normals see the surface as its positions join it (a UV seam is no crease); the
+    # UVs then split the vertices they differ at.
+    kept, merged = _coincident(positions)
+    source, normals, creased = _crease(positions[kept], merged[faces], crease_angle)
+    positions = positions[kept][source]
+    if uvs is None:
+        return Mesh(positions, normals, creased, str(path))
+    vertex, creased, uvs = weld_corners(creased, uvs[faces])
+    return Mesh(positions[vertex], normals[vertex], creased, str(path), uvs=uvs)
 
 
 @contextlib.contextmanager
@@ -127,7 +140,8 @@ def _quiet_libraries():
 
 
 def _read_with_trimesh(path: Path):
-    """(positions (V, 3), faces (F, 3), normals (V, 3) or None) of every triangle mesh in the file.
+    """(positions (V, 3), faces (F, 3), normals (V, 3) or None, UVs (V, 2) or None) of every
+    triangle mesh in the file.
 
     process=False keeps the file's vertices and normals as written (no merging, no repair).
     """
@@ -153,8 +167,9 @@ def _read_with_trimesh(path: Path):
     if not parts:
         raise _MeshProblem("mesh has no triangles")
 
-    positions, faces, normals, offset = [], [], [], 0
+    positions, faces, normals, uvs, offset = [], [], [], [], 0
     all_have_normals = all(_has_file_normals(g) for _, g in parts)
+    all_have_uvs = all(_file_uvs(g) is not None for _, g in parts)
     for transform, geometry in parts:
         v = np.asarray(geometry.vertices, dtype=np.float64).reshape(-1, 3)
         f = np.asarray(geometry.faces, dtype=np.int64).reshape(-1, 3)
@@ -167,9 +182,21 @@ def _read_with_trimesh(path: Path):
             if not np.allclose(transform, np.eye(4)):
                 n = n @ np.linalg.inv(transform[:3, :3])   # (M^-T n) for row vectors
             normals.append(n)
+        if all_have_uvs:
+            uvs.append(_file_uvs(geometry))
         offset += len(v)
     return (np.concatenate(positions), np.concatenate(faces),
-            np.concatenate(normals) if all_have_normals else None)
+            np.concatenate(normals) if all_have_normals else None,
+            np.concatenate(uvs) if all_have_uvs else None)
+
+
+def _file_uvs(geometry: trimesh.Trimesh) -> np.ndarray | None:
+    """The part's UVs (V, 2) float64 as trimesh read them (v up, glTF's already turned), or
+    None. trimesh keeps glTF's TEXCOORD_0 only on primitives that name a material."""
+    uv = getattr(geometry.visual, "uv", None)
+    if uv is None or np.shape(uv)[0] != len(geometry.vertices) or np.ndim(uv) != 2:
+        return None
+    return np.asarray(uv, dtype=np.float64)[:, :2]
 
 
 def _has_file_normals(geometry: trimesh.Trimesh) -> bool:
@@ -187,14 +214,12 @@ def _check_geometry(positions: np.ndarray, faces: np.ndarray) -> None:
         raise _MeshProblem("mesh has no triangles")
     bad = ~np.isfinite(positions).all(axis=1)
     if bad.any():
-        i = int(np.argmax(bad))
-        shown = ", ".join(show_number(x) for x in positions[i])
+        i, shown = _first(bad, positions)
         raise _MeshProblem(f"vertex {i} is not finite ({shown}); "
                            f"{int(bad.sum())} of {len(positions)} vertices are NaN or Inf")
     large = (np.abs(positions) > MAX_COORDINATE).any(axis=1)
     if large.any():
-        i = int(np.argmax(large))
-        shown = ", ".join(show_number(x) for x in positions[i])
+        i, shown = _first(large, positions)
         raise _MeshProblem(f"vertex {i} ({shown}) is too large for the GPU's float32 "
                            f"arithmetic; coordinates must satisfy |x| <= {MAX_COORDINATE:g} "
                            f"({int(large.sum())} of {len(positions)} vertices do not)")
@@ -204,6 +229,23 @@ def _check_geometry(positions: np.ndarray, faces: np.ndarray) -> None:
         raise _MeshProblem(f"face {f} has vertex index {int(faces[f][out[f]][0])} out of range "
                            f"(the mesh has {len(positions)} vertices, indices 0 to "
                            f"{len(positions) - 1})")
+
+
+def _check_uvs(uvs: np.ndarray | None) -> None:
+    if uvs is None:
+        return
+    bad = ~np.isfinite(uvs).all(axis=1) | (np.abs(uvs) > MAX_COORDINATE).any(axis=1)
+    if bad.any():
+        i, shown = _first(bad, uvs)
+        raise _MeshProblem(f"vertex {i} has texture coordinates ({shown}) that are not finite "
+                           f"numbers within |x| <= {MAX_COORDINATE:g} ({int(bad.sum())} of "
+                           f"{len(uvs)} vertices)")
+
+
+def _first(bad: np.ndarray, rows: np.ndarray) -> tuple[int, str]:
+    """The first bad row's index and its numbers as a message shows them."""
+    i = int(np.argmax(bad))
+    return i, ", ".join(show_number(x) for x in rows[i])
 
 
 def _check_obj_face_indices(path: Path) -> None:
@@ -285,11 +327,18 @@ def _check_ascii_ply_face_indices(path: Path) -> None:
 def merge_coincident_vertices(positions: np.ndarray, faces: np.ndarray):
     """Join vertices with exactly equal positions (STL stores three per triangle), keeping
     the order of first appearance. Returns (positions, faces)."""
-    unique, first, inverse = np.unique(positions, axis=0, return_index=True, return_inverse=True)
+    kept, merged = _coincident(positions)
+    return positions[kept], merged[faces]
+
+
+def _coincident(positions: np.ndarray):
+    """(kept, merged): the first vertex of each distinct position, in order of first
+    appearance, and each vertex's index among them."""
+    _, first, inverse = np.unique(positions, axis=0, return_index=True, return_inverse=True)
     order = np.argsort(first)                 # unique rows in order of first appearance
     rank = np.empty_like(order)
     rank[order] = np.arange(len(order))
-    return unique[order], rank[np.asarray(inverse).reshape(-1)][faces]
+    return first[order], rank[np.asarray(inverse).reshape(-1)]
 
 
 def _face_normals_and_angles(positions: np.ndarray, faces: np.ndarray):
@@ -337,9 +386,15 @@ def crease_vertex_normals(positions: np.ndarray, faces: np.ndarray,
     (FALLBACK_NORMAL). `crease_angle >= 180` is smooth_vertex_normals, nothing split.
     """
     positions = np.asarray(positions, dtype=np.float64)
+    source, normals, faces = _crease(positions, faces, crease_angle)
+    return positions[source], normals, faces
+
+
+def _crease(positions: np.ndarray, faces: np.ndarray, crease_angle: float):
+    """crease_vertex_normals as (the input vertex of each output vertex, normals, faces)."""
     faces = np.asarray(faces, dtype=np.int64)
     if crease_angle >= 180.0:
-        return positions, smooth_vertex_normals(positions, faces), faces
+        return np.arange(len(positions)), smooth_vertex_normals(positions, faces), faces
     cos_crease = np.cos(np.radians(crease_angle))
     face_count, vertex_count = len(faces), len(positions)
     corner_count = 3 * face_count
@@ -400,7 +455,7 @@ def crease_vertex_normals(positions: np.ndarray, faces: np.ndarray,
     new_faces = new_index[group].reshape(3, face_count).T.copy()
     fallback = np.broadcast_to(FALLBACK_NORMAL, (len(out_order), 3))
     normals = _unit_or_fallback(out_sum[out_order], fallback)
-    return positions[out_vertex[out_order]], normals, new_faces
+    return out_vertex[out_order], normals, new_faces
 
 
 def _pairs_of_equal_rows(rows: np.ndarray):

@@ -34,8 +34,11 @@ from renderer.core.paths import checked_path
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core import shapes
+from renderer.core.gltf_texture import base_colour_texture
+from renderer.core.texture_keys import read_texture
 from renderer.core.shadow_settings import (FILTERS, MAX_BIAS_TEXELS, RESOLUTIONS, BiasRule, Shadow,
                                            auto_bias)
+from renderer.core.textures import MaterialTexture
 from renderer.core.scene import (AREA_SHAPES, SHADING_MODES, Camera, DirectionalLight, LightArea,
                             Material, Mesh, Plane, PointLight, Scene, SceneObject, Sphere,
                             Transform, energy_excess, world_shape)
@@ -49,7 +52,8 @@ TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials
 LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
                *LENS_KEYS, "shutter")
-MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss")
+MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss",
+                 "texture")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 AREA_KEYS = ("area", "size", "radius", "normal")   # a point light's area (LightArea), `area` first
 AREA_SHAPE_KEYS = {"rectangle": ("size", "normal"), "disc": ("radius", "normal"),
@@ -262,6 +266,7 @@ class _Reader:
         self.source = source
         self.base_dir = base_dir
         self.primitive_triangles = 0      # so far, for the memory check before building more
+        self.textures: dict = {}          # each image, checker and mesh file's texture, made once
 
     def fail(self, key: str | None, reason: str) -> NoReturn:
         raise SceneError(reason, file=self.source, key=key or None)
@@ -349,6 +354,9 @@ class _Reader:
         if not isinstance(value, str):
             self.fail(path, f"expected a string, got {describe_value(value)}")
         return value
+
+    def describe(self, value: Any) -> str:
+        return describe_value(value)
 
     def choice(self, value: Any, path: str, what: str, known) -> str:
         text = self.string(value, path)
@@ -513,6 +521,8 @@ class _Reader:
             mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
         if "gloss" in raw:
             mat.gloss = self.gloss(raw["gloss"], _join(path, "gloss"))
+        if "texture" in raw:
+            mat.texture = read_texture(self, raw["texture"], _join(path, "texture"), self.textures)
         channel = energy_excess(mat.kr, mat.kt)
         if channel is not None:
             where = _join(path, "kt" if "kt" in raw else "kr")
@@ -656,6 +666,14 @@ class _Reader:
         material = Material()
         if "material" in raw:
             material = self.object_material(raw["material"], key("material"), materials)
+        if not material.textured and "file" in raw.get("mesh", {}):
+            texture = self.mesh_file_texture(raw["mesh"]["file"], key("mesh.file"))
+            if texture is not None:
+                material = dataclasses.replace(material, texture=texture)
+        if material.textured and mesh.uvs is None:
+            self.fail(key("material"), f"has a texture, but the mesh ({mesh.source}) has no "
+                                       f"texture coordinates; give the file UVs (OBJ vt, PLY "
+                                       f"u v, glTF TEXCOORD_0) or use a primitive or a shape")
         obj = SceneObject(name=name, mesh=mesh, material=material,
                           transform=self.transform(raw, path), shape=shape)
         if "parent" in raw:
@@ -832,11 +850,28 @@ class _Reader:
         return angle
 
     def mesh_file(self, value: Any, path: str, crease_angle: float = DEFAULT_CREASE_ANGLE) -> Mesh:
-        """Relative paths start at the scene file's folder, then at the built-in assets folder
-        (so any scene can use the built-in meshes as "meshes/NAME")."""
+        return load_mesh(self.find_file(value, path, "mesh"), source=self.source, key=path,
+                         crease_angle=crease_angle)
+
+    def mesh_file_texture(self, value: Any, path: str) -> MaterialTexture | None:
+        """A glTF/GLB mesh file's base-colour texture (renderer/core/gltf_texture.py), made
+        once per file; None for other files and for a glTF without one."""
+        file = self.find_file(value, path, "mesh")
+        if file.suffix.lower() not in (".glb", ".gltf"):
+            return None
+        cache_key = ("mesh file", str(file.resolve()))
+        if cache_key not in self.textures:
+            self.textures[cache_key] = base_colour_texture(file, source=self.source, key=path)
+        return self.textures[cache_key]
+
+    def find_file(self, value: Any, path: str, what: str) -> Path:
+        """A file a scene names (a mesh, an image): relative paths start at the scene file's
+        folder, then at the built-in assets folder (so any scene can use the built-in meshes
+        and textures as "meshes/NAME", "textures/NAME")."""
         text = self.string(value, path)
         if not text:
-            self.fail(path, "is empty; expected a mesh file path")
+            self.fail(path, f"is empty; expected {'an' if what[0] in 'aeiou' else 'a'} {what} "
+                            f"file path")
         checked_path(text, file=self.source, key=path, error=SceneError)
         candidates = [Path(text)] if Path(text).is_absolute() else [self.base_dir / text]
         assets = _builtin_assets_dir()
@@ -845,10 +880,9 @@ class _Reader:
         for candidate in candidates:
             checked_path(candidate, file=self.source, key=path, error=SceneError)
             if candidate.exists():
-                return load_mesh(candidate, source=self.source, key=path,
-                                 crease_angle=crease_angle)
+                return candidate
         looked = " and ".join(str(c.parent.resolve()) for c in candidates)
-        self.fail(path, f"mesh file not found: {text!r} (looked in {looked})")
+        self.fail(path, f"{what} file not found: {text!r} (looked in {looked})")
 
     # ---- names and parents
 

@@ -12,6 +12,10 @@ that every scene renders both ways. Both are deterministic and counted before th
   lies outside the view. A ray-traced plane is infinite: where the square ends inside the
   view (a far plane beyond size / 2, or a horizon), the two renderings differ; make `size`
   larger than twice the distance to the far plane to avoid it.
+
+Their UVs are the shapes' own (renderer/core/uv_rules.py), which the ray tracer computes at
+its hits: the sphere's from the direction from its centre, the plane's from the object-space
+point, so both renderings texture a shape alike.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import numpy as np
 
 from renderer.core.primitives import icosphere, plane as plane_primitive
 from renderer.core.scene import Mesh, Plane, Sphere
+from renderer.core.uv_rules import plane_uv
 
 SPHERE_SUBDIVISIONS = 3          # 1280 triangles
 PLANE_SIZE = 1000.0
@@ -34,7 +39,8 @@ TRIANGLES = {
 def sphere_mesh(sphere: Sphere, subdivisions: int = SPHERE_SUBDIVISIONS) -> Mesh:
     mesh = icosphere(float(sphere.radius), subdivisions)
     positions = mesh.positions + np.asarray(sphere.centre, dtype=np.float64)
-    return Mesh(positions, mesh.normals, mesh.faces, f"sphere(subdivisions={subdivisions})")
+    return Mesh(positions, mesh.normals, mesh.faces, f"sphere(subdivisions={subdivisions})",
+                uvs=mesh.uvs)
 
 
 def plane_basis(normal) -> np.ndarray:
@@ -58,4 +64,5 @@ def plane_mesh(shape: Plane, size: float = PLANE_SIZE, segments: int = PLANE_SEG
     square = plane_primitive(size, segments)
     positions = square.positions @ basis.T + foot
     normals = np.tile(basis[:, 1], (len(positions), 1))
-    return Mesh(positions, normals, square.faces, f"plane(size={size:g}, segments={segments})")
+    return Mesh(positions, normals, square.faces, f"plane(size={size:g}, segments={segments})",
+                uvs=plane_uv(positions, n))

@@ -9,6 +9,9 @@ twin to their hits, so that a sphere or plane gets the same UVs both ways.
 - Plane with normal n: T = the object x axis projected into the plane, normalised (the
   -z axis where |n.x| > PLANE_AXIS_SWITCH), B = n x T for unit n; u = p.T, v = p.B for the
   object-space point p (one unit, one repeat before uv_scale). For n = +y: T = +x, B = -z.
+
+`weld_corners` is the seam rule for meshes: a vertex whose faces give it different UVs
+becomes one vertex per UV (primitives, mesh files).
 """
 
 from __future__ import annotations
@@ -47,3 +50,25 @@ def plane_uv(points, normal) -> np.ndarray:
     t, b = plane_uv_axes(normal)
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     return np.stack([p @ t, p @ b], axis=1)
+
+
+def weld_corners(faces: np.ndarray, corner_uvs: np.ndarray):
+    """Vertices from per-corner UVs (F, 3, 2): one vertex per distinct (vertex, UV) among the
+    faces' corners, so that a vertex splits where its corners' UVs differ (a seam). Returns
+    (the source vertex of each new vertex, new faces, new UVs). Vertices keep their order
+    (those no face uses are left out); a vertex's copies follow it, in the order faces first
+    use them."""
+    corner_vertex = faces.reshape(-1)
+    uv = corner_uvs.reshape(-1, 2)
+    count = len(corner_vertex)
+    order = np.lexsort((np.arange(count), uv[:, 1], uv[:, 0], corner_vertex))
+    vertex_sorted, uv_sorted = corner_vertex[order], uv[order]
+    starts = np.ones(count, dtype=bool)
+    starts[1:] = (vertex_sorted[1:] != vertex_sorted[:-1]) | (uv_sorted[1:] != uv_sorted[:-1]).any(axis=1)
+    group = np.empty(count, dtype=np.int64)
+    group[order] = np.cumsum(starts) - 1
+    first = order[starts]                           # each group's first corner in face order
+    by_vertex = np.lexsort((first, corner_vertex[first]))
+    rank = np.empty_like(by_vertex)
+    rank[by_vertex] = np.arange(len(by_vertex))
+    return corner_vertex[first][by_vertex], rank[group].reshape(faces.shape), uv[first][by_vertex]

@@ -15,6 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+# The kinds of surface a ray hits (trace.py's scene_hit; the GLSL's TRACE_MISS ... in trace.glsl).
+MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
+
 
 def _float_dtype(*arrays) -> np.dtype:
     dtype = np.result_type(*arrays)

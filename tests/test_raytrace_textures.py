@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from reference.raytrace.pipeline import render as reference_raytrace
-from reference.raytrace.textures import hit_uv, sphere_uv, texture_atan2
+from reference.raytrace.textures import texture_uv, texture_sphere_uv, texture_atan2
 from reference.raytrace.trace import scene_hit, surface
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
@@ -71,7 +71,7 @@ def rays_at(scene, points, origins=None):
     O = np.broadcast_to(origins - eye, D.shape).astype(F32)
     kind, index, s, uv = scene_hit(rs, O, D, F32(0), F32(np.inf))
     P = surface(rs, O, D, kind, index, s, uv)[0]
-    return hit_uv(rs, kind, index, P, uv).astype(np.float64)
+    return texture_uv(rs, kind, index, P, uv).astype(np.float64)
 
 
 # --------------------------------------------------------------------------- by hand
@@ -98,7 +98,7 @@ def test_the_sphere_rule_at_known_hits():
     d = np.array([[0.3, -0.4, 0.5], [-2, 1, -0.1]], F32)
     expected = [[0.5 + math.atan2(x, z) / (2 * math.pi), 0.5 + math.asin(y / math.dist(p, (0, 0, 0))) / math.pi]
                 for p in d.astype(np.float64) for x, y, z in [p]]
-    np.testing.assert_allclose(sphere_uv(d), expected, atol=1e-7)      # no normalising needed
+    np.testing.assert_allclose(texture_sphere_uv(d), expected, atol=1e-7)      # no normalising needed
 
 
 def test_a_turned_globe_moves_the_marker():
@@ -385,5 +385,5 @@ def test_the_glsl_sphere_rule_is_the_twins(gl_contexts):
         inputs.use(0)
         out = probe.run(u_inputs=0).reshape(-1, 4)
         inputs.release()
-    assert np.array_equal(out[:, :2], sphere_uv(d))
+    assert np.array_equal(out[:, :2], texture_sphere_uv(d))
     assert np.array_equal(out[:, 2], texture_atan2(d[:, 1], d[:, 0]))

@@ -53,7 +53,7 @@ def texture_atan2(y, x):
     return np.where(y < t(0), -r, r)
 
 
-def sphere_uv(d):
+def texture_sphere_uv(d):
     """(R, 2) UVs of object-space directions d (R, 3) from a sphere's centre, any length:
     u = 1/2 + atan2(x, z) / (2 pi), v = 1/2 + atan2(y, |(x, z)|) / pi."""
     t = d.dtype.type
@@ -69,7 +69,7 @@ def _rows(M, p):
                      for i in range(3)], -1)
 
 
-def _time0(rows, k, P, time):
+def texture_time0(rows, k, P, time):
     """The hits P on shapes k moved back to the shapes' time-0 frame (motion rows per shape)."""
     if rows is None or time is None:
         return P
@@ -80,7 +80,7 @@ def _time0(rows, k, P, time):
     return out
 
 
-def hit_uv(rs, kind, index, P, bary, time=None):
+def texture_uv(rs, kind, index, P, bary, time=None):
     """(R, 2) the UV of each hit (trace.py's kind and index; P the hit points; bary the
     triangles' (u, v)); `time` each hit's time where motion blur runs."""
     tx, t = rs.textures, P.dtype.type
@@ -91,13 +91,13 @@ def hit_uv(rs, kind, index, P, bary, time=None):
         k = index[m]
         rows = rs.motion.rows(rs.sphere_object) if moving else None
         centres = rs.sphere_centre[k].astype(t)        # time 0, where P is moved back to
-        d = _time0(rows, k, P[m], None if time is None else time[m]) - centres
-        uv[m] = sphere_uv(_rows(tx.sphere_rotation[k].astype(t), d))
+        d = texture_time0(rows, k, P[m], None if time is None else time[m]) - centres
+        uv[m] = texture_sphere_uv(_rows(tx.sphere_rotation[k].astype(t), d))
     m = kind == PLANE
     if m.any():
         k = index[m]
         rows = rs.motion.rows(rs.plane_object) if moving else None
-        p = _time0(rows, k, P[m], None if time is None else time[m])
+        p = texture_time0(rows, k, P[m], None if time is None else time[m])
         U = tx.plane_map[k].astype(t)
         uv[m] = np.stack([U[:, i, 0] * p[:, 0] + U[:, i, 1] * p[:, 1] + U[:, i, 2] * p[:, 2]
                           + U[:, i, 3] for i in range(2)], -1)
@@ -109,9 +109,10 @@ def hit_uv(rs, kind, index, P, bary, time=None):
     return uv
 
 
-def texels(rs, obj, uv):
+def texture_texel(rs, obj, uv):
     """(R, 3) the RGB each hit's texture gives at its UV (1 where the object is untextured):
-    the lookup at uv * scale + offset, per slot through its ray sampler at level 0."""
+    the lookup at uv * scale + offset, per slot through its ray sampler at level 0; in
+    float32 (the sampler's) whatever the hits' dtype."""
     tx, t = rs.textures, uv.dtype.type
     out = np.ones((len(uv), 3), t)
     slot = tx.slot[obj]
@@ -125,11 +126,11 @@ def texels(rs, obj, uv):
     return out
 
 
-def textured_materials(rs, mats: MaterialUniforms, obj, kind, index, P, bary,
-                       time=None) -> MaterialUniforms:
-    """The hits' materials with each coefficient its texture modulates multiplied by the
-    texel (trace.py's materials at the hits; the GLSL's texture_modulate)."""
-    texel = texels(rs, obj, hit_uv(rs, kind, index, P, bary, time)).astype(mats.u_kd.dtype)
+def texture_modulate(rs, mats: MaterialUniforms, obj, kind, index, P, bary,
+                     time=None) -> MaterialUniforms:
+    """The hits' materials (trace.py's `materials`) with each coefficient their texture
+    modulates multiplied by the texel; an untextured object's left as they are."""
+    texel = texture_texel(rs, obj, texture_uv(rs, kind, index, P, bary, time)).astype(mats.u_kd.dtype)
     flags = rs.textures.modulate[obj]
 
     def by(i, k):

@@ -24,6 +24,9 @@ bounce (every ray of one depth at once), no Python loop over pixels or rays.
   transmitted weight k_t (1 - F) along ray_refract(Du, N, eta) from offset_ray_origin(P, -Ng)
   (none under total internal reflection, where F = 1). A ray's colour is
   local + w_r reflected + w_t transmitted; a ray that misses brings the background colour;
+- textures (docs/conventions.md, "Textures in the ray tracer"; textures.py): where some
+  material is textured, the coefficients its texture modulates are multiplied by the texel at
+  the hit's UV before lighting (texture_modulate);
 - glossy reflection (docs/conventions.md, "Glossy reflection"; glossy.py): where some material
   sets `gloss`, each reflected ray is drawn from the Phong lobe of its material's exponent
   about the mirror direction with the hit's GLOSSY_DIMENSION point, absorbed below the
@@ -44,7 +47,7 @@ from renderer.core.ray_sampling import TIME_DIMENSION
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from reference.raytrace.area_lights import AreaDraw, area_light_terms
 from reference.raytrace.glossy import glossy_rays
-from reference.raytrace.textures import textured_materials
+from reference.raytrace.textures import texture_modulate
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
 F32 = np.float32
@@ -394,7 +397,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
             area_light_shadow(rs, lights, Ng, shape, record, _at(time, owner)) if shadows else None)
         mats = materials(rs, obj, specular, t)
         if rs.textures is not None:     # the texel multiplies the coefficients it modulates
-            mats = textured_materials(rs, mats, obj, kind, index, P, uv, _at(time, owner))
+            mats = texture_modulate(rs, mats, obj, kind, index, P, uv, _at(time, owner))
         local = lighting(P, N, O, mats, lights,
                          shadow_visibility(rs, lights, Ng, shape, record, _at(time, owner))
                          if shadows else None,

@@ -765,6 +765,37 @@ BAD_SCENES = [
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
      "two_sided, shading, kr, kt, ior, gloss, texture"),
+    # textures (docs/scene-format.md, "Textures")
+    ("texture without a source", OBJECT + "material = { texture = { wrap = \"clamp\" } }\n",
+     'objects[0].material.texture: needs image = "FILE" or checker = { ... }'),
+    ("unknown wrap", OBJECT + 'material = { texture = { checker = {}, wrap = "repet" } }\n',
+     "objects[0].material.texture.wrap: unknown wrap mode 'repet'; did you mean 'repeat'? "
+     "expected one of: repeat, clamp, mirror"),
+    ("unknown filter", OBJECT + 'material = { texture = { checker = {}, filter = "linear" } }\n',
+     "objects[0].material.texture.filter: unknown filter 'linear'; did you mean 'bilinear'? "
+     "expected one of: nearest, bilinear, mip-nearest, trilinear, anisotropic"),
+    ("unknown colorspace", OBJECT + 'material = { texture = { image = "textures/globe.png", '
+                                    'colorspace = "rgb" } }\n',
+     "objects[0].material.texture.colorspace: unknown colorspace 'rgb'; did you mean 'srgb'? "
+     "expected one of: srgb, linear"),
+    ("unknown modulate", OBJECT + 'material = { texture = { checker = {}, modulate = ["kt"] } }\n',
+     "objects[0].material.texture.modulate[0]: unknown coefficient 'kt'; expected one of: ka, kd, "
+     "ks"),
+    ("anisotropy 17", OBJECT + 'material = { texture = { checker = {}, filter = "anisotropic", '
+                               'anisotropy = 17 } }\n',
+     "objects[0].material.texture.anisotropy: must be <= 16, got 17"),
+    ("anisotropy 1", OBJECT + 'material = { texture = { checker = {}, filter = "anisotropic", '
+                              'anisotropy = 1 } }\n',
+     "objects[0].material.texture.anisotropy: must be >= 2, got 1"),
+    ("anisotropy without its filter", OBJECT + "material = { texture = { checker = {}, "
+                                               "anisotropy = 4 } }\n",
+     "objects[0].material.texture.anisotropy: needs filter = \"anisotropic\" (the filter here "
+     "is 'trilinear')"),
+    ("checker colour over 1", OBJECT + "material = { texture = { checker = { colors = [1, 2] } } }\n",
+     "objects[0].material.texture.checker.colors[1]: must be <= 1 in every component (a texel "
+     "holds 0..1), got [2.0, 2.0, 2.0]"),
+    ("named texture", "[materials.m]\ntexture = { checker = { squares = 0 } }\n" + OBJECT,
+     "materials.m.texture.checker.squares: must be >= 1, got 0"),
 ]
 
 
@@ -880,6 +911,81 @@ def test_cli_bad_scene_exits_2_with_one_line(tmp_path, text, expected, request):
     assert str(bad_scene) in lines[0]
     assert expected.replace("NANMESH", str(nan_mesh)) in lines[0]
     assert not out_png.exists()
+
+
+@pytest.mark.parametrize("image, reason", [
+    (None, "image file not found: 'art.png'"),
+    (b"", "ART: image is empty (0 bytes)"),
+    (b"\x89PNG\r\n\x1a\n not really", "ART: could not be read as an image"),
+])
+def test_cli_bad_image_exits_2_with_one_line(tmp_path, cli_here, image, reason):
+    """Missing, zero-size and corrupt images: one line naming the scene file, the key and
+    the image, status 2, nothing written."""
+    if image is not None:
+        (tmp_path / "art.png").write_bytes(image)
+    scene = write(tmp_path, "s.toml", OBJECT + 'material = { texture = { image = "art.png" } }\n')
+    result = cli_here("render", scene, "-o", tmp_path / "out.png", *RENDER_SMALL)
+    assert result.returncode == 2 and "Traceback" not in result.stderr
+    assert result.stderr.splitlines() == [result.stderr.strip()]
+    expected = reason.replace("ART", str(tmp_path / "art.png"))
+    assert result.stderr.startswith(f"renderer: {scene}: objects[0].material.texture.image: "
+                                    f"{expected}"), result.stderr
+    assert not (tmp_path / "out.png").exists()
+
+
+def test_a_textured_material_on_a_mesh_without_uvs_is_refused(tmp_path, cli_here):
+    mesh = write(tmp_path, "tri.obj", OBJ_TRIANGLE)
+    scene = write(tmp_path, "s.toml", "[materials.checked]\ntexture = { checker = {} }\n"
+                  '[[objects]]\nmesh = { file = "tri.obj" }\nmaterial = "checked"\n')
+    result = cli_here("render", scene, "-o", tmp_path / "out.png", *RENDER_SMALL)
+    assert result.returncode == 2 and not (tmp_path / "out.png").exists()
+    assert result.stderr == (f"renderer: {scene}: objects[0].material: has a texture, but the "
+                             f"mesh ({mesh}) has no texture coordinates; give the file UVs (OBJ "
+                             f"vt, PLY u v, glTF TEXCOORD_0) or use a primitive or a shape\n")
+
+
+def test_texture_tables_make_shared_textures(tmp_path):
+    """An image path is relative to the scene file; each image and checker is one Texture
+    however many materials use it; a glTF's base-colour texture is the object's where its
+    material sets none; the defaults are the design's."""
+    (tmp_path / "art").mkdir()
+    (tmp_path / "art" / "a.png").write_bytes((REPO / "assets" / "textures" / "crate.png").read_bytes())
+    scene = load_scene(write(tmp_path, "s.toml", """
+[materials.one]
+texture = { image = "art/a.png" }
+[materials.two]
+kd = 0.5
+[materials.two.texture]
+image = "art/a.png"
+wrap = "mirror"
+filter = "anisotropic"
+uv_scale = [2, 3]
+uv_offset = [0.5, 0]
+modulate = ["ka", "kd", "ks"]
+[[objects]]
+mesh = { primitive = "cube" }
+material = "one"
+[[objects]]
+shape = { type = "sphere" }
+material = "two"
+[[objects]]
+mesh = { primitive = "plane" }
+material = { texture = { checker = {} } }
+[[objects]]
+mesh = { file = "meshes/textured_box.glb" }
+[[objects]]
+mesh = { file = "meshes/textured_box.glb" }
+material = "one"
+"""))
+    one, two, checker, box, box_one = (obj.material.texture for obj in scene.objects)
+    assert one.texture is two.texture and one.texture.source == str(tmp_path / "art" / "a.png")
+    assert (one.sampler.wrap, one.sampler.filter, one.uv_scale, one.uv_offset, one.modulate) == \
+        ("repeat", "trilinear", (1.0, 1.0), (0.0, 0.0), ("kd",))
+    assert (two.sampler.wrap, two.sampler.filter, two.sampler.anisotropy) == ("mirror", "anisotropic", 16)
+    assert (two.uv_scale, two.uv_offset, two.modulate) == ((2.0, 3.0), (0.5, 0.0), ("ka", "kd", "ks"))
+    assert checker.texture.source == "checker 8x8 at 256" and checker.texture.colorspace == "linear"
+    assert box.texture.source.endswith("textured_box.glb (base colour)")
+    assert box_one is one and scene.objects[1].material.kd == (0.5, 0.5, 0.5)
 
 
 def test_cli_unknown_scene_name_exits_2_and_lists_builtins(tmp_path, cli):

@@ -73,6 +73,21 @@ def test_mip_chain_of_an_npot_image_weights_partly_covered_texels():
     assert levels[2][..., 0].tolist() == [[85]]
 
 
+def box_weights(n: int, size: int) -> np.ndarray:
+    """(size, n): how much of texel x lies in cell i of width n / size, over the width."""
+    edges = np.arange(size + 1) * n / size
+    low, high = np.maximum.outer(edges[:-1], np.arange(n)), np.minimum.outer(edges[1:], np.arange(n) + 1)
+    return np.clip(high - low, 0, None) / (n / size)
+
+
+@pytest.mark.parametrize("height, width", [(5, 7), (3, 6), (1, 13), (8, 4)])
+def test_mip_chain_is_the_box_filter_written_as_weight_matrices(height, width):
+    level0 = np.random.default_rng(width).random((height, width, 4))
+    for (w_k, h_k), level in zip(level_sizes(width, height), mip_chain(level0)):
+        expected = np.einsum("iy,yxc,jx->ijc", box_weights(height, h_k), level0, box_weights(width, w_k))
+        assert level.tolist() == to_unorm8(expected).tolist()
+
+
 def test_a_region_of_one_value_keeps_it_at_every_level():
     """0.5 is the one tie of unorm8 rounding float64 holds exactly (127.5 + 0.5 = 128): the
     averages must not drift below it, at NPOT sizes neither."""

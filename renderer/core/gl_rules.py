@@ -296,3 +296,85 @@ def check_light_count(scene) -> None:
         problem = f"object {scene.objects[index].name!r}: {reason}"
     if problem:
         raise SceneError(problem, file=getattr(scene, "source", "") or None)
+
+
+# --- texture sampling ------------------------------------------------------------------------
+#
+# How GL's sampler is set for each of renderer/core/textures.py's wraps and filters (the GPU
+# path, renderer/gpu/textures.py), and the numbers llvmpipe's sampler (Mesa's gallivm,
+# lp_bld_sample*.c) computes with, which the twin (reference/sampler.py) follows:
+# /work/notes/llvmpipe-texture-sampler.md, checked on this machine in tests/test_sampler_gl.py.
+
+GL_NEAREST, GL_LINEAR = 0x2600, 0x2601
+GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR_MIPMAP_LINEAR = 0x2701, 0x2703
+GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT = 0x2901, 0x812F, 0x8370
+GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T = 0x2802, 0x2803
+GL_TEXTURE_MAG_FILTER, GL_TEXTURE_MIN_FILTER = 0x2800, 0x2801
+GL_TEXTURE_BASE_LEVEL, GL_TEXTURE_MAX_LEVEL = 0x813C, 0x813D
+GL_TEXTURE_MAX_ANISOTROPY = 0x84FE
+
+TEXTURE_WRAP_MODES = {"repeat": GL_REPEAT, "clamp": GL_CLAMP_TO_EDGE, "mirror": GL_MIRRORED_REPEAT}
+# (min, mag) filter of each filter name. Min and mag image filters are equal in every pair:
+# llvmpipe then never switches filters by the sign of the LOD (with them unequal it would
+# decide for 8 pixels by the first quad's LOD, a FIXME in lp_bld_sample_aos.c).
+TEXTURE_FILTER_MODES = {
+    "nearest": (GL_NEAREST, GL_NEAREST),
+    "bilinear": (GL_LINEAR, GL_LINEAR),
+    "mip-nearest": (GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR),
+    "trilinear": (GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR),
+    "anisotropic": (GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR),   # and GL_TEXTURE_MAX_ANISOTROPY
+}
+MAX_TEXTURE_MAX_ANISOTROPY = 16          # GL_MAX_TEXTURE_MAX_ANISOTROPY on llvmpipe
+
+UNORM8_MAX = 255                         # an RGBA8 texel channel c means c / 255
+TEXEL_WEIGHT_BITS = 8                    # llvmpipe's unorm8 filter: bilinear weights in 1/256
+MIP_WEIGHT_BITS = 8                      # ... and the trilinear weight between levels
+
+
+def unorm8_to_float(c: np.ndarray) -> np.ndarray:
+    """An unorm8 texel channel as the sampler returns it: float32(c) * float32(1/255), one
+    float32 product (llvmpipe's lp_build_unsigned_norm_to_float), which is not always the
+    correctly rounded c / 255 (126 of the 256 values are one ulp off it)."""
+    return np.asarray(c).astype(np.float32) * np.float32(1.0 / UNORM8_MAX)
+
+
+def _float32_exponent(x: np.ndarray) -> np.ndarray:
+    """The unbiased exponent field of float32 x (int32): e with x = m 2^e, m in [1, 2);
+    -127 for 0 and denormals, 128 for inf and NaN."""
+    bits = np.asarray(x, dtype=np.float32).view(np.int32)
+    return ((bits >> 23) & 255) - 127
+
+
+def fast_log2(x: np.ndarray) -> np.ndarray:
+    """llvmpipe's log2 for the LOD (lp_build_fast_log2), float32, piecewise linear:
+    x = m 2^e with m in [1, 2) gives (e - 1) + m, one float32 add; exact at powers of two,
+    below log2 x in between by up to 0.086 (0.043 once halved for the LOD)."""
+    x = np.asarray(x, dtype=np.float32)
+    mantissa = ((x.view(np.int32) & 0x7FFFFF) | 0x3F800000).view(np.float32)
+    return (_float32_exponent(x) - 1).astype(np.float32) + mantissa
+
+
+def round_log2_sqrt(x: np.ndarray) -> np.ndarray:
+    """round(log2 sqrt(x)) with halves rounded up, exactly, from float32 x's exponent
+    (llvmpipe's lp_build_ilog2_sqrt, the LOD of the nearest mip filter, x = rho^2):
+    (e + 1) >> 1, int32."""
+    return (_float32_exponent(x) + 1) >> 1
+
+
+# llvmpipe's anisotropic filter (lp_build_sample_aniso) is an elliptical weighted average
+# (Heckbert's EWA) over the texels of one mip level, each texel's weight read from a table
+# of exp(-2 r^2) at r^2 = i / (ANISO_WEIGHT_TABLE_SIZE - 1), i = 0..SIZE-1, the ellipse scaled
+# so that its edge is r^2 = 1. The table is float32 values written to 6 decimals in Mesa's
+# source (aniso_filter_table); `anisotropic_weight_table` makes the same 1024 floats.
+ANISO_WEIGHT_TABLE_SIZE = 1024
+ANISO_WEIGHT_ALPHA = 2.0
+ANISO_WEIGHT_DECIMALS = 6
+
+
+def anisotropic_weight_table() -> np.ndarray:
+    """The EWA weights (float32, ANISO_WEIGHT_TABLE_SIZE): float32 r^2 = i / (SIZE - 1), the
+    float32 exp(-ALPHA r^2), written with 6 decimals and read back as float32, as Mesa's table."""
+    index = np.arange(ANISO_WEIGHT_TABLE_SIZE, dtype=np.float32)
+    r2 = index / np.float32(ANISO_WEIGHT_TABLE_SIZE - 1)
+    weights = np.exp((np.float32(-ANISO_WEIGHT_ALPHA) * r2).astype(np.float64)).astype(np.float32)
+    return np.array([float(f"{float(w):.{ANISO_WEIGHT_DECIMALS}f}") for w in weights], dtype=np.float32)

@@ -169,7 +169,7 @@ def _read_with_trimesh(path: Path):
 
     positions, faces, normals, uvs, offset = [], [], [], [], 0
     all_have_normals = all(_has_file_normals(g) for _, g in parts)
-    all_have_uvs = all(file_uvs(g) is not None for _, g in parts)
+    all_have_uvs = all(_file_uvs(g) is not None for _, g in parts)
     for transform, geometry in parts:
         v = np.asarray(geometry.vertices, dtype=np.float64).reshape(-1, 3)
         f = np.asarray(geometry.faces, dtype=np.int64).reshape(-1, 3)
@@ -183,14 +183,14 @@ def _read_with_trimesh(path: Path):
                 n = n @ np.linalg.inv(transform[:3, :3])   # (M^-T n) for row vectors
             normals.append(n)
         if all_have_uvs:
-            uvs.append(file_uvs(geometry))
+            uvs.append(_file_uvs(geometry))
         offset += len(v)
     return (np.concatenate(positions), np.concatenate(faces),
             np.concatenate(normals) if all_have_normals else None,
             np.concatenate(uvs) if all_have_uvs else None)
 
 
-def file_uvs(geometry: trimesh.Trimesh) -> np.ndarray | None:
+def _file_uvs(geometry: trimesh.Trimesh) -> np.ndarray | None:
     """The part's UVs (V, 2) float64 as trimesh read them (v up, glTF's already turned), or
     None. trimesh keeps glTF's TEXCOORD_0 only on primitives that name a material."""
     uv = getattr(geometry.visual, "uv", None)
@@ -214,14 +214,12 @@ def _check_geometry(positions: np.ndarray, faces: np.ndarray) -> None:
         raise _MeshProblem("mesh has no triangles")
     bad = ~np.isfinite(positions).all(axis=1)
     if bad.any():
-        i = int(np.argmax(bad))
-        shown = ", ".join(show_number(x) for x in positions[i])
+        i, shown = _first(bad, positions)
         raise _MeshProblem(f"vertex {i} is not finite ({shown}); "
                            f"{int(bad.sum())} of {len(positions)} vertices are NaN or Inf")
     large = (np.abs(positions) > MAX_COORDINATE).any(axis=1)
     if large.any():
-        i = int(np.argmax(large))
-        shown = ", ".join(show_number(x) for x in positions[i])
+        i, shown = _first(large, positions)
         raise _MeshProblem(f"vertex {i} ({shown}) is too large for the GPU's float32 "
                            f"arithmetic; coordinates must satisfy |x| <= {MAX_COORDINATE:g} "
                            f"({int(large.sum())} of {len(positions)} vertices do not)")
@@ -238,11 +236,16 @@ def _check_uvs(uvs: np.ndarray | None) -> None:
         return
     bad = ~np.isfinite(uvs).all(axis=1) | (np.abs(uvs) > MAX_COORDINATE).any(axis=1)
     if bad.any():
-        i = int(np.argmax(bad))
-        shown = ", ".join(show_number(x) for x in uvs[i])
+        i, shown = _first(bad, uvs)
         raise _MeshProblem(f"vertex {i} has texture coordinates ({shown}) that are not finite "
                            f"numbers within |x| <= {MAX_COORDINATE:g} ({int(bad.sum())} of "
                            f"{len(uvs)} vertices)")
+
+
+def _first(bad: np.ndarray, rows: np.ndarray) -> tuple[int, str]:
+    """The first bad row's index and its numbers as a message shows them."""
+    i = int(np.argmax(bad))
+    return i, ", ".join(show_number(x) for x in rows[i])
 
 
 def _check_obj_face_indices(path: Path) -> None:

@@ -40,9 +40,11 @@ MODULATED = ("ka", "kd", "ks")             # the coefficients a texel may multip
 ANISOTROPY_RANGE = (2, 16)                 # llvmpipe's GL_MAX_TEXTURE_MAX_ANISOTROPY is 16
 DEFAULT_ANISOTROPY = 16                    # "anisotropic" without a degree: the most there is
 
-# Decoding an image: float64 RGBA level 0 (32 bytes a texel), the mip chain's half-width
-# pass (16) and the uint8 levels (about 6), rounded up.
-TEXTURE_BYTES_PER_TEXEL = 64
+# Decoding an image, at the peak (NumPy's allocations, measured with tracemalloc on 1024² and
+# 2048² PNGs: 127 bytes a texel), with room for Pillow's own buffers: the decoded linear RGB
+# (24), float64 RGBA level 0 (32), its running sums along the rows (32), the first level's
+# half-width passes (16 each) and the uint8 levels (about 6).
+TEXTURE_BYTES_PER_TEXEL = 160
 
 
 @dataclass(frozen=True)
@@ -70,13 +72,17 @@ class Sampler:
         return self.filter in MIPMAPPED_FILTERS
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, repr=False)
 class Texture:
     """A texture's mip levels, (H_k, W_k, 4) uint8, row 0 at the top, linear values (module
     docstring). Compared by identity: each Texture object is uploaded once."""
     levels: tuple
     source: str                            # file path or "checker 8x8 at 256", for messages
     colorspace: str = "srgb"               # what the file held: "srgb" (decoded) or "linear"
+
+    def __repr__(self) -> str:             # short: materials are printed and hashed by repr
+        return (f"Texture({self.source!r}, {self.colorspace}, {self.width}x{self.height}, "
+                f"{len(self.levels)} levels)")
 
     @property
     def width(self) -> int:
@@ -121,28 +127,38 @@ def level_sizes(width: int, height: int) -> list[tuple[int, int]]:
     return [(max(1, width >> k), max(1, height >> k)) for k in range(count)]
 
 
-def _area_average(image: np.ndarray, size: int, axis: int) -> np.ndarray:
-    """`image` (float64) averaged along `axis` from n to `size` cells: cell i is the mean
-    over [i n/size, (i+1) n/size), texels partly inside weighted by how much of them is.
+def _prefix(image: np.ndarray, axis: int) -> np.ndarray:
+    """The running sums of `image` along `axis`, from 0: (n + 1) entries, moved to axis 0."""
+    shape = list(image.shape)
+    shape[axis] += 1
+    prefix = np.zeros(shape)
+    np.cumsum(image, axis=axis, out=prefix[(slice(None),) * axis + (slice(1, None),)])
+    return np.moveaxis(prefix, axis, 0)
 
-    Weights are the overlaps times `size`, integers (min((x+1) size, (i+1) n) - max(x size,
-    i n)) summing to n per cell, and the sum is divided by n once, so that a region of one
-    value stays that value exactly where it can (0.5, the only tie of unorm8 rounding that
-    float64 holds exactly, keeps rounding up)."""
+
+def _area_average(image: np.ndarray, size: int, axis: int, prefix=None) -> np.ndarray:
+    """`image` (float64) averaged along `axis` from n to `size` cells: cell i is the mean
+    over [i n/size, (i+1) n/size), a texel partly inside weighted by how much of it is.
+    `prefix`: _prefix(image, axis), where the caller has it already.
+
+    With the integral F(x) of the texels up to x, cell i is size (F(b_i+1) - F(b_i)) / n at
+    the boundaries b_i = i n / size = q + r / size (q, r: the quotient and remainder of
+    i n by size), where size F(b_i) = size prefix[q] + r texel[q]: whole numbers times
+    sums, divided by n once, so that a region of 0.5 (the one tie of unorm8 rounding that
+    float64 holds exactly) stays exactly 0.5."""
     n = image.shape[axis]
     if size == n:
         return image
     moved = np.moveaxis(image, axis, 0)
-    cells = np.arange(size)
-    first = cells * n // size                                   # first texel touching cell i
-    last = ((cells + 1) * n - 1) // size                        # last texel touching it
-    total = np.zeros((size, *moved.shape[1:]))
-    for step in range(int((last - first).max()) + 1):           # at most n / size + 2 steps
-        x = np.minimum(first + step, n - 1)
-        weight = np.minimum((x + 1) * size, (cells + 1) * n) - np.maximum(x * size, cells * n)
-        weight = np.where(first + step <= last, weight, 0).astype(np.float64)
-        total += weight.reshape(-1, *[1] * (moved.ndim - 1)) * moved[x]
-    return np.moveaxis(total / n, 0, axis)
+    prefix = _prefix(image, axis) if prefix is None else prefix
+    q, r = np.divmod(np.arange(size + 1) * n, size)
+    r = r.reshape(-1, *[1] * (moved.ndim - 1)).astype(np.float64)
+    scaled = prefix[q]
+    scaled *= size
+    scaled += r * moved[np.minimum(q, n - 1)]
+    average = np.diff(scaled, axis=0)
+    average /= n
+    return np.moveaxis(average, 0, axis)
 
 
 def mip_chain(level0: np.ndarray) -> tuple:
@@ -155,9 +171,10 @@ def mip_chain(level0: np.ndarray) -> tuple:
     box filters and rounds each level once."""
     level0 = np.asarray(level0, dtype=np.float64)
     height, width = level0.shape[:2]
+    along_rows = _prefix(level0, axis=1) if width > 1 else None     # shared by every level
     levels = []
     for w_k, h_k in level_sizes(width, height):
-        across = _area_average(level0, w_k, axis=1)
+        across = _area_average(level0, w_k, axis=1, prefix=along_rows)
         levels.append(gl_rules.to_unorm8(_area_average(across, h_k, axis=0)))
     return tuple(levels)
 
@@ -172,8 +189,16 @@ def texture_from_image(rgb: np.ndarray, source: str, colorspace: str = "srgb",
     if colorspace not in COLORSPACES:
         raise ValueError(f"colorspace must be one of {', '.join(COLORSPACES)}, got {colorspace!r}")
     rgb = np.clip(np.asarray(rgb, dtype=np.float64), 0.0, 1.0)
-    linear = (srgb_to_linear(rgb) if colorspace == "srgb" else rgb) * np.asarray(tint, dtype=np.float64)
-    rgba = np.concatenate([linear, np.ones((*linear.shape[:2], 1))], axis=2)
+    return texture_from_linear(srgb_to_linear(rgb) if colorspace == "srgb" else rgb, source,
+                               colorspace, tint)
+
+
+def texture_from_linear(linear: np.ndarray, source: str, colorspace: str,
+                        tint=(1.0, 1.0, 1.0)) -> Texture:
+    """A Texture from linear RGB (H, W, 3) float64, times `tint`; alpha 1. `colorspace`
+    records what the source held."""
+    rgba = np.ones((*linear.shape[:2], 4))
+    np.multiply(linear, np.asarray(tint, dtype=np.float64), out=rgba[..., :3])
     return Texture(mip_chain(rgba), source, colorspace)
 
 
@@ -229,14 +254,17 @@ def texture_from_bytes(data: bytes, name: str, colorspace: str = "srgb", *, tint
             if too_much:
                 _image_problem(f"a {width} x {height} texture {too_much}", name, source, key)
             image.load()
-            rgb = _rgb(image)
+            codes, largest_code = _codes(image)
     except UnidentifiedImageError:
         _image_problem("could not be read as an image: not a format Pillow knows (PNG, JPEG)",
                        name, source, key)
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as exc:
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         _image_problem(f"could not be read as an image (PNG or JPEG): {reason}", name, source, key)
-    return texture_from_image(rgb, name, colorspace, tint)
+    # Decoded through a table of every code's value (the same formula, once per code).
+    values = np.arange(largest_code + 1) / largest_code
+    table = srgb_to_linear(values) if colorspace == "srgb" else values
+    return texture_from_linear(table[codes], name, colorspace, tint)
 
 
 def _image_problem(reason: str, name, source: str | None, key: str | None):
@@ -246,9 +274,10 @@ def _image_problem(reason: str, name, source: str | None, key: str | None):
     raise SceneError(reason, file=str(name), key=key)
 
 
-def _rgb(image) -> np.ndarray:
-    """Float RGB (H, W, 3) in [0, 1] of a loaded Pillow image."""
+def _codes(image) -> tuple[np.ndarray, int]:
+    """The integer RGB codes (H, W, 3) of a loaded Pillow image and the largest code (255,
+    or 65535 for 16-bit greyscale), clipped to it."""
     if image.mode in ("I;16", "I;16B", "I;16L", "I"):            # 16-bit greyscale PNG
-        grey = np.asarray(image, dtype=np.float64) / 65535.0
-        return np.repeat(grey[:, :, None], 3, axis=2)
-    return np.asarray(image.convert("RGB"), dtype=np.float64) / 255.0
+        grey = np.clip(np.asarray(image, dtype=np.int64), 0, 65535)
+        return np.repeat(grey[:, :, None], 3, axis=2), 65535
+    return np.asarray(image.convert("RGB")), 255

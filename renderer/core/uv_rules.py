@@ -59,10 +59,16 @@ def weld_corners(faces: np.ndarray, corner_uvs: np.ndarray):
     (those no face uses are left out); a vertex's copies follow it, in the order faces first
     use them."""
     corner_vertex = faces.reshape(-1)
-    key = np.column_stack([corner_vertex, corner_uvs.reshape(-1, 2)])
-    _, first, inverse = np.unique(key, axis=0, return_index=True, return_inverse=True)
-    order = np.lexsort((first, corner_vertex[first]))                # by vertex, then use
-    rank = np.empty_like(order)
-    rank[order] = np.arange(len(order))
-    new_faces = rank[np.asarray(inverse).reshape(-1)].reshape(faces.shape)
-    return corner_vertex[first][order], new_faces, corner_uvs.reshape(-1, 2)[first][order]
+    uv = corner_uvs.reshape(-1, 2)
+    count = len(corner_vertex)
+    order = np.lexsort((np.arange(count), uv[:, 1], uv[:, 0], corner_vertex))
+    vertex_sorted, uv_sorted = corner_vertex[order], uv[order]
+    starts = np.ones(count, dtype=bool)
+    starts[1:] = (vertex_sorted[1:] != vertex_sorted[:-1]) | (uv_sorted[1:] != uv_sorted[:-1]).any(axis=1)
+    group = np.empty(count, dtype=np.int64)
+    group[order] = np.cumsum(starts) - 1
+    first = order[starts]                           # each group's first corner in face order
+    by_vertex = np.lexsort((first, corner_vertex[first]))
+    rank = np.empty_like(by_vertex)
+    rank[by_vertex] = np.arange(len(by_vertex))
+    return corner_vertex[first][by_vertex], rank[group].reshape(faces.shape), uv[first][by_vertex]

@@ -64,7 +64,7 @@ def truth_scene(scene: Scene) -> Scene:
 def scene_digest(scene: Scene) -> str:
     """SHA-256 of everything that decides the image: camera, lights, ambient, background,
     and per object its name, material, transform, parent, culling, motion and mesh arrays
-    (and, textured, its texture's levels and its UVs)."""
+    (with a textured material, its UVs and texture levels)."""
     digest = hashlib.sha256()
     for part in (scene.camera, scene.directional_lights, scene.point_lights, scene.ambient,
                  scene.background):
@@ -78,11 +78,10 @@ def scene_digest(scene: Scene) -> str:
         for array, dtype in ((obj.mesh.positions, np.float64), (obj.mesh.normals, np.float64),
                              (obj.mesh.faces, np.int64)):
             digest.update(np.ascontiguousarray(array, dtype=dtype).tobytes())
-        if obj.material.textured:             # its texels and UVs (a repr elides arrays)
+        if obj.material.textured:             # its texels and where they go (the repr is short)
+            digest.update(np.ascontiguousarray(obj.mesh.uvs, dtype=np.float64).tobytes())
             for level in obj.material.texture.texture.levels:
-                digest.update(np.ascontiguousarray(level, dtype=np.uint8).tobytes())
-            if obj.mesh.uvs is not None:
-                digest.update(np.ascontiguousarray(obj.mesh.uvs, dtype=np.float64).tobytes())
+                digest.update(level.tobytes())
     return digest.hexdigest()
 
 

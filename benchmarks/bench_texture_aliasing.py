@@ -8,7 +8,8 @@ The ray tracer reads a texture's level 0 with its magnification filter (no deriv
 mipmaps), so where a pixel covers many texels (a checkerboard to the horizon, a globe's
 texture at its limb) one sample per pixel picks texels at random and aliases (moire); more
 samples per pixel average the texels over the pixel, as a box filter. For each scene (by
-default the textured test scenes, tests/scenes/rt_checker_horizon.toml and rt_globe.toml),
+default the analytic shapes' textured scenes, tests/scenes/rt_checker_horizon.toml and
+rt_globe.toml, and the built-in checker_horizon, globe and textured_mesh),
 the GPU ray tracer (renderer/gpu/raytracer.py) at --size: 1 sample (regular: the pixel's
 centre), 4 and 16 jittered samples, and --truth jittered samples as the reference; the RMSE of
 each against it over the RGB of rgba8 (0-255; the compare tool's `rmse`), over all pixels and
@@ -25,14 +26,17 @@ from pathlib import Path
 
 import numpy as np
 
+from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.gpu.raytracer import RayTracer
 
 from common import machine, parser       # benchmarks/common.py
 
+# The analytic shapes' textured scenes, and the built-in textured scenes where they exist.
 SCENES = [str(Path(__file__).resolve().parents[1] / "tests" / "scenes" / f"{name}.toml")
-          for name in ("rt_checker_horizon", "rt_globe")]
+          for name in ("rt_checker_horizon", "rt_globe")] \
+    + [name for name in ("checker_horizon", "globe", "textured_mesh") if name in builtin_scenes()]
 SETTINGS = ((1, "regular"), (4, "jittered"), (16, "jittered"))
 
 

@@ -22,7 +22,7 @@ from reference.raytrace.textures import texture_uv, texture_sphere_uv, texture_a
 from reference.raytrace.trace import scene_hit, surface
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.core import primitives
+from renderer.core.builtin import builtin_scenes
 from renderer.core.ray_textures import TEXTURE_SLOTS, ray_sampler
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene_file import load_scene, scene_from_dict
@@ -302,7 +302,10 @@ def test_the_gpu_textures_moving_shapes_as_the_twin_small(gl_contexts):
 
 
 SCENE_DIR = Path(__file__).resolve().parent / "scenes"
-TEXTURED_SCENES = ("rt_globe", "rt_checker_horizon")
+# The analytic shapes' textured scenes (tests/scenes/), and the built-in textured scenes (meshes:
+# a UV sphere, a plane primitive, a glTF box) where the rasteriser's branch has brought them.
+TEXTURED_SCENES = [str(SCENE_DIR / f"{name}.toml") for name in ("rt_globe", "rt_checker_horizon")] \
+    + [name for name in ("globe", "checker_horizon", "textured_mesh") if name in builtin_scenes()]
 
 
 def with_filter(scene, name):
@@ -321,7 +324,7 @@ def textured_references():
 
     def frame(name, filter_name):
         if (name, filter_name) not in frames:
-            scene = with_filter(load_scene(str(SCENE_DIR / f"{name}.toml")), filter_name)
+            scene = with_filter(load_scene(name), filter_name)
             frames[name, filter_name] = (scene, reference_raytrace(scene, 320, 240, samples=4,
                                                                    pattern="jittered"))
         return frames[name, filter_name]
@@ -331,7 +334,7 @@ def textured_references():
 @pytest.mark.slow
 @pytest.mark.parametrize("context_kind", ("egl", "osmesa"))
 @pytest.mark.parametrize("filter_name", ("nearest", "trilinear"))
-@pytest.mark.parametrize("name", TEXTURED_SCENES)
+@pytest.mark.parametrize("name", TEXTURED_SCENES, ids=lambda name: Path(name).stem)
 def test_the_gpu_textures_the_scenes_as_the_twin(name, filter_name, context_kind, gl_contexts,
                                                  textured_references):
     """320 x 240, 4 jittered samples, EGL and OSMesa: within PIPELINE_TOLERANCE (trilinear is

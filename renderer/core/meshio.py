@@ -169,7 +169,7 @@ def _read_with_trimesh(path: Path):
 
     positions, faces, normals, uvs, offset = [], [], [], [], 0
     all_have_normals = all(_has_file_normals(g) for _, g in parts)
-    all_have_uvs = all(file_uvs(g) is not None for _, g in parts)
+    all_have_uvs = all(_file_uvs(g) is not None for _, g in parts)
     for transform, geometry in parts:
         v = np.asarray(geometry.vertices, dtype=np.float64).reshape(-1, 3)
         f = np.asarray(geometry.faces, dtype=np.int64).reshape(-1, 3)
@@ -183,14 +183,14 @@ def _read_with_trimesh(path: Path):
                 n = n @ np.linalg.inv(transform[:3, :3])   # (M^-T n) for row vectors
             normals.append(n)
         if all_have_uvs:
-            uvs.append(file_uvs(geometry))
+            uvs.append(_file_uvs(geometry))
         offset += len(v)
     return (np.concatenate(positions), np.concatenate(faces),
             np.concatenate(normals) if all_have_normals else None,
             np.concatenate(uvs) if all_have_uvs else None)
 
 
-def file_uvs(geometry: trimesh.Trimesh) -> np.ndarray | None:
+def _file_uvs(geometry: trimesh.Trimesh) -> np.ndarray | None:
     """The part's UVs (V, 2) float64 as trimesh read them (v up, glTF's already turned), or
     None. trimesh keeps glTF's TEXCOORD_0 only on primitives that name a material."""
     uv = getattr(geometry.visual, "uv", None)

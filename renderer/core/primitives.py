@@ -10,6 +10,8 @@ triangle's UVs span the texture the wrong way round.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 import trimesh
 
@@ -97,13 +99,21 @@ def icosphere(radius: float = 1.0, subdivisions: int = 2) -> Mesh:
     UVs by the sphere rule per vertex (uv_rules.sphere_uv), made continuous per triangle
     (_sphere_corner_uvs): a triangle across the seam gets vertices of its own at u + 1, a
     vertex on the seam one with u = 0 and one with u = 1, a pole vertex one per triangle."""
+    normals, faces, uvs = _unit_icosphere(subdivisions)
+    return Mesh(normals * radius, normals.copy(), faces.copy(), f"icosphere({subdivisions})",
+                uvs=uvs.copy())
+
+
+@functools.lru_cache(maxsize=None)
+def _unit_icosphere(subdivisions: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The unit icosphere's normals (= positions), faces and UVs, made once per subdivision
+    count (icosphere() scales copies: a scene of forty at 6 subdivisions builds one)."""
     ico = trimesh.creation.icosphere(subdivisions=subdivisions, radius=1.0)
     normals = np.asarray(ico.vertices, dtype=float)
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
     faces = np.asarray(ico.faces, dtype=np.int64)
     vertex, faces, uvs = weld_corners(faces, _sphere_corner_uvs(normals, faces))
-    return Mesh(normals[vertex] * radius, normals[vertex], faces, f"icosphere({subdivisions})",
-                uvs=uvs)
+    return normals[vertex], faces, uvs
 
 
 def _sphere_corner_uvs(directions: np.ndarray, faces: np.ndarray) -> np.ndarray:

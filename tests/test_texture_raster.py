@@ -24,7 +24,7 @@ from reference.texture import lookup_coordinates
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.builtin import builtin_scenes
-from renderer.core.gl_rules import to_unorm8
+from renderer.core.gl_rules import to_unorm8, unorm8_to_float
 from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, Scene, SceneObject,
                                  Transform)
 from renderer.core.scene_file import load_scene
@@ -170,7 +170,7 @@ def test_the_texel_multiplies_the_coefficients_it_names(gl_contexts, modulate, s
     """A one-colour texture t on a quad facing the camera and a light straight down its normal
     (N.L = 1, R = N, and n = 0 so that spec = 1 wherever R.V > 0):
     I = I_a k_a t_a + I_l k_d t_d + I_l k_s t_s, with t_x = t where the material names k_x and
-    1 elsewhere, t = c * fl32(1/255) (unorm8 to float, reference/sampler.py). Every shading
+    1 elsewhere, t = c * fl32(1/255) (gl_rules.unorm8_to_float). Every shading
     mode, with the lighting handed on in two parts (flat, Gouraud) and with shadow maps (each
     light's term in two parts too)."""
     texels = np.broadcast_to(np.r_[TEXEL, 255], (2, 2, 4)).astype(np.uint8)
@@ -179,7 +179,7 @@ def test_the_texel_multiplies_the_coefficients_it_names(gl_contexts, modulate, s
     light = DirectionalLight((0.0, 0.0, -1.0), LIGHT, Shadow(enabled=shadows))
     scene = Scene(camera=Camera(eye=(0.0, 0.0, 3.0)), ambient=AMBIENT, directional_lights=[light],
                   objects=[SceneObject("quad", quad(4.0, 4.0), material)])
-    t = TEXEL.astype(np.float32) * np.float32(1 / 255)
+    t = unorm8_to_float(TEXEL)
     factor = {k: (t.astype(np.float64) if k in modulate else 1.0) for k in MODULATION_MATERIAL}
     expected = to_unorm8(np.asarray(AMBIENT) * MODULATION_MATERIAL["ka"] * factor["ka"]
                          + np.asarray(LIGHT) * MODULATION_MATERIAL["kd"] * factor["kd"]

@@ -229,7 +229,9 @@ def too_many_lights(directional: int, point: int, directional_shadows: int = 0,
 # a vec3 varying each, which takes a whole vec4 slot. GL 4.5 guarantees 64 vertex output
 # components (16 slots: Gouraud's limit) and 128 geometry output and fragment input
 # components (32 slots: flat's, whose vertex stage hands on the position alone); llvmpipe
-# allows 32 everywhere. As with the uniforms, the guarantee is the rule.
+# allows 32 everywhere. As with the uniforms, the guarantee is the rule. A textured material
+# hands each term on in two parts (the coefficients its texel modulates and the others,
+# glsl/lighting.glsl's TERM_PARTS) and its UV beside them.
 
 GL_MIN_VERTEX_OUTPUT_COMPONENTS = 64     # GL 4.5's minimum of GL_MAX_VERTEX_OUTPUT_COMPONENTS
 GL_MIN_FRAGMENT_INPUT_COMPONENTS = 128   # ... of GL_MAX_{GEOMETRY_OUTPUT,FRAGMENT_INPUT}_COMPONENTS
@@ -237,27 +239,34 @@ VARYING_SLOT_LIMITS = {"gouraud": GL_MIN_VERTEX_OUTPUT_COMPONENTS // 4,
                        "flat": GL_MIN_FRAGMENT_INPUT_COMPONENTS // 4}
 
 
-def light_term_slots(directional: int, point: int, two_sided: bool) -> int:
+def light_term_slots(directional: int, point: int, two_sided: bool, textured: bool = False) -> int:
     """vec4 slots the varyings of a flat or Gouraud receiver of shadows take: the ambient term
-    and a term per light, per side, and the position and normal:
-    (1 + directional + point) (2 if two-sided else 1) + 2."""
-    return (1 + directional + point) * (2 if two_sided else 1) + 2
+    and a term per light, per side, per part when textured, and the position and normal (and
+    the UV when textured): (1 + directional + point) (2 if two-sided else 1) (2 if textured
+    else 1) + 2 (+ 1 if textured)."""
+    parts = 2 if textured else 1
+    return (1 + directional + point) * (2 if two_sided else 1) * parts + 2 + (parts - 1)
 
 
-def too_many_varyings(shading: str, directional: int, point: int, two_sided: bool) -> str | None:
-    """Why a `shading` receiver of shadows cannot be drawn with these lights, or None."""
+def too_many_varyings(shading: str, directional: int, point: int, two_sided: bool,
+                      textured: bool = False) -> str | None:
+    """Why a `shading` receiver of shadows (of a textured material, when `textured`) cannot be
+    drawn with these lights, or None."""
     limit = VARYING_SLOT_LIMITS.get(shading)
-    used = light_term_slots(directional, point, two_sided)
+    used = light_term_slots(directional, point, two_sided, textured)
     if limit is None or used <= limit:
         return None
     sides = 2 if two_sided else 1
     stage = "vertex output" if shading == "gouraud" else "fragment input"
-    return (f"too many lights for a {'two-sided ' if two_sided else ''}{shading} object that "
+    kind = f"{'two-sided ' if two_sided else ''}{'textured ' if textured else ''}{shading}"
+    parts = " x 2 parts (modulated by the texture and not)" if textured else ""
+    uv = ", UV" if textured else ""
+    return (f"too many lights for a {kind} object that "
             f"receives shadows: with {directional} directional and {point} point lights its "
             f"varyings take {used} vec4 slots ((1 + {directional + point}) terms x {sides} "
-            f"side{'s' if two_sided else ''} + position and normal), the limit is {limit} (GL's "
-            f"guaranteed {limit * 4} {stage} components); set `shadows = false` on the lights, "
-            f"`receives_shadows = false` on the object, or use phong shading")
+            f"side{'s' if two_sided else ''}{parts} + position{uv} and normal), the limit is "
+            f"{limit} (GL's guaranteed {limit * 4} {stage} components); set `shadows = false` "
+            f"on the lights, `receives_shadows = false` on the object, or use phong shading")
 
 
 def scene_light_problem(scene) -> str | None:
@@ -278,7 +287,8 @@ def scene_varying_problem(scene) -> tuple[int, str] | None:
         return None
     for index, obj in enumerate(scene.objects):
         problem = obj.receives_shadows and too_many_varyings(
-            obj.material.shading, len(directional), len(point), obj.material.two_sided)
+            obj.material.shading, len(directional), len(point), obj.material.two_sided,
+            obj.material.textured)
         if problem:
             return index, problem
     return None

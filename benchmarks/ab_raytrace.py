@@ -1,7 +1,7 @@
-"""Two versions of the GPU ray tracer timed side by side, frames interleaved, printed.
+"""Two versions of the GPU ray tracer (or rasteriser) timed side by side, frames interleaved, printed.
 
     .venv/bin/python benchmarks/ab_raytrace.py BASE [HEAD] [--scene classic] [--size 640x480]
-        [--spp 1] [--max-depth 4] [--rounds 15] [--context egl]
+        [--spp 1] [--max-depth 4] [--rounds 15] [--context egl] [--method raytrace]
 
 BASE and HEAD are git revisions of this repository (`HEAD~1`, a branch, a commit); HEAD
 defaults to the working tree (`.`, uncommitted changes included). Each version is exported
@@ -11,6 +11,9 @@ turns, one frame each per round (A B, then B A, ... so that neither always goes 
 only one runs at a time, so both see the same machine. The scene (--scene: a built-in
 name, or a path; `classic` is the ray tracer's benchmark scene) is read from the working
 tree for both.
+
+`--method raster` times GpuRenderer.render() instead (the rasteriser's frame, with its depth
+read back), e.g. of a scene whose programs a change should leave as they were.
 
 Printed: each version's median RayTracer.render() time (the draw and the read-back, as
 benchmarks/bench_raytrace.py), the ratio of the medians, the median of the per-round
@@ -64,11 +67,15 @@ def worker(args) -> None:
     """Runs in the exported tree: traces on request, one frame per line on stdin."""
     from renderer.core.scene_file import load_scene
     from renderer.gpu.context import make_context
-    from renderer.gpu.raytracer import RayTracer
 
     ctx = make_context(args.context)
-    tracer = RayTracer(load_scene(args.scene), *args.size, context=ctx, samples=args.spp,
-                       max_depth=args.max_depth)
+    if args.method == "raster":
+        from renderer.gpu import GpuRenderer
+        tracer = GpuRenderer(load_scene(args.scene), *args.size, context=ctx)
+    else:
+        from renderer.gpu.raytracer import RayTracer
+        tracer = RayTracer(load_scene(args.scene), *args.size, context=ctx, samples=args.spp,
+                           max_depth=args.max_depth)
     frame = tracer.render()                                   # compiles; not timed
     print(json.dumps({"rgba8": hashlib.sha256(frame.rgba8.tobytes()).hexdigest(),
                       "renderer": ctx.info["GL_RENDERER"]}), flush=True)
@@ -84,7 +91,7 @@ def start(tree: Path, args) -> tuple[subprocess.Popen, dict]:
     env = dict(os.environ, PYTHONPATH=str(tree))
     command = [sys.executable, str(Path(__file__).resolve()), "--worker", "--scene", args.scene,
                "--size", f"{args.size[0]}x{args.size[1]}", "--spp", str(args.spp),
-               "--max-depth", str(args.max_depth), "--context", args.context]
+               "--max-depth", str(args.max_depth), "--context", args.context, "--method", args.method]
     process = subprocess.Popen(command, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                text=True, cwd=tree)
     return process, json.loads(process.stdout.readline())
@@ -116,6 +123,7 @@ def main() -> None:
     parser.add_argument("--max-depth", type=int, default=4)
     parser.add_argument("--rounds", type=int, default=15)
     parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
+    parser.add_argument("--method", choices=("raytrace", "raster"), default="raytrace")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
@@ -129,8 +137,10 @@ def main() -> None:
         processes, infos = zip(*(start(export(r, Path(d)), args) for r, d in zip(names, (a_dir, b_dir))))
         print(f"{platform.node()}: {os.cpu_count()} CPUs; {infos[0]['renderer']}; "
               f"{time.strftime('%Y-%m-%d %H:%M')}; load average {load()}")
-        print(f"{Path(args.scene).name} {args.size[0]}x{args.size[1]}, {args.spp} spp, max depth "
-              f"{args.max_depth}, {args.context}; {args.rounds} rounds, frames interleaved")
+        what = (f"{args.spp} spp, max depth {args.max_depth}" if args.method == "raytrace"
+                else "rasterised")
+        print(f"{Path(args.scene).name} {args.size[0]}x{args.size[1]}, {what}, {args.context}; "
+              f"{args.rounds} rounds, frames interleaved")
         times = ([], [])
         for k in range(args.rounds):
             for i in ((0, 1) if k % 2 == 0 else (1, 0)):

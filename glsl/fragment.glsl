@@ -12,6 +12,12 @@
 // and Gouraud get the terms apart from geometry.glsl (one per triangle, the face normal) or
 // vertex.glsl (interpolated, the interpolated normal renormalised): the ambient term plus each
 // light's term times its visibility, with no lookup where the term is 0.
+// TEXTURED (a textured material): the texel at the fragment's UV (glsl/texture.glsl) multiplies
+// the coefficients the material names (TEXTURE_KA, TEXTURE_KD, TEXTURE_KS): Phong lights with
+// them so (lighting.glsl's material_factors); flat and Gouraud get their lighting in two parts
+// (the other coefficients' and the modulated ones', glsl/vertex.glsl) and add other +
+// modulated * texel: the colour, the ambient term and each light's term (before its visibility
+// weighs it) alike.
 
 #ifdef SHADOW_MAPS
 #define SHADOWS
@@ -22,6 +28,17 @@
 #ifdef SHADOW_MAPS
 #include "shadow/lookup.glsl"
 #endif
+#ifdef TEXTURED
+#include "texture.glsl"
+#ifdef SHADING_FLAT
+in vec2 f_uv;                        // from geometry.glsl
+#define UV f_uv
+#else
+in vec2 v_uv;                        // from vertex.glsl
+#define UV v_uv
+#endif
+vec3 texel;                          // the material's texel at this fragment (main() looks it up)
+#endif
 
 #if defined(SHADING_PHONG)
 in vec3 v_world_position;
@@ -30,6 +47,9 @@ in vec3 v_world_normal;
 in vec3 f_world_position;            // from geometry.glsl
 flat in vec3 f_face_normal;          // the terms: one per triangle
 flat in vec3 f_ambient;
+#ifdef TEXTURED
+flat in vec3 f_modulated_ambient;
+#endif
 #if NUM_DIRECTIONAL_TERMS > 0
 flat in vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
 #ifdef TWO_SIDED
@@ -43,6 +63,7 @@ flat in vec3 f_point_terms_back[NUM_POINT_TERMS];
 #endif
 #endif
 #define AMBIENT f_ambient
+#define MODULATED_AMBIENT f_modulated_ambient
 #define DIRECTIONAL_TERMS_FRONT f_directional_terms_front
 #define DIRECTIONAL_TERMS_BACK f_directional_terms_back
 #define POINT_TERMS_FRONT f_point_terms_front
@@ -51,6 +72,9 @@ flat in vec3 f_point_terms_back[NUM_POINT_TERMS];
 in vec3 v_world_position;            // from vertex.glsl, interpolated
 in vec3 v_world_normal;
 in vec3 v_ambient;
+#ifdef TEXTURED
+in vec3 v_modulated_ambient;
+#endif
 #if NUM_DIRECTIONAL_TERMS > 0
 in vec3 v_directional_terms_front[NUM_DIRECTIONAL_TERMS];
 #ifdef TWO_SIDED
@@ -64,6 +88,7 @@ in vec3 v_point_terms_back[NUM_POINT_TERMS];
 #endif
 #endif
 #define AMBIENT v_ambient
+#define MODULATED_AMBIENT v_modulated_ambient
 #define DIRECTIONAL_TERMS_FRONT v_directional_terms_front
 #define DIRECTIONAL_TERMS_BACK v_directional_terms_back
 #define POINT_TERMS_FRONT v_point_terms_front
@@ -73,10 +98,22 @@ flat in vec3 f_color_front;          // from geometry.glsl, one per triangle
 #ifdef TWO_SIDED
 flat in vec3 f_color_back;
 #endif
+#ifdef TEXTURED
+flat in vec3 f_modulated_front;
+#ifdef TWO_SIDED
+flat in vec3 f_modulated_back;
+#endif
+#endif
 #else
 in vec3 v_color_front;               // from vertex.glsl, interpolated
 #ifdef TWO_SIDED
 in vec3 v_color_back;
+#endif
+#ifdef TEXTURED
+in vec3 v_modulated_front;
+#ifdef TWO_SIDED
+in vec3 v_modulated_back;
+#endif
 #endif
 #endif
 
@@ -95,16 +132,28 @@ layout(location = 1) out vec4 out_linear_color;
 #endif
 
 #if defined(SHADOW_MAPS) && !defined(SHADING_PHONG)
+// Light i's term in `terms` (TEXTURED: its other part plus its modulated part times the texel).
+#ifdef TEXTURED
+#define LIGHT_TERM(terms, rows, i) (terms[i] + terms[(rows) + (i)] * texel)
+#else
+#define LIGHT_TERM(terms, rows, i) terms[i]
+#endif
+
 // The terms of the side seen (`back`: a two-sided back face), each light's weighed by its
 // visibility at P with the lit normal N, added to the ambient term in lighting()'s order.
 vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
+#ifdef TEXTURED
+    vec3 color = AMBIENT + MODULATED_AMBIENT * texel;
+#else
     vec3 color = AMBIENT;
+#endif
 #if NUM_DIRECTIONAL_TERMS > 0
     for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
 #ifdef TWO_SIDED
-        vec3 term = back ? DIRECTIONAL_TERMS_BACK[i] : DIRECTIONAL_TERMS_FRONT[i];
+        vec3 term = back ? LIGHT_TERM(DIRECTIONAL_TERMS_BACK, DIRECTIONAL_TERM_ROWS, i)
+                         : LIGHT_TERM(DIRECTIONAL_TERMS_FRONT, DIRECTIONAL_TERM_ROWS, i);
 #else
-        vec3 term = DIRECTIONAL_TERMS_FRONT[i];
+        vec3 term = LIGHT_TERM(DIRECTIONAL_TERMS_FRONT, DIRECTIONAL_TERM_ROWS, i);
 #endif
         color += shadowed_directional(i, P, N, term);
     }
@@ -112,9 +161,10 @@ vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
 #if NUM_POINT_TERMS > 0
     for (int i = 0; i < POINT_LIGHTS; ++i) {
 #ifdef TWO_SIDED
-        vec3 term = back ? POINT_TERMS_BACK[i] : POINT_TERMS_FRONT[i];
+        vec3 term = back ? LIGHT_TERM(POINT_TERMS_BACK, POINT_TERM_ROWS, i)
+                         : LIGHT_TERM(POINT_TERMS_FRONT, POINT_TERM_ROWS, i);
 #else
-        vec3 term = POINT_TERMS_FRONT[i];
+        vec3 term = LIGHT_TERM(POINT_TERMS_FRONT, POINT_TERM_ROWS, i);
 #endif
         color += shadowed_point(i, P, N, term);
     }
@@ -124,6 +174,9 @@ vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
 #endif
 
 void main() {
+#ifdef TEXTURED
+    texel = material_texel(UV);
+#endif
 #if defined(SHADING_PHONG) || defined(SHADOW_MAPS)
 #if defined(SHADING_PHONG)
     vec3 P = v_world_position;
@@ -143,6 +196,9 @@ void main() {
     }
 #endif
 #if defined(SHADING_PHONG)
+#ifdef TEXTURED
+    material_factors(texel, vec3(1.0));
+#endif
     vec3 color = lighting(P, N);
 #else
     vec3 color = shadowed_terms(P, N, back);
@@ -150,14 +206,26 @@ void main() {
 #elif defined(SHADING_FLAT)
 #ifdef TWO_SIDED
     vec3 color = BACK_FACE_LIT ? f_color_back : f_color_front;
+#ifdef TEXTURED
+    color += (BACK_FACE_LIT ? f_modulated_back : f_modulated_front) * texel;
+#endif
 #else
     vec3 color = f_color_front;
+#ifdef TEXTURED
+    color += f_modulated_front * texel;
+#endif
 #endif
 #else
 #ifdef TWO_SIDED
     vec3 color = BACK_FACE_LIT ? v_color_back : v_color_front;
+#ifdef TEXTURED
+    color += (BACK_FACE_LIT ? v_modulated_back : v_modulated_front) * texel;
+#endif
 #else
     vec3 color = v_color_front;
+#ifdef TEXTURED
+    color += v_modulated_front * texel;
+#endif
 #endif
 #endif
     out_color = vec4(color, 1.0);

@@ -9,6 +9,10 @@
 // ambient term and each light's term, one per triangle), with the face normal and the
 // interpolated world position, for fragment.glsl to weigh each light's term by its
 // visibility per fragment.
+// TEXTURED: the vertices' UVs pass through (f_uv, interpolated), and the face's lighting is
+// kept apart by coefficient as the vertex stage's Gouraud lighting is (glsl/vertex.glsl):
+// f_modulated_* beside f_color_*, or with SHADOW_MAPS each light's term in TERM_PARTS rows
+// and f_modulated_ambient beside f_ambient.
 
 #include "lighting.glsl"
 
@@ -16,11 +20,18 @@ layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
 
 in vec3 v_world_position[];
+#ifdef TEXTURED
+in vec2 v_uv[];
+out vec2 f_uv;
+#endif
 
 #ifdef SHADOW_MAPS
 out vec3 f_world_position;           // where fragment.glsl looks the maps up
 flat out vec3 f_face_normal;
 flat out vec3 f_ambient;             // I_a k_a
+#ifdef TEXTURED
+flat out vec3 f_modulated_ambient;   // I_a k_a where the texel modulates k_a, else 0
+#endif
 #if NUM_DIRECTIONAL_TERMS > 0
 flat out vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
 #ifdef TWO_SIDED
@@ -34,10 +45,57 @@ flat out vec3 f_point_terms_back[NUM_POINT_TERMS];
 #endif
 #endif
 #else
-flat out vec3 f_color_front;         // lit with N
+flat out vec3 f_color_front;         // lit with N (TEXTURED: the unmodulated coefficients')
 #ifdef TWO_SIDED
 flat out vec3 f_color_back;          // lit with -N
 #endif
+#ifdef TEXTURED
+flat out vec3 f_modulated_front;     // the modulated coefficients' terms, lit with N
+#ifdef TWO_SIDED
+flat out vec3 f_modulated_back;
+#endif
+#endif
+#endif
+
+#ifdef SHADOW_MAPS
+// The face's terms, each light's lit with N and (two-sided) -N, in TERM_PARTS rows a light
+// (lighting.glsl), and the ambient term of each part.
+#if NUM_DIRECTIONAL_TERMS > 0
+vec3 directional_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+vec3 directional_back[NUM_DIRECTIONAL_TERMS];
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+vec3 point_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+vec3 point_back[NUM_POINT_TERMS];
+#endif
+#endif
+vec3 ambient[TERM_PARTS];
+
+// The `part`'s terms at P (unit normal N, view vector V) into its rows.
+void light_face(vec3 P, vec3 N, vec3 V, int part) {
+    ambient[part] = ambient_term();
+#if NUM_DIRECTIONAL_TERMS > 0
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
+        int row = part * DIRECTIONAL_TERM_ROWS + i;
+        directional_front[row] = directional_term(i, N, V);
+#ifdef TWO_SIDED
+        directional_back[row] = directional_term(i, -N, V);
+#endif
+    }
+#endif
+#if NUM_POINT_TERMS > 0
+    for (int i = 0; i < POINT_LIGHTS; ++i) {
+        int row = part * POINT_TERM_ROWS + i;
+        point_front[row] = point_term(i, P, N, V);
+#ifdef TWO_SIDED
+        point_back[row] = point_term(i, P, -N, V);
+#endif
+    }
+#endif
+}
 #endif
 
 void main() {
@@ -48,31 +106,21 @@ void main() {
     vec3 face_centroid = (p0 + p1 + p2) / 3.0;
 #ifdef SHADOW_MAPS
     vec3 V = view_vector(face_centroid);
-#if NUM_DIRECTIONAL_TERMS > 0
-    vec3 directional_front[NUM_DIRECTIONAL_TERMS];
-#ifdef TWO_SIDED
-    vec3 directional_back[NUM_DIRECTIONAL_TERMS];
+#ifdef TEXTURED
+    material_part(MODULATED_PART);
+    light_face(face_centroid, face_normal, V, MODULATED_PART);
+    material_part(OTHER_PART);
 #endif
-    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
-        directional_front[i] = directional_term(i, face_normal, V);
-#ifdef TWO_SIDED
-        directional_back[i] = directional_term(i, -face_normal, V);
-#endif
-    }
-#endif
-#if NUM_POINT_TERMS > 0
-    vec3 point_front[NUM_POINT_TERMS];
-#ifdef TWO_SIDED
-    vec3 point_back[NUM_POINT_TERMS];
-#endif
-    for (int i = 0; i < POINT_LIGHTS; ++i) {
-        point_front[i] = point_term(i, face_centroid, face_normal, V);
-#ifdef TWO_SIDED
-        point_back[i] = point_term(i, face_centroid, -face_normal, V);
-#endif
-    }
-#endif
+    light_face(face_centroid, face_normal, V, OTHER_PART);
 #else
+#ifdef TEXTURED
+    material_part(MODULATED_PART);
+    vec3 modulated_front = lighting(face_centroid, face_normal);
+#ifdef TWO_SIDED
+    vec3 modulated_back = lighting(face_centroid, -face_normal);
+#endif
+    material_part(OTHER_PART);
+#endif
     vec3 front_color = lighting(face_centroid, face_normal);
 #ifdef TWO_SIDED
     vec3 back_color = lighting(face_centroid, -face_normal);
@@ -80,10 +128,16 @@ void main() {
 #endif
     for (int i = 0; i < 3; ++i) {
         gl_Position = gl_in[i].gl_Position;
+#ifdef TEXTURED
+        f_uv = v_uv[i];
+#endif
 #ifdef SHADOW_MAPS
         f_world_position = v_world_position[i];
         f_face_normal = face_normal;
-        f_ambient = ambient_term();
+        f_ambient = ambient[OTHER_PART];
+#ifdef TEXTURED
+        f_modulated_ambient = ambient[MODULATED_PART];
+#endif
 #if NUM_DIRECTIONAL_TERMS > 0
         f_directional_terms_front = directional_front;
 #ifdef TWO_SIDED
@@ -100,6 +154,12 @@ void main() {
         f_color_front = front_color;
 #ifdef TWO_SIDED
         f_color_back = back_color;
+#endif
+#ifdef TEXTURED
+        f_modulated_front = modulated_front;
+#ifdef TWO_SIDED
+        f_modulated_back = modulated_back;
+#endif
 #endif
 #endif
         EmitVertex();

@@ -19,6 +19,15 @@
 //   AREA_LIGHTS: a point light with an area (has_area(i)) lights by area_light_term(i, P, N,
 //     V); the including shader defines both (its samples on the area, each point_term_at a
 //     sampled point, shadowed, averaged); the others light as without it.
+// The rasteriser's textured materials add one (renderer/gpu/shaders.py, glsl/texture.glsl):
+//   TEXTURED: the coefficients lit are u_ka, u_kd and u_ks each times a factor, which the
+//     caller sets with material_factors(modulated, other): `modulated` for the coefficients
+//     the texel modulates (TEXTURE_KA, TEXTURE_KD, TEXTURE_KS), `other` for the rest. Phong
+//     lights once with (texel, 1); flat and Gouraud, which light before the texel is known,
+//     light each part alone (material_part: OTHER_PART (0, 1), MODULATED_PART (1, 0)) and
+//     hand both on (glsl/vertex.glsl, glsl/geometry.glsl); a receiver of shadows hands each
+//     light's term on in TERM_PARTS rows of its array (NUM_DIRECTIONAL_TERMS = TERM_PARTS x
+//     the lights, renderer/gpu/shaders.py): OTHER_PART's rows first, then MODULATED_PART's.
 // Each light's term is a function of its own (directional_term, point_term), which flat and
 // Gouraud receivers of shadows also call to keep the terms apart (glsl/vertex.glsl).
 
@@ -49,6 +58,52 @@ uniform vec3 u_eye;                  // E, the camera's eye, world space
 #endif
 
 uniform vec3 u_ambient;              // I_a
+
+// The coefficients as lit (TEXTURED: times the factors material_factors set).
+#ifdef TEXTURED
+vec3 ka_factor = vec3(1.0);
+vec3 kd_factor = vec3(1.0);
+vec3 ks_factor = vec3(1.0);
+#define MATERIAL_KA (u_ka * ka_factor)
+#define MATERIAL_KD (u_kd * kd_factor)
+#define MATERIAL_KS (u_ks * ks_factor)
+
+void material_factors(vec3 modulated, vec3 other) {
+#ifdef TEXTURE_KA
+    ka_factor = modulated;
+#else
+    ka_factor = other;
+#endif
+#ifdef TEXTURE_KD
+    kd_factor = modulated;
+#else
+    kd_factor = other;
+#endif
+#ifdef TEXTURE_KS
+    ks_factor = modulated;
+#else
+    ks_factor = other;
+#endif
+}
+
+#define OTHER_PART 0
+#define MODULATED_PART 1
+#define TERM_PARTS 2
+void material_part(int part) {
+    float modulated = float(part == MODULATED_PART);
+    material_factors(vec3(modulated), vec3(1.0 - modulated));
+}
+#else
+#define MATERIAL_KA u_ka
+#define MATERIAL_KD u_kd
+#define MATERIAL_KS u_ks
+#define OTHER_PART 0
+#define TERM_PARTS 1
+#endif
+#ifdef NUM_DIRECTIONAL_TERMS
+#define DIRECTIONAL_TERM_ROWS (NUM_DIRECTIONAL_TERMS / TERM_PARTS)
+#define POINT_TERM_ROWS (NUM_POINT_TERMS / TERM_PARTS)
+#endif
 
 #ifdef ALL_FEATURES
 uniform int u_num_directional_lights;
@@ -99,10 +154,10 @@ float specular_term(float n_dot_l, float r_dot_v, float n) {
 // N, L, V are unit vectors (V is unused without SPECULAR); att_intensity is att * I_l.
 vec3 light_contribution(vec3 N, vec3 L, vec3 V, vec3 att_intensity) {
     float n_dot_l = dot(N, L);
-    vec3 I = att_intensity * u_kd * max(n_dot_l, 0.0);
+    vec3 I = att_intensity * MATERIAL_KD * max(n_dot_l, 0.0);
 #ifdef SPECULAR
     vec3 R = 2.0 * n_dot_l * N - L;                  // perfect reflection of L about N
-    I += att_intensity * u_ks * specular_term(n_dot_l, dot(R, V), u_n);
+    I += att_intensity * MATERIAL_KS * specular_term(n_dot_l, dot(R, V), u_n);
 #endif
     return I;
 }
@@ -118,7 +173,7 @@ vec3 view_vector(vec3 P) {
 
 // The ambient term I_a k_a.
 vec3 ambient_term() {
-    return u_ambient * u_ka;
+    return u_ambient * MATERIAL_KA;
 }
 
 // The term of light i at P with unit normal N (its diffuse and specular terms): what

@@ -9,6 +9,13 @@
 //                  position and normal, for fragment.glsl to weigh each light's term by its
 //                  visibility per fragment (fixed-function GL's ARB_shadow, per light).
 // SHADING_PHONG:   hands world position and normal on to fragment.glsl.
+// TEXTURED (a textured material, glsl/texture.glsl): the vertex's UV is handed on too
+// (perspective-correct), and Gouraud's lighting is kept apart by coefficient, the terms of
+// the coefficients the texel modulates (lighting.glsl's material_factors(1, 0)) from the
+// others' (factors (0, 1)): v_modulated_* beside v_color_*, and with SHADOW_MAPS each
+// light's term twice in its array (TERM_PARTS rows a light: the others' rows first, then
+// the modulated ones') and v_modulated_ambient beside v_ambient. fragment.glsl adds them
+// up as other + modulated * texel.
 
 #include "lighting.glsl"
 
@@ -19,6 +26,10 @@ uniform mat4 u_projection;           // P
 
 in vec3 in_position;                 // object space
 in vec3 in_normal;                   // object space, unit
+#ifdef TEXTURED
+in vec2 in_uv;                       // (u, v), docs/conventions.md "Texture coordinates"
+out vec2 v_uv;
+#endif
 
 #if defined(SHADING_FLAT)
 out vec3 v_world_position;
@@ -26,6 +37,9 @@ out vec3 v_world_position;
 out vec3 v_world_position;           // where fragment.glsl looks the maps up
 out vec3 v_world_normal;
 out vec3 v_ambient;                  // I_a k_a
+#ifdef TEXTURED
+out vec3 v_modulated_ambient;        // I_a k_a where the texel modulates k_a, else 0
+#endif
 #if NUM_DIRECTIONAL_TERMS > 0
 out vec3 v_directional_terms_front[NUM_DIRECTIONAL_TERMS];   // directional_term, lit with N
 #ifdef TWO_SIDED
@@ -39,9 +53,15 @@ out vec3 v_point_terms_back[NUM_POINT_TERMS];
 #endif
 #endif
 #elif defined(SHADING_GOURAUD)
-out vec3 v_color_front;              // lit with N
+out vec3 v_color_front;              // lit with N (TEXTURED: the unmodulated coefficients')
 #ifdef TWO_SIDED
 out vec3 v_color_back;               // lit with -N
+#endif
+#ifdef TEXTURED
+out vec3 v_modulated_front;          // the modulated coefficients' terms, lit with N
+#ifdef TWO_SIDED
+out vec3 v_modulated_back;
+#endif
 #endif
 #elif defined(SHADING_PHONG)
 out vec3 v_world_position;
@@ -50,9 +70,37 @@ out vec3 v_world_normal;
 #error "define one of SHADING_FLAT, SHADING_GOURAUD, SHADING_PHONG"
 #endif
 
+#if defined(SHADING_GOURAUD) && defined(SHADOW_MAPS)
+// Each light's term at P (unit normal N, view vector V), lit with N and (two-sided) -N, into
+// its `part`'s rows of the term arrays (lighting.glsl, TERM_PARTS).
+void hand_on_light_terms(vec3 P, vec3 N, vec3 V, int part) {
+#if NUM_DIRECTIONAL_TERMS > 0
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
+        int row = part * DIRECTIONAL_TERM_ROWS + i;
+        v_directional_terms_front[row] = directional_term(i, N, V);
+#ifdef TWO_SIDED
+        v_directional_terms_back[row] = directional_term(i, -N, V);
+#endif
+    }
+#endif
+#if NUM_POINT_TERMS > 0
+    for (int i = 0; i < POINT_LIGHTS; ++i) {
+        int row = part * POINT_TERM_ROWS + i;
+        v_point_terms_front[row] = point_term(i, P, N, V);
+#ifdef TWO_SIDED
+        v_point_terms_back[row] = point_term(i, P, -N, V);
+#endif
+    }
+#endif
+}
+#endif
+
 void main() {
     vec4 world_position = u_model * vec4(in_position, 1.0);
     gl_Position = u_projection * (u_view * world_position);        // p_clip = P V M p
+#ifdef TEXTURED
+    v_uv = in_uv;
+#endif
 #if defined(SHADING_FLAT)
     v_world_position = world_position.xyz;
 #else
@@ -60,25 +108,24 @@ void main() {
 #if defined(SHADING_GOURAUD) && defined(SHADOW_MAPS)
     v_world_position = world_position.xyz;
     v_world_normal = world_normal;
-    v_ambient = ambient_term();
     vec3 V = view_vector(world_position.xyz);
-#if NUM_DIRECTIONAL_TERMS > 0
-    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
-        v_directional_terms_front[i] = directional_term(i, world_normal, V);
-#ifdef TWO_SIDED
-        v_directional_terms_back[i] = directional_term(i, -world_normal, V);
+#ifdef TEXTURED
+    material_part(MODULATED_PART);
+    v_modulated_ambient = ambient_term();
+    hand_on_light_terms(world_position.xyz, world_normal, V, MODULATED_PART);
+    material_part(OTHER_PART);
 #endif
-    }
-#endif
-#if NUM_POINT_TERMS > 0
-    for (int i = 0; i < POINT_LIGHTS; ++i) {
-        v_point_terms_front[i] = point_term(i, world_position.xyz, world_normal, V);
-#ifdef TWO_SIDED
-        v_point_terms_back[i] = point_term(i, world_position.xyz, -world_normal, V);
-#endif
-    }
-#endif
+    v_ambient = ambient_term();
+    hand_on_light_terms(world_position.xyz, world_normal, V, OTHER_PART);
 #elif defined(SHADING_GOURAUD)
+#ifdef TEXTURED
+    material_part(MODULATED_PART);
+    v_modulated_front = lighting(world_position.xyz, world_normal);
+#ifdef TWO_SIDED
+    v_modulated_back = lighting(world_position.xyz, -world_normal);
+#endif
+    material_part(OTHER_PART);
+#endif
     v_color_front = lighting(world_position.xyz, world_normal);
 #ifdef TWO_SIDED
     v_color_back = lighting(world_position.xyz, -world_normal);

@@ -15,12 +15,19 @@ Phong as above; flat with P from f_world_position, its face normal and the trian
 (f_ambient, f_*_terms_*), Gouraud with normalize_or_zero(v_world_normal) and the vertices'
 terms interpolated (v_ambient, v_*_terms_*), of the
 side seen: out_color = ambient + sum_l visibility_l term_l, no lookup where a term is 0.
+A textured material (TEXTURED) looks its texel up at the fragment's UV (reference/texture.py;
+a mipmapped sampler's level of detail from the UVs at the fragment's quad reference pixels,
+its triangle's planes evaluated there whether it covers them or not): Phong lights with the
+modulated coefficients times the texel (MaterialUniforms.with_factors); flat and Gouraud add
+their two parts (reference/vertex.py) as other + modulated * texel, the colours or, with
+SHADOW_MAPS, the ambient term and each light's term (LightTerms.modulated).
 Alpha is 1. Also out_view_depth, the interpolated -z_eye, for the depth image.
 
 Inputs:  `ObjectVaryings` (the vertex and geometry stage outputs of one object, its faces
          and material), and per fragment: triangle (N,) int64 index into the object's
          faces, weights (N, 3) perspective-correct weights of that triangle's vertices,
-         gl_FrontFacing (N,) bool.
+         gl_FrontFacing (N,) bool; for a textured material also gl_FragCoord (N, 2), the
+         pixel's centre in window coordinates, and the viewport's (width, height).
 Outputs: out_color (N, 4) and out_view_depth (N,), in the pipeline's dtype, and the shadow
          ties: None, or (tied (N,) bool, out_color (N, 4) with tied shadow-map taps decided
          the other way) (reference/shadow/lookup.py, "Ties").
@@ -34,8 +41,11 @@ import numpy as np
 
 from reference.geometry import TriangleOutputs
 from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, lighting, normalize_or_zero
+from reference.rasterizer import perspective_weights_at
+from reference.sampler import quad_reference
 from reference.shadow.lookup import FragmentShadows, ShadowMaps
-from reference.vertex import VertexOutputs
+from reference.texture import material_texel
+from reference.vertex import VertexOutputs, modulated
 
 
 @dataclass
@@ -80,31 +90,63 @@ def lit_point(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
     return P, N
 
 
+def fragment_texel(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
+                   gl_FragCoord: np.ndarray, viewport: tuple[int, int]) -> np.ndarray:
+    """material_texel(UV) (N, 3) of a textured object's fragments: the UV interpolated at
+    each fragment (flat: f_uv, from its triangle's corners) and, for a mipmapped sampler, at
+    its quad's reference pixels from the same triangle's planes."""
+    texture = obj.material.texture
+    if obj.material.shading == "flat":
+        corners = obj.triangles.f_uv[triangle]                               # (N, 3, 2)
+        at = lambda w: np.einsum("nk,nkc->nc", w, corners)                  # noqa: E731
+    else:
+        at = lambda w: interpolate(obj.vertices.v_uv, obj.faces, triangle, w)   # noqa: E731
+    uv_quad = None
+    if texture.sampler.mipmapped:
+        clip = obj.vertices.gl_Position[obj.faces[triangle]]                 # (N, 3, 4)
+        uv_quad = np.stack([at(perspective_weights_at(clip, x, y, *viewport))
+                            for x, y in quad_reference(gl_FragCoord[:, 0], gl_FragCoord[:, 1])])
+    return material_texel(texture, at(weights), uv_quad)
+
+
 def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
                     gl_FrontFacing: np.ndarray, lights: Lights, u_eye: np.ndarray,
-                    shadows: ShadowMaps | None = None):
+                    shadows: ShadowMaps | None = None, *, gl_FragCoord: np.ndarray | None = None,
+                    viewport: tuple[int, int] | None = None):
     """The fragment stage for one object's surviving fragments -> (out_color, out_view_depth,
-    shadow ties or None). `shadows`: the frame's maps, or None (no SHADOW_MAPS)."""
+    shadow ties or None). `shadows`: the frame's maps, or None (no SHADOW_MAPS).
+    `gl_FragCoord` and `viewport`: a textured material's only."""
     material, faces, vertices = obj.material, obj.faces, obj.vertices
     dtype = vertices.gl_Position.dtype
     if material.shading not in ("flat", "gouraud", "phong"):
         raise ValueError(f"unknown shading mode {material.shading!r}")
     shadowed = shadows is not None and obj.receives_shadows
+    texel = (None if material.texture is None
+             else fragment_texel(obj, triangle, weights, gl_FragCoord, viewport))
     tie = None
     if material.shading == "flat" and not shadowed:
-        color = select_by_facing(gl_FrontFacing, obj.triangles.f_color_front[triangle],
-                                 obj.triangles.f_color_back[triangle])
+        side = lambda front, back: select_by_facing(                       # noqa: E731
+            gl_FrontFacing, front[triangle], back[triangle])
+        color = _with_texel(side(obj.triangles.f_color_front, obj.triangles.f_color_back),
+                            lambda: side(obj.triangles.f_modulated_front, obj.triangles.f_modulated_back),
+                            texel)
     elif material.shading == "gouraud" and not shadowed:
-        color = select_by_facing(gl_FrontFacing,
-                                 interpolate(vertices.v_color_front, faces, triangle, weights),
-                                 interpolate(vertices.v_color_back, faces, triangle, weights))
+        side = lambda front, back: select_by_facing(                       # noqa: E731
+            gl_FrontFacing, interpolate(front, faces, triangle, weights),
+            interpolate(back, faces, triangle, weights))
+        color = _with_texel(side(vertices.v_color_front, vertices.v_color_back),
+                            lambda: side(vertices.v_modulated_front, vertices.v_modulated_back),
+                            texel)
     else:
         P, N = lit_point(obj, triangle, weights, gl_FrontFacing)
         E, uniforms = np.asarray(u_eye, dtype=dtype), MaterialUniforms.from_material(material, dtype)
+        if texel is not None and material.shading == "phong":
+            uniforms = uniforms.with_factors(modulated(material), texel, 1.0)
         if not shadowed:
             color = lighting(P, N, E, uniforms, lights)
         else:
-            terms = _terms_of_side(obj, triangle, weights, gl_FrontFacing, P, N, E, uniforms, lights)
+            terms = _terms_of_side(obj, triangle, weights, gl_FrontFacing, P, N, E, uniforms, lights,
+                                   texel)
             # the tie bands' scale: GL interpolates P from these vertices (lookup.py, SHADOW_TIE)
             scale = np.abs(vertices.v_world_position[faces[triangle]]).max(axis=(1, 2))
             look = FragmentShadows(shadows, scale)
@@ -118,15 +160,26 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
     return out_color, out_view_depth, tie
 
 
+def _with_texel(color: np.ndarray, modulated_color, texel: np.ndarray | None) -> np.ndarray:
+    """Flat and Gouraud's colour: other + modulated * texel for a textured material (the
+    modulated part's colour from the callable), else the colour as it is."""
+    return color if texel is None else color + modulated_color() * texel
+
+
 def _terms_of_side(obj: ObjectVaryings, triangle, weights, gl_FrontFacing, P, N, E, uniforms,
-                   lights) -> LightTerms:
+                   lights, texel=None) -> LightTerms:
     """The lighting's terms at the fragments, of the side seen: Phong lights P with N here;
-    flat takes its triangle's (flat varyings), Gouraud interpolates its vertices'."""
+    flat takes its triangle's (flat varyings), Gouraud interpolates its vertices', and adds
+    their parts up at the texel when textured."""
     if obj.material.shading == "phong":
         return light_terms(P, N, E, uniforms, lights)
     if obj.material.shading == "flat":
-        front, back = (obj.triangles.light_terms(side).map(lambda a: a[triangle]) for side in (False, True))
+        at = lambda a: a[triangle]                                            # noqa: E731
+        varyings, modulated_ambient = obj.triangles, obj.triangles.f_modulated_ambient
     else:
-        front, back = (obj.vertices.light_terms(side).map(lambda a: interpolate(a, obj.faces, triangle, weights))
-                       for side in (False, True))
+        at = lambda a: interpolate(a, obj.faces, triangle, weights)           # noqa: E731
+        varyings, modulated_ambient = obj.vertices, obj.vertices.v_modulated_ambient
+    front, back = (varyings.light_terms(side).map(at) for side in (False, True))
+    if texel is not None:
+        front, back = (terms.modulated(at(modulated_ambient), texel) for terms in (front, back))
     return front.where(gl_FrontFacing, back) if obj.material.two_sided else front

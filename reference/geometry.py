@@ -3,7 +3,12 @@
 Flat shading: one colour per triangle, lit at the triangle's centroid with the face normal
 normalize((p1 - p0) x (p2 - p0)) in world space (vertex order as in the mesh).
 
+A textured material (TEXTURED) passes its vertices' UVs through and is lit in two parts as
+Gouraud's (reference/vertex.py): the colours and terms below are OTHER_PART's, the
+f_modulated_* MODULATED_PART's, and each light's term has a row of each part.
+
 Inputs:  v_world_position (T, 3, 3) world positions of each triangle's vertices (`dtype`),
+         v_uv (T, 3, 2) their UVs (a textured material's only, else None),
          the material, the packed lights and the eye (3,).
 Outputs: `TriangleOutputs` in the same dtype:
          f_face_normal (T, 3)   unit face normal
@@ -17,6 +22,10 @@ Outputs: `TriangleOutputs` in the same dtype:
          (T, Lp, 3), f_*_terms_back (lit with -normal; the front's when one-sided): the same
                                 lighting kept apart (`LightTerms`), whose sums the colours
                                 are: what a flat receiver of shadows hands on (SHADOW_MAPS)
+                                (textured: 2 Ld and 2 Lp rows, `stacked_parts`)
+         f_uv (T, 3, 2)         v_uv passed on (None unless textured)
+         f_modulated_ambient, f_modulated_front, f_modulated_back (T, 3): MODULATED_PART's
+                                ambient term and colours (None unless textured)
 """
 
 from __future__ import annotations
@@ -25,7 +34,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, normalize_or_zero
+from reference.lighting import (MODULATED_PART, OTHER_PART, LightTerms, Lights, MaterialUniforms, lit_parts,
+                                normalize_or_zero, side_colors, stacked_parts)
+from reference.vertex import modulated
 
 
 @dataclass
@@ -40,6 +51,10 @@ class TriangleOutputs:
     f_directional_terms_back: np.ndarray
     f_point_terms_front: np.ndarray
     f_point_terms_back: np.ndarray
+    f_uv: np.ndarray | None = None
+    f_modulated_ambient: np.ndarray | None = None
+    f_modulated_front: np.ndarray | None = None
+    f_modulated_back: np.ndarray | None = None
 
     def light_terms(self, back: bool) -> LightTerms:
         """The terms of the front (or back) side, per triangle."""
@@ -55,7 +70,7 @@ def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
 
 
 def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,
-                    u_eye: np.ndarray) -> TriangleOutputs:
+                    u_eye: np.ndarray, v_uv: np.ndarray | None = None) -> TriangleOutputs:
     """The geometry stage for a flat-shaded object."""
     dtype = v_world_position.dtype
     p0, p1, p2 = v_world_position[:, 0], v_world_position[:, 1], v_world_position[:, 2]
@@ -63,12 +78,21 @@ def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,
     f_centroid = (p0 + p1 + p2) / 3.0
     uniforms = MaterialUniforms.from_material(material, dtype)
     eye = np.asarray(u_eye, dtype=dtype)
+    modulate = modulated(material)
     with np.errstate(invalid="ignore"):
-        front = light_terms(f_centroid, f_face_normal, eye, uniforms, lights)
-        back = (light_terms(f_centroid, -f_face_normal, eye, uniforms, lights)
+        front = lit_parts(f_centroid, f_face_normal, eye, uniforms, lights, modulate)
+        back = (lit_parts(f_centroid, -f_face_normal, eye, uniforms, lights, modulate)
                 if material.two_sided else front)
-        f_color_front = front.shade(f_centroid, f_face_normal)
-        f_color_back = (back.shade(f_centroid, -f_face_normal)
-                        if material.two_sided else f_color_front)
-    return TriangleOutputs(f_face_normal, f_centroid, f_color_front, f_color_back, v_world_position,
-                           front.ambient, front.directional, back.directional, front.point, back.point)
+        colors = [side_colors(front, back, f_centroid, f_face_normal, material.two_sided, part)
+                  for part in range(len(front))]
+    out = TriangleOutputs(f_face_normal, f_centroid, *colors[OTHER_PART], v_world_position,
+                          *_terms(stacked_parts(front), stacked_parts(back)), f_uv=v_uv)
+    if modulate:
+        out.f_modulated_ambient = front[MODULATED_PART].ambient
+        out.f_modulated_front, out.f_modulated_back = colors[MODULATED_PART]
+    return out
+
+
+def _terms(front: LightTerms, back: LightTerms) -> tuple:
+    """TriangleOutputs' f_ambient and term fields, in its order."""
+    return front.ambient, front.directional, back.directional, front.point, back.point

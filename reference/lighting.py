@@ -14,17 +14,26 @@ Output:  I (..., 3) linear RGB in that dtype, unclamped.
 light's term, the GLSL's ambient_term, directional_term and point_term), as flat and Gouraud
 receivers of shadows hand them on; lighting() is their sum, one light at a time.
 
+A textured material (the GLSL's TEXTURED) lights its coefficients times factors
+(`MaterialUniforms.with_factors`, the GLSL's material_factors): the texel on the coefficients
+it modulates (Phong), or each part alone (`MaterialUniforms.part`, material_part: OTHER_PART
+the other coefficients, MODULATED_PART the modulated ones), which flat and Gouraud light and
+hand on apart (`lit_parts`, `stacked_parts`; LightTerms.modulated adds them up again).
+
 The sides rule (one-sided / two-sided) is not applied here: callers pass the normal that
 is to be lit (the vertex, geometry and fragment stages flip it for back faces).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from renderer.core.uniforms import light_uniforms, material_uniforms
+
+# The parts a textured material's flat and Gouraud lighting is handed on in (glsl/lighting.glsl).
+OTHER_PART, MODULATED_PART = 0, 1
 
 
 @dataclass
@@ -65,6 +74,21 @@ class MaterialUniforms:
     def from_material(cls, material, dtype=np.float64) -> "MaterialUniforms":
         return cls(**{name: value.astype(dtype) for name, value in material_uniforms(material).items()},
                    specular=material.has_specular)
+
+    def with_factors(self, modulate, modulated, other) -> "MaterialUniforms":
+        """material_factors(modulated, other): each coefficient named in `modulate` ("ka",
+        "kd", "ks") times `modulated`, the others times `other` (scalars, (3,) or (N, 3) per
+        point)."""
+        factor = {k: modulated if k in modulate else other for k in ("ka", "kd", "ks")}
+        return replace(self, u_ka=self.u_ka * factor["ka"], u_kd=self.u_kd * factor["kd"],
+                       u_ks=self.u_ks * factor["ks"])
+
+    def part(self, modulate, part: int) -> "MaterialUniforms":
+        """material_part(part): the coefficients of MODULATED_PART (those in `modulate`) or
+        of OTHER_PART (the rest) alone, the others 0."""
+        modulated = 1.0 if part == MODULATED_PART else 0.0
+        return self.with_factors(modulate, modulated, 1.0 - modulated)
+
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -157,6 +181,16 @@ class LightTerms:
         """I = ambient + sum_l term_l (shade_terms)."""
         return shade_terms(self.ambient, self.terms, P, N, visibility)
 
+    def modulated(self, modulated_ambient: np.ndarray, texel: np.ndarray) -> "LightTerms":
+        """Terms stacked by `stacked_parts` added up at a texel (N, 3) (the GLSL's LIGHT_TERM):
+        each light's OTHER_PART row plus its MODULATED_PART row times the texel, and the
+        ambient term plus `modulated_ambient` times the texel."""
+        def add(stacked):
+            rows = stacked.shape[-2] // 2
+            return stacked[..., :rows, :] + stacked[..., rows:, :] * texel[..., None, :]
+        return LightTerms(self.ambient + modulated_ambient * texel, add(self.directional),
+                          add(self.point))
+
 
 def shade_terms(ambient: np.ndarray, terms, P: np.ndarray, N: np.ndarray, visibility=None) -> np.ndarray:
     """I = ambient + sum_l term_l over (kind, i, term) `terms` in order, each term times
@@ -212,6 +246,33 @@ def light_terms(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialU
     empty = np.zeros(ambient.shape[:-1] + (0, 3), P.dtype)
     return LightTerms(ambient, *(np.stack(terms, axis=-2) if terms else empty
                                  for terms in stacked.values()))
+
+
+def lit_parts(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,
+              lights: Lights, modulate=()) -> list[LightTerms]:
+    """What flat and Gouraud light at P with N: light_terms of the material, or, when a
+    texture modulates the coefficients in `modulate`, of each part alone, indexed by part
+    (OTHER_PART, MODULATED_PART)."""
+    if not modulate:
+        return [light_terms(P, N, E, material, lights)]
+    return [light_terms(P, N, E, material.part(modulate, part), lights)
+            for part in (OTHER_PART, MODULATED_PART)]
+
+
+def side_colors(front: list[LightTerms], back: list[LightTerms], P: np.ndarray, N: np.ndarray,
+                two_sided: bool, part: int = OTHER_PART) -> tuple[np.ndarray, np.ndarray]:
+    """One part's colours (lit_parts' sums) lit with N and with -N: (front, back); the back
+    is the front's when the material is one-sided."""
+    lit_front = front[part].shade(P, N)
+    return lit_front, (back[part].shade(P, -N) if two_sided else lit_front)
+
+
+def stacked_parts(parts: list[LightTerms]) -> LightTerms:
+    """The terms a receiver of shadows hands on: OTHER_PART's ambient term, and each kind's
+    lights' terms part after part (TERM_PARTS rows a light: (..., parts x L, 3))."""
+    return LightTerms(parts[OTHER_PART].ambient,
+                      np.concatenate([p.directional for p in parts], axis=-2),
+                      np.concatenate([p.point for p in parts], axis=-2))
 
 
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,

@@ -74,9 +74,11 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     vertices = shade_vertices(mesh.positions, mesh.normals, u_model=matrices.model,
                               u_normal_matrix=matrices.normal, u_view=frame_matrices.view,
                               u_projection=frame_matrices.projection, u_eye=eye,
-                              material=material, lights=lights, dtype=dtype)
+                              material=material, lights=lights, dtype=dtype,
+                              in_uv=texture_coordinates(obj))
     faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
-    triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye)
+    triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye,
+                                 v_uv=None if vertices.v_uv is None else vertices.v_uv[faces])
                  if material.shading == "flat" else None)
     clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
@@ -84,6 +86,17 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows),
                           window.select(keep),
                           clipped.source[keep], clipped.weights[keep])
+
+
+def texture_coordinates(obj) -> np.ndarray | None:
+    """The mesh's UVs, which a textured material's vertex stage reads (in_uv); None for an
+    object without a texture."""
+    if obj.material.texture is None:
+        return None
+    if obj.mesh.uvs is None:
+        raise ValueError(f"object {obj.name!r}: its material has a texture but its mesh "
+                         f"({obj.mesh.source or 'made in code'}) has no texture coordinates")
+    return obj.mesh.uvs
 
 
 def draw_tile(index: int, prepared: PreparedObject, depth: DepthBuffer, first_order: int,
@@ -201,8 +214,9 @@ def _render_tile(region, prepared: PreparedFrame, scene, width, height, linear, 
     depth_buffer = depth_test_tile(region, prepared, width, height, scene.camera.reversed_z, dtype)
     objects, lights, eye, shadows = prepared.varyings, prepared.lights, prepared.eye, prepared.shadows
     drawn = depth_buffer.drawn
+    window = (region, width, height)
     color, view_depth, shadow_tied, shadow_other = shade_surviving(
-        objects, depth_buffer.payload, drawn, lights, eye, dtype, shadows)
+        objects, depth_buffer.payload, drawn, lights, eye, dtype, shadows, window)
     frame = compose_frame(color, drawn, view_depth if depth else None, scene.background,
                           x1 - x0, y1 - y0, linear=linear)
     # Where two surfaces are closer in depth than GL can order, the other one may show: its
@@ -214,7 +228,8 @@ def _render_tile(region, prepared: PreparedFrame, scene, width, height, linear, 
         return frame
     alternative = np.where(shadow_tied[:, None], shadow_other, color)
     if ties.any():
-        other = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype, shadows)[0]
+        other = shade_surviving(objects, depth_buffer.payload_second, ties, lights, eye, dtype, shadows,
+                                window)[0]
         alternative = np.where(ties[:, None], other, alternative)
     frame.rgba8_tie = compose_frame(alternative, drawn, None, scene.background, x1 - x0, y1 - y0,
                                     linear=False).rgba8
@@ -251,10 +266,12 @@ def _render_in_tiles(bands, prepared: PreparedFrame, scene, width, height, linea
 
 
 def shade_surviving(objects: list[ObjectVaryings | None], payload: dict, pixels_mask: np.ndarray,
-                    lights: Lights, eye, dtype, shadows: ShadowMaps | None = None):
+                    lights: Lights, eye, dtype, shadows: ShadowMaps | None = None, window=None):
     """Fragment stage for the fragments `payload` names at the pixels of `pixels_mask`:
     (colour (H*W, 4), view depth (H*W,), shadow-tied (H*W,) bool, the colour with the tied
-    taps decided the other way (H*W, 4)), zero (False) elsewhere."""
+    taps decided the other way (H*W, 4)), zero (False) elsewhere. `window` (region, width,
+    height): where the tile's pixels are in the viewport (a textured material's lookup needs
+    each fragment's gl_FragCoord)."""
     color = np.zeros((len(pixels_mask), 4), dtype=dtype)
     view_depth = np.full(len(pixels_mask), np.inf, dtype=dtype)
     shadow_tied = np.zeros(len(pixels_mask), bool)
@@ -267,10 +284,21 @@ def shade_surviving(objects: list[ObjectVaryings | None], payload: dict, pixels_
             continue
         color[pixels], view_depth[pixels], tie = shade_fragments(
             varyings, payload["triangle"][pixels], payload["weights"][pixels],
-            payload["gl_FrontFacing"][pixels], lights, eye, shadows)
+            payload["gl_FrontFacing"][pixels], lights, eye, shadows,
+            **_fragment_window(varyings, pixels, window))
         if tie is not None:
             shadow_tied[pixels], shadow_other[pixels] = tie
     return color, view_depth, shadow_tied, shadow_other
+
+
+def _fragment_window(varyings: ObjectVaryings, pixels: np.ndarray, window) -> dict:
+    """shade_fragments' gl_FragCoord (pixel centres, window coordinates) and viewport for
+    the tile's `pixels` of a textured object; nothing for another."""
+    if varyings.material.texture is None:
+        return {}
+    (x0, y0, x1, _), width, height = window
+    x, y = x0 + pixels % (x1 - x0), y0 + pixels // (x1 - x0)
+    return {"gl_FragCoord": np.stack([x, y], axis=-1) + 0.5, "viewport": (width, height)}
 
 
 @dataclass

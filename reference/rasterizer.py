@@ -17,7 +17,11 @@ against it in tests/test_rasterizer.py):
   screen-space (affine) for z_w, since z_ndc is affine in window coordinates; like
   llvmpipe's attribute set-up they are computed from the unsnapped window positions (this
   keeps depth within float32 rounding of llvmpipe's; the snapped positions would put it up
-  to 1/512 px of slope away on steep triangles).
+  to 1/512 px of slope away on steep triangles);
+- a triangle's varyings are planes over the whole window, evaluated also at pixels it does not
+  cover: GL shades 2x2 quads, the pixels of a quad outside the triangle as helper
+  invocations, whose values the quad's derivatives (a texture's level of detail) take
+  (`perspective_weights_at`).
 
 The triangles are walked in batches: each batch expands its triangles' bounding boxes
 (clipped to the viewport) into (triangle, pixel) candidates with np.repeat and tests them
@@ -208,6 +212,22 @@ def screen_barycentrics(tris: WindowTriangles, t: np.ndarray, px: np.ndarray,
     l1 = (qx * dy2 - qy * dx2) / area
     l2 = (dx1 * qy - dy1 * qx) / area
     return np.stack([1.0 - l1 - l2, l1, l2], axis=-1)
+
+
+def perspective_weights_at(gl_Position: np.ndarray, x_w: np.ndarray, y_w: np.ndarray,
+                           width: int, height: int) -> np.ndarray:
+    """Perspective-correct weights (N, 3) of the vertices of triangles given in clip
+    coordinates (N, 3, 4) at window points (x_w, y_w) (N,), inside each triangle or not (a
+    helper pixel's): the weights b, summing to 1, whose combination of the vertices' clip
+    (x, y, w) lies on the point's ray, b ~ adj(M) (x_ndc, y_ndc, 1) with M's columns the
+    vertices' (x, y, w) (homogeneous rasterisation: no divide by a vertex's w, so a clipped
+    triangle's source triangle, whose vertices may lie behind the eye, serves as well)."""
+    c = gl_Position[..., [0, 1, 3]]                              # (N, 3, 3): rows (x, y, w)
+    ndc = np.stack([2.0 * x_w / width - 1.0, 2.0 * y_w / height - 1.0, np.ones_like(x_w)],
+                   axis=-1).astype(c.dtype)
+    b = np.stack([np.einsum("ni,ni->n", ndc, np.cross(c[:, (k + 1) % 3], c[:, (k + 2) % 3]))
+                  for k in range(3)], axis=-1)
+    return b / b.sum(axis=-1, keepdims=True)
 
 
 def depth_planes(tris: WindowTriangles):

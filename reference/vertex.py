@@ -3,8 +3,12 @@
 Vertex processing for one object: world position, world normal (normal matrix, then
 renormalised), clip position gl_Position = P V M p, the camera-space depth -z_eye, and for
 Gouraud materials the per-vertex lit colours (front with N, back with -N when two-sided).
+A textured material (TEXTURED) hands its UVs on, and Gouraud lights it in two parts
+(reference/lighting.py, lit_parts): the colours and terms below are OTHER_PART's, the
+v_modulated_* MODULATED_PART's, and each light's term has a row of each part.
 
-Inputs:  in_position (V, 3) and in_normal (V, 3) from the Mesh (float64, cast to `dtype`);
+Inputs:  in_position (V, 3) and in_normal (V, 3) from the Mesh (float64, cast to `dtype`),
+         in_uv (V, 2) (its UVs: a textured material's only, else None);
          u_model (4, 4), u_normal_matrix (3, 3), u_view (4, 4), u_projection (4, 4),
          u_eye (3,), the material and the packed lights.
 Outputs: `VertexOutputs`, every array in `dtype`:
@@ -12,6 +16,7 @@ Outputs: `VertexOutputs`, every array in `dtype`:
          v_world_position (V, 3)  world-space position
          v_world_normal (V, 3)    unit world-space normal
          v_view_depth (V,)        -z_eye, the distance along the viewing axis
+         v_uv (V, 2)              in_uv (None unless textured)
          v_color_front (V, 3)     Gouraud colour lit with N        (None unless gouraud)
          v_color_back (V, 3)      Gouraud colour lit with -N       (the front colour when
                                   the material is one-sided; None unless gouraud)
@@ -19,7 +24,11 @@ Outputs: `VertexOutputs`, every array in `dtype`:
          (V, Lp, 3), v_*_terms_back (lit with -N; the front's when one-sided): the same
                                   lighting kept apart (`LightTerms`), whose sums the colours
                                   are: what a Gouraud receiver of shadows hands on
-                                  (SHADOW_MAPS); None unless gouraud
+                                  (SHADOW_MAPS); None unless gouraud (textured: 2 Ld and 2 Lp
+                                  rows, `stacked_parts`)
+         v_modulated_ambient (V, 3), v_modulated_front (V, 3), v_modulated_back (V, 3):
+                                  MODULATED_PART's ambient term and colours (None unless
+                                  Gouraud and textured)
 Every output is an affine function of the vertex in clip space or is interpolated as one,
 so clipping and perspective-correct interpolation treat them all alike.
 """
@@ -30,7 +39,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, normalize_or_zero
+from reference.lighting import (MODULATED_PART, OTHER_PART, LightTerms, Lights, MaterialUniforms, lit_parts,
+                                normalize_or_zero, side_colors, stacked_parts)
 
 
 @dataclass
@@ -46,6 +56,10 @@ class VertexOutputs:
     v_directional_terms_back: np.ndarray | None = None
     v_point_terms_front: np.ndarray | None = None
     v_point_terms_back: np.ndarray | None = None
+    v_uv: np.ndarray | None = None
+    v_modulated_ambient: np.ndarray | None = None
+    v_modulated_front: np.ndarray | None = None
+    v_modulated_back: np.ndarray | None = None
 
     def light_terms(self, back: bool) -> LightTerms:
         """The terms of the front (or back) side, per vertex."""
@@ -59,9 +73,14 @@ def transform_points(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
     return points @ matrix[:, :3].T + matrix[:, 3]
 
 
-def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, *, u_model: np.ndarray,
-                   u_normal_matrix: np.ndarray, u_view: np.ndarray, u_projection: np.ndarray,
-                   u_eye: np.ndarray, material, lights: Lights,
+def modulated(material) -> tuple:
+    """The coefficients `material`'s texel modulates; empty without a texture."""
+    return () if material.texture is None else tuple(material.texture.modulate)
+
+
+def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, in_uv: np.ndarray | None = None,
+                   *, u_model: np.ndarray, u_normal_matrix: np.ndarray, u_view: np.ndarray,
+                   u_projection: np.ndarray, u_eye: np.ndarray, material, lights: Lights,
                    dtype=np.float64) -> VertexOutputs:
     """Run the vertex stage over all of an object's vertices at once."""
     in_position = np.asarray(in_position, dtype=dtype)
@@ -77,16 +96,23 @@ def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, *, u_model: n
     v_view_depth = -eye_space[:, 2]
 
     out = VertexOutputs(gl_Position, v_world_position, v_world_normal, v_view_depth)
+    if in_uv is not None:
+        out.v_uv = np.asarray(in_uv, dtype=dtype)
     if material.shading == "gouraud":
         uniforms = MaterialUniforms.from_material(material, dtype)
         eye = np.asarray(u_eye, dtype=dtype)
-        front = light_terms(v_world_position, v_world_normal, eye, uniforms, lights)
-        back = (light_terms(v_world_position, -v_world_normal, eye, uniforms, lights)
+        modulate = modulated(material)
+        front = lit_parts(v_world_position, v_world_normal, eye, uniforms, lights, modulate)
+        back = (lit_parts(v_world_position, -v_world_normal, eye, uniforms, lights, modulate)
                 if material.two_sided else front)
-        out.v_ambient = front.ambient
-        out.v_directional_terms_front, out.v_point_terms_front = front.directional, front.point
-        out.v_directional_terms_back, out.v_point_terms_back = back.directional, back.point
-        out.v_color_front = front.shade(v_world_position, v_world_normal)
-        out.v_color_back = (back.shade(v_world_position, -v_world_normal)
-                            if material.two_sided else out.v_color_front)
+        stacked_front, stacked_back = stacked_parts(front), stacked_parts(back)
+        out.v_ambient = stacked_front.ambient
+        out.v_directional_terms_front, out.v_point_terms_front = stacked_front.directional, stacked_front.point
+        out.v_directional_terms_back, out.v_point_terms_back = stacked_back.directional, stacked_back.point
+        colors = [side_colors(front, back, v_world_position, v_world_normal, material.two_sided, part)
+                  for part in range(len(front))]
+        out.v_color_front, out.v_color_back = colors[OTHER_PART]
+        if modulate:
+            out.v_modulated_ambient = front[MODULATED_PART].ambient
+            out.v_modulated_front, out.v_modulated_back = colors[MODULATED_PART]
     return out

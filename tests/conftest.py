@@ -9,8 +9,9 @@ Why an option rather than `-m "not slow and not window"` in addopts: undoing an 
 `-m` takes another `-m` with an expression that selects everything, which nobody guesses,
 and a user's own `-m` would silently replace ours; `--all` says what it does.
 
-The built-in scenes made for the ray tracer (RAYTRACE_SCENES) are rasterised by the tests
-that take every built-in scene only in the full run: `raster_scene_params(names)` marks them.
+The built-in scenes made for the ray tracer (RAYTRACE_SCENES) and for textures
+(TEXTURE_SCENES) are rasterised by the tests that take every built-in scene only in the full
+run: `raster_scene_params(names)` marks them.
 
 Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
 `on_x_display` (Xvfb), `cli` (the command line in a new process), `gpu_stand_in` (the command
@@ -100,15 +101,23 @@ RAYTRACE_SCENES = frozenset({"classic", "cornell_box", "mesh_shadow", "tir_bubbl
 # run like the others; their spheres and floors are analytic shapes so that the ray tracer's
 # shadow rays, their truth, see exact surfaces (tests/test_scene_shapes.py).
 SHADOW_SCENES = frozenset({"shadow_plane", "shadow_room", "shadow_curved"})
+# The built-in scenes made for textures (issue 17). The rasteriser's tests over every built-in
+# scene hold them in the full run, as the ray tracer's: in the default run they would add
+# about 5 s (goldens, determinism, specialisation: measured at load average 2, 2026-12-02),
+# where tests/test_texture_raster.py and tests/test_shadow_shading.py hold the textured path,
+# GPU against the twin, on small cases in 2 s. Their own bar (every filter, both contexts,
+# 320 x 240) is tests/test_texture_raster.py's full run.
+TEXTURE_SCENES = frozenset({"textured_mesh", "checker_horizon", "globe"})
 
 
 def raster_scene_params(names, ids=None):
     """pytest.param for each case of a rasteriser test over built-in scenes: `names` are scene
-    names, or tuples whose first item is one; a ray-tracing scene's case is marked slow."""
+    names, or tuples whose first item is one; a ray-tracing or texture scene's case is marked
+    slow."""
     params = []
     for index, case in enumerate(names):
         name = case[0] if isinstance(case, tuple) else case
-        marks = [pytest.mark.slow] if name in RAYTRACE_SCENES else []
+        marks = [pytest.mark.slow] if name in RAYTRACE_SCENES | TEXTURE_SCENES else []
         params.append(pytest.param(*(case if isinstance(case, tuple) else (case,)), marks=marks,
                                    id=None if ids is None else ids[index]))
     return params

@@ -14,7 +14,8 @@ name a program lacks. So the `in`, `out` and `uniform` declarations of each GLSL
   fields of either; the vertex attributes and matrices are the parameters of
   reference.vertex.shade_vertices; the material and light uniforms are the fields of
   reference.lighting.MaterialUniforms and Lights (a light array in GLSL is an array of one
-  row per light in the twin);
+  row per light in the twin); the material lookup's (texture.glsl) are the parameters of
+  reference.texture.lookup_coordinates;
 - the GPU path: every declared uniform is uploaded by renderer/gpu/pipeline.py and every
   uploaded name is declared; the vertex attributes are the ones GpuRenderer binds.
 
@@ -25,7 +26,7 @@ from __future__ import annotations
 
 import inspect
 import re
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import moderngl
 import numpy as np
@@ -34,20 +35,24 @@ import pytest
 from reference.fragment import shade_fragments
 from reference.geometry import TriangleOutputs, shade_triangles
 from reference.lighting import Lights, MaterialUniforms
+from reference.texture import lookup_coordinates
 from reference.vertex import VertexOutputs, shade_vertices
 from renderer.core.builtin import builtin_scenes
 from renderer.core.resources import glsl_dir
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import load_scene
 from renderer.core.shadows import plan_shadows, shadow_layout
+from renderer.core.textures import MaterialTexture, checkerboard
 from renderer.core.uniforms import SHADOW_PASS_UNIFORMS, UNIFORM_TYPES
 from renderer.gpu import GpuRenderer
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS
 
 STAGES = ("vertex.glsl", "geometry.glsl", "fragment.glsl")      # in pipeline order
 LIGHTING = "lighting.glsl"
+TEXTURE = "texture.glsl"                 # the material lookup (TEXTURED)
 SHADOW_FILES = ("shadow/lookup.glsl", "shadow/depth.vert")   # the lookup and the depth pass
-# A scene with both kinds of light, specular materials and all three shading modes.
+# A scene with both kinds of light, specular materials and all three shading modes (the GPU
+# path's checks give one of its materials a texture: every_feature_scene).
 EVERY_FEATURE_SCENE = "hierarchy"
 # Uniforms of the GPU path alone, and why the twin has no field for them.
 GPU_ONLY_UNIFORMS = {
@@ -57,7 +62,18 @@ GPU_ONLY_UNIFORMS = {
     "u_two_sided": "all-features build: two-sidedness at run time; the twin reads "
                    "Material.two_sided",
     "u_shadow_maps": "the maps' texture unit; the twin reads its array of layers",
+    "u_texture": "the material texture's unit; the twin reads the MaterialTexture",
 }
+
+
+def every_feature_scene():
+    """EVERY_FEATURE_SCENE with its first object's material textured (its primitives have UVs)."""
+    scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
+    first = scene.objects[0]
+    texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2),
+                              uv_offset=(0.25, 0.0))
+    return replace(scene, objects=[replace(first, material=replace(first.material, texture=texture)),
+                                   *scene.objects[1:]])
 
 
 # -- what the GPU path uses (change here if renderer/gpu moves them) ------------------------------
@@ -66,7 +82,7 @@ def uploaded_uniform_names() -> set[str]:
     """Every uniform name the GPU path uploads for a scene with every feature, in the
     specialised and in the all-features build."""
     from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
-    scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
+    scene = every_feature_scene()
     matrices = scene.matrices(64, 48)
     shadows = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48)).uniforms
     names = set(frame_uniform_values(scene, matrices, shadows=shadows))
@@ -88,7 +104,7 @@ def bound_attribute_names(ctx) -> set[str]:
             bound.update(names)
         return original(self, program, content, *args, **kwargs)
 
-    scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
+    scene = every_feature_scene()
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(moderngl.Context, "vertex_array", recording)
         for mode in SHADING_MODES:
@@ -179,7 +195,7 @@ def declarations(file: str, text: str) -> list[Declaration]:
 
 def read_glsl() -> dict[str, str]:
     return {name: (glsl_dir() / name).read_text(encoding="utf-8")
-            for name in (*STAGES, LIGHTING, *SHADOW_FILES)}
+            for name in (*STAGES, LIGHTING, TEXTURE, *SHADOW_FILES)}
 
 
 def parse(sources: dict[str, str]) -> dict[str, list[Declaration]]:
@@ -283,7 +299,8 @@ def varyings_not_in_the_twin(parsed) -> list[str]:
 def uniforms_not_in_the_twin(parsed) -> list[str]:
     """vertex.glsl's own uniforms are parameters of shade_vertices; lighting.glsl's are
     fields of Lights or MaterialUniforms, or u_eye (a parameter of every stage of the twin
-    that lights); fragment.glsl's are the GPU path's alone (GPU_ONLY_UNIFORMS)."""
+    that lights); fragment.glsl's are the GPU path's alone (GPU_ONLY_UNIFORMS); texture.glsl's
+    are parameters of lookup_coordinates, but its texture unit."""
     vertex_parameters = parameters(shade_vertices)
     every_lighting_stage = parameters(shade_vertices) & parameters(shade_triangles) & \
         parameters(shade_fragments)                             # u_eye (and lights)
@@ -297,6 +314,9 @@ def uniforms_not_in_the_twin(parsed) -> list[str]:
     problems += names_missing_from(
         of(parsed["fragment.glsl"], "uniform").values(), set(GPU_ONLY_UNIFORMS),
         "GPU_ONLY_UNIFORMS of this test")
+    problems += names_missing_from(
+        of(parsed[TEXTURE], "uniform").values(), parameters(lookup_coordinates) | set(GPU_ONLY_UNIFORMS),
+        "the parameters of reference.texture.lookup_coordinates or GPU_ONLY_UNIFORMS")
     scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
     plan = plan_shadows(scene, scene.matrices(64, 48), shadow_layout(scene, 64, 48))
     problems += names_missing_from(

@@ -3,8 +3,9 @@ receivers keep the lighting equation's terms apart (the ambient term, each light
 face or per vertex) and the fragment stage weighs each light's term by its visibility at the
 fragment, as Phong does (glsl/vertex.glsl, glsl/geometry.glsl, glsl/fragment.glsl and their
 twins). Hand-checked on the floor under a sphere (tests/test_shadow_gpu.py's scene), then GPU
-against the reference; and the varying budget that refuses a receiver with too many lights
-(renderer/core/gl_rules.py, too_many_varyings)."""
+against the reference (textured receivers too, their terms in two parts); and the varying
+budget that refuses a receiver with too many lights (renderer/core/gl_rules.py,
+too_many_varyings)."""
 
 from dataclasses import replace
 
@@ -17,6 +18,7 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.gl_rules import check_light_count, light_term_slots, too_many_varyings
 from renderer.core.scene import DirectionalLight, PointLight
 from renderer.core.shadow_settings import Shadow
+from renderer.core.textures import MaterialTexture, checkerboard
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS
@@ -27,12 +29,20 @@ from test_shadow_gpu import (FAR_FROM_IT, LIGHT, SPHERE_CENTRE, UNDER_SPHERE, H,
 POINT_LIGHT = PointLight((0.3, 3.0, 0.2), LIGHT.intensity, shadow=Shadow(resolution=128))
 
 
-def shaded(shading: str, two_sided: bool = False, point: bool = False, ball_too: bool = False):
+# A texture for textured receivers: 4 x 4 checks of two colours, modulating k_a and k_d.
+CHECKS = MaterialTexture(checkerboard(4, ((1.0, 0.9, 0.6), (0.4, 0.5, 0.9)), 16), uv_scale=(0.5, 0.5),
+                         modulate=("ka", "kd"))
+
+
+def shaded(shading: str, two_sided: bool = False, point: bool = False, ball_too: bool = False,
+           textured: bool = False):
     """The sphere over the floor, the floor (and the ball: `ball_too`) in `shading`; under
-    test_shadow_gpu's directional light, or a point light above the sphere (`point`)."""
+    test_shadow_gpu's directional light, or a point light above the sphere (`point`);
+    `textured`: with CHECKS."""
     scene = sphere_over_plane()
     for obj in scene.objects[:2 if ball_too else 1]:
-        obj.material = replace(obj.material, shading=shading, two_sided=two_sided)
+        obj.material = replace(obj.material, shading=shading, two_sided=two_sided,
+                               texture=CHECKS if textured else None)
     if point:
         scene.directional_lights, scene.point_lights = [], [POINT_LIGHT]
     return scene
@@ -102,6 +112,24 @@ def test_gpu_matches_reference(gl_contexts, shading, two_sided, context_kind, po
     assert (frame.rgba8[..., :3] == floor_colour(lit=False)).all(axis=-1).any()
 
 
+@pytest.mark.parametrize("shading, two_sided, point", [
+    pytest.param("gouraud", False, False, id="gouraud-one-sided-directional"),
+    pytest.param("flat", True, False, id="flat-two-sided-directional", marks=pytest.mark.slow),
+    pytest.param("gouraud", True, True, id="gouraud-two-sided-point", marks=pytest.mark.slow),
+    pytest.param("phong", False, True, id="phong-one-sided-point", marks=pytest.mark.slow)])
+def test_textured_receivers_match_the_reference(gl_contexts, shading, two_sided, point):
+    """Textured floor and ball: each light's term in two parts (the texture's coefficients and
+    the others), added up at the fragment's texel before its visibility weighs it."""
+    scene = shaded(shading, two_sided, point, ball_too=True, textured=True)
+    with GpuRenderer(scene, W, H, context=gl_contexts["egl"]) as gpu:
+        frame = gpu.render(depth=True)
+        assert all(variant.texture and variant.shadows for variant in gpu.programs)
+    expected = reference.render(scene, W, H, subpixel_bits=gpu.subpixel_bits)
+    result = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,
+                            reference_tie=expected.rgba8_tie)
+    assert PIPELINE_TOLERANCE.passes(result), (PIPELINE_TOLERANCE.failures(result), result.as_dict())
+
+
 # -- the varying budget -------------------------------------------------------------------------
 
 def test_the_varying_budget_by_hand():
@@ -120,6 +148,22 @@ def test_the_varying_budget_by_hand():
     assert message.endswith("set `shadows = false` on the lights, `receives_shadows = false` on "
                             "the object, or use phong shading")
     assert "limit is 32 (GL's guaranteed 128 fragment input" in too_many_varyings("flat", 15, 0, True)
+
+
+def test_the_varying_budget_of_a_textured_receiver_by_hand():
+    """Each term in two parts, and the UV: (1 + lights) x sides x 2 + 3 slots."""
+    assert light_term_slots(5, 0, False, textured=True) == 15
+    assert light_term_slots(2, 0, True, textured=True) == 15
+    assert light_term_slots(13, 0, False, textured=True) == 31
+    assert light_term_slots(6, 0, True, textured=True) == 31
+    assert too_many_varyings("gouraud", 5, 0, False, textured=True) is None
+    assert too_many_varyings("flat", 6, 0, True, textured=True) is None
+    assert too_many_varyings("gouraud", 6, 0, False) is None          # untextured: 9 slots
+    message = too_many_varyings("gouraud", 6, 0, False, textured=True)
+    assert message.startswith("too many lights for a textured gouraud object that receives "
+                              "shadows: with 6 directional and 0 point lights its varyings take "
+                              "17 vec4 slots ((1 + 6) terms x 1 side x 2 parts")
+    assert "limit is 32" in too_many_varyings("flat", 7, 0, True, textured=True)
 
 
 def test_a_receiver_over_the_budget_is_refused_before_drawing(gl_contexts):
@@ -141,13 +185,15 @@ def test_a_receiver_over_the_budget_is_refused_before_drawing(gl_contexts):
 
 
 @pytest.mark.slow                       # a map per light, 3 programs on 2 contexts
-@pytest.mark.parametrize("shading, two_sided, lights", [("gouraud", False, 13), ("gouraud", True, 6),
-                                                        ("flat", True, 14)])
-def test_receivers_at_the_budget_compile_and_render(gl_contexts, shading, two_sided, lights):
-    scene = shaded(shading, two_sided, ball_too=True)
+@pytest.mark.parametrize("shading, two_sided, lights, textured", [
+    ("gouraud", False, 13, False), ("gouraud", True, 6, False), ("flat", True, 14, False),
+    ("gouraud", False, 5, True), ("flat", True, 6, True)])
+def test_receivers_at_the_budget_compile_and_render(gl_contexts, shading, two_sided, lights, textured):
+    scene = shaded(shading, two_sided, ball_too=True, textured=textured)
     scene.directional_lights = [DirectionalLight((0.1 * i, -1.0, 0.2), (0.05, 0.05, 0.05),
                                                  Shadow(resolution=64)) for i in range(lights)]
-    assert light_term_slots(lights, 0, two_sided) == (16 if shading == "gouraud" else 32)
+    # At the limit (a textured receiver's count is odd: one slot short of it)
+    assert light_term_slots(lights, 0, two_sided, textured) == (16 if shading == "gouraud" else 32) - int(textured)
     builds = (True, False) if lights <= ALL_FEATURES_LIGHTS else (True,)      # its arrays' size
     for ctx in gl_contexts.values():
         for specialise in builds:

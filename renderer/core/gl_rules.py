@@ -229,7 +229,9 @@ def too_many_lights(directional: int, point: int, directional_shadows: int = 0,
 # a vec3 varying each, which takes a whole vec4 slot. GL 4.5 guarantees 64 vertex output
 # components (16 slots: Gouraud's limit) and 128 geometry output and fragment input
 # components (32 slots: flat's, whose vertex stage hands on the position alone); llvmpipe
-# allows 32 everywhere. As with the uniforms, the guarantee is the rule.
+# allows 32 everywhere. As with the uniforms, the guarantee is the rule. A textured material
+# hands each term on in two parts (the coefficients its texel modulates and the others,
+# glsl/lighting.glsl's TERM_PARTS) and its UV beside them.
 
 GL_MIN_VERTEX_OUTPUT_COMPONENTS = 64     # GL 4.5's minimum of GL_MAX_VERTEX_OUTPUT_COMPONENTS
 GL_MIN_FRAGMENT_INPUT_COMPONENTS = 128   # ... of GL_MAX_{GEOMETRY_OUTPUT,FRAGMENT_INPUT}_COMPONENTS
@@ -237,27 +239,34 @@ VARYING_SLOT_LIMITS = {"gouraud": GL_MIN_VERTEX_OUTPUT_COMPONENTS // 4,
                        "flat": GL_MIN_FRAGMENT_INPUT_COMPONENTS // 4}
 
 
-def light_term_slots(directional: int, point: int, two_sided: bool) -> int:
+def light_term_slots(directional: int, point: int, two_sided: bool, textured: bool = False) -> int:
     """vec4 slots the varyings of a flat or Gouraud receiver of shadows take: the ambient term
-    and a term per light, per side, and the position and normal:
-    (1 + directional + point) (2 if two-sided else 1) + 2."""
-    return (1 + directional + point) * (2 if two_sided else 1) + 2
+    and a term per light, per side, per part when textured, and the position and normal (and
+    the UV when textured): (1 + directional + point) (2 if two-sided else 1) (2 if textured
+    else 1) + 2 (+ 1 if textured)."""
+    parts = 2 if textured else 1
+    return (1 + directional + point) * (2 if two_sided else 1) * parts + 2 + (parts - 1)
 
 
-def too_many_varyings(shading: str, directional: int, point: int, two_sided: bool) -> str | None:
-    """Why a `shading` receiver of shadows cannot be drawn with these lights, or None."""
+def too_many_varyings(shading: str, directional: int, point: int, two_sided: bool,
+                      textured: bool = False) -> str | None:
+    """Why a `shading` receiver of shadows (of a textured material, when `textured`) cannot be
+    drawn with these lights, or None."""
     limit = VARYING_SLOT_LIMITS.get(shading)
-    used = light_term_slots(directional, point, two_sided)
+    used = light_term_slots(directional, point, two_sided, textured)
     if limit is None or used <= limit:
         return None
     sides = 2 if two_sided else 1
     stage = "vertex output" if shading == "gouraud" else "fragment input"
-    return (f"too many lights for a {'two-sided ' if two_sided else ''}{shading} object that "
+    kind = f"{'two-sided ' if two_sided else ''}{'textured ' if textured else ''}{shading}"
+    parts = " x 2 parts (modulated by the texture and not)" if textured else ""
+    uv = ", UV" if textured else ""
+    return (f"too many lights for a {kind} object that "
             f"receives shadows: with {directional} directional and {point} point lights its "
             f"varyings take {used} vec4 slots ((1 + {directional + point}) terms x {sides} "
-            f"side{'s' if two_sided else ''} + position and normal), the limit is {limit} (GL's "
-            f"guaranteed {limit * 4} {stage} components); set `shadows = false` on the lights, "
-            f"`receives_shadows = false` on the object, or use phong shading")
+            f"side{'s' if two_sided else ''}{parts} + position{uv} and normal), the limit is "
+            f"{limit} (GL's guaranteed {limit * 4} {stage} components); set `shadows = false` "
+            f"on the lights, `receives_shadows = false` on the object, or use phong shading")
 
 
 def scene_light_problem(scene) -> str | None:
@@ -278,7 +287,8 @@ def scene_varying_problem(scene) -> tuple[int, str] | None:
         return None
     for index, obj in enumerate(scene.objects):
         problem = obj.receives_shadows and too_many_varyings(
-            obj.material.shading, len(directional), len(point), obj.material.two_sided)
+            obj.material.shading, len(directional), len(point), obj.material.two_sided,
+            obj.material.textured)
         if problem:
             return index, problem
     return None
@@ -296,3 +306,85 @@ def check_light_count(scene) -> None:
         problem = f"object {scene.objects[index].name!r}: {reason}"
     if problem:
         raise SceneError(problem, file=getattr(scene, "source", "") or None)
+
+
+# --- texture sampling ------------------------------------------------------------------------
+#
+# How GL's sampler is set for each of renderer/core/textures.py's wraps and filters (the GPU
+# path, renderer/gpu/textures.py), and the numbers llvmpipe's sampler (Mesa's gallivm,
+# lp_bld_sample*.c) computes with, which the twin (reference/sampler.py) follows:
+# /work/notes/llvmpipe-texture-sampler.md, checked on this machine in tests/test_sampler_gl.py.
+
+GL_NEAREST, GL_LINEAR = 0x2600, 0x2601
+GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR_MIPMAP_LINEAR = 0x2701, 0x2703
+GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT = 0x2901, 0x812F, 0x8370
+GL_TEXTURE_WRAP_S, GL_TEXTURE_WRAP_T = 0x2802, 0x2803
+GL_TEXTURE_MAG_FILTER, GL_TEXTURE_MIN_FILTER = 0x2800, 0x2801
+GL_TEXTURE_BASE_LEVEL, GL_TEXTURE_MAX_LEVEL = 0x813C, 0x813D
+GL_TEXTURE_MAX_ANISOTROPY = 0x84FE
+
+TEXTURE_WRAP_MODES = {"repeat": GL_REPEAT, "clamp": GL_CLAMP_TO_EDGE, "mirror": GL_MIRRORED_REPEAT}
+# (min, mag) filter of each filter name. Min and mag image filters are equal in every pair:
+# llvmpipe then never switches filters by the sign of the LOD (with them unequal it would
+# decide for 8 pixels by the first quad's LOD, a FIXME in lp_bld_sample_aos.c).
+TEXTURE_FILTER_MODES = {
+    "nearest": (GL_NEAREST, GL_NEAREST),
+    "bilinear": (GL_LINEAR, GL_LINEAR),
+    "mip-nearest": (GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR),
+    "trilinear": (GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR),
+    "anisotropic": (GL_LINEAR_MIPMAP_LINEAR, GL_LINEAR),   # and GL_TEXTURE_MAX_ANISOTROPY
+}
+MAX_TEXTURE_MAX_ANISOTROPY = 16          # GL_MAX_TEXTURE_MAX_ANISOTROPY on llvmpipe
+
+UNORM8_MAX = 255                         # an RGBA8 texel channel c means c / 255
+TEXEL_WEIGHT_BITS = 8                    # llvmpipe's unorm8 filter: bilinear weights in 1/256
+MIP_WEIGHT_BITS = 8                      # ... and the trilinear weight between levels
+
+
+def unorm8_to_float(c: np.ndarray) -> np.ndarray:
+    """An unorm8 texel channel as the sampler returns it: float32(c) * float32(1/255), one
+    float32 product (llvmpipe's lp_build_unsigned_norm_to_float), which is not always the
+    correctly rounded c / 255 (126 of the 256 values are one ulp off it)."""
+    return np.asarray(c).astype(np.float32) * np.float32(1.0 / UNORM8_MAX)
+
+
+def _float32_exponent(x: np.ndarray) -> np.ndarray:
+    """The unbiased exponent field of float32 x (int32): e with x = m 2^e, m in [1, 2);
+    -127 for 0 and denormals, 128 for inf and NaN."""
+    bits = np.asarray(x, dtype=np.float32).view(np.int32)
+    return ((bits >> 23) & 255) - 127
+
+
+def fast_log2(x: np.ndarray) -> np.ndarray:
+    """llvmpipe's log2 for the LOD (lp_build_fast_log2), float32, piecewise linear:
+    x = m 2^e with m in [1, 2) gives (e - 1) + m, one float32 add; exact at powers of two,
+    below log2 x in between by up to 0.086 (0.043 once halved for the LOD)."""
+    x = np.asarray(x, dtype=np.float32)
+    mantissa = ((x.view(np.int32) & 0x7FFFFF) | 0x3F800000).view(np.float32)
+    return (_float32_exponent(x) - 1).astype(np.float32) + mantissa
+
+
+def round_log2_sqrt(x: np.ndarray) -> np.ndarray:
+    """round(log2 sqrt(x)) with halves rounded up, exactly, from float32 x's exponent
+    (llvmpipe's lp_build_ilog2_sqrt, the LOD of the nearest mip filter, x = rho^2):
+    (e + 1) >> 1, int32."""
+    return (_float32_exponent(x) + 1) >> 1
+
+
+# llvmpipe's anisotropic filter (lp_build_sample_aniso) is an elliptical weighted average
+# (Heckbert's EWA) over the texels of one mip level, each texel's weight read from a table
+# of exp(-2 r^2) at r^2 = i / (ANISO_WEIGHT_TABLE_SIZE - 1), i = 0..SIZE-1, the ellipse scaled
+# so that its edge is r^2 = 1. The table is float32 values written to 6 decimals in Mesa's
+# source (aniso_filter_table); `anisotropic_weight_table` makes the same 1024 floats.
+ANISO_WEIGHT_TABLE_SIZE = 1024
+ANISO_WEIGHT_ALPHA = 2.0
+ANISO_WEIGHT_DECIMALS = 6
+
+
+def anisotropic_weight_table() -> np.ndarray:
+    """The EWA weights (float32, ANISO_WEIGHT_TABLE_SIZE): float32 r^2 = i / (SIZE - 1), the
+    float32 exp(-ALPHA r^2), written with 6 decimals and read back as float32, as Mesa's table."""
+    index = np.arange(ANISO_WEIGHT_TABLE_SIZE, dtype=np.float32)
+    r2 = index / np.float32(ANISO_WEIGHT_TABLE_SIZE - 1)
+    weights = np.exp((np.float32(-ANISO_WEIGHT_ALPHA) * r2).astype(np.float64)).astype(np.float32)
+    return np.array([float(f"{float(w):.{ANISO_WEIGHT_DECIMALS}f}") for w in weights], dtype=np.float32)

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from renderer.core.scene import FrameMatrices, Material, ObjectMatrices, Scene, SceneObject
+from renderer.core.textures import MaterialTexture
 
 # name -> GLSL type; "vec3[]" is an array with one row per light of that kind.
 LIGHT_UNIFORMS = {
@@ -42,6 +43,13 @@ OBJECT_UNIFORMS = {
     **MATERIAL_UNIFORMS,
     "u_two_sided": "bool",                  # read by the all-features build only
 }
+# A textured material's lookup (glsl/texture.glsl), in its programs only: the lookup is at
+# uv * u_uv_scale + u_uv_offset; the texture is on the GPU path's MATERIAL_TEXTURE_UNIT.
+TEXTURE_UNIFORMS = {
+    "u_texture": "sampler2D",               # the texture unit (the GPU path's alone)
+    "u_uv_scale": "vec2",                   # MaterialTexture.uv_scale
+    "u_uv_offset": "vec2",                  # MaterialTexture.uv_offset
+}
 # The all-features build (renderer/gpu/shaders.py) reads the light counts at run time.
 LIGHT_COUNT_UNIFORMS = {"u_num_directional_lights": "int", "u_num_point_lights": "int"}
 # The shadow-map lookup (glsl/shadow/lookup.glsl), in programs of objects that receive shadows:
@@ -61,8 +69,8 @@ SHADOW_UNIFORMS = {
 ROWS_PER_LIGHT = {"u_point_shadow_tiles": 6}   # other light arrays: 1
 # The depth pass (glsl/shadow/depth.vert): light clip from object coordinates, per pass and object.
 SHADOW_PASS_UNIFORMS = {"u_clip_from_model": "mat4"}
-UNIFORM_TYPES = (FRAME_UNIFORMS | OBJECT_UNIFORMS | LIGHT_COUNT_UNIFORMS | SHADOW_UNIFORMS
-                 | SHADOW_PASS_UNIFORMS)
+UNIFORM_TYPES = (FRAME_UNIFORMS | OBJECT_UNIFORMS | TEXTURE_UNIFORMS | LIGHT_COUNT_UNIFORMS
+                 | SHADOW_UNIFORMS | SHADOW_PASS_UNIFORMS)
 
 
 def _rows(values) -> np.ndarray:
@@ -98,8 +106,19 @@ def material_uniforms(material: Material) -> dict[str, np.ndarray]:
             "u_n": np.asarray(material.n, dtype=np.float64)}
 
 
+def texture_uniforms(texture: MaterialTexture | None) -> dict[str, np.ndarray]:
+    """A material's texture's UV transform (TEXTURE_UNIFORMS but the texture unit), float64;
+    empty for a material without a texture."""
+    if texture is None:
+        return {}
+    return {"u_uv_scale": np.asarray(texture.uv_scale, dtype=np.float64),
+            "u_uv_offset": np.asarray(texture.uv_offset, dtype=np.float64)}
+
+
 def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.ndarray]:
-    """One object's uniforms (OBJECT_UNIFORMS): its matrices and its material."""
+    """One object's uniforms (OBJECT_UNIFORMS): its matrices and its material, and its
+    material's UV transform when it is textured."""
     return {"u_model": matrices.model, "u_normal_matrix": matrices.normal,
             **material_uniforms(obj.material),
-            "u_two_sided": np.asarray(int(bool(obj.material.two_sided)))}
+            "u_two_sided": np.asarray(int(bool(obj.material.two_sided))),
+            **texture_uniforms(obj.material.texture)}

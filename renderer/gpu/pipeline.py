@@ -15,7 +15,10 @@ first time either way).
 
 Everything GL is made once per renderer: one program per shader variant the scene's materials
 use, one vertex buffer (positions and normals, float32, interleaved), index buffer and vertex
-array per object, and a single-sample framebuffer with an RGBA8 colour buffer and a 32-bit
+array per object (and for an object with a textured material, a buffer of its vertices' UVs,
+float32, the program's in_uv: no other object has one), each texture the materials use, with
+its sampler object (renderer/gpu/textures.py, TextureCache: one upload per texture however
+many materials share it), and a single-sample framebuffer with an RGBA8 colour buffer and a 32-bit
 float depth buffer (DEPTH_COMPONENT32F, so the stored depth is the rasteriser's float z_w with
 no 24-bit rounding; moderngl only makes 24-bit depth, so the storage is re-specified through
 glRenderbufferStorage). An RGBA32F buffer for the unclamped linear colour, and the program
@@ -44,6 +47,11 @@ renderer/core/gl_rules.py: reversed-Z draws with glClipControl ZERO_TO_ONE, dept
 0 and GL_GREATER; every frame sets the clip control either way and a reversed-Z
 frame puts GL's default back, so renderers sharing a context never see each other's.
 
+Textures: a textured material's program (ShaderVariant.texture) samples its texture on
+MATERIAL_TEXTURE_UNIT (renderer/gpu/uniforms.py); each draw binds its texture and sampler
+object there, and the frame unbinds the sampler object after its last draw, so that a context
+shared with other drawing (a viewer) is left with no sampler state of ours.
+
 Uniform values are computed once per update(), as bytes (renderer/gpu/uniforms.py, from the
 layout the reference reads too: renderer/core/uniforms.py), from `Scene.matrices()`
 (camera-relative) and the scene's lights and materials, and `render()` only hands them to GL;
@@ -71,8 +79,9 @@ from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.gpu.shadow_maps import ShadowMaps
+from renderer.gpu.textures import TextureCache
 from renderer.core.transforms import jitter, to_glsl
-from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
+from renderer.gpu.uniforms import MATERIAL_TEXTURE_UNIT, frame_uniform_values, object_uniform_values
 from renderer.core.visibility import visible_objects
 
 GL_DITHER = 0x0BD0
@@ -139,8 +148,10 @@ class _ObjectBuffers:
     mesh: Mesh                             # the mesh uploaded (update() re-uploads a new one)
     vbo: moderngl.Buffer | None            # in_position, in_normal: float32, interleaved
     ibo: moderngl.Buffer | None            # faces, uint32
+    uv_vbo: moderngl.Buffer | None         # in_uv, float32 (a textured material's object only)
     vertex_arrays: dict                    # ShaderVariant -> moderngl.VertexArray
     uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
+    texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
 
 
 @dataclass
@@ -150,6 +161,7 @@ class _Draw:
     enable: int                            # moderngl flags for enable_only
     cull_face: str | None
     uploads: list                          # [(moderngl Uniform, bytes)]
+    texture: tuple | None = None           # (texture, sampler) bound on MATERIAL_TEXTURE_UNIT
 
 
 class GpuRenderer:
@@ -174,6 +186,7 @@ class GpuRenderer:
         self.ctx = make_context(context_kind) if context is None else context
         self._released = False
         self._programs = ProgramCache(self.ctx)
+        self._textures = TextureCache(self.ctx)
         self._objects: list[_ObjectBuffers] = []
         self._renderbuffers: list = []
         self._framebuffers: dict[bool, moderngl.Framebuffer] = {}
@@ -250,7 +263,7 @@ class GpuRenderer:
             if obj.cull not in CULL_FLAGS:
                 raise ValueError(f"object {obj.name!r}: cull must be one of "
                                  f"{', '.join(CULL_FLAGS)}, got {obj.cull!r}")
-            item = _ObjectBuffers(obj, obj.mesh, None, None, {}, {})
+            item = _ObjectBuffers(obj, obj.mesh, None, None, None, {}, {})
             self._objects.append(item)
             self._upload(item)
 
@@ -260,15 +273,17 @@ class GpuRenderer:
             vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
             item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
+            if item.obj.material.texture is not None:
+                item.uv_vbo = self.ctx.buffer(_texture_coordinates(item.obj).tobytes())
 
     @staticmethod
     def _release_buffers(item: _ObjectBuffers) -> None:
         for vao in item.vertex_arrays.values():
             vao.release()
-        for buffer in (item.vbo, item.ibo):
+        for buffer in (item.vbo, item.ibo, item.uv_vbo):
             if buffer is not None:
                 buffer.release()
-        item.vertex_arrays, item.vbo, item.ibo = {}, None, None
+        item.vertex_arrays, item.vbo, item.ibo, item.uv_vbo = {}, None, None, None
 
     def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
         return ShaderVariant.for_material(self.scene, obj.material, linear,
@@ -281,10 +296,12 @@ class GpuRenderer:
         if vao is None:
             program = self._programs.get(variant)
             if program.get("in_normal", None) is not None:
-                content = (item.vbo, "3f 3f", "in_position", "in_normal")
+                content = [(item.vbo, "3f 3f", "in_position", "in_normal")]
             else:                                    # flat: the normal is the face's, not read
-                content = (item.vbo, "3f 3x4", "in_position")
-            vao = self.ctx.vertex_array(program, [content], index_buffer=item.ibo,
+                content = [(item.vbo, "3f 3x4", "in_position")]
+            if program.get("in_uv", None) is not None:   # textured, and the texel is used
+                content.append((item.uv_vbo, "2f", "in_uv"))
+            vao = self.ctx.vertex_array(program, content, index_buffer=item.ibo,
                                         index_element_size=4)
             item.vertex_arrays[variant] = vao
         return vao
@@ -312,6 +329,9 @@ class GpuRenderer:
         self._visible = visible if self.specialise else [True] * len(self._objects)
         for item, object_matrices in zip(self._objects, matrices.objects):
             item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
+            # Uploaded the first time a texture is asked for; a material's new texture then.
+            texture = item.obj.material.texture
+            item.texture = None if texture is None else self._textures.get(texture)
         self._depth_from_window = _depth_conversion(matrices.projection, (self.height, self.width),
                                                     scene.camera.reversed_z)
         self._projection = matrices.projection
@@ -376,7 +396,7 @@ class GpuRenderer:
                        if program.get(name, None) is not None]
             cull = CULL_FLAGS[item.obj.cull]
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
-            plan.append(_Draw(vao, enable, cull, uploads))
+            plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None))
         self._shadowed[linear] = any(variant.shadows for variant in programs)
         for program in programs.values():          # the same for every object: set once here
             for name, data in self._frame_uniforms.items():
@@ -463,10 +483,17 @@ class GpuRenderer:
                     ctx.cull_face = draw.cull_face
                 for uniform, data in draw.uploads:
                     uniform.write(data)
+                if draw.texture is not None:
+                    texture, sampler = draw.texture
+                    texture.use(MATERIAL_TEXTURE_UNIT)
+                    sampler.use(MATERIAL_TEXTURE_UNIT)
                 draw.vertex_array.render(moderngl.TRIANGLES)
             if target is not fbo:
                 ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
         finally:
+            textured = [draw.texture for draw in plan if draw.texture is not None]
+            if textured:                              # unbinds (glBindSampler(unit, 0))
+                textured[-1][1].clear(MATERIAL_TEXTURE_UNIT)
             ctx.wireframe = False
             if mapping is not STANDARD_DEPTH:
                 self._clip_control(STANDARD_DEPTH)
@@ -591,6 +618,7 @@ class GpuRenderer:
                 self._release_buffers(item)
             self._release_targets()
             self._programs.release()
+            self._textures.release()
         finally:
             self._objects, self._framebuffers, self._renderbuffers = [], {}, []
             self._multisample = {}
@@ -606,6 +634,14 @@ class GpuRenderer:
     def __repr__(self) -> str:
         state = "released" if self._released else context_kind(self.ctx)
         return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
+
+
+def _texture_coordinates(obj: SceneObject) -> np.ndarray:
+    """The object's vertex UVs as its textured material's in_uv takes them: float32 (V, 2)."""
+    if obj.mesh.uvs is None:
+        raise ValueError(f"object {obj.name!r}: its material has a texture but its mesh "
+                         f"({obj.mesh.source or 'made in code'}) has no texture coordinates")
+    return np.ascontiguousarray(obj.mesh.uvs, dtype=np.float32)
 
 
 def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:

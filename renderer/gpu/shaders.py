@@ -26,6 +26,7 @@ import moderngl
 
 from renderer.core.resources import glsl_dir
 from renderer.core.shadow_settings import shared_kernel
+from renderer.core.textures import MODULATED
 
 _INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
 _INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
@@ -155,6 +156,14 @@ class ShaderVariant:
     every light with shadows has the same filter (shadow_settings.shared_kernel): its taps'
     loops then have constant bounds; 0 reads each light's from its uniform. It is not in
     `name`: all the programs of a scene have the same.
+
+    `texture` (define TEXTURED, and TEXTURE_KA / TEXTURE_KD / TEXTURE_KS for the coefficients
+    named) is what a textured material's texel modulates, empty for a material without a
+    texture, whose program has no texture code, sampler or UV at all (glsl/texture.glsl). It is
+    a variant in the all-features build too: GL requires a texture behind every sampler a
+    program reads, so a program cannot carry the lookup for materials that have none. Flat and
+    Gouraud light a textured material in two parts (glsl/lighting.glsl), so a receiver of
+    shadows hands each light's term on twice (TERM_PARTS rows a light).
     """
     shading: str                     # "flat", "gouraud" or "phong"
     two_sided: bool = False
@@ -165,12 +174,16 @@ class ShaderVariant:
     all_features: bool = False
     shadows: bool = False            # the shadow-map lookup
     shadow_kernel: int = 0           # every map's filter kernel, compiled in (0: read per light)
+    texture: tuple[str, ...] = ()    # the coefficients the texel modulates ("ka", "kd", "ks")
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
             raise ValueError(f"unknown shading mode {self.shading!r}")
         if self.shadow_kernel and not self.shadows:
             raise ValueError("a shadow kernel is compiled in only with the shadow-map lookup")
+        if not set(self.texture) <= set(MODULATED):
+            raise ValueError(f"a texture modulates some of {MODULATED}, "
+                             f"not {self.texture}")
 
     @property
     def light_terms(self) -> bool:
@@ -179,8 +192,11 @@ class ShaderVariant:
         return self.shadows and self.shading != "phong"
 
     def defines(self) -> dict[str, object]:
-        terms = {"NUM_DIRECTIONAL_TERMS": self.num_directional_lights,
-                 "NUM_POINT_TERMS": self.num_point_lights} if self.light_terms else {}
+        parts = 2 if self.texture else 1           # glsl/lighting.glsl's TERM_PARTS
+        terms = {"NUM_DIRECTIONAL_TERMS": parts * self.num_directional_lights,
+                 "NUM_POINT_TERMS": parts * self.num_point_lights} if self.light_terms else {}
+        terms |= {"TEXTURED": bool(self.texture)} | {
+            f"TEXTURE_{k.upper()}": k in self.texture for k in MODULATED}
         if self.all_features:
             return {
                 f"SHADING_{self.shading.upper()}": True,
@@ -210,6 +226,7 @@ class ShaderVariant:
         """A file-name-safe label, e.g. "phong-two-sided-specular-1dir-2point-shadows"."""
         linear = "-linear" if self.linear_output else ""
         shadows = "-shadows" if self.shadows else ""
+        shadows += "".join(f"-textured-{k}" for k in self.texture)
         if self.all_features:
             terms = (f"-{self.num_directional_lights}dir-{self.num_point_lights}point"
                      if self.light_terms else "")
@@ -230,14 +247,25 @@ class ShaderVariant:
         specialised to what they use, or the all-features build. `shadows`: the object
         receives shadows and the scene's layout has maps."""
         shadows = bool(shadows)
+        texture = modulated_coefficients(material)
         if all_features:
             counts = ((len(scene.directional_lights), len(scene.point_lights))
                       if shadows and material.shading != "phong" else (0, 0))
             return cls(material.shading, False, *counts, linear_output=bool(linear_output),
-                       all_features=True, shadows=shadows)
+                       all_features=True, shadows=shadows, texture=texture)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
                    len(scene.point_lights), bool(linear_output), material.has_specular,
-                   shadows=shadows, shadow_kernel=shared_kernel(scene) if shadows else 0)
+                   shadows=shadows, shadow_kernel=shared_kernel(scene) if shadows else 0,
+                   texture=texture)
+
+
+
+def modulated_coefficients(material) -> tuple[str, ...]:
+    """The coefficients `material`'s texel modulates, in MODULATED's order (ka, kd, ks);
+    empty for a material without a texture."""
+    if material.texture is None:
+        return ()
+    return tuple(k for k in MODULATED if k in material.texture.modulate)
 
 
 STAGES = (("vertex_shader", "vertex.glsl"),

@@ -4,7 +4,8 @@ column-major float32 (transforms.to_glsl, so that GLSL `M * v` is `M @ v`), flag
 int32. A light array of a kind the scene lacks is left out (neither does the shader declare
 it), except in the all-features build, whose arrays have `light_slots` rows, zeros past the
 scene's lights, with the counts as uniforms. The shadow-map lookup's uniforms are the frame's
-ShadowPlan.uniforms (renderer/core/shadows.py), the maps on texture unit SHADOW_MAPS_UNIT.
+ShadowPlan.uniforms (renderer/core/shadows.py), the maps on texture unit SHADOW_MAPS_UNIT; a
+textured material's texture is on MATERIAL_TEXTURE_UNIT.
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms, object_uniforms
 
 SHADOW_MAPS_UNIT = 0                     # the texture unit the shadow maps are bound to
+MATERIAL_TEXTURE_UNIT = 1                # the unit a textured material's texture is bound to
 
 
 def as_bytes(name: str, value) -> bytes:
@@ -23,7 +25,7 @@ def as_bytes(name: str, value) -> bytes:
     kind = UNIFORM_TYPES[name]
     if kind in ("mat3", "mat4", "mat4[]"):
         return to_glsl(value)
-    if kind in ("int", "bool", "sampler2DArrayShadow"):
+    if kind in ("int", "bool", "sampler2DArrayShadow", "sampler2D"):
         return np.asarray(value, dtype=np.int32).tobytes()
     return np.asarray(value, dtype=np.float32).tobytes()
 
@@ -56,8 +58,12 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices, light_slots: int
 
 
 def object_uniform_values(obj: SceneObject, matrices) -> dict[str, bytes]:
-    """One object's uniforms: its model and normal matrices and its material."""
-    return {name: as_bytes(name, value) for name, value in object_uniforms(obj, matrices).items()}
+    """One object's uniforms: its model and normal matrices and its material (a textured
+    one's UV transform and texture unit too)."""
+    values = object_uniforms(obj, matrices)
+    if obj.material.texture is not None:
+        values["u_texture"] = np.asarray(MATERIAL_TEXTURE_UNIT)
+    return {name: as_bytes(name, value) for name, value in values.items()}
 
 
 def uniform_values(scene: Scene, obj: SceneObject, matrices: FrameMatrices,

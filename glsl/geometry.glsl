@@ -57,47 +57,6 @@ flat out vec3 f_modulated_back;
 #endif
 #endif
 
-#ifdef SHADOW_MAPS
-// The face's terms, each light's lit with N and (two-sided) -N, in TERM_PARTS rows a light
-// (lighting.glsl), and the ambient term of each part.
-#if NUM_DIRECTIONAL_TERMS > 0
-vec3 directional_front[NUM_DIRECTIONAL_TERMS];
-#ifdef TWO_SIDED
-vec3 directional_back[NUM_DIRECTIONAL_TERMS];
-#endif
-#endif
-#if NUM_POINT_TERMS > 0
-vec3 point_front[NUM_POINT_TERMS];
-#ifdef TWO_SIDED
-vec3 point_back[NUM_POINT_TERMS];
-#endif
-#endif
-vec3 ambient[TERM_PARTS];
-
-// The `part`'s terms at P (unit normal N, view vector V) into its rows.
-void light_face(vec3 P, vec3 N, vec3 V, int part) {
-    ambient[part] = ambient_term();
-#if NUM_DIRECTIONAL_TERMS > 0
-    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
-        int row = part * DIRECTIONAL_TERM_ROWS + i;
-        directional_front[row] = directional_term(i, N, V);
-#ifdef TWO_SIDED
-        directional_back[row] = directional_term(i, -N, V);
-#endif
-    }
-#endif
-#if NUM_POINT_TERMS > 0
-    for (int i = 0; i < POINT_LIGHTS; ++i) {
-        int row = part * POINT_TERM_ROWS + i;
-        point_front[row] = point_term(i, P, N, V);
-#ifdef TWO_SIDED
-        point_back[row] = point_term(i, P, -N, V);
-#endif
-    }
-#endif
-}
-#endif
-
 void main() {
     vec3 p0 = v_world_position[0];
     vec3 p1 = v_world_position[1];
@@ -105,13 +64,7 @@ void main() {
     vec3 face_normal = normalize_or_zero(cross(p1 - p0, p2 - p0));
     vec3 face_centroid = (p0 + p1 + p2) / 3.0;
 #ifdef SHADOW_MAPS
-    vec3 V = view_vector(face_centroid);
-#ifdef TEXTURED
-    material_part(MODULATED_PART);
-    light_face(face_centroid, face_normal, V, MODULATED_PART);
-    material_part(OTHER_PART);
-#endif
-    light_face(face_centroid, face_normal, V, OTHER_PART);
+    keep_light_terms(face_centroid, face_normal, view_vector(face_centroid));
 #else
 #ifdef TEXTURED
     material_part(MODULATED_PART);
@@ -134,20 +87,20 @@ void main() {
 #ifdef SHADOW_MAPS
         f_world_position = v_world_position[i];
         f_face_normal = face_normal;
-        f_ambient = ambient[OTHER_PART];
+        f_ambient = kept_ambient[OTHER_PART];
 #ifdef TEXTURED
-        f_modulated_ambient = ambient[MODULATED_PART];
+        f_modulated_ambient = kept_ambient[MODULATED_PART];
 #endif
 #if NUM_DIRECTIONAL_TERMS > 0
-        f_directional_terms_front = directional_front;
+        f_directional_terms_front = kept_directional_front;
 #ifdef TWO_SIDED
-        f_directional_terms_back = directional_back;
+        f_directional_terms_back = kept_directional_back;
 #endif
 #endif
 #if NUM_POINT_TERMS > 0
-        f_point_terms_front = point_front;
+        f_point_terms_front = kept_point_front;
 #ifdef TWO_SIDED
-        f_point_terms_back = point_back;
+        f_point_terms_back = kept_point_back;
 #endif
 #endif
 #else

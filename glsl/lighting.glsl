@@ -29,7 +29,7 @@
 //     light's term on in TERM_PARTS rows of its array (NUM_DIRECTIONAL_TERMS = TERM_PARTS x
 //     the lights, renderer/gpu/shaders.py): OTHER_PART's rows first, then MODULATED_PART's.
 // Each light's term is a function of its own (directional_term, point_term), which flat and
-// Gouraud receivers of shadows also call to keep the terms apart (glsl/vertex.glsl).
+// Gouraud receivers of shadows also call to keep the terms apart (keep_light_terms).
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
 #define NUM_DIRECTIONAL_LIGHTS 0
@@ -198,6 +198,58 @@ vec3 point_term_at(int i, vec3 Q, vec3 P, vec3 N, vec3 V) {
 
 vec3 point_term(int i, vec3 P, vec3 N, vec3 V) {
     return point_term_at(i, u_point_position[i], P, N, V);
+}
+#endif
+
+#ifdef NUM_DIRECTIONAL_TERMS
+// Flat and Gouraud receivers of shadows (NUM_DIRECTIONAL_TERMS and NUM_POINT_TERMS defined)
+// keep the terms apart: keep_light_terms(P, N, V) puts the ambient term and each light's term
+// lit with N (and, two-sided, with -N) into these, a row per light and part (TERM_PARTS: a
+// textured material's modulated coefficients and the others, each lit alone), for the stage
+// to hand on (glsl/vertex.glsl, glsl/geometry.glsl).
+vec3 kept_ambient[TERM_PARTS];
+#if NUM_DIRECTIONAL_TERMS > 0
+vec3 kept_directional_front[NUM_DIRECTIONAL_TERMS];
+#ifdef TWO_SIDED
+vec3 kept_directional_back[NUM_DIRECTIONAL_TERMS];
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+vec3 kept_point_front[NUM_POINT_TERMS];
+#ifdef TWO_SIDED
+vec3 kept_point_back[NUM_POINT_TERMS];
+#endif
+#endif
+
+void keep_part(vec3 P, vec3 N, vec3 V, int part) {
+    kept_ambient[part] = ambient_term();
+#if NUM_DIRECTIONAL_TERMS > 0
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
+        int row = part * DIRECTIONAL_TERM_ROWS + i;
+        kept_directional_front[row] = directional_term(i, N, V);
+#ifdef TWO_SIDED
+        kept_directional_back[row] = directional_term(i, -N, V);
+#endif
+    }
+#endif
+#if NUM_POINT_TERMS > 0
+    for (int i = 0; i < POINT_LIGHTS; ++i) {
+        int row = part * POINT_TERM_ROWS + i;
+        kept_point_front[row] = point_term(i, P, N, V);
+#ifdef TWO_SIDED
+        kept_point_back[row] = point_term(i, P, -N, V);
+#endif
+    }
+#endif
+}
+
+void keep_light_terms(vec3 P, vec3 N, vec3 V) {
+#ifdef TEXTURED
+    material_part(MODULATED_PART);
+    keep_part(P, N, V, MODULATED_PART);
+    material_part(OTHER_PART);
+#endif
+    keep_part(P, N, V, OTHER_PART);
 }
 #endif
 

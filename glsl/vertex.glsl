@@ -70,31 +70,6 @@ out vec3 v_world_normal;
 #error "define one of SHADING_FLAT, SHADING_GOURAUD, SHADING_PHONG"
 #endif
 
-#if defined(SHADING_GOURAUD) && defined(SHADOW_MAPS)
-// Each light's term at P (unit normal N, view vector V), lit with N and (two-sided) -N, into
-// its `part`'s rows of the term arrays (lighting.glsl, TERM_PARTS).
-void hand_on_light_terms(vec3 P, vec3 N, vec3 V, int part) {
-#if NUM_DIRECTIONAL_TERMS > 0
-    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
-        int row = part * DIRECTIONAL_TERM_ROWS + i;
-        v_directional_terms_front[row] = directional_term(i, N, V);
-#ifdef TWO_SIDED
-        v_directional_terms_back[row] = directional_term(i, -N, V);
-#endif
-    }
-#endif
-#if NUM_POINT_TERMS > 0
-    for (int i = 0; i < POINT_LIGHTS; ++i) {
-        int row = part * POINT_TERM_ROWS + i;
-        v_point_terms_front[row] = point_term(i, P, N, V);
-#ifdef TWO_SIDED
-        v_point_terms_back[row] = point_term(i, P, -N, V);
-#endif
-    }
-#endif
-}
-#endif
-
 void main() {
     vec4 world_position = u_model * vec4(in_position, 1.0);
     gl_Position = u_projection * (u_view * world_position);        // p_clip = P V M p
@@ -108,15 +83,23 @@ void main() {
 #if defined(SHADING_GOURAUD) && defined(SHADOW_MAPS)
     v_world_position = world_position.xyz;
     v_world_normal = world_normal;
-    vec3 V = view_vector(world_position.xyz);
+    keep_light_terms(world_position.xyz, world_normal, view_vector(world_position.xyz));
+    v_ambient = kept_ambient[OTHER_PART];
 #ifdef TEXTURED
-    material_part(MODULATED_PART);
-    v_modulated_ambient = ambient_term();
-    hand_on_light_terms(world_position.xyz, world_normal, V, MODULATED_PART);
-    material_part(OTHER_PART);
+    v_modulated_ambient = kept_ambient[MODULATED_PART];
 #endif
-    v_ambient = ambient_term();
-    hand_on_light_terms(world_position.xyz, world_normal, V, OTHER_PART);
+#if NUM_DIRECTIONAL_TERMS > 0
+    v_directional_terms_front = kept_directional_front;
+#ifdef TWO_SIDED
+    v_directional_terms_back = kept_directional_back;
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+    v_point_terms_front = kept_point_front;
+#ifdef TWO_SIDED
+    v_point_terms_back = kept_point_back;
+#endif
+#endif
 #elif defined(SHADING_GOURAUD)
 #ifdef TEXTURED
     material_part(MODULATED_PART);

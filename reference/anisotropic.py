@@ -35,6 +35,8 @@ _TABLE = anisotropic_weight_table()
 _LAST_ENTRY = len(_TABLE) - 1
 SCAN_BUDGET = 1 << 20     # box texels (fragments x largest rows x largest columns) scanned at
                           # once: fragments go in order of box size, a group closes at this
+LARGEST_BOX = 1 << 26     # texels one fragment's box may have (llvmpipe scans any box; the
+                          # twin refuses rather than fill memory: 8192 x 8192 texels)
 
 
 def anisotropic_level(texture, derivatives, lod=None):
@@ -71,7 +73,8 @@ def sample_anisotropic(texture, sampler, u, v, *, derivatives=None,
     for chosen in _groups(ellipse):
         colour[chosen], weight_sum[chosen] = _scan(ellipse.part(chosen), store, level[chosen], pots,
                                                    sampler.wrap)
-    colour = (colour / weight_sum[:, None]).astype(f32)
+    with np.errstate(invalid="ignore", divide="ignore"):      # 0 / 0: the fallback below
+        colour = (colour / weight_sum[:, None]).astype(f32)
     empty = weight_sum == 0
     if empty.any():
         colour[empty] = float_level(store, level[empty], u[empty], v[empty], "linear", pots, sampler.wrap)
@@ -82,6 +85,9 @@ def _groups(ellipse):
     """Fragment indices in groups whose scan (count x largest rows x largest columns) stays
     within SCAN_BUDGET (a larger box goes alone), in order of box size."""
     rows, columns = ellipse.v1 - ellipse.v0 + 1, ellipse.u1 - ellipse.u0 + 1
+    if (rows * columns).max(initial=0) > LARGEST_BOX:
+        raise ValueError(f"an anisotropic lookup's ellipse spans {int((rows * columns).max())} texels; "
+                         f"the twin scans at most {LARGEST_BOX}")
     order = np.argsort(rows * columns, kind="stable")
     start = 0
     while start < len(order):
@@ -101,6 +107,10 @@ class _Ellipse:
         if _parts is not None:
             self.__dict__.update(_parts)
             return
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):   # inf, NaN as llvmpipe's
+            self._compute(texture, derivatives, level, u, v)
+
+    def _compute(self, texture, derivatives, level, u, v):
         scaling = (f32(1) / (np.int64(1) << level).astype(f32)).astype(f32)
         width, height = f32(texture.width), f32(texture.height)
         ux = (derivatives.dudx * width).astype(f32) * scaling
@@ -112,10 +122,9 @@ class _Ellipse:
         c = (ux * ux + uy * uy) + f32(1)
         f = a * c - (b * b) / f32(4)
         d = -(b * b) + (a * c) * f32(4)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            box_u = (f32(2) / d) * np.sqrt((d * c) * f)
-            box_v = (f32(2) / d) * np.sqrt((a * d) * f)
-            scale = f32(_LAST_ENTRY) / f
+        box_u = (f32(2) / d) * np.sqrt((d * c) * f)
+        box_v = (f32(2) / d) * np.sqrt((a * d) * f)
+        scale = f32(_LAST_ENTRY) / f
         self.a, self.b, self.c = a * scale, b * scale, c * scale
         self.tex_u = u * (width * scaling) + f32(-0.5)
         self.tex_v = v * (height * scaling) + f32(-0.5)

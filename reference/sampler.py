@@ -8,7 +8,8 @@ Constants and the LOD's log2 rules are renderer/core/gl_rules.py's; one level's 
 filters are reference/texels.py's, the anisotropic filter reference/anisotropic.py's.
 
 Coordinates are GL's: u along a level's columns, v from its bottom row. Every input is taken
-as float32 and every step rounds as llvmpipe's float32 code does.
+as float32 (denormals as 0, as llvmpipe's flush-to-zero mode takes them) and every step
+rounds as llvmpipe's float32 code does.
 
 - Level of detail (`select_levels`): one per 2x2 quad from the quad's differences
   (`QuadDerivatives`, taken at `quad_reference`'s pixels), rho^2 = max(|d/dx|^2, |d/dy|^2) in
@@ -29,7 +30,7 @@ import numpy as np
 
 from reference.anisotropic import sample_anisotropic
 from reference.texels import (base_level_pots, cvt_round, cvt_trunc, fixed_level, float_lerp, float_level,
-                              lerp8, texel_levels)
+                              flush_denormals, lerp8, texel_levels)
 from renderer.core.gl_rules import MIP_WEIGHT_BITS, fast_log2, round_log2_sqrt, unorm8_to_float
 
 f32 = np.float32
@@ -124,8 +125,13 @@ def sample(texture, sampler, u, v, *, derivatives: QuadDerivatives | None = None
     """The texel colour (N, 4) float32 that texture() (with `derivatives`) or textureLod (with
     `lod`, a scalar or (N,)) returns at (u, v) (N,). Mipmapped samplers need exactly one of
     them; nearest and bilinear read level 0 and ignore both."""
-    u = np.atleast_1d(np.asarray(u, dtype=f32)).ravel()
-    v = np.atleast_1d(np.asarray(v, dtype=f32)).ravel()
+    u = flush_denormals(np.atleast_1d(np.asarray(u, dtype=f32)).ravel())
+    v = flush_denormals(np.atleast_1d(np.asarray(v, dtype=f32)).ravel())
+    if derivatives is not None:
+        derivatives = QuadDerivatives(*(flush_denormals(d) for d in (derivatives.dudx, derivatives.dudy,
+                                                                      derivatives.dvdx, derivatives.dvdy)))
+    if lod is not None:
+        lod = flush_denormals(lod)
     if sampler.filter == "anisotropic":
         return sample_anisotropic(texture, sampler, u, v, derivatives=derivatives, lod=lod)
     if sampler.mipmapped:

@@ -33,6 +33,14 @@ BELOW_ONE = np.nextafter(f32(1), f32(0))    # the largest float32 below 1 (fract
 
 # --------------------------------------------------------------------------- float32 rules
 
+def flush_denormals(x):
+    """x (float32) with denormals made 0: llvmpipe's shaders run with the CPU's denormals-are-
+    zero and flush-to-zero modes, so a denormal coordinate samples as 0 (u = -1e-45 with NPOT
+    repeat reads texel 0, not the last texel)."""
+    x = np.asarray(x, dtype=f32)
+    return np.where(np.abs(x) < np.finfo(f32).tiny, f32(0), x)
+
+
 def cvt_round(x):
     """float32 -> int32 rounded to nearest, ties to even (cvtps2dq); NaN and |x| >= 2^31 give
     INT32_MIN, as the instruction does. int64 out, for exact arithmetic after."""

@@ -126,6 +126,13 @@ DEFINITIONS = [
     ("snapping", "renderer/core/gl_rules.py", r"np\.rint\(coordinate"),
     ("fill rule", "renderer/core/gl_rules.py", r"\(dy == 0\) & \(dx > 0\)|edge_value >= 0, edge_value > 0"),
     ("unorm8", "renderer/core/gl_rules.py", r"255\.0 \+ 0\.5"),
+    ("texture filter and wrap enums", "renderer/core/gl_rules.py",
+     r"\b0x(2701|2703|8370|84FE)\b|\b(9985|9987|33648|34046)\b"),
+    ("unorm8 texel to float", "renderer/core/gl_rules.py", r"(float32|f32)\(1 ?/ ?255(\.0)?\)"),
+    ("texel weight bits", "renderer/core/gl_rules.py", r"\b(TEXEL|MIP)_WEIGHT_BITS = \d"),
+    ("fast log2", "renderer/core/gl_rules.py", r"\b(0x3[fF]800000|1065353216)\b"),
+    ("max anisotropy", "renderer/core/gl_rules.py", r"ANISOTROPY_RANGE = \(2, 16\)|MAX_ANISOTROPY = \d"),
+    ("EWA weight table", "renderer/core/gl_rules.py", r"\bWEIGHT_LUT_SIZE\b|WEIGHT_TABLE_SIZE = \d"),
     ("pipeline tolerance", "renderer/checks/tolerance.py",
      r"\b(RAW_MISMATCH_LIMIT|DEPTH_REL_LIMIT) = |DEFAULT_(THRESHOLD|DEVIATION) = \d"),
 ]
@@ -174,10 +181,14 @@ def test_the_search_finds_the_literals_it_replaced():
                                     "ctx.depth_func = '>' if reversed_z else '<'\n",
         "reference/output.py": "u = np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5)\n",
         "tests/test_x.py": "RAW_MISMATCH_LIMIT = 0.001\n",
+        "reference/sampler.py": "TEXEL_WEIGHT_BITS = 8\nc = c.astype(np.float32) * np.float32(1 / 255)\n"
+                                "m = (bits & 8388607 | 0x3F800000).view(np.float32)\nF = 0x2703\n"
+                                "ANISOTROPY_RANGE = (2, 16)\nWEIGHT_LUT_SIZE = 1024\n",
         "reference/depth_buffer.py": '"""DEPTH_CLEAR_VALUE in a docstring is fine"""\n# (z_ndc + 1.0) / 2.0\n',
     }
     rules = sorted({line.split(": ")[1].split(" (")[0] for line in redefinitions(old)})
-    assert rules == ["clip control modes", "depth clear value", "depth compare", "fill rule",
-                     "pipeline tolerance", "sub-pixel bits", "unorm8", "window depth",
-                     "window depth inverse"]
+    assert rules == ["EWA weight table", "clip control modes", "depth clear value", "depth compare",
+                     "fast log2", "fill rule", "max anisotropy", "pipeline tolerance", "sub-pixel bits",
+                     "texel weight bits", "texture filter and wrap enums", "unorm8", "unorm8 texel to float",
+                     "window depth", "window depth inverse"]
     assert not any(line.startswith("reference/depth_buffer.py") for line in redefinitions(old))

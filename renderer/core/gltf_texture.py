@@ -22,12 +22,14 @@ import struct
 from pathlib import Path
 from urllib.parse import unquote
 
+from renderer.core import gl_rules
 from renderer.core.textures import MaterialTexture, Sampler, texture_from_bytes
 from renderer.errors import SceneError
 
 GLB_MAGIC = b"glTF"
 GLB_JSON, GLB_BIN = 0x4E4F534A, 0x004E4942          # chunk types "JSON", "BIN\0"
-WRAP_MODES = {10497: "repeat", 33071: "clamp", 33648: "mirror"}   # GL enums, glTF's sampler
+# glTF's sampler names wrap modes by their GL enums
+WRAP_MODES = {enum: wrap for wrap, enum in gl_rules.TEXTURE_WRAP_MODES.items()}
 
 
 class _Problem(Exception):
@@ -103,7 +105,7 @@ def _base_colour(header: dict, material):
         texture = header["textures"][reference["index"]]
         factor = tuple(float(x) for x in pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3])
         sampler = header["samplers"][texture["sampler"]] if "sampler" in texture else {}
-        wrap_s, wrap_t = sampler.get("wrapS", 10497), sampler.get("wrapT", 10497)
+        wrap_s, wrap_t = sampler.get("wrapS", gl_rules.GL_REPEAT), sampler.get("wrapT", gl_rules.GL_REPEAT)
         if wrap_s != wrap_t:
             raise _Problem(f"material {material}'s base-colour sampler has wrapS {wrap_s} and "
                            f"wrapT {wrap_t}; a material has one wrap mode")

@@ -37,7 +37,7 @@ FILTERS = ("nearest", "bilinear", "mip-nearest", "trilinear", "anisotropic")
 MIPMAPPED_FILTERS = ("mip-nearest", "trilinear", "anisotropic")
 COLORSPACES = ("srgb", "linear")           # what an image file's values are
 MODULATED = ("ka", "kd", "ks")             # the coefficients a texel may multiply
-ANISOTROPY_RANGE = (2, 16)                 # llvmpipe's GL_MAX_TEXTURE_MAX_ANISOTROPY is 16
+ANISOTROPY_RANGE = (2, gl_rules.MAX_TEXTURE_MAX_ANISOTROPY)
 DEFAULT_ANISOTROPY = 16                    # "anisotropic" without a degree: the most there is
 
 # Decoding an image, at the peak (NumPy's allocations, measured with tracemalloc on 1024² and

@@ -58,16 +58,11 @@ def default_cache_dir() -> Path:
     return Path.home() / ".cache" / "checked-renderer" / "truth"
 
 
-def truth_geometry(scene: Scene) -> Scene:
-    """`scene` with Phong shading everywhere and the finest tessellation."""
-    return scene_at_level(scene.with_shading("phong"), FINEST)
-
-
 def truth_scene(scene: Scene) -> Scene:
-    """The scene the rasteriser's truth draws: truth_geometry, and every texture as the truth
-    samples it (renderer/study/texture_report.py truth_textures: its texels integrated over the
-    pixel)."""
-    return truth_textures(truth_geometry(scene))
+    """`scene` with Phong shading everywhere, the finest tessellation, and every texture as
+    the truth samples it (renderer/study/texture_report.py truth_textures: its texels
+    integrated over the pixel)."""
+    return truth_textures(scene_at_level(scene.with_shading("phong"), FINEST))
 
 
 def scene_digest(scene: Scene) -> str:

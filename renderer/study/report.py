@@ -16,9 +16,9 @@ image against the ground truth (renderer/study/ground_truth.py) make one row of 
     shadows-*       map resolution, filter, bias rule (shadow_report.py;  as authored, one
                     scenes with shadow maps): error against ray-cast      sample per pixel
                     truth, not the image's
-    filter,         the texture filter; the textures resampled to R       the truth's geometry
-    texture_        texels on their long side (texture_report.py;         and shading, one
-    resolution      textured scenes)                                      sample per pixel
+    filter,         the texture filter; the textures resampled to R       as authored, one
+    texture_        texels on their long side (texture_report.py;         sample per pixel
+    resolution      textured scenes)
 
 Errors are on the float image in [0, 1] (renderer/study/supersample.py) against the float truth:
 rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 8 bits) and
@@ -44,8 +44,7 @@ import numpy as np
 from renderer.core import sampling
 from renderer.core.shadow_settings import BIAS_RULES, FILTERS
 from renderer.study.report_output import csv_text, plot_png, report_markdown
-from renderer.study.ground_truth import (MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth,
-                                         truth_geometry, truth_scene)
+from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
 from renderer.core.imageio import outputs
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
@@ -150,7 +149,7 @@ class SceneRun:
                 truth_scene(self.scene) if kind == "truth" else
                 scene_at_level(self.scene.with_shading("phong"), variant[1]) if kind == "level" else
                 with_shadow_setting(self.scene, *variant[1:]) if kind == "shadow" else
-                with_texture_setting(truth_geometry(self.scene), *variant[1:]) if kind == "texture" else
+                with_texture_setting(self.scene, *variant[1:]) if kind == "texture" else
                 self.scene.with_shading(variant[1]))
         return self._scenes[variant]
 

@@ -85,9 +85,9 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
             series[series_key(row)].append(row)
     names = list(dict.fromkeys(series_name(row) for row in rows))
     for index, (name, members) in enumerate(series.items()):
-        # Along the knob: samples per pixel, else the depth (the ray tracer's), else time.
-        members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         first = members[0]
+        if first["knob"] in PATTERN_KNOBS:          # along the samples; other knobs as swept
+            members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         marker, line = STYLES[first["backend"]]
         colour = (_colour(series_name(first), names) if first["knob"] in PATTERN_KNOBS
                   else f"C{index}")

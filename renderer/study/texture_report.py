@@ -10,10 +10,11 @@ ground truth, and its frame time, move with the texture filter and the texture's
                         checker stays the same checkerboard)
 
 A setting applies to every textured material of the scene; a scene without one gets neither
-knob. Both draw the ground truth's geometry and shading (Phong, finest tessellation:
-ground_truth.truth_geometry) with one sample at each pixel's centre, so that the differences
-between settings are the texture's, as a real-time frame sees them (one lookup per pixel);
-the error common to every setting is that sample's aliasing at the silhouettes.
+knob. Both draw the scene as authored otherwise, one sample at each pixel's centre, and time a
+frame: what a real-time frame costs and shows with that texture (one lookup per pixel). The
+error every setting of a scene shares is that sample's aliasing at the silhouettes, and the
+authored shading and tessellation against the truth's (the built-in textured scenes are Phong
+shaded; of them only the globe is curved, 64 x 32 segments against the truth's 256 x 128).
 
 The ground truth of a textured scene (`truth_textures`, applied by ground_truth.truth_scene)
 is the texture integrated over each pixel:
@@ -124,9 +125,10 @@ def method_bullet() -> str:
     return ("- **filter** (nearest, bilinear, mip-nearest, trilinear, anisotropic 2 to 16) and "
             "**texture_resolution** (every texture resampled by the mip chain's area rule to R "
             "texels on its long side, the aspect kept; the scene's filter), textured scenes only: "
-            "each setting on every textured material, the truth's geometry and shading, one "
+            "each setting on every textured material, the scene otherwise as authored, one "
             "sample at each pixel's centre (a real-time frame's one lookup per pixel), timed per "
-            "frame. The error all settings share is that sample's aliasing at silhouettes.")
+            "frame. The error all of a scene's settings share is that sample's aliasing at "
+            "silhouettes and the authored shading and tessellation's.")
 
 
 def texture_line(scene) -> str:

@@ -19,10 +19,11 @@ shaded; of them only the globe is curved, 64 x 32 segments against the truth's 2
 The ground truth of a textured scene (`truth_textures`, applied by ground_truth.truth_scene)
 is the texture integrated over each pixel:
 - the texture is its texels, each a square of constant colour (what a checkerboard is):
-  level 0 enlarged a whole number of times to at least TRUTH_TEXELS texels on its long side
+  level 0 enlarged k times, the least whole number bringing its long side to TRUTH_TEXELS
   (a repeat of each texel, exactly the same image), so that the truth's bilinear magnification
-  blurs a texel's edge over 1/k of a texel, below the truth's sub-pixel spacing wherever a
-  texel covers fewer than 16 k pixels;
+  blurs a texel's edge over 1/k of a texel. What is left of that blur: at 2048 texels
+  checker_horizon's truth at 160 x 120 moves by an RMSE of 0.0007 (at most 0.023 in a pixel
+  near the camera), 1.5 % of the error of its best setting; 2048 costs 1.5 GB at the peak;
 - sampled with TRUTH_FILTER (trilinear) at the truth's 16 x 16 samples per pixel, each with
   the level of detail of its own 1/16-pixel footprint: where a sample still spans several
   texels the mip chain's area averages integrate them, where it spans less than one the

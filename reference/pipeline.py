@@ -75,7 +75,7 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
                               u_normal_matrix=matrices.normal, u_view=frame_matrices.view,
                               u_projection=frame_matrices.projection, u_eye=eye,
                               material=material, lights=lights, dtype=dtype,
-                              in_uv=texture_coordinates(obj))
+                              in_uv=obj.texture_coordinates())
     faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
     triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye,
                                  v_uv=None if vertices.v_uv is None else vertices.v_uv[faces])
@@ -86,17 +86,6 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows),
                           window.select(keep),
                           clipped.source[keep], clipped.weights[keep])
-
-
-def texture_coordinates(obj) -> np.ndarray | None:
-    """The mesh's UVs, which a textured material's vertex stage reads (in_uv); None for an
-    object without a texture."""
-    if obj.material.texture is None:
-        return None
-    if obj.mesh.uvs is None:
-        raise ValueError(f"object {obj.name!r}: its material has a texture but its mesh "
-                         f"({obj.mesh.source or 'made in code'}) has no texture coordinates")
-    return obj.mesh.uvs
 
 
 def draw_tile(index: int, prepared: PreparedObject, depth: DepthBuffer, first_order: int,

@@ -70,8 +70,7 @@ def every_feature_scene():
     """EVERY_FEATURE_SCENE with its first object's material textured (its primitives have UVs)."""
     scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
     first = scene.objects[0]
-    texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2),
-                              uv_offset=(0.25, 0.0))
+    texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2))
     return replace(scene, objects=[replace(first, material=replace(first.material, texture=texture)),
                                    *scene.objects[1:]])
 

@@ -22,6 +22,7 @@ RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
                   "raytrace/area_lights.glsl": "reference/raytrace/area_lights.py",
                   "raytrace/glossy.glsl": "reference/raytrace/glossy.py",
                   "raytrace/motion.glsl": "reference/raytrace/motion.py",
+                  "raytrace/textures.glsl": "reference/raytrace/textures.py",
                   "raytrace/trace.glsl": "reference/raytrace/trace.py"}
 
 

@@ -24,7 +24,7 @@ from reference.texture import lookup_coordinates
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.builtin import builtin_scenes
-from renderer.core.gl_rules import to_unorm8
+from renderer.core.gl_rules import to_unorm8, unorm8_to_float
 from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, Scene, SceneObject,
                                  Transform)
 from renderer.core.scene_file import load_scene
@@ -170,7 +170,7 @@ def test_the_texel_multiplies_the_coefficients_it_names(gl_contexts, modulate, s
     """A one-colour texture t on a quad facing the camera and a light straight down its normal
     (N.L = 1, R = N, and n = 0 so that spec = 1 wherever R.V > 0):
     I = I_a k_a t_a + I_l k_d t_d + I_l k_s t_s, with t_x = t where the material names k_x and
-    1 elsewhere, t = c * fl32(1/255) (unorm8 to float, reference/sampler.py). Every shading
+    1 elsewhere, t = c * fl32(1/255) (gl_rules.unorm8_to_float). Every shading
     mode, with the lighting handed on in two parts (flat, Gouraud) and with shadow maps (each
     light's term in two parts too)."""
     texels = np.broadcast_to(np.r_[TEXEL, 255], (2, 2, 4)).astype(np.uint8)
@@ -179,7 +179,7 @@ def test_the_texel_multiplies_the_coefficients_it_names(gl_contexts, modulate, s
     light = DirectionalLight((0.0, 0.0, -1.0), LIGHT, Shadow(enabled=shadows))
     scene = Scene(camera=Camera(eye=(0.0, 0.0, 3.0)), ambient=AMBIENT, directional_lights=[light],
                   objects=[SceneObject("quad", quad(4.0, 4.0), material)])
-    t = TEXEL.astype(np.float32) * np.float32(1 / 255)
+    t = unorm8_to_float(TEXEL)
     factor = {k: (t.astype(np.float64) if k in modulate else 1.0) for k in MODULATION_MATERIAL}
     expected = to_unorm8(np.asarray(AMBIENT) * MODULATION_MATERIAL["ka"] * factor["ka"]
                          + np.asarray(LIGHT) * MODULATION_MATERIAL["kd"] * factor["kd"]
@@ -275,8 +275,7 @@ def test_only_a_textured_material_gets_texture_code_and_uvs(gl_contexts):
     """A textured and an untextured quad in one scene: the textured material's program has the
     material sampler, the UV transform and in_uv, and only its object's vertex array binds UVs;
     the other program has none of them (no TEXTURED define: the code is not compiled)."""
-    texture = MaterialTexture(texture_of(np.full((2, 2, 4), 255, np.uint8), "white"),
-                              uv_offset=(0.5, 0.0))
+    texture = MaterialTexture(texture_of(np.full((2, 2, 4), 255, np.uint8), "white"))
     scene = Scene(camera=Camera(eye=(0.0, 0.0, 4.0)), directional_lights=[DirectionalLight()], objects=[
         SceneObject("textured", quad(1.0, 1.0), Material(texture=texture), Transform(translate=(-1, 0, 0))),
         SceneObject("plain", quad(1.0, 1.0), Material(), Transform(translate=(1, 0, 0)))])
@@ -296,3 +295,44 @@ def test_only_a_textured_material_gets_texture_code_and_uvs(gl_contexts):
     assert set(members) == {("kd",), ()}
     assert texture_names <= members[("kd",)] and not texture_names & members[()]
     assert bound == [{"in_position", "in_normal", "in_uv"}, {"in_position", "in_normal"}]
+
+
+def test_a_texture_is_uploaded_once_however_many_materials_and_frames_use_it(gl_contexts):
+    """Two materials share one texture, a third has its own: two uploads, none again when
+    update() recomputes the frame."""
+    shared, own = (texture_of(np.full((4, 4, 4), c, np.uint8), f"grey {c}") for c in (90, 200))
+    objects = [SceneObject(f"quad{i}", quad(0.8, 0.8), Material(texture=MaterialTexture(texture)),
+                           Transform(translate=(i - 1.0, 0, 0)))
+               for i, texture in enumerate((shared, shared, own))]
+    scene = Scene(camera=Camera(eye=(0.0, 0.0, 4.0)), directional_lights=[DirectionalLight()],
+                  objects=objects)
+    uploads = []
+    original = moderngl.Context.texture
+
+    def counting(self, size, components, *args, **kwargs):
+        uploads.append(size)
+        return original(self, size, components, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(moderngl.Context, "texture", counting)
+        with GpuRenderer(scene, 16, 12, context=gl_contexts["egl"]) as gpu:
+            gpu.render()
+            gpu.update()
+            gpu.render()
+    assert uploads == [(4, 4), (4, 4)]
+
+
+def test_a_material_given_a_texture_after_the_renderer_was_made(gl_contexts):
+    """update() after an object's material gains a texture uploads its UVs and draws it
+    textured: its texels, as a new renderer draws them."""
+    texels = np.random.default_rng(3).integers(0, 256, (8, 8, 4), dtype=np.uint8)
+    camera = Camera(eye=(0.0, 0.0, 5.0), projection="parallel", height=2.0)
+    scene = texels_out_scene(texture_of(texels, "random"), Sampler(filter="nearest"), "gouraud",
+                             quad(2.0, 2.0), camera)
+    textured = scene.objects[0].material
+    scene.objects[0].material = replace(textured, texture=None)
+    with GpuRenderer(scene, 8, 8, context=gl_contexts["egl"]) as gpu:
+        assert (gpu.render().rgba8[..., :3] == 255).all()           # k_a = I_a = 1, untextured
+        scene.objects[0].material = textured
+        gpu.update()
+        assert np.array_equal(gpu.render().rgba8[..., :3], texels[..., :3])

@@ -9,7 +9,8 @@
 // SECONDARY (some k_r or k_t > 0), GLOSSY (such a material has a finite gloss: reflected rays
 // drawn from a lobe), MAX_DEPTH, MOTION and NUM_MOVING_MESHES
 // (motion blur), and lighting.glsl's light counts and SPECULAR; AREA_LIGHTS (some point light
-// has an area of size > 0: LIGHT_SAMPLES shadow rays to points of it per hit, area_light_term).
+// has an area of size > 0: LIGHT_SAMPLES shadow rays to points of it per hit, area_light_term);
+// TEXTURES and NUM_TEXTURES (some material is textured: textures.glsl's texture_modulate).
 
 #include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
 #include "raytrace/optics.glsl"
@@ -390,6 +391,10 @@ float trace_sample_time() {
 }
 #endif
 
+#ifdef TEXTURES
+#include "raytrace/textures.glsl"
+#endif
+
 // The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
 // from 0 to infinity); hit and s: the first ray's hit.
 vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s_hit) {
@@ -439,6 +444,9 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
             u_ks = m2.xyz;
             u_n = m0.w;
             u_eye = O;
+#endif
+#ifdef TEXTURES
+            texture_modulate(obj, kind, index, P, uv);
 #endif
             vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
             g_geometric_normal = Ng;

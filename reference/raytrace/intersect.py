@@ -15,6 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+# The kinds of surface a ray hits (trace.py's scene_hit; the GLSL's TRACE_MISS ... in trace.glsl).
+MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
+
 
 def _float_dtype(*arrays) -> np.dtype:
     dtype = np.result_type(*arrays)
@@ -22,8 +25,11 @@ def _float_dtype(*arrays) -> np.dtype:
 
 
 def _dot(a, b):
-    """Sum of the three products in x, y, z order (as GLSL's dot; no pairwise summation)."""
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+    """GLSL's dot as llvmpipe sums it: the products added z first, (z + y) + x (NIR scalarises
+    the reduction from its last component). Summed x first, a third to two fifths of the hits
+    parted from the GPU's by an ulp or so of s or (u, v); so, bit for bit on EGL and OSMesa
+    (tests/test_raytrace_intersect.py)."""
+    return a[..., 2] * b[..., 2] + a[..., 1] * b[..., 1] + a[..., 0] * b[..., 0]
 
 
 def _cross(a, b):

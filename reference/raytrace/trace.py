@@ -24,6 +24,9 @@ bounce (every ray of one depth at once), no Python loop over pixels or rays.
   transmitted weight k_t (1 - F) along ray_refract(Du, N, eta) from offset_ray_origin(P, -Ng)
   (none under total internal reflection, where F = 1). A ray's colour is
   local + w_r reflected + w_t transmitted; a ray that misses brings the background colour;
+- textures (docs/conventions.md, "Textures in the ray tracer"; textures.py): where some
+  material is textured, the coefficients its texture modulates are multiplied by the texel at
+  the hit's UV before lighting (texture_modulate);
 - glossy reflection (docs/conventions.md, "Glossy reflection"; glossy.py): where some material
   sets `gloss`, each reflected ray is drawn from the Phong lobe of its material's exponent
   about the mirror direction with the hit's GLOSSY_DIMENSION point, absorbed below the
@@ -36,18 +39,18 @@ import numpy as np
 
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
-from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere_from, sphere_normal,
-                                          triangle_normal)
+from reference.raytrace.intersect import (MISS, PLANE, SPHERE, TRIANGLE, plane_normal, ray_plane,
+                                          ray_sphere_from, sphere_normal, triangle_normal)
 from reference.raytrace.motion import (motion_at, motion_direction, motion_direction_back,
                                        motion_plane, motion_point, motion_point_back, motion_time)
 from renderer.core.ray_sampling import TIME_DIMENSION
 from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from reference.raytrace.area_lights import AreaDraw, area_light_terms
 from reference.raytrace.glossy import glossy_rays
+from reference.raytrace.textures import texture_modulate
 from renderer.core.ray_depth import RAY_WEIGHT_CUTOFF
 
 F32 = np.float32
-MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
 # Hits closer than this, relative, are a tie, kept by the surface found first (scene_hit; the
 # GLSL's TRACE_HIT_TIE): 64 eps32, above the few ulps by which the rounding of a triangle's
 # vertices and of the two intersection formulas moves a triangle lying in a plane off it.
@@ -392,7 +395,10 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         area_light = None if areas is None else area_light_terms(
             lights, areas, AreaDraw(samples, owner, key),
             area_light_shadow(rs, lights, Ng, shape, record, _at(time, owner)) if shadows else None)
-        local = lighting(P, N, O, materials(rs, obj, specular, t), lights,
+        mats = materials(rs, obj, specular, t)
+        if rs.textures is not None:     # the texel multiplies the coefficients it modulates
+            mats = texture_modulate(rs, mats, obj, kind, index, P, uv, _at(time, owner))
+        local = lighting(P, N, O, mats, lights,
                          shadow_visibility(rs, lights, Ng, shape, record, _at(time, owner))
                          if shadows else None,
                          area_light)

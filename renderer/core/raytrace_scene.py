@@ -12,6 +12,9 @@ renderer/gpu/raytracer.py, reference/raytrace/trace.py): made once per scene, ca
   build for that eye gives);
 - the materials, one row per object: k_a, k_d, k_s, n, k_r, k_t, ior, two-sided, gloss (the
   reflected rays' lobe exponent, inf for a mirror).
+- textures (renderer/core/ray_textures.py): None where no material is textured, else each
+  object's texture slot and lookup, the triangles' vertex UVs, each sphere's world-to-object
+  rotation and each plane's UV map;
 - motion blur (`motion=True`; renderer/core/motion.py): every object's motion, and the BVH is
   a `forest`: the static triangles' tree first (if there are any), then one tree per moving
   mesh object over its time-0 triangles (each built eye-free and refitted as above), which the
@@ -27,6 +30,7 @@ import numpy as np
 
 from renderer.core.bvh import Bvh, build_bvh, forest, refit, roots
 from renderer.core.motion import SceneMotion, declares_motion, has_motion, scene_motion
+from renderer.core.ray_textures import RayTextures, mesh_uvs, ray_textures
 from renderer.core.scene import Scene, WorldPlane, WorldSphere
 
 
@@ -56,6 +60,7 @@ class RayScene:
     motion: SceneMotion | None = None    # per object; None: no motion code (the still scene)
     mesh_object: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     # (K,) per tree of `bvh`: the object it moves with, -1 for the static triangles' tree
+    textures: RayTextures | None = None  # None: no material is textured (no texture code)
 
     @property
     def mesh_roots(self) -> np.ndarray:
@@ -92,9 +97,10 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
     shapes = scene.world_shapes()
     matrices = scene.matrices(1, 1)
     world_matrices = scene.world_matrices()
+    textured = any(obj.material.textured for obj in scene.objects)
     spheres = [(k, s) for k, s in enumerate(shapes) if isinstance(s, WorldSphere)]
     planes = [(k, s) for k, s in enumerate(shapes) if isinstance(s, WorldPlane)]
-    tris, world_tris, normals, owner = [], [], [], []
+    tris, world_tris, normals, owner, uvs = [], [], [], [], []
     for k, (obj, shape) in enumerate(zip(scene.objects, shapes)):
         if shape is not None or len(obj.mesh.faces) == 0:
             continue
@@ -108,6 +114,8 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         world_tris.append(absolute[faces])
         normals.append(vertex_normals[faces])
         owner.append(np.full(len(faces), k, np.int64))
+        if textured:
+            uvs.append(mesh_uvs(obj)[faces])
     triangles = np.concatenate(tris) if tris else np.zeros((0, 3, 3))
     owners = np.concatenate(owner) if owner else np.zeros(0, np.int64)
     mesh_object = _tree_objects(scene, owners, motion)
@@ -136,6 +144,8 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         gloss_set=any(m.gloss is not None for m in mats),
         glossy=any(m.is_glossy for m in mats),
         motion=scene_motion(scene) if motion else None, mesh_object=mesh_object,
+        textures=ray_textures(scene, [k for k, _ in spheres], [k for k, _ in planes],
+                              np.concatenate(uvs) if uvs else np.zeros((0, 3, 2))),
     )
 
 

@@ -263,6 +263,17 @@ class SceneObject:
     velocity: tuple | None = None
     angular_velocity: tuple | None = None
 
+    def texture_coordinates(self) -> np.ndarray | None:
+        """The mesh's UVs (V, 2) where the material is textured (what its lookup reads), None
+        where it is not; a ValueError naming the object for a textured material on a mesh
+        without UVs (a scene file is refused so as it loads, renderer/core/scene_file.py)."""
+        if self.material.texture is None:
+            return None
+        if self.mesh.uvs is None:
+            raise ValueError(f"object {self.name!r}: its material has a texture but its mesh "
+                             f"({self.mesh.source or 'made in code'}) has no texture coordinates")
+        return self.mesh.uvs
+
 
 @dataclass
 class DirectionalLight:

@@ -273,8 +273,14 @@ class GpuRenderer:
             vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
             item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
-            if item.obj.material.texture is not None:
-                item.uv_vbo = self.ctx.buffer(_texture_coordinates(item.obj).tobytes())
+        self._upload_uvs(item)
+
+    def _upload_uvs(self, item: _ObjectBuffers) -> None:
+        """The mesh's UVs (in_uv, float32) once the object's material is textured: when it is
+        made, or at the update() after a material gains a texture."""
+        uvs = item.obj.texture_coordinates()
+        if uvs is not None and item.uv_vbo is None and item.vbo is not None:
+            item.uv_vbo = self.ctx.buffer(np.ascontiguousarray(uvs, dtype=np.float32).tobytes())
 
     @staticmethod
     def _release_buffers(item: _ObjectBuffers) -> None:
@@ -319,6 +325,7 @@ class GpuRenderer:
             if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
                 self._release_buffers(item)
                 self._upload(item)
+            self._upload_uvs(item)
         matrices = scene.matrices(self.width, self.height)
         visible = visible_objects(scene, matrices)
         shadows = self._update_shadows(matrices, visible)
@@ -634,14 +641,6 @@ class GpuRenderer:
     def __repr__(self) -> str:
         state = "released" if self._released else context_kind(self.ctx)
         return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
-
-
-def _texture_coordinates(obj: SceneObject) -> np.ndarray:
-    """The object's vertex UVs as its textured material's in_uv takes them: float32 (V, 2)."""
-    if obj.mesh.uvs is None:
-        raise ValueError(f"object {obj.name!r}: its material has a texture but its mesh "
-                         f"({obj.mesh.source or 'made in code'}) has no texture coordinates")
-    return np.ascontiguousarray(obj.mesh.uvs, dtype=np.float32)
 
 
 def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:

@@ -11,13 +11,16 @@ the scene uses (light counts, SPECULAR, SHADOWS when there are lights, NUM_SPHER
 MESHES when there are triangles, SECONDARY when some k_r or k_t > 0, GLOSSY when such a material
 has a finite gloss, MAX_DEPTH, LENS when the camera's aperture is above 0, AREA_LIGHTS when some
 point light has an area of size > 0, MOTION and NUM_MOVING_MESHES where something moves during
-the shutter (docs/conventions.md, "Motion blur"), and the sample pattern's constants from
+the shutter (docs/conventions.md, "Motion blur"), TEXTURES and NUM_TEXTURES where some material
+is textured (renderer/core/ray_textures.py), and the sample pattern's constants from
 renderer/core/ray_sampling.py, LIGHT_SAMPLES among them); the uniforms (camera rays and the thin
 lens from renderer/core/camera_rays.py, lights from renderer/core/uniforms.py and their areas
 from renderer/core/light_areas.py, shapes, the objects' motions from renderer/core/motion.py,
 the pattern's); the
 materials, the BVH (nodes and triangles, `texels` of renderer/core/bvh.py's layout, as
-renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures. A viewer moving
+renderer/gpu/bvh.py) and the triangles' vertices and normals as float textures; the image
+textures through renderer/gpu/textures.py's TextureCache (each uploaded once, one unit per
+slot, after the float textures' units). A viewer moving
 the camera calls update() (and resize()), which keeps all of them and writes new contents: the
 same image as a RayTracer made afresh, without the BVH build or (unless the light counts
 changed) the compile.
@@ -29,7 +32,8 @@ aperture), MOTION (each moving mesh in its own tree wherever an object declares 
 MESHES (the BVH walk; a scene without static triangles gets a one-triangle tree of a degenerate
 triangle at root 0, which no ray hits) and AREA_LIGHTS (where there are point lights;
 renderer/core/light_areas.py). The light, sphere and plane counts stay compile-time
-constants. The image is the same.
+constants, and TEXTURES stays where some material is textured (an array of samplers with
+no texture to read is no feature). The image is the same.
 """
 
 from __future__ import annotations
@@ -56,6 +60,7 @@ from renderer.core.uniforms import light_uniforms
 from renderer.gpu.bvh import texel_texture
 from renderer.gpu.context import activate, context_kind, make_context, release_context
 from renderer.gpu.shaders import shader_source
+from renderer.gpu.textures import TextureCache
 
 DEFAULT_MAX_DEPTH = 4
 
@@ -81,6 +86,7 @@ class RayTracer:
         self._owns_context = context is None
         self.ctx = make_context(context_kind) if context is None else context
         self._resources: list = []
+        self._image_textures = TextureCache(self.ctx)     # the materials' images, uploaded once
         self._released = False
         try:
             activate(self.ctx)
@@ -126,6 +132,7 @@ class RayTracer:
             **self.sampling.defines(),
             **area_light_defines(scene, every),
             **self._motion_defines(rs),
+            **({"TEXTURES": True, "NUM_TEXTURES": len(rs.textures.textures)} if rs.textures else {}),
         }
 
     def _compile(self) -> None:
@@ -163,12 +170,16 @@ class RayTracer:
             values["u_planes"] = np.concatenate([rs.plane_normal, rs.plane_offset[:, None]], 1).astype(np.float32).tobytes()
             values["u_plane_object"] = rs.plane_object.astype(np.int32).tobytes()
         values.update(self._motion_uniforms(rs))
+        values.update(self._texture_uniforms(rs))
         for name, value in values.items():
             if name in program:
                 program[name].write(value)
         for name, unit in self._units.items():
             if name in program:
                 program[name].value = unit
+        if "u_textures" in program:
+            units = [unit for unit, _ in self._image_units()]
+            program["u_textures"].write(np.asarray(units, np.int32).tobytes())
 
     def _lens_values(self, matrices) -> dict:
         """The thin lens's uniforms (renderer/core/camera_rays.py, lens_uniforms) as float32
@@ -196,7 +207,39 @@ class RayTracer:
             data[:, 3:, :3] = normals
             data[:, 3, 3] = owner
             arrays["u_triangle_data"] = data
+        if rs.textures is not None:
+            arrays.update(self._texture_texels(rs))
         return arrays
+
+    # -- textures (docs/conventions.md, "Textures in the ray tracer") -------------------------
+    def _texture_texels(self, rs) -> dict:
+        """Per object its slot, modulate flags and UV transform; per triangle its vertex UVs
+        (a placeholder triangle's where MESHES walks a placeholder tree)."""
+        tx = rs.textures
+        flags = np.concatenate([tx.slot[:, None], tx.modulate], 1).astype(np.float64)
+        arrays = {"u_texture_materials": np.stack([flags, tx.uv_transform], 1)}     # (M, 2, 4)
+        if self.defines["MESHES"]:
+            uvs = tx.triangle_uvs if len(tx.triangle_uvs) else np.zeros((1, 3, 2))
+            data = np.zeros((len(uvs), 2, 4))
+            data[:, 0] = uvs[:, :2].reshape(-1, 4)
+            data[:, 1, :2] = uvs[:, 2]
+            arrays["u_triangle_uvs"] = data
+        return arrays
+
+    def _image_units(self) -> list[tuple[int, object]]:
+        """(unit, MaterialTexture) of each slot: the units after the float textures'."""
+        if self.ray_scene.textures is None:
+            return []
+        return [(len(self._units) + k, material_texture)
+                for k, material_texture in enumerate(self.ray_scene.textures.textures)]
+
+    def _texture_uniforms(self, rs) -> dict:
+        """Each sphere's world-to-object rotation (rows) and each plane's UV map (rows)."""
+        if rs.textures is None:
+            return {}
+        rows = {"u_sphere_rotation": rs.textures.sphere_rotation, "u_plane_uv": rs.textures.plane_map}
+        return {name: np.asarray(value, np.float32).tobytes() for name, value in rows.items()
+                if np.size(value)}
 
     # -- motion blur (docs/conventions.md, "Motion blur") ------------------------------------
     def _motion_now(self) -> bool:
@@ -269,7 +312,11 @@ class RayTracer:
                              "was made; make a new one")
         check_light_count(self.scene)
         activate(self.ctx)
-        rs = self.ray_scene = ray_scene(self.scene, tree=self.ray_scene.bvh, motion=self._motion_layout)
+        rs = ray_scene(self.scene, tree=self.ray_scene.bvh, motion=self._motion_layout)
+        if (rs.textures is None) != (self.ray_scene.textures is None):
+            raise ValueError("the scene's textures switched on or off since this RayTracer was "
+                             "made; make a new one")
+        self.ray_scene = rs
         defines = self._defines(rs)
         if defines != self.defines:
             self.defines = defines
@@ -313,9 +360,14 @@ class RayTracer:
             self.program["u_first_sample"].value = first_sample
         for unit, texture in self._textures:
             texture.use(unit)
+        images = self._image_units()
+        for unit, material_texture in images:
+            self._image_textures.bind(material_texture, unit)
         self._fbo.use()
         self.ctx.viewport = (0, 0, self.width, self.height)
         self._vao.render(vertices=3)
+        for unit, material_texture in images:     # no sampler state of ours left on the context
+            self._image_textures.get(material_texture)[1].clear(unit)
         h, w = self.height, self.width
         linear = np.frombuffer(self._fbo.read(components=4, attachment=0, dtype="f4"), np.float32).reshape(h, w, 4)
         depth = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="f4"), np.float32).reshape(h, w)
@@ -338,6 +390,7 @@ class RayTracer:
         self._released = True
         try:
             activate(self.ctx)
+            self._image_textures.release()
             for thing in reversed(self._resources):
                 thing.release()
         finally:

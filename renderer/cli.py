@@ -232,8 +232,8 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--knobs", type=lambda text: tuple(k.strip() for k in text.split(",")),
                         metavar="K,K", help="only these knob families (default all): raster: "
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
-                        "filter, bias rule against ray-cast truth); raytrace: antialiasing, "
-                        "max_depth, precision")
+                        "filter, bias rule against ray-cast truth), filter and texture_resolution "
+                        "(textured scenes); raytrace: antialiasing, max_depth, precision")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 

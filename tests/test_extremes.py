@@ -29,6 +29,9 @@ from renderer.core.primitives import plane
 from renderer.core.scene import Camera, Material, PointLight, Scene, SceneObject, Transform
 from renderer.core.scene_file import load_scene
 from renderer.core.shadows import plan_shadows, shadow_layout
+from renderer.core.gl_rules import unorm8_to_float
+from renderer.core.textures import FILTERS, Sampler, texture_from_linear
+from reference.sampler import sample
 
 SIZE = (160, 120)
 REFUSED = ("nan_mesh",)
@@ -268,8 +271,14 @@ def test_ray_traced_extreme_case_is_finite_and_within_tolerance_of_float64(name,
         assert case["grazing_pixels"] >= 24 and case["worst_truth"]["mismatched_pixels"] > 0
 
 
+# Cases whose reference frame takes seconds (the anisotropic filter's texel scan) run in the
+# full run only, on either context.
+SLOW_CASES = ("tex_1x1", "tex_grazing")
+
+
 @pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
-@pytest.mark.parametrize("name", RENDERED)
+@pytest.mark.parametrize("name", [pytest.param(n, marks=pytest.mark.slow) if n in SLOW_CASES else n
+                                  for n in RENDERED])
 def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, gl_contexts,
                                                           reference_frames):
     with GpuRenderer(extreme_scene(name), *SIZE, context=gl_contexts[context_kind]) as gpu:
@@ -389,3 +398,76 @@ def test_a_light_inside_a_closed_mesh_lights_nothing_outside_it(gl_contexts):
         with GpuRenderer(dark, 64, 48, context=ctx) as gpu:
             ambient = gpu.render().rgba8
         assert np.abs(shadowed.astype(int) - ambient).max() <= 1     # the ambient term alone
+
+
+# -- textures ------------------------------------------------------------------------------------
+
+TEXTURE_CASES = sorted(n for n in RENDERED if n.startswith("tex_"))
+
+
+def test_the_texture_cases_are_the_issues():
+    """Issue 17's list: a checkerboard plane to the horizon (minification, moire), a texture
+    magnified 1000 times, a 1 x 1 texture, a non-power-of-two texture, UVs of +-1e6 with
+    repeat, a grazing view for anisotropy."""
+    assert TEXTURE_CASES == ["tex_1x1", "tex_grazing", "tex_horizon", "tex_huge_uv", "tex_magnified",
+                             "tex_npot"]
+    textures = {name: [o.material.texture for o in extreme_scene(name).objects] for name in TEXTURE_CASES}
+    horizon = extreme_scene("tex_horizon")
+    far_edge = np.abs(horizon.objects[0].mesh.positions).max()           # 10,000 (a plane centred below)
+    below_horizon = math.degrees(math.atan(horizon.camera.eye[1] / far_edge))
+    assert below_horizon < horizon.camera.fov_y / SIZE[1] / 10            # a tenth of a pixel
+    assert {t.sampler.filter for t in textures["tex_horizon"]} == {"nearest"}
+    camera = extreme_scene("tex_magnified").camera
+    for t in textures["tex_magnified"]:                                  # texel width / pixel height
+        assert 1 / (t.texture.width * t.uv_scale[0]) / (camera.height / SIZE[1]) == pytest.approx(1000)
+    assert {(t.texture.width, t.texture.height, len(t.texture.levels)) for t in textures["tex_1x1"]} == {(1, 1, 1)}
+    assert {t.sampler.filter for t in textures["tex_1x1"]} == set(FILTERS)
+    assert {(t.texture.width, t.texture.height) for t in textures["tex_npot"]} == {(37, 23)}
+    assert {t.sampler.wrap for t in textures["tex_npot"]} == {"repeat", "mirror", "clamp"}
+    huge = extreme_scene("tex_huge_uv")
+    assert np.abs(huge.objects[0].mesh.uvs).min() >= 1e6 - 1                # the mesh's own UVs
+    assert {tuple(map(abs, t.uv_offset)) for t in textures["tex_huge_uv"][1:]} == {(1e6, 1e6)}
+    assert all(t.sampler.wrap == "repeat" for t in textures["tex_huge_uv"])
+    assert {(t.sampler.filter, t.sampler.anisotropy) for t in textures["tex_grazing"]} == {("anisotropic", 16)}
+
+
+def lerp8_half(a, b):
+    """llvmpipe's 8-bit lerp at weight 128 (reference/texels.py's rule, written out)."""
+    return a + ((128 * (b - a) + 128) >> 8)
+
+
+def test_a_repeat_coordinate_past_int32_reads_the_last_and_first_texels_half_and_half():
+    """round(s W 256) - 128 wraps past int32 (|s| W 256 >= 2^31, here 1e6 x 64 x 256): texel
+    63 and texel 0 at weight 128 on each axis, wherever s is, not the texel the textbook's
+    wrap of s - floor(s) gives."""
+    rng = np.random.default_rng(17)
+    texture = texture_from_linear(rng.random((64, 64, 3)), "noise", "linear")
+    level = texture.levels[0].astype(np.int64)
+
+    def texel(i, j):                                   # j counted from the bottom
+        return level[63 - j, i]
+
+    expected = lerp8_half(lerp8_half(texel(63, 63), texel(0, 63)), lerp8_half(texel(63, 0), texel(0, 0)))
+    u = np.array([1e6 + 0.3, 1e6 + 0.71, -1e6 + 0.5, 3e6])
+    v = np.array([-1e6 + 0.2, 1e6 + 0.9, 1e6, -2e6 + 0.4])
+    bilinear = Sampler("repeat", "bilinear")
+    np.testing.assert_array_equal(sample(texture, bilinear, u, v), np.tile(unorm8_to_float(expected), (4, 1)))
+    textbook = sample(texture, bilinear, u - np.round(u), v - np.round(v))
+    assert (np.abs(textbook - unorm8_to_float(expected)).max(axis=1) > 0.01).all()
+
+
+def test_the_huge_uv_squares_are_flat_grey_on_the_gpu(gl_contexts):
+    """tex_huge_uv's top squares (vertex UVs of +-1e6, bilinear): every pixel the hand-computed
+    half-and-half of the checker's corner texels (light, dark, dark, light: the squares (7, 7),
+    (0, 7), (7, 0), (0, 0)), lit by an ambient 1 alone."""
+    light, dark = np.array([230, 230, 230]), np.array([20, 20, 26])   # (0.9, 0.9, 0.9), (0.08, 0.08, 0.1)
+    expected = lerp8_half(lerp8_half(light, dark), lerp8_half(dark, light))
+    assert list(expected) == [125, 125, 128]
+    scene = extreme_scene("tex_huge_uv")
+    alone = replace(scene, objects=scene.objects[:1])
+    for ctx in gl_contexts.values():
+        with GpuRenderer(alone, 64, 48, context=ctx) as gpu:
+            frame = gpu.render()
+        drawn = frame.rgba8[..., 3] == 255
+        assert drawn.sum() > 100
+        assert (frame.rgba8[drawn][:, :3] == expected).all()

@@ -74,7 +74,8 @@ def test_every_knob_runs_on_its_backends():
                         ("tessellation", "gpu"), ("tessellation", "reference"),
                         ("shading", "gpu"), ("shading", "reference"), ("precision", "reference"),
                         *((f"shadows-{knob}", b) for knob in ("resolution", "filter", "bias")
-                          for b in ("gpu", "reference"))}
+                          for b in ("gpu", "reference")),
+                        *((knob, b) for knob in ("filter", "texture_resolution") for b in ("gpu", "reference"))}
     assert {s.setting for s in plan if s.pattern == "msaa"} == {"msaa 1", "msaa 4"}
     assert {s.setting for s in plan if s.pattern == "regular" and s.knob == "antialiasing"} == \
         {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
@@ -90,7 +91,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
         reader = csv.DictReader(handle)
         assert tuple(reader.fieldnames) == CSV_COLUMNS
         rows = list(reader)
-    assert len(rows) == len(settings(QUICK, [1, 4]))
+    assert len(rows) == len([s for s in settings(QUICK, [1, 4]) if s.variant[0] != "texture"])
     assert {row["scene"] for row in rows} == {"point_light_plane"}
     assert all(int(row["runs"]) >= 5 and float(row["median_ms"]) > 0 for row in rows)
     image_rows = [row for row in rows if not row["knob"].startswith("shadows-")]
@@ -174,7 +175,7 @@ def test_a_scene_gets_the_shadow_settings_its_maps_allow():
     assert shadow_settings(shadowless) == set()
     assert "2048" in shadow_settings(room) and "4096" not in shadow_settings(room)   # 6 x 4096^2 texels
     assert len(RasterStudy().scene_settings(plan, shadowless, 160, 120)) == \
-        len([s for s in plan if not s.knob.startswith("shadows-")])
+        len([s for s in plan if s.variant[0] not in ("shadow", "texture")])    # nor textures
 
 
 def _shadow_row(scene, setting, backend, ms, outside, wrong, acne):

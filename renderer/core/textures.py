@@ -179,6 +179,17 @@ def mip_chain(level0: np.ndarray) -> tuple:
     return tuple(levels)
 
 
+def resampled(texture: Texture, width: int, height: int) -> Texture:
+    """`texture` at width x height texels, with its own mip chain: level 0 resampled by the
+    mip chain's area rule, up or down (each new texel the average, over its footprint, of the
+    old texels taken as squares of constant colour: a whole-number enlargement repeats each
+    texel, so a checkerboard stays the same checkerboard), in float64 from the stored unorm8
+    values. The report's texture resolutions and its ground truth (renderer/study/texture_report.py)."""
+    level0 = np.asarray(texture.levels[0], dtype=np.float64) / 255.0
+    image = _area_average(_area_average(level0, width, axis=1), height, axis=0)
+    return Texture(mip_chain(image), f"{texture.source} at {width}x{height}", texture.colorspace)
+
+
 # --------------------------------------------------------------------------- sources
 
 def texture_from_image(rgb: np.ndarray, source: str, colorspace: str = "srgb",

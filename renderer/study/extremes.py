@@ -96,6 +96,27 @@ STABILITY = {
     "shadow_tiny_caster": "a directional map is fitted to the receivers in view cut to the "
                           "casters' box across the light: its texels are the caster's size / R, "
                           "not the floor's; the floor is not drawn into it",
+    # textures (docs/conventions.md, "Texture coordinates"; reference/sampler.py)
+    "tex_1x1": "a 1 x 1 texture is one level, and every wrap, filter and blend of it reads its "
+               "one texel (lerp8 of equal texels is the texel): the level of detail, the wrap "
+               "and the anisotropic footprint cannot show",
+    "tex_grazing": "llvmpipe's anisotropic filter twinned texel for texel (the EWA over the "
+                   "footprint's ellipse at the level of its minor axis, NEAREST texels, the "
+                   "Gaussian table); a floor with small UVs, whose float32 interpolation "
+                   "stays within a weight step",
+    "tex_horizon": "the nearest texel is floor(fl32(u W)) on both sides; the plane centred under "
+                   "the camera keeps u small where a square covers many pixels, so GL's float32 "
+                   "interpolation picks the twin's texel there, and the moire is the same in both",
+    "tex_huge_uv": "the fixed-point coordinate's int32 wrap (round(s W 256) - 128 at |s| W 256 >= "
+                   "2^31 is INT_MIN - 128: the last and first texels half and half) reproduced, "
+                   "not the textbook's repeat; NPOT repeat takes the fraction first; uv_offset "
+                   "added in float32 on both sides",
+    "tex_magnified": "texel coordinates in 1/256 of a texel (round(s W 256)) and 8-bit weights on "
+                     "both sides: at 1000 pixels a texel each weight step spans about 4 pixels, "
+                     "the same steps in both",
+    "tex_npot": "NPOT repeat takes u's fraction before the texel, at every level by the base "
+                "level's size (as llvmpipe); mirror takes the float path; the mip chain's "
+                "fractional box weights are the same uploaded levels for both",
     # ray traced (docs/conventions.md, "Rays")
     "rt_coplanar": "hit ties: a surface replaces the nearest hit only when nearer by more than "
                    "2^-18 relative, so the plane, found first, shows wherever the triangle lies "

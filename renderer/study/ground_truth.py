@@ -1,8 +1,9 @@
 """The ground truths the report measures every setting against, cached on disk by content.
 
 The rasteriser's truth is the NumPy reference in float64, Phong shading on every object, every
-curved primitive at the finest tessellation (renderer/study/tessellation.py FINEST), and
-16 x 16 supersampling per pixel. Rendering the reference once at 16W x 16H and averaging each
+curved primitive at the finest tessellation (renderer/study/tessellation.py FINEST), every
+texture as renderer/study/texture_report.py's truth_textures samples it (its texels, trilinear
+at each sub-sample), and 16 x 16 supersampling per pixel. Rendering the reference once at 16W x 16H and averaging each
 16 x 16 block of clamped linear colour is exactly the 16 x 16 regular grid of sample offsets
 ((a + 0.5) / 16 - 0.5, (b + 0.5) / 16 - 0.5) (renderer/core/sampling.py regular_grid(256)) at a
 256th of the passes' cost.
@@ -37,6 +38,7 @@ from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.study.supersample import clamped
 from renderer.study.tessellation import FINEST, scene_at_level
+from renderer.study.texture_report import truth_textures
 
 TRUTH_GRID = 16                        # samples per pixel along x and along y
 TRUTH_VERSION = 1                      # bump when the truth's recipe changes: old entries miss
@@ -57,8 +59,10 @@ def default_cache_dir() -> Path:
 
 
 def truth_scene(scene: Scene) -> Scene:
-    """`scene` with Phong shading everywhere and the finest tessellation."""
-    return scene_at_level(scene.with_shading("phong"), FINEST)
+    """`scene` with Phong shading everywhere, the finest tessellation, and every texture as
+    the truth samples it (renderer/study/texture_report.py truth_textures: its texels
+    integrated over the pixel)."""
+    return truth_textures(scene_at_level(scene.with_shading("phong"), FINEST))
 
 
 def scene_digest(scene: Scene) -> str:

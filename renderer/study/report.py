@@ -16,6 +16,9 @@ image against the ground truth (renderer/study/ground_truth.py) make one row of 
     shadows-*       map resolution, filter, bias rule (shadow_report.py;  as authored, one
                     scenes with shadow maps): error against ray-cast      sample per pixel
                     truth, not the image's
+    filter,         the texture filter; the textures resampled to R       as authored, one
+    texture_        texels on their long side (texture_report.py;         sample per pixel
+    resolution      textured scenes)
 
 Errors are on the float image in [0, 1] (renderer/study/supersample.py) against the float truth:
 rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 8 bits) and
@@ -51,6 +54,8 @@ from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_S
 from renderer.study.shadow_report import (fits, plot_axis, shadow_errors, shadow_variants,
                                           with_shadow_setting)
 from renderer.study.tessellation import FINEST, LEVELS, scene_at_level
+from renderer.study.texture_report import (FILTER_SETTINGS, TEXTURE_RESOLUTIONS, is_textured,
+                                           texture_line, texture_variants, with_texture_setting)
 from renderer.study.timing import median_timed
 
 @dataclass(frozen=True)
@@ -62,13 +67,18 @@ class Sweep:
     shadow_resolutions: tuple = SHADOW_RESOLUTIONS
     shadow_filters: tuple = tuple(FILTERS)
     shadow_biases: tuple = BIAS_RULES
+    texture_filters: tuple = FILTER_SETTINGS
+    texture_resolutions: tuple = TEXTURE_RESOLUTIONS
     runs: int = 5
 
 
 FULL = Sweep()
 QUICK = Sweep(adaptive=((4, 16, 0.05),), levels=(0.25, 1.0, FINEST), shadow_resolutions=(256, 1024),
-              shadow_filters=("hard", "pcf2x2"), shadow_biases=("auto", "none"))
-KNOB_FAMILIES = ("antialiasing", "tessellation", "shading", "precision", "shadows")
+              shadow_filters=("hard", "pcf2x2"), shadow_biases=("auto", "none"),
+              texture_filters=(("nearest", 1), ("trilinear", 1), ("anisotropic", 16)),
+              texture_resolutions=(64, 256))
+KNOB_FAMILIES = ("antialiasing", "tessellation", "shading", "precision", "shadows", "filter",
+                 "texture_resolution")
 
 
 @dataclass(frozen=True)
@@ -79,7 +89,8 @@ class Setting:
     backend: str                     # "gpu" or "reference"
     pattern: str                     # a sampling pattern, "adaptive", "msaa", or "regular"
     variant: tuple                   # ("truth",) | ("level", L) | ("shading", mode) |
-                                     # ("shadow", field, value): shadow_report.py
+                                     # ("shadow", field, value): shadow_report.py |
+                                     # ("texture", field, value): texture_report.py
     sampling: tuple                  # ("pattern", name, N) | ("adaptive", first, total, t) | ("msaa", N)
     dtype: str = "float64"
 
@@ -115,6 +126,8 @@ def settings(sweep: Sweep, msaa_counts: list[int]) -> list[Setting]:
     for knob, name, variant in shadow_variants(sweep.shadow_resolutions, sweep.shadow_filters,
                                                sweep.shadow_biases):
         out += [Setting(knob, name, b, "regular", variant, ("pattern", "regular", 1)) for b in both]
+    for knob, name, variant in texture_variants(sweep.texture_filters, sweep.texture_resolutions):
+        out += [Setting(knob, name, b, "regular", variant, ("pattern", "regular", 1)) for b in both]
     return out
 
 
@@ -136,6 +149,7 @@ class SceneRun:
                 truth_scene(self.scene) if kind == "truth" else
                 scene_at_level(self.scene.with_shading("phong"), variant[1]) if kind == "level" else
                 with_shadow_setting(self.scene, *variant[1:]) if kind == "shadow" else
+                with_texture_setting(self.scene, *variant[1:]) if kind == "texture" else
                 self.scene.with_shading(variant[1]))
         return self._scenes[variant]
 
@@ -208,8 +222,10 @@ class RasterStudy:
         return settings(sweep, multisample_counts(ctx))
 
     def scene_settings(self, plan: list[Setting], scene, width: int, height: int) -> list[Setting]:
-        """The settings `scene` gets: the shadow knobs only where it has shadow maps that fit."""
-        return [s for s in plan if s.variant[0] != "shadow" or fits(scene, s.variant, width, height)]
+        """The settings `scene` gets: the shadow knobs only where it has shadow maps that fit,
+        the texture knobs only where some material is textured."""
+        return [s for s in plan if (s.variant[0] != "shadow" or fits(scene, s.variant, width, height))
+                and (s.variant[0] != "texture" or is_textured(scene))]
 
     def needs_truth(self, plan: list[Setting]) -> bool:
         """Whether some setting's error is against the ground truth image (not a shadow knob's)."""
@@ -219,9 +235,10 @@ class RasterStudy:
         return ground_truth(scene, width, height, cache_dir)
 
     def describe(self, scene) -> tuple:
-        """The Scenes table's cells: triangles as authored, at the finest tessellation."""
-        return tuple(sum(obj.mesh.triangle_count for obj in drawn.objects)
-                     for drawn in (scene, truth_scene(scene)))
+        """The Scenes table's cells: triangles as authored, at the finest tessellation; the
+        textures as authored."""
+        return (*(sum(obj.mesh.triangle_count for obj in drawn.objects)
+                  for drawn in (scene, truth_scene(scene))), texture_line(scene))
 
     def scene_run(self, scene, width: int, height: int, ctx) -> SceneRun:
         return SceneRun(scene, width, height, ctx)

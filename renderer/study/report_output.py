@@ -18,6 +18,7 @@ from renderer.core import sampling
 from renderer.study.ground_truth import TRUTH_GRID
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, MISMATCH_LEVELS,
                                             PATTERN_KNOBS, TARGETS_RMSE, TEXTBOOK_SLOPES)
+from renderer.study import texture_report
 from renderer.study.shadow_report import method_bullet, shadow_sections
 
 BACKENDS = ("gpu", "reference")
@@ -84,9 +85,9 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
             series[series_key(row)].append(row)
     names = list(dict.fromkeys(series_name(row) for row in rows))
     for index, (name, members) in enumerate(series.items()):
-        # Along the knob: samples per pixel, else the depth (the ray tracer's), else time.
-        members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         first = members[0]
+        if first["knob"] in PATTERN_KNOBS:          # along the samples; other knobs as swept
+            members.sort(key=lambda r: (r["samples"], r.get("max_depth", 0), r["median_ms"]))
         marker, line = STYLES[first["backend"]]
         colour = (_colour(series_name(first), names) if first["knob"] in PATTERN_KNOBS
                   else f"C{index}")
@@ -177,23 +178,27 @@ def _ms(value: float) -> str:
 
 def cheapest_sections(rows: list[dict], scenes: list[str], antialiasing: str) -> list[str]:
     """The markdown lines naming, per scene and backend, the cheapest setting reaching each of
-    TARGETS_RMSE; `antialiasing` says in parentheses what the anti-aliasing settings draw."""
+    TARGETS_RMSE; `antialiasing` says in parentheses what the anti-aliasing settings draw (their
+    table is left out when no row is theirs)."""
     return [line for target in TARGETS_RMSE
             for line in _cheapest_section(rows, scenes, target, antialiasing)]
 
 
 def _cheapest_section(rows: list[dict], scenes: list[str], target: float,
                       antialiasing: str) -> list[str]:
+    tables = [("Any knob", None)]
+    if any(r["knob"] == "antialiasing" for r in rows):
+        tables.append(("Anti-aliasing only", "antialiasing"))
     lines = [
         "",
         f"## Cheapest setting reaching RMSE <= {target:g} (about {target * 255:.1f}/255)",
         "",
         "The fastest setting (median time per image) whose RMSE against the ground truth is at "
-        "most the target, first over every knob's settings, then among the anti-aliasing "
-        f"settings alone ({antialiasing}).",
+        "most the target" + (", first over every knob's settings, then among the anti-aliasing "
+                             f"settings alone ({antialiasing})." if len(tables) > 1 else "."),
         "",
     ]
-    for title, knob in (("Any knob", None), ("Anti-aliasing only", "antialiasing")):
+    for title, knob in tables:
         lines += [f"{title}:", "",
                   "| scene | GPU | ms | RMSE | reference | ms | RMSE |",
                   "| --- | --- | ---: | ---: | --- | ---: | ---: |"]
@@ -250,8 +255,10 @@ def plots_section(scenes: list[str], plots: dict) -> list[str]:
 
 
 def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
+    """report.md: the Method bullets and the sections of the knob families in the rows."""
     rows = result.rows
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    families = {r["knob"].split("-")[0] for r in rows}
     lines = [
         "# Error against run time",
         "",
@@ -260,9 +267,11 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "",
         "## Scenes",
         "",
-        "| scene | triangles as authored | at the finest tessellation (ground truth, anti-aliasing) |",
-        "| --- | ---: | ---: |",
-        *(f"| {name} | {authored} | {finest} |" for name, (authored, finest) in result.scenes.items()),
+        "| scene | triangles as authored | at the finest tessellation (ground truth, anti-aliasing) "
+        "| textures (as authored) |",
+        "| --- | ---: | ---: | --- |",
+        *(f"| {name} | {authored} | {finest} | {textures or 'none'} |"
+          for name, (authored, finest, textures) in result.scenes.items()),
         "",
         "## Method",
         "",
@@ -271,50 +280,93 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         f"segment counts), {TRUTH_GRID}x{TRUTH_GRID} regular-grid supersampling per pixel "
         "(rendered once at 16W x 16H and box-filtered), clamped linear colour in [0, 1]. It is "
         "cached on disk by a hash of the scene's content, the size and these parameters.",
-        errors_bullet() + " MSAA resolves into an 8-bit buffer, so its error has a 1/255 "
-        "quantisation floor (RMSE about 0.001) that the float accumulation does not.",
-        "- **antialiasing** draws the truth's scene (Phong, finest tessellation), so its error is "
-        "the sampling error alone. Supersampling accumulates one full-frame pass per sample, "
-        "each pass the projection moved by the sample's offset (every pixel uses the same "
-        "pattern), and averages the clamped linear colour; the GPU and the reference use the "
-        "same offsets. Patterns (`renderer/core/sampling.py`): `regular` k x k grid, `random` "
-        "uniform, `jittered` one sample per stratum, `poisson` dart throwing (fixed seeds). "
-        "`msaa N` is GL's multisampling (GPU only; the sample counts the context offers for an "
-        "RGBA8 buffer, which on llvmpipe are 1 and 4 (GL_MAX_SAMPLES = 4; a request for 2 gets 4); "
-        "`msaa 1` is one sample at the pixel centre).",
-        "- **adaptive FIRST->TOTAL @T**: FIRST jittered samples; a pixel whose samples' range "
-        "(max - min, largest channel) exceeds T gets TOTAL - FIRST more. `samples` in "
-        "`results.csv` is the mean spent per pixel. The extra samples are paid in full: each is a "
-        "full-frame pass on both backends (no scissor or stencil), whose result is used only at "
-        "the flagged pixels, so adaptive sampling saves samples per pixel but not time here.",
-        f"- **tessellation** (levels x{', x'.join(f'{l:g}' for l in sweep.levels)} of the "
-        f"authored segment counts; icospheres +-log2 subdivisions), **shading** (each mode at "
-        f"the authored tessellation) and **precision** (reference in float32 and float64, the "
-        f"truth's scene) are sampled with a {BASE_SAMPLES}-sample regular grid, the same for "
-        "every setting of a knob, so the differences between settings are the knob's.",
-        method_bullet(),
+        *([texture_report.truth_bullet()] if any(textures for *_, textures in result.scenes.values()) else []),
+        errors_bullet() + (" MSAA resolves into an 8-bit buffer, so its error has a 1/255 "
+                           "quantisation floor (RMSE about 0.001) that the float accumulation "
+                           "does not." if "antialiasing" in families else ""),
     ]
-    if not any(r.get("rmse") is not None for r in rows):         # only the shadow knobs ran
-        return "\n".join(lines + shadow_sections(rows, scenes) + [""] + plots_section(scenes, plots))
-    lines += [
-        "",
-        "## Convergence of the sampling patterns",
-        "",
-        "Least-squares slope of log RMSE against log N (samples per pixel) over all scenes, each "
-        "scene with its own intercept, beside the textbook rate (Mitchell 1996). The textbook "
-        "rates are asymptotic and for edge pixels; a scene's RMSE also holds smooth shading, "
-        "which every pattern resolves at N = 1 already, and the fitted range starts at N = 1. "
-        "Each N is one realisation of its pattern (fixed seeds; at N = 1 random, jittered and "
-        "Poisson are the same single uniform sample), so a slope carries that pattern's noise.",
-        "",
-        "| pattern | backend | fitted slope | per scene: median (range) | points | N | textbook | why |",
-        "| --- | --- | ---: | --- | ---: | --- | --- | --- |",
-    ]
-    for (pattern, backend), fit in convergence_slopes(rows).items():
-        rate, why = TEXTBOOK_SLOPES[pattern]
-        lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread(fit)} | {fit.points} | "
-                     f"{fit.samples[0]:g}-{fit.samples[1]:g} | {rate} | {why} |")
-    lines += cheapest_sections(rows, scenes, "which draw the truth's geometry and shading")
+    if "antialiasing" in families:
+        lines += [
+            "- **antialiasing** draws the truth's scene (Phong, finest tessellation), so its error is "
+            "the sampling error alone. Supersampling accumulates one full-frame pass per sample, "
+            "each pass the projection moved by the sample's offset (every pixel uses the same "
+            "pattern), and averages the clamped linear colour; the GPU and the reference use the "
+            "same offsets. Patterns (`renderer/core/sampling.py`): `regular` k x k grid, `random` "
+            "uniform, `jittered` one sample per stratum, `poisson` dart throwing (fixed seeds). "
+            "`msaa N` is GL's multisampling (GPU only; the sample counts the context offers for an "
+            "RGBA8 buffer, which on llvmpipe are 1 and 4 (GL_MAX_SAMPLES = 4; a request for 2 gets 4); "
+            "`msaa 1` is one sample at the pixel centre).",
+            "- **adaptive FIRST->TOTAL @T**: FIRST jittered samples; a pixel whose samples' range "
+            "(max - min, largest channel) exceeds T gets TOTAL - FIRST more. `samples` in "
+            "`results.csv` is the mean spent per pixel. The extra samples are paid in full: each is a "
+            "full-frame pass on both backends (no scissor or stencil), whose result is used only at "
+            "the flagged pixels, so adaptive sampling saves samples per pixel but not time here."]
+    if families & {"tessellation", "shading", "precision"}:
+        lines.append(
+            f"- **tessellation** (levels x{', x'.join(f'{l:g}' for l in sweep.levels)} of the "
+            f"authored segment counts; icospheres +-log2 subdivisions), **shading** (each mode at "
+            f"the authored tessellation) and **precision** (reference in float32 and float64, the "
+            f"truth's scene) are sampled with a {BASE_SAMPLES}-sample regular grid, the same for "
+            "every setting of a knob, so the differences between settings are the knob's.")
+    if "shadows" in families:
+        lines.append(method_bullet())
+    if families & set(texture_report.KNOBS):
+        lines.append(texture_report.method_bullet())
+    if "antialiasing" in families:
+        lines += [
+            "",
+            "## Convergence of the sampling patterns",
+            "",
+            "Least-squares slope of log RMSE against log N (samples per pixel) over all scenes, each "
+            "scene with its own intercept, beside the textbook rate (Mitchell 1996). The textbook "
+            "rates are asymptotic and for edge pixels; a scene's RMSE also holds smooth shading, "
+            "which every pattern resolves at N = 1 already, and the fitted range starts at N = 1. "
+            "Each N is one realisation of its pattern (fixed seeds; at N = 1 random, jittered and "
+            "Poisson are the same single uniform sample), so a slope carries that pattern's noise.",
+            "",
+            "| pattern | backend | fitted slope | per scene: median (range) | points | N | textbook | why |",
+            "| --- | --- | ---: | --- | ---: | --- | --- | --- |",
+        ]
+        for (pattern, backend), fit in convergence_slopes(rows).items():
+            rate, why = TEXTBOOK_SLOPES[pattern]
+            lines.append(f"| {pattern} | {backend} | {fit.slope:.2f} | {spread(fit)} | {fit.points} | "
+                         f"{fit.samples[0]:g}-{fit.samples[1]:g} | {rate} | {why} |")
+    if any(r.get("rmse") is not None for r in rows):
+        lines += cheapest_sections(rows, scenes, "which draw the truth's geometry and shading")
+    lines += texture_sections(rows)
     lines += shadow_sections(rows, scenes) + [""]
     lines += plots_section(scenes, plots)
     return "\n".join(lines)
+
+
+def texture_sections(rows: list[dict]) -> list[str]:
+    """The section on the texture knobs present in `rows` (renderer/study/texture_report.py),
+    per scene: every setting's time and error on both backends, and the settings on each
+    backend's Pareto front of time and RMSE."""
+    rows = [r for r in rows if r["knob"] in texture_report.KNOBS]
+    if not rows:
+        return []
+    lines = ["", "## Textures: filter and resolution", "",
+             "Per textured scene, each setting's median frame time and its error against the "
+             "truth (RMSE, and ꟻLIP on the GPU's image) on the GPU and in the reference, then the "
+             "settings on each backend's Pareto front (no other setting both faster and more "
+             "accurate)."]
+    for name in dict.fromkeys(r["scene"] for r in rows):
+        scene_rows = [r for r in rows if r["scene"] == name]
+        lines += ["", f"### {name}", "",
+                  "| knob | setting | GPU ms | GPU RMSE | GPU ꟻLIP | reference ms | reference RMSE |",
+                  "| --- | --- | ---: | ---: | ---: | ---: | ---: |"]
+        for knob, setting in dict.fromkeys((r["knob"], r["setting"]) for r in scene_rows):
+            cells = {r["backend"]: r for r in scene_rows if (r["knob"], r["setting"]) == (knob, setting)}
+            gpu, ref = cells.get("gpu"), cells.get("reference")
+            figures = ([_ms(gpu["median_ms"]), f"{gpu['rmse']:.4f}", f"{gpu['flip_mean']:.4f}"]
+                       if gpu else ["", "", ""])
+            figures += [_ms(ref["median_ms"]), f"{ref['rmse']:.4f}"] if ref else ["", ""]
+            lines.append(f"| {knob} | {setting} | " + " | ".join(figures) + " |")
+        for backend in BACKENDS:
+            members = [r for r in scene_rows if r["backend"] == backend]
+            front = [members[i] for i in pareto_front([(r["median_ms"], r["rmse"]) for r in members])]
+            lines += ["", f"Pareto front, {backend} (fastest first): " + ", ".join(
+                f"{r['knob']} {r['setting']} ({_ms(r['median_ms'])} ms, RMSE {r['rmse']:.4f})"
+                for r in front) + "."]
+    return lines

@@ -10,7 +10,7 @@ average (Heckbert's EWA) over the texels of ONE mip level, in float32:
   reads each 8-fragment vector's level sizes from its first two fragments (a lane mix-up in
   lp_build_sample_aniso with per-fragment lods), which the twin does not follow. The anisotropy N never changes it: llvmpipe means to raise pmin^2 to
   pmax^2 / N^2 but compares pmin^2 > pmin^2 N^2, never true, so N > 1 only turns the path on
-  and every N gives the same image (probed: /work/notes/llvmpipe-texture-sampler.md).
+  and every N gives the same image (probed: docs/llvmpipe/texture-sampler.md).
 - The ellipse at that level: with the quad's derivatives in the level's texels (ux, uy) =
   (ds/dx, ds/dy), (vx, vy) = (dt/dx, dt/dy): A = vx^2 + vy^2 + 1, B = -2 (ux vx + uy vy),
   C = ux^2 + uy^2 + 1, F = A C - B^2 / 4, scaled by 1023 / F; its bounding box around the

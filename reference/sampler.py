@@ -2,7 +2,7 @@
 
 What `texture(s, uv)` (implicit LOD) and `textureLod(s, uv, lod)` return in a fragment shader
 for an RGBA8 2D texture (renderer/core/textures.py: `Texture`, `Sampler`), computed as Mesa's
-llvmpipe (gallivm) computes it on this machine: /work/notes/llvmpipe-texture-sampler.md (the
+llvmpipe (gallivm) computes it on this machine: docs/llvmpipe/texture-sampler.md (the
 source study and "Probes on this machine"), held bit for bit in tests/test_sampler_gl.py.
 Constants and the LOD's log2 rules are renderer/core/gl_rules.py's; one level's texels and
 filters are reference/texels.py's, the anisotropic filter reference/anisotropic.py's.

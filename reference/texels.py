@@ -2,7 +2,7 @@
 
 One mip level's part of a texture lookup (reference/sampler.py chooses the levels and blends
 them): texel coordinates, the wrap modes and the nearest and linear filters, on llvmpipe's two
-paths (/work/notes/llvmpipe-texture-sampler.md):
+paths (docs/llvmpipe/texture-sampler.md):
 
 - the fixed-point path (repeat and clamp to edge): texel coordinates in 1/256 of a texel,
   bilinear weights of TEXEL_WEIGHT_BITS, the 8-bit `lerp8` per channel, x first, then y;

@@ -1,7 +1,7 @@
 """Test helpers for the shadow maps on llvmpipe (tests/test_shadow_lookup.py,
 tests/test_shadow_depth.py): a DEPTH_COMPONENT32F texture and a DEPTH_COMPONENT32F 2D array
 texture (moderngl makes neither: they are re-specified through glTexImage2D / glTexImage3D,
-/work/notes/llvmpipe-shadow-sampler.md section 1), and tests/glsl/shadow_lookup.frag run once
+docs/llvmpipe/shadow-sampler.md section 1), and tests/glsl/shadow_lookup.frag run once
 per input texel."""
 
 import ctypes

@@ -41,7 +41,7 @@ from renderer.core.memory import REFERENCE_TILE_PIXELS
 # llvmpipe sets up and evaluates the depth plane in float32 from the window origin (a0 at
 # (0, 0), then a0 + dz/dx x + dz/dy y: lp_state_setup.c calc_coef4, lp_bld_interp.c), so its
 # stored depth is off the exact plane by rounding of the size of 2^-24 (|z| + |dz/dx| x +
-# |dz/dy| y) (/work/notes/llvmpipe-shadow-sampler.md section 5), plus its float32 vertex
+# |dz/dy| y) (docs/llvmpipe/shadow-sampler.md section 5), plus its float32 vertex
 # transform moving the vertices by 2^-24 times the magnitude of the products that make them.
 # Every map is drawn from texel (0, 0) of its layer, so x, y < R. The bound below is that sum
 # times STORE_TIE_ROUNDINGS: the roundings of the vertex product (4 terms), the plane's set-up

@@ -6,7 +6,7 @@ normals N (the normals that are lit), as lighting.py's `visibility` hook asks: 1
 shadow, a fraction where a filter straddles a shadow edge. In the pipeline's dtype, vectorised
 over fragments, with the GLSL's formulas in the GLSL's order: the point moved by the bias
 rule, then compared with the depth its map's layer stored (depth.py) as llvmpipe's
-depth-compare sampler does it (/work/notes/llvmpipe-shadow-sampler.md: the layer chosen, texel
+depth-compare sampler does it (docs/llvmpipe/shadow-sampler.md: the layer chosen, texel
 choice and bilinear weights within it from one float32 product u * S, CLAMP_TO_EDGE to the
 layer's S x S, compare ref <= stored unclamped, denormals flushed).
 

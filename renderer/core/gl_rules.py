@@ -313,7 +313,7 @@ def check_light_count(scene) -> None:
 # How GL's sampler is set for each of renderer/core/textures.py's wraps and filters (the GPU
 # path, renderer/gpu/textures.py), and the numbers llvmpipe's sampler (Mesa's gallivm,
 # lp_bld_sample*.c) computes with, which the twin (reference/sampler.py) follows:
-# /work/notes/llvmpipe-texture-sampler.md, checked on this machine in tests/test_sampler_gl.py.
+# docs/llvmpipe/texture-sampler.md, checked on this machine in tests/test_sampler_gl.py.
 
 GL_NEAREST, GL_LINEAR = 0x2600, 0x2601
 GL_LINEAR_MIPMAP_NEAREST, GL_LINEAR_MIPMAP_LINEAR = 0x2701, 0x2703

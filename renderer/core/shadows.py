@@ -73,7 +73,7 @@ class Tile:
     Every map starts at texel (0, 0) of its own layer, because llvmpipe evaluates a triangle's
     depth plane from the window origin in float32: a map drawn at an offset in a larger texture
     would store depths hundreds of float32 units from the plane's (the probe in
-    /work/notes/llvmpipe-shadow-sampler.md, section 6)."""
+    docs/llvmpipe/shadow-sampler.md, section 6)."""
     layer: int
     size: int
 

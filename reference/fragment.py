@@ -55,6 +55,7 @@ class ObjectVaryings:
     vertices: VertexOutputs
     triangles: TriangleOutputs | None  # flat shading only
     receives_shadows: bool = False
+    displace_lookup: object = None     # a check's displacement of the texture lookup (reference/texture.py)
 
 
 def interpolate(varying: np.ndarray, faces: np.ndarray, triangle: np.ndarray,
@@ -106,7 +107,7 @@ def fragment_texel(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarra
         clip = obj.vertices.gl_Position[obj.faces[triangle]]                 # (N, 3, 4)
         uv_quad = np.stack([at(perspective_weights_at(clip, x, y, *viewport))
                             for x, y in quad_reference(gl_FragCoord[:, 0], gl_FragCoord[:, 1])])
-    return material_texel(texture, at(weights), uv_quad)
+    return material_texel(texture, at(weights), uv_quad, obj.displace_lookup)
 
 
 def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,

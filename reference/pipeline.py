@@ -67,7 +67,7 @@ class PreparedObject:
 
 
 def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: int, height: int,
-                   subpixel_bits: int, reversed_z: bool, dtype) -> PreparedObject:
+                   subpixel_bits: int, reversed_z: bool, dtype, displace_lookup=None) -> PreparedObject:
     """Vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping ->
     viewport transform and snapping -> facing and culling, for one object."""
     mesh, material = obj.mesh, obj.material
@@ -83,7 +83,8 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
-    return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows),
+    return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows,
+                                         displace_lookup),
                           window.select(keep),
                           clipped.source[keep], clipped.weights[keep])
 
@@ -118,14 +119,16 @@ def tiles(width: int, height: int, tile_pixels: int = TILE_PIXELS) -> list[tuple
 
 def render(scene, width: int, height: int, *, dtype=np.float64, subpixel_bits: int = SUBPIXEL_BITS,
            linear: bool = False, depth: bool = True, sample_offset=(0.0, 0.0),
-           tile_pixels: int = TILE_PIXELS) -> Frame:
+           tile_pixels: int = TILE_PIXELS, displace_lookup=None) -> Frame:
     """Render `scene` at width x height with the NumPy reference pipeline, each pixel sampled
     at `sample_offset` (dx, dy) pixels from its centre (Scene.matrices). A frame of more than
     `tile_pixels` pixels is drawn band by band (the same image: every stage after culling
-    works pixel by pixel), so its memory beyond the output arrays stays bounded."""
+    works pixel by pixel), so its memory beyond the output arrays stays bounded.
+    `displace_lookup`: a check's only (reference/texture.py), None for the picture."""
     start = time.perf_counter()
     dtype = np.dtype(dtype)
-    prepared = prepare_frame(scene, width, height, dtype, subpixel_bits, sample_offset, tile_pixels)
+    prepared = prepare_frame(scene, width, height, dtype, subpixel_bits, sample_offset, tile_pixels,
+                             displace_lookup)
     bands = tiles(width, height, tile_pixels)
     if len(bands) == 1:
         frame = _render_tile(bands[0], prepared, scene, width, height, linear, depth, dtype)
@@ -152,7 +155,8 @@ class PreparedFrame:
 
 
 def prepare_frame(scene, width: int, height: int, dtype, subpixel_bits: int = SUBPIXEL_BITS,
-                  sample_offset=(0.0, 0.0), tile_pixels: int = TILE_PIXELS) -> PreparedFrame:
+                  sample_offset=(0.0, 0.0), tile_pixels: int = TILE_PIXELS,
+                  displace_lookup=None) -> PreparedFrame:
     """Every object through prepare_object (those in view), and the frame's shadow maps."""
     check_light_count(scene)             # the GPU's limit, held alike (renderer/core/gl_rules.py)
     frame_matrices = scene.matrices(width, height, sample_offset)
@@ -166,7 +170,8 @@ def prepare_frame(scene, width: int, height: int, dtype, subpixel_bits: int = SU
     prepared, first_orders, first_order = [], [], 0
     for obj, matrices, shown in zip(scene.objects, frame_matrices.objects, visible):
         prepared.append(prepare_object(obj, matrices, frame_matrices, lights, eye, width, height,
-                                       subpixel_bits, reversed_z, dtype) if shown else None)
+                                       subpixel_bits, reversed_z, dtype, displace_lookup)
+                        if shown else None)
         first_orders.append(first_order)
         first_order += len(obj.mesh.faces)
     shadows = shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype, tile_pixels)

@@ -12,6 +12,10 @@ at the fragment's UV, whose RGB (linear) multiplies the coefficients the materia
   pixel is outside it (GL's helper invocations; reference/rasterizer.py,
   perspective_weights_at), differenced in float32 (QuadDerivatives.from_reference).
 - The sampling itself is reference/sampler.py's, texel for texel llvmpipe's.
+- `displace` is a check's, never the picture's: a function (sampler, st) -> st applied to st
+  at the fragment and at its quad's reference pixels alike (so the derivatives follow), for
+  holding GL against the twin at coordinates the texture verifier's bound allows
+  (renderer/checks/texture_bounds.py). None, the default, is the lookup at st itself.
 
 Inputs:  a renderer.core.textures.MaterialTexture (its UV transform as the uniforms
          u_uv_scale, u_uv_offset of renderer/core/uniforms.py); uv (N, 2) the fragments' interpolated UVs
@@ -35,15 +39,23 @@ def lookup_coordinates(uv: np.ndarray, u_uv_scale, u_uv_offset) -> np.ndarray:
     return st + np.asarray(u_uv_offset, dtype=np.float32)
 
 
-def material_texel(material_texture, uv: np.ndarray, uv_quad: np.ndarray | None = None) -> np.ndarray:
+def material_texel(material_texture, uv: np.ndarray, uv_quad: np.ndarray | None = None,
+                   displace=None) -> np.ndarray:
     """The texel (N, 3) at the fragments' UVs (texture(u_texture, st).rgb), in uv's dtype;
-    `uv_quad` is needed (and read) only when the sampler is mipmapped."""
+    `uv_quad` is needed (and read) only when the sampler is mipmapped; `displace` (a check's,
+    see above) moves st before the lookup."""
     uniforms = texture_uniforms(material_texture)
-    st = lookup_coordinates(uv, **uniforms)
+    sampler = material_texture.sampler
+
+    def lookup(q):
+        st = lookup_coordinates(q, **uniforms)
+        return st if displace is None else displace(sampler, st)
+
+    st = lookup(uv)
     derivatives = None
-    if material_texture.sampler.mipmapped:
-        st_quad = np.stack([lookup_coordinates(q, **uniforms) for q in uv_quad])
+    if sampler.mipmapped:
+        st_quad = np.stack([lookup(q) for q in uv_quad])
         derivatives = QuadDerivatives.from_reference(st_quad[..., 0], st_quad[..., 1])
-    rgba = sample(material_texture.texture, material_texture.sampler, st[:, 0], st[:, 1],
+    rgba = sample(material_texture.texture, sampler, st[:, 0], st[:, 1],
                   derivatives=derivatives)
     return np.asarray(rgba[:, :3], dtype=uv.dtype)

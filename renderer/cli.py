@@ -563,6 +563,7 @@ def cmd_compare(args) -> int:
     import reference
     from renderer.checks.compare import (compare_frames, depth_tie_pixels, either_precision, heat_map,
                                          shadow_tie_pixels)
+    from renderer.checks.texture_bounds import accepted_colours
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.paths import output_stem
     from renderer.core.jsonio import finite_or_none, to_json
@@ -582,7 +583,7 @@ def cmd_compare(args) -> int:
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
-    tie, tie_depth, grazing = None, None, 0
+    tie, tie_depth, grazing, envelope_renders = None, None, 0, 0
     if args.method == "raytrace":
         from reference.raytrace.pipeline import render as reference_raytrace
         gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
@@ -596,27 +597,30 @@ def cmd_compare(args) -> int:
         # elsewhere the adaptive pattern's other decision, rgba8_tie).
         truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64", rs=rs)
         tie, tie_depth, grazing = either_precision(ref_frame, truth)
+        expected = ref_frame.rgba8
     else:
         gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
         start = time.perf_counter()
         ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
         reference_ms = (time.perf_counter() - start) * 1000.0
-        tie = ref_frame.rgba8_tie
+        # Anisotropic lookups: the twin's range over the texture verifier's coordinate bound.
+        accepted = accepted_colours(scene, ref_frame, *args.size, subpixel_bits=subpixel_bits)
+        expected, tie, envelope_renders = accepted.rgba8, accepted.tie, accepted.displaced_renders
     warn_if_nothing_drawn(scene, gpu_frame)
     tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
-    result = compare_frames(gpu_frame.rgba8, ref_frame.rgba8, gpu_frame.depth, ref_frame.depth,
+    result = compare_frames(gpu_frame.rgba8, expected, gpu_frame.depth, ref_frame.depth,
                             threshold=tolerance.threshold, deviation=tolerance.deviation,
                             reference_tie=tie, reference_tie_depth=tie_depth)
     with outputs(*names) as written:             # all three or none
         written.png(names[0], gpu_frame.rgba8)
         written.png(names[1], ref_frame.rgba8)
-        written.png(names[2], heat_map(gpu_frame.rgba8, ref_frame.rgba8, tolerance.threshold,
+        written.png(names[2], heat_map(gpu_frame.rgba8, expected, tolerance.threshold,
                                        tolerance.deviation, reference_tie=tie))
     figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
                "shadow_tie_pixels": shadow_tie_pixels(ref_frame) if args.method == "raster" else 0,
-               "grazing_ray_pixels": grazing,
+               "grazing_ray_pixels": grazing, "anisotropic_envelope_renders": envelope_renders,
                "gpu_ms": gpu_ms, "reference_ms": reference_ms,
                "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
     if args.method == "raytrace":        # adaptive: the samples traced, and where the twins chose differently

@@ -4,9 +4,9 @@ import math
 
 import numpy as np
 
-from renderer.checks.compare import (compare_frames, depth_max_rel, either_precision,
-                                     grazing_ray_pixels, heat_map, position_deviation_mismatch,
-                                     raw_mismatch)
+from renderer.checks.compare import (Envelope, channel_difference, compare_frames, depth_max_rel,
+                                     either_precision, grazing_ray_pixels, heat_map,
+                                     position_deviation_mismatch, raw_mismatch)
 from renderer.core.frame import Frame
 
 
@@ -123,3 +123,33 @@ def test_grazing_rays_accept_either_precision_there_and_nothing_else():
     assert compare_frames(result, ref32.rgba8, reference_tie=tie).mismatched_pixels == 1
     result[4, 4], result[1, 1] = ref32.rgba8[4, 4], (200, 10, 10, 255)   # float64's, elsewhere
     assert compare_frames(result, ref32.rgba8, reference_tie=tie).mismatched_pixels == 1
+
+
+def test_an_envelope_accepts_its_range_widened_by_the_threshold_and_nothing_more():
+    """Against an Envelope (several acceptable references: the twin over the texture
+    verifier's coordinate bound, renderer/checks/texture_bounds.py) a channel matches within
+    the threshold of [low, high] and differs by its distance outside; an envelope of one
+    image is that image; the ±1 px allowance and both directions hold as for an image."""
+    low, high = blank(value=100), blank(value=100)
+    high[4, 4, 0] = 110                                  # one channel may be 100..110
+    envelope = Envelope(low, high)
+    result = blank(value=100)
+    for red, outside in [(90, 10), (97, 3), (98, 2), (105, 0), (112, 2), (113, 3)]:
+        result[4, 4, 0] = red
+        assert channel_difference(result, envelope)[4, 4, 0] == outside
+        assert compare_frames(result, envelope).max_abs == outside
+        assert raw_mismatch(result, envelope).sum() == (outside > 2)
+    result[4, 4, 0] = 113                                # beyond high + 2: fails, even within ±1 px
+    assert position_deviation_mismatch(result, envelope).sum() == 1
+    result[4, 4, 0], result[4, 5, 0] = 100, 112          # the neighbour's range holds it
+    assert raw_mismatch(result, envelope).sum() == 1
+    assert not position_deviation_mismatch(result, envelope).any()
+    image = blank(value=60)
+    image[2, 2] = 61
+    same = Envelope.of([image, image])
+    for other in (image, blank(value=64)):
+        assert (position_deviation_mismatch(other, same) == position_deviation_mismatch(other, image)).all()
+        assert (channel_difference(other, same) == channel_difference(other, image)).all()
+    both = Envelope.of([blank(value=10), blank(value=30)])
+    assert (both.low == 10).all() and (both.high == 30).all()
+    assert compare_frames(blank(value=20), both).max_abs == 0

@@ -11,6 +11,11 @@ accepted wherever it differs from the first: the rasteriser reference's rgba8_ti
 ties, and for the ray tracer the float64 reference's colour and depth at grazing pixels, where
 the float32 and float64 references' ray trees differ (`grazing_ray_pixels`,
 `either_precision`; docs/conventions.md, "Grazing rays").
+
+Where a reference is a range rather than one image (an `Envelope`: the twin rendered at the
+corners of the texture verifier's coordinate bound, renderer/checks/texture_bounds.py), a
+channel matches within the threshold of the range, and differences are measured from it:
+the gap between two ranges, which for two images is their difference.
 """
 
 from __future__ import annotations
@@ -27,6 +32,39 @@ DEFAULT_THRESHOLD = PIPELINE_TOLERANCE.threshold          # of 255, per channel
 DEFAULT_DEVIATION = PIPELINE_TOLERANCE.deviation          # pixels
 
 
+@dataclass(frozen=True, eq=False)
+class Envelope:
+    """Several acceptable references as one: per pixel and channel, the lowest and highest
+    of their values ((H, W, C) uint8 each). Where every channel of a result lies within
+    [low, high], it differs from the envelope by 0."""
+    low: np.ndarray
+    high: np.ndarray
+
+    @classmethod
+    def of(cls, images) -> "Envelope":
+        stack = np.stack(images)
+        return cls(stack.min(axis=0), stack.max(axis=0))
+
+    @property
+    def shape(self) -> tuple:
+        return self.low.shape
+
+
+def _range(image) -> tuple[np.ndarray, np.ndarray]:
+    """(low, high) int16 of an Envelope; (image, image) of an image."""
+    if isinstance(image, Envelope):
+        return image.low.astype(np.int16), image.high.astype(np.int16)
+    values = image.astype(np.int16)
+    return values, values
+
+
+def _gap(a, b) -> np.ndarray:
+    """Per channel, how far the ranges a and b ((low, high) pairs) lie apart (0 where they
+    overlap): |a - b| for two single values."""
+    (a_low, a_high), (b_low, b_high) = a, b
+    return np.maximum(np.maximum(b_low - a_high, a_low - b_high), 0)
+
+
 def _offsets(deviation: int):
     return [(dy, dx) for dy in range(-deviation, deviation + 1) for dx in range(-deviation, deviation + 1)]
 
@@ -41,24 +79,27 @@ def _shifted(image: np.ndarray, dy: int, dx: int, fill) -> np.ndarray:
     return out
 
 
-def _matches_nearby(a: np.ndarray, b: np.ndarray, threshold: int, deviation: int) -> np.ndarray:
-    """(H, W) bool: pixel of `a` has a pixel of `b` within ±deviation matching within threshold."""
-    a16, b16 = a.astype(np.int16), b.astype(np.int16)
+def _matches_nearby(a, b, threshold: int, deviation: int) -> np.ndarray:
+    """(H, W) bool: pixel of `a` has a pixel of `b` within ±deviation matching within threshold
+    (either may be an Envelope)."""
+    a_range, (b_low, b_high) = _range(a), _range(b)
     ok = np.zeros(a.shape[:2], dtype=bool)
     for dy, dx in _offsets(deviation):
-        nearby = _shifted(b16, dy, dx, fill=np.int16(-1000))   # outside never matches
-        ok |= np.abs(a16 - nearby).max(axis=-1) <= threshold
+        nearby = (_shifted(b_low, dy, dx, fill=np.int16(-1000)),   # outside never matches
+                  _shifted(b_high, dy, dx, fill=np.int16(-1000)))
+        ok |= _gap(a_range, nearby).max(axis=-1) <= threshold
     return ok
 
 
-def position_deviation_mismatch(result: np.ndarray, reference: np.ndarray,
+def position_deviation_mismatch(result: np.ndarray, reference,
                                 threshold: int = DEFAULT_THRESHOLD,
                                 deviation: int = DEFAULT_DEVIATION,
-                                reference_tie: np.ndarray | None = None) -> np.ndarray:
+                                reference_tie=None) -> np.ndarray:
     """(H, W) bool mask of pixels that fail the dEQP compare in either direction.
 
     `reference_tie` (the reference frame's rgba8_tie) is a second acceptable reference: at
-    a depth tie either surface may show, so a pixel matching either one matches.
+    a depth tie either surface may show, so a pixel matching either one matches. Either
+    reference may be an Envelope.
     """
     result_ok = _matches_nearby(result, reference, threshold, deviation)
     reference_ok = _matches_nearby(reference, result, threshold, deviation)
@@ -68,20 +109,20 @@ def position_deviation_mismatch(result: np.ndarray, reference: np.ndarray,
     return ~(result_ok & reference_ok)
 
 
-def channel_difference(result: np.ndarray, reference: np.ndarray,
-                       reference_tie: np.ndarray | None = None) -> np.ndarray:
-    """(H, W, C) int16 |result - reference| per channel; where `reference_tie` (the
-    reference frame's rgba8_tie) is nearer in its largest channel, against that instead."""
-    diff = np.abs(result.astype(np.int16) - reference.astype(np.int16))
+def channel_difference(result: np.ndarray, reference, reference_tie=None) -> np.ndarray:
+    """(H, W, C) int16 |result - reference| per channel (from an Envelope: how far outside it);
+    where `reference_tie` (the reference frame's rgba8_tie) is nearer in its largest channel,
+    against that instead."""
+    diff = _gap(_range(result), _range(reference))
     if reference_tie is not None:
-        tie_diff = np.abs(result.astype(np.int16) - reference_tie.astype(np.int16))
+        tie_diff = _gap(_range(result), _range(reference_tie))
         closer = tie_diff.max(axis=-1) < diff.max(axis=-1)
         diff[closer] = tie_diff[closer]
     return diff
 
 
-def raw_mismatch(result: np.ndarray, reference: np.ndarray, threshold: int = DEFAULT_THRESHOLD,
-                 reference_tie: np.ndarray | None = None) -> np.ndarray:
+def raw_mismatch(result: np.ndarray, reference, threshold: int = DEFAULT_THRESHOLD,
+                 reference_tie=None) -> np.ndarray:
     """(H, W) bool mask of pixels with any channel off by more than the threshold (from
     both the reference and, if given, its depth-tie alternative)."""
     return channel_difference(result, reference, reference_tie).max(axis=-1) > threshold
@@ -173,15 +214,16 @@ class Comparison:
         return asdict(self)
 
 
-def compare_frames(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
+def compare_frames(result_rgba8: np.ndarray, reference_rgba8,
                    result_depth: np.ndarray | None = None, reference_depth: np.ndarray | None = None,
                    threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION,
-                   reference_tie: np.ndarray | None = None,
+                   reference_tie=None,
                    reference_tie_depth: np.ndarray | None = None) -> Comparison:
     """The figures of `renderer compare`. `reference_tie`: the reference frame's rgba8_tie,
     accepted wherever it differs (pixels at a depth tie), or the other precision's colour at
     grazing rays (`either_precision`, with its depth as `reference_tie_depth`); max_abs and
-    the like measure against the nearer of the two there."""
+    the like measure against the nearer of the two there. Either colour reference may be an
+    Envelope (texture_bounds.py), measured from its range."""
     if result_rgba8.shape != reference_rgba8.shape:
         raise ValueError(f"image sizes differ: {result_rgba8.shape} and {reference_rgba8.shape}")
     difference = channel_difference(result_rgba8, reference_rgba8, reference_tie)
@@ -209,9 +251,9 @@ _RAMP_FULL_SCALE = 8.0
 _MISMATCH_COLOUR = (255, 0, 255)
 
 
-def heat_map(result_rgba8: np.ndarray, reference_rgba8: np.ndarray,
+def heat_map(result_rgba8: np.ndarray, reference_rgba8,
              threshold: int = DEFAULT_THRESHOLD, deviation: int = DEFAULT_DEVIATION,
-             reference_tie: np.ndarray | None = None) -> np.ndarray:
+             reference_tie=None) -> np.ndarray:
     """(H, W, 3) uint8 amplified difference: the ramp reaches white at 8 levels of 255, and
     pixels that fail the position-deviation compare are magenta."""
     diff = channel_difference(result_rgba8, reference_rgba8, reference_tie).max(axis=-1)

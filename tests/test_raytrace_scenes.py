@@ -187,15 +187,10 @@ def test_gpu_ray_tracer_matches_the_reference_small(name, gl_contexts, traced_re
     assert_within_tolerance(frame, reference)
 
 
-# Issue 16's scenes are held at 4 and 16 samples (their own tests; glossy:
-# tests/test_raytrace_glossy.py): at 1 sample a pixel is one camera ray's path, and a glossy
-# path bouncing between curved surfaces amplifies the GPU's and the twin's last-bit
-# differences (intersections, lighting) until, now and then, a shadow ray or a reflected ray
-# on the edge of a surface goes another way: glossy at 320x240, 1 regular sample, has one
-# pixel 11/255 apart (docs/conventions.md, "Glossy reflection").
-ISSUE_16_SCENES = {"glossy"}
-RULE_CASES = [(name, samples) for name in SCENES for samples in (1, 4)
-              if not (samples == 1 and name in ISSUE_16_SCENES)]
+# Every built-in ray-traced scene at 1 and 4 regular samples, glossy included: its one pixel
+# 11/255 apart at 1 sample went when the twin's intersections took GLSL's dot in llvmpipe's
+# order (reference/raytrace/intersect.py, _dot; docs/conventions.md, "Glossy reflection").
+RULE_CASES = [(name, samples) for name in SCENES for samples in (1, 4)]
 
 
 @pytest.mark.slow

@@ -85,13 +85,11 @@ def ray_textures(scene, sphere_object, plane_object, triangle_uvs) -> RayTexture
 
 
 def mesh_uvs(obj) -> np.ndarray:
-    """The object's vertex UVs (V, 2) for the ray scene's triangles: its mesh's, or zeros
-    where it has none (a ValueError if its material is textured: nothing to look up)."""
-    uvs = obj.mesh.uvs
+    """The object's vertex UVs (V, 2) for the ray scene's triangles: what its lookup reads
+    (SceneObject.texture_coordinates: a ValueError for a textured material on a mesh without
+    UVs), or zeros where its material is untextured (never looked up)."""
+    uvs = obj.texture_coordinates()
     if uvs is None:
-        if obj.material.textured:
-            raise ValueError(f"object {obj.name!r}: its material is textured but its mesh has "
-                             "no texture coordinates")
         return np.zeros((len(obj.mesh.positions), 2))
     return np.asarray(uvs, np.float64)
 

@@ -179,7 +179,7 @@ def test_the_search_finds_the_literals_it_replaced():
         "renderer/gpu/pipeline.py": "GL_ZERO_TO_ONE = 0x935F\ns_ndc, t_ndc = (1.0, 0.0) if reversed_z else (2.0, -1.0)\n"
                                     "target.clear(r, g, b, 0.0, depth=0.0 if reversed_z else 1.0)\n"
                                     "ctx.depth_func = '>' if reversed_z else '<'\n",
-        "reference/output.py": "u = np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5)\n",
+        "reference/framebuffer.py": "u = np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5)\n",
         "tests/test_x.py": "RAW_MISMATCH_LIMIT = 0.001\n",
         "reference/sampler.py": "TEXEL_WEIGHT_BITS = 8\nc = c.astype(np.float32) * np.float32(1 / 255)\n"
                                 "m = (bits & 8388607 | 0x3F800000).view(np.float32)\nF = 0x2703\n"

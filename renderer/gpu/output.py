@@ -71,7 +71,8 @@ class OutputPass:
         self._blue_noise: moderngl.Buffer | None = None
 
     # -- GL objects, each made once ------------------------------------------------------------
-    def _program(self, settings: OutputSettings) -> moderngl.ComputeShader:
+    def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
+        """The compiled program that runs `settings` (made on first use)."""
         defines = settings.defines()
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
@@ -126,7 +127,7 @@ class OutputPass:
             raise ValueError(f"the output stage takes (H, W, 4) linear colour, got {linear.shape}")
         height, width = linear.shape[:2]
         activate(self.ctx)
-        program = self._program(settings)
+        program = self.program(settings)
         source, target = self._image_pair(width, height, settings.quantised)
         source.write(linear)
         source.bind_to_image(INPUT_IMAGE, read=True, write=False)

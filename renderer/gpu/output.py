@@ -73,6 +73,7 @@ class OutputPass:
     # -- GL objects, each made once ------------------------------------------------------------
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
         """The compiled program that runs `settings` (made on first use)."""
+        activate(self.ctx)              # another context may be current: compile on ours
         defines = settings.defines()
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
@@ -166,6 +167,7 @@ class OutputPass:
         raise NotImplementedError(f"--dither {settings.dither}: not yet on the GPU")
 
     def release(self) -> None:
+        activate(self.ctx)
         for obj in self.gl_objects():
             obj.release()
         self._programs.clear()

@@ -11,8 +11,9 @@ so the shader's y is the image row from the top, the dither patterns' y. Quantis
 give codes in [0, 2^N - 1], N = settings.code_bits; float formats give encode(L) per RGB
 channel and alpha as it is.
 
-GL objects are made on first use and kept: a program per set of defines (settings.defines():
-a program holds only the method it runs), the input and output images per size and kind,
+GL objects are made on first use and kept: a program per set of defines (program_defines:
+settings.defines(), so that a program holds only the method it runs, less the transfer of
+codes, which the tables carry), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (one SSBO, renderer/core/quantise.py), the
 blue-noise ranks once. A second apply() with settings and a size seen before makes no GL
 object. Error diffusion runs its own program in wavefronts (`_diffuse`).
@@ -59,6 +60,15 @@ def transfer_uniforms(transfer: Transfer) -> dict:
                             (SRGB_LINEAR_LIMIT, SRGB_SLOPE, 1.0 + SRGB_A, SRGB_A))}
 
 
+def program_defines(settings: OutputSettings) -> dict[str, str]:
+    """settings.defines() less the transfer's where the output is quantised: codes come from
+    the tables of (transfer, bits), so the define would only compile the same program again."""
+    defines = settings.defines()
+    if settings.quantised:
+        defines = {name: value for name, value in defines.items() if not name.startswith("TRANSFER_")}
+    return defines
+
+
 class OutputPass:
     """The GPU output stage of one context; see the module docstring."""
 
@@ -73,7 +83,8 @@ class OutputPass:
     # -- GL objects, each made once ------------------------------------------------------------
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
         """The compiled program that runs `settings` (made on first use)."""
-        defines = settings.defines()
+        activate(self.ctx)              # another context may be current: compile on ours
+        defines = program_defines(settings)
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
         if program is None:
@@ -166,6 +177,7 @@ class OutputPass:
         raise NotImplementedError(f"--dither {settings.dither}: not yet on the GPU")
 
     def release(self) -> None:
+        activate(self.ctx)
         for obj in self.gl_objects():
             obj.release()
         self._programs.clear()

@@ -37,7 +37,7 @@ from reference.depth_buffer import DepthBuffer
 from reference.fragment import ObjectVaryings, lit_point, shade_fragments
 from reference.geometry import shade_triangles
 from reference.lighting import Lights, normalize_or_zero
-from reference.output import compose_frame
+from reference.framebuffer import compose_frame
 from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
 from reference.shadow.depth import render_layers
 from reference.shadow.lookup import ShadowMaps

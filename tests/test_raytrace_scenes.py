@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from reference.lighting import Lights
-from reference.output import flip_rows
+from reference.framebuffer import flip_rows
 from reference.raytrace.camera import camera_ray, pixel_windows
 from reference.raytrace.pipeline import render as reference_raytrace
 from reference.raytrace.trace import trace

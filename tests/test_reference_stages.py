@@ -1,7 +1,7 @@
 """The reference pipeline stage by stage, each case worked out by hand.
 
 Clipping (reference/clipping.py), rasterisation (reference/rasterizer.py), depth test
-(reference/depth_buffer.py), output conversion (reference/output.py) and the whole draw
+(reference/depth_buffer.py), output conversion (reference/framebuffer.py) and the whole draw
 (reference/pipeline.py). The llvmpipe comparisons of the fill rule and snapping are in
 tests/test_rasterizer.py; the lighting equation in tests/test_lighting.py.
 """

@@ -32,7 +32,7 @@ import time
 import numpy as np
 
 from reference.lighting import Lights
-from reference.output import flip_rows
+from reference.framebuffer import flip_rows
 from reference.raytrace.camera import camera_ray, lens_point, thin_lens_ray
 from reference.raytrace.sampling import RaySamples, sample_offset
 from reference.raytrace.trace import mix64, trace

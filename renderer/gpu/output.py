@@ -11,12 +11,20 @@ so the shader's y is the image row from the top, the dither patterns' y. Quantis
 give codes in [0, 2^N - 1], N = settings.code_bits; float formats give encode(L) per RGB
 channel and alpha as it is.
 
-GL objects are made on first use and kept: a program per set of defines (program_defines:
-settings.defines(), so that a program holds only the method it runs, less the transfer of
-codes, which the tables carry), the input and output images per size and kind,
-the quantisation tables per (transfer, bits) (one SSBO, renderer/core/quantise.py), the
-blue-noise ranks once. A second apply() with settings and a size seen before makes no GL
-object. Error diffusion runs its own program in wavefronts (`_diffuse`).
+GL objects are made on first use and kept: a program per set of defines (settings.defines():
+a program holds only the method it runs), the input and output images per size and kind,
+the quantisation tables per (transfer, bits) (renderer/core/quantise.py; one float texture,
+`table_texture`), the blue-noise ranks once (an SSBO). A second apply() with settings and a
+size seen before makes no GL object. Error diffusion runs its own program in wavefronts
+(`_diffuse`).
+
+Why the tables are a texture and not an SSBO: on llvmpipe (Mesa 22.3.6, EGL and OSMesa) the
+read of l_c0 that follows quantise.glsl's search loops, from an SSBO, read the wrong entry in
+34 of 1440 pixels (0.0, or with one invocation per work group the entry after it) though the
+count it used was right: a driver fault with SSBO loads after such loops (a plain loop with
+an SSBO read in its condition did not show it). The same search reading a texture is exact
+on every test, and texelFetch gathers about 2.2 times faster (measured: a 640 x 480 binary
+search of 8 steps per channel, 84 ms from an SSBO, 38 ms from a texture).
 """
 
 from __future__ import annotations
@@ -35,21 +43,33 @@ from renderer.gpu.shaders import ShaderSourceError, shader_source
 
 GROUP_SIZE = 8                       # output.comp's local_size_x and _y
 LINEAR = Transfer("linear")
-# Bindings, as the GLSL declares them: images 0 (input) and 1 (output); SSBOs 0 (tables),
-# 1 (blue-noise ranks).
+# Bindings, as the GLSL declares them: images 0 (input) and 1 (output), texture unit 0 (the
+# tables), SSBO 1 (blue-noise ranks).
 INPUT_IMAGE, OUTPUT_IMAGE = 0, 1
-TABLES_BUFFER, BLUE_NOISE_BUFFER = 0, 1
+TABLES_UNIT, BLUE_NOISE_BUFFER = 0, 1
+TABLE_ROW_BITS = 12                  # the tables' texture is 2^12 entries wide
 
 
 def table_layout(transfer: Transfer, bits: int) -> tuple[np.ndarray, dict[str, int]]:
-    """The quantisation SSBO of (transfer, bits) and the uniforms naming where each table
-    starts (glsl/output/quantise.glsl): decision points of the transfer, of the linear
-    transfer (alpha), the codes' linear values."""
+    """The quantisation tables of (transfer, bits), one after the other, and the uniforms
+    naming where each starts (glsl/output/quantise.glsl): the decision points of the
+    transfer, those of the linear transfer (alpha), the codes' linear values."""
     tables = (decision_points(transfer, bits), decision_points(LINEAR, bits),
               code_values(transfer, bits))
     offsets = np.cumsum([0] + [len(t) for t in tables[:-1]])
     names = ("u_decision_points", "u_alpha_points", "u_code_values")
     return np.concatenate(tables), dict(zip(names, map(int, offsets)))
+
+
+def table_texture(ctx: moderngl.Context, transfer: Transfer, bits: int):
+    """(texture, uniforms): table_layout's entries in a float texture 2^TABLE_ROW_BITS wide,
+    entry i at texel (i mod width, i div width), and the uniforms that find them."""
+    data, offsets = table_layout(transfer, bits)
+    width = 1 << TABLE_ROW_BITS
+    texels = np.zeros(-(-data.size // width) * width, np.float32)
+    texels[:data.size] = data
+    texture = ctx.texture((width, texels.size // width), 1, texels.tobytes(), dtype="f4")
+    return texture, {"u_table_row_bits": TABLE_ROW_BITS, **offsets}
 
 
 def transfer_uniforms(transfer: Transfer) -> dict:
@@ -60,15 +80,6 @@ def transfer_uniforms(transfer: Transfer) -> dict:
                             (SRGB_LINEAR_LIMIT, SRGB_SLOPE, 1.0 + SRGB_A, SRGB_A))}
 
 
-def program_defines(settings: OutputSettings) -> dict[str, str]:
-    """settings.defines() less the transfer's where the output is quantised: codes come from
-    the tables of (transfer, bits), so the define would only compile the same program again."""
-    defines = settings.defines()
-    if settings.quantised:
-        defines = {name: value for name, value in defines.items() if not name.startswith("TRANSFER_")}
-    return defines
-
-
 class OutputPass:
     """The GPU output stage of one context; see the module docstring."""
 
@@ -77,14 +88,14 @@ class OutputPass:
         self.last_milliseconds = 0.0
         self._programs: dict[tuple, moderngl.ComputeShader] = {}
         self._images: dict[tuple, tuple[moderngl.Texture, moderngl.Texture]] = {}
-        self._tables: dict[tuple, tuple[moderngl.Buffer, dict]] = {}
+        self._tables: dict[tuple, tuple[moderngl.Texture, dict]] = {}
         self._blue_noise: moderngl.Buffer | None = None
 
     # -- GL objects, each made once ------------------------------------------------------------
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
         """The compiled program that runs `settings` (made on first use)."""
         activate(self.ctx)              # another context may be current: compile on ours
-        defines = program_defines(settings)
+        defines = settings.defines()
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
         if program is None:
@@ -109,13 +120,11 @@ class OutputPass:
             pair = self._images[key] = (source, target)
         return pair
 
-    def _table_buffer(self, transfer: Transfer, bits: int):
+    def _table_texture(self, transfer: Transfer, bits: int):
         key = (transfer, bits)
-        entry = self._tables.get(key)
-        if entry is None:
-            data, offsets = table_layout(transfer, bits)
-            entry = self._tables[key] = (self.ctx.buffer(data.tobytes()), offsets)
-        return entry
+        if key not in self._tables:
+            self._tables[key] = table_texture(self.ctx, transfer, bits)
+        return self._tables[key]
 
     def _blue_noise_buffer(self) -> moderngl.Buffer:
         if self._blue_noise is None:
@@ -126,7 +135,7 @@ class OutputPass:
     def gl_objects(self) -> list:
         """Every GL object the pass holds (tests: a repeated apply() adds none)."""
         objects = [*self._programs.values(), *(t for pair in self._images.values() for t in pair),
-                   *(buffer for buffer, _ in self._tables.values())]
+                   *(texture for texture, _ in self._tables.values())]
         return objects + ([self._blue_noise] if self._blue_noise is not None else [])
 
     # -- the stage ------------------------------------------------------------------------------
@@ -156,17 +165,15 @@ class OutputPass:
         return out
 
     def _set_uniforms(self, program: moderngl.ComputeShader, settings: OutputSettings) -> None:
-        values = {}
+        values = transfer_uniforms(settings.transfer)    # float output; codes' first guess
         if settings.quantised:
             bits = settings.code_bits
-            buffer, offsets = self._table_buffer(settings.transfer, bits)
-            buffer.bind_to_storage_buffer(TABLES_BUFFER)
-            values |= {"u_bits": bits, **offsets}
+            texture, uniforms = self._table_texture(settings.transfer, bits)
+            texture.use(TABLES_UNIT)
+            values |= {"u_bits": bits, "u_tables": TABLES_UNIT, **uniforms}
             if settings.dither == "blue-noise":
                 self._blue_noise_buffer().bind_to_storage_buffer(BLUE_NOISE_BUFFER)
                 values["u_blue_noise_size"] = blue_noise_ranks().shape[0]
-        else:
-            values |= transfer_uniforms(settings.transfer)
         for name, value in values.items():
             uniform = program.get(name, None)     # the compiler drops what a variant never reads
             if uniform is not None:

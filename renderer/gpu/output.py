@@ -14,8 +14,9 @@ channel and alpha as it is.
 GL objects are made on first use and kept: a program per set of defines (settings.defines():
 a program holds only the method it runs), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (one SSBO, renderer/core/quantise.py), the
-blue-noise ranks once. A second apply() with settings and a size seen before makes no GL
-object. Error diffusion runs its own program in wavefronts (`_diffuse`).
+blue-noise ranks once, error diffusion's error image per size. A second apply() with settings
+and a size seen before makes no GL object. Error diffusion runs its own program in wavefronts
+(`_diffuse`).
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ import moderngl
 import numpy as np
 
 from renderer.core.blue_noise import blue_noise_ranks
+from renderer.core.error_kernels import KERNELS, pull_taps, wavefronts
+from renderer.core.halftone_screen import screen_basis
 from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Transfer
 from renderer.core.quantise import (SRGB_A, SRGB_EXPONENT, SRGB_LINEAR_LIMIT, SRGB_SLOPE,
                                     code_values, decision_points)
@@ -33,10 +36,12 @@ from renderer.gpu.context import activate
 from renderer.gpu.shaders import ShaderSourceError, shader_source
 
 GROUP_SIZE = 8                       # output.comp's local_size_x and _y
+WAVEFRONT_GROUP = 64                 # error_diffusion.comp's local_size_x
+MAX_TAPS = 12                        # error_diffusion.comp's tap arrays
 LINEAR = Transfer("linear")
-# Bindings, as the GLSL declares them: images 0 (input) and 1 (output); SSBOs 0 (tables),
-# 1 (blue-noise ranks).
-INPUT_IMAGE, OUTPUT_IMAGE = 0, 1
+# Bindings, as the GLSL declares them: images 0 (input), 1 (output) and 2 (error diffusion's
+# errors); SSBOs 0 (tables), 1 (blue-noise ranks).
+INPUT_IMAGE, OUTPUT_IMAGE, ERROR_IMAGE = 0, 1, 2
 TABLES_BUFFER, BLUE_NOISE_BUFFER = 0, 1
 
 
@@ -69,6 +74,7 @@ class OutputPass:
         self._images: dict[tuple, tuple[moderngl.Texture, moderngl.Texture]] = {}
         self._tables: dict[tuple, tuple[moderngl.Buffer, dict]] = {}
         self._blue_noise: moderngl.Buffer | None = None
+        self._errors: dict[tuple, moderngl.Texture] = {}
 
     # -- GL objects, each made once ------------------------------------------------------------
     def _program(self, settings: OutputSettings) -> moderngl.ComputeShader:
@@ -111,10 +117,21 @@ class OutputPass:
             self._blue_noise = self.ctx.buffer(ranks.tobytes())
         return self._blue_noise
 
+    def _error_image(self, width: int, height: int, reach: int) -> moderngl.Texture:
+        """Error diffusion's errors: (W + 2 reach) x (H + reach) rgba32f, made zero; only the
+        image's own pixels are ever written, so the border stays zero."""
+        key = (width, height, reach)
+        image = self._errors.get(key)
+        if image is None:
+            size = (width + 2 * reach, height + reach)
+            image = self._errors[key] = self.ctx.texture(size, 4, dtype="f4")
+            image.write(np.zeros((size[1], size[0], 4), np.float32))
+        return image
+
     def gl_objects(self) -> list:
         """Every GL object the pass holds (tests: a repeated apply() adds none)."""
         objects = [*self._programs.values(), *(t for pair in self._images.values() for t in pair),
-                   *(buffer for buffer, _ in self._tables.values())]
+                   *(buffer for buffer, _ in self._tables.values()), *self._errors.values()]
         return objects + ([self._blue_noise] if self._blue_noise is not None else [])
 
     # -- the stage ------------------------------------------------------------------------------
@@ -153,6 +170,8 @@ class OutputPass:
             if settings.dither == "blue-noise":
                 self._blue_noise_buffer().bind_to_storage_buffer(BLUE_NOISE_BUFFER)
                 values["u_blue_noise_size"] = blue_noise_ranks().shape[0]
+            if settings.halftone is not None:
+                program["u_screen"].write(screen_basis(settings.halftone))
         else:
             values |= transfer_uniforms(settings.transfer)
         for name, value in values.items():
@@ -161,8 +180,26 @@ class OutputPass:
                 uniform.value = value
 
     def _diffuse(self, program, settings: OutputSettings, width: int, height: int) -> None:
-        """Error diffusion: one dispatch per wavefront (glsl/output/error_diffusion.comp)."""
-        raise NotImplementedError(f"--dither {settings.dither}: not yet on the GPU")
+        """Error diffusion: one dispatch per wavefront t = x + s y, in order, with a memory
+        barrier between them (the next reads what this one wrote), W + s (H - 1) dispatches
+        (glsl/output/error_diffusion.comp; renderer/core/error_kernels.py)."""
+        kernel = KERNELS[settings.dither]
+        offsets, weights = pull_taps(settings.dither)
+        tap_offsets = np.zeros((MAX_TAPS, 2), np.int32)
+        tap_weights = np.zeros(MAX_TAPS, np.float32)
+        tap_offsets[:len(weights)], tap_weights[:len(weights)] = offsets, weights
+        program["u_tap_offset"].write(tap_offsets)
+        program["u_tap_weight"].write(tap_weights)
+        program["u_taps"].value = len(weights)
+        program["u_skew"].value = kernel.skew
+        program["u_reach"].value = kernel.reach
+        self._error_image(width, height, kernel.reach).bind_to_image(ERROR_IMAGE, read=True,
+                                                                     write=True)
+        wavefront = program["u_wavefront"]
+        for t, first, last in wavefronts(width, height, kernel.skew):
+            wavefront.value = (t, first, last)
+            program.run((last - first) // WAVEFRONT_GROUP + 1)
+            self.ctx.memory_barrier()
 
     def release(self) -> None:
         for obj in self.gl_objects():
@@ -170,4 +207,5 @@ class OutputPass:
         self._programs.clear()
         self._images.clear()
         self._tables.clear()
+        self._errors.clear()
         self._blue_noise = None

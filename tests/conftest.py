@@ -176,7 +176,7 @@ def cli():
 @pytest.fixture
 def gpu_stand_in(monkeypatch):
     """gpu_stand_in(frame): from now on, in this test, the command line's GPU render
-    (renderer.cli._render_gpu, which `render --backend gpu` and `compare` call) hands back
+    (renderer.cli._render_gpu, which `compare` calls) hands back
     `frame` instead of drawing, so that `renderer.cli.main([...])` can be run in-process on a
     frame made to order (e.g. a reference frame with some pixels changed)."""
     from renderer import cli

@@ -11,8 +11,9 @@ so the shader's y is the image row from the top, the dither patterns' y. Quantis
 give codes in [0, 2^N - 1], N = settings.code_bits; float formats give encode(L) per RGB
 channel and alpha as it is.
 
-GL objects are made on first use and kept: a program per set of defines (settings.defines():
-a program holds only the method it runs), the input and output images per size and kind,
+GL objects are made on first use and kept: a program per set of defines (program_defines:
+settings.defines(), so that a program holds only the method it runs, less the transfer of
+codes, which the tables carry), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (one SSBO, renderer/core/quantise.py), the
 blue-noise ranks once, error diffusion's error image per size and shares per kernel. A second apply() with settings
 and a size seen before makes no GL object. Error diffusion runs its own program in wavefronts
@@ -64,6 +65,15 @@ def transfer_uniforms(transfer: Transfer) -> dict:
                             (SRGB_LINEAR_LIMIT, SRGB_SLOPE, 1.0 + SRGB_A, SRGB_A))}
 
 
+def program_defines(settings: OutputSettings) -> dict[str, str]:
+    """settings.defines() less the transfer's where the output is quantised: codes come from
+    the tables of (transfer, bits), so the define would only compile the same program again."""
+    defines = settings.defines()
+    if settings.quantised:
+        defines = {name: value for name, value in defines.items() if not name.startswith("TRANSFER_")}
+    return defines
+
+
 class OutputPass:
     """The GPU output stage of one context; see the module docstring."""
 
@@ -78,8 +88,10 @@ class OutputPass:
         self._weights: dict[str, moderngl.Buffer] = {}
 
     # -- GL objects, each made once ------------------------------------------------------------
-    def _program(self, settings: OutputSettings) -> moderngl.ComputeShader:
-        defines = settings.defines()
+    def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
+        """The compiled program that runs `settings` (made on first use)."""
+        activate(self.ctx)              # another context may be current: compile on ours
+        defines = program_defines(settings)
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
         if program is None:
@@ -150,7 +162,7 @@ class OutputPass:
             raise ValueError(f"the output stage takes (H, W, 4) linear colour, got {linear.shape}")
         height, width = linear.shape[:2]
         activate(self.ctx)
-        program = self._program(settings)
+        program = self.program(settings)
         source, target = self._image_pair(width, height, settings.quantised)
         source.write(linear)
         source.bind_to_image(INPUT_IMAGE, read=True, write=False)
@@ -208,6 +220,7 @@ class OutputPass:
             self.ctx.memory_barrier()
 
     def release(self) -> None:
+        activate(self.ctx)
         for obj in self.gl_objects():
             obj.release()
         self._programs.clear()

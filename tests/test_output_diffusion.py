@@ -15,7 +15,7 @@ from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Trans
 from renderer.core.quantise import code_values
 from reference.output.error_diffusion import diffuse
 from reference.output.quantise import clamp_light
-from test_output_stage import test_frame
+from output_cases import linear_frame
 
 LINEAR, SRGB = Transfer("linear"), Transfer("srgb")
 
@@ -188,7 +188,7 @@ def test_a_flat_fields_blocks_keep_its_level(name, levels, side):
 @pytest.mark.parametrize("name", ERROR_DIFFUSION)
 @pytest.mark.parametrize("transfer", (LINEAR, SRGB), ids=str)
 def test_the_gpu_wavefronts_are_the_twin(output_passes, kind, name, transfer):
-    frame = test_frame(width=23, height=17)
+    frame = linear_frame(width=23, height=17)
     for bits in (1, 2, 4, 8):
         settings = OutputSettings(transfer=transfer, bits=bits, dither=name)
         np.testing.assert_array_equal(output_passes[kind].apply(frame, settings),

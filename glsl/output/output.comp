@@ -7,6 +7,7 @@
 //   (none)                  the nearest code, quantise.glsl
 //   DITHER_ORDERED=n        Bayer n x n thresholds, dither.glsl
 //   DITHER_BLUE_NOISE       a void-and-cluster mask's thresholds, dither.glsl
+//   HALFTONE                clustered-dot screens of inks C, M, Y, K, halftone.glsl
 //   FLOAT_OUTPUT            encode(), transfer.glsl
 // Alpha is always the plain nearest code of the linear transfer. Error diffusion has its own
 // program (error_diffusion.comp; it is sequential); a half-tone screens here (HALFTONE).
@@ -20,6 +21,9 @@ layout(rgba32f, binding = 1) uniform writeonly image2D u_encoded;
 layout(rgba16ui, binding = 1) uniform writeonly uimage2D u_codes;
 #include "quantise.glsl"
 #include "dither.glsl"
+#if defined(HALFTONE)
+#include "halftone.glsl"
+#endif
 #endif
 
 void main() {
@@ -32,7 +36,9 @@ void main() {
     imageStore(u_encoded, p, vec4(encode(linear.r), encode(linear.g), encode(linear.b), linear.a));
 #else
     uvec4 code;
-#if defined(DITHER_ORDERED) || defined(DITHER_BLUE_NOISE)
+#if defined(HALFTONE)
+    code.rgb = halftone_codes(linear.rgb, uvec2(p));
+#elif defined(DITHER_ORDERED) || defined(DITHER_BLUE_NOISE)
     float threshold = dither_threshold(uvec2(p));
     code.r = bracketed_code(linear.r, threshold);
     code.g = bracketed_code(linear.g, threshold);

@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from renderer.core.output_settings import ORDERED, OutputSettings, Transfer
-from reference.output import dither, quantise, transfer
+from renderer.core.output_settings import ERROR_DIFFUSION, ORDERED, OutputSettings, Transfer
+from reference.output import dither, error_diffusion, halftone, quantise, transfer
 
 LINEAR = Transfer("linear")
 
@@ -25,6 +25,8 @@ METHODS = {
     "none": quantise.undithered,
     **{name: dither.dithered for name in ORDERED},
     "blue-noise": dither.dithered,
+    **{name: error_diffusion.diffused for name in ERROR_DIFFUSION},
+    "halftone": halftone.halftoned,
 }
 
 

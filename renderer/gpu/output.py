@@ -14,9 +14,9 @@ channel and alpha as it is.
 GL objects are made on first use and kept: a program per set of defines (settings.defines():
 a program holds only the method it runs), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (renderer/core/quantise.py; one float texture,
-`table_texture`), the blue-noise ranks once (an SSBO). A second apply() with settings and a
-size seen before makes no GL object. Error diffusion runs its own program in wavefronts
-(`_diffuse`).
+`table_texture`), the blue-noise ranks once (an SSBO), error diffusion's error image per size
+and its shares per kernel (a float texture). A second apply() with settings and a size seen
+before makes no GL object. Error diffusion runs its own program in wavefronts (`_diffuse`).
 
 Why the tables are a texture and not an SSBO: on llvmpipe (Mesa 22.3.6, EGL and OSMesa) the
 read of l_c0 that follows quantise.glsl's search loops, from an SSBO, read the wrong entry in
@@ -35,6 +35,8 @@ import moderngl
 import numpy as np
 
 from renderer.core.blue_noise import blue_noise_ranks
+from renderer.core.error_kernels import KERNELS, pull_taps, sender_weights, wavefronts
+from renderer.core.halftone_screen import screen_basis
 from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Transfer
 from renderer.core.quantise import (SRGB_A, SRGB_EXPONENT, SRGB_LINEAR_LIMIT, SRGB_SLOPE,
                                     code_values, decision_points)
@@ -42,11 +44,14 @@ from renderer.gpu.context import activate
 from renderer.gpu.shaders import ShaderSourceError, shader_source
 
 GROUP_SIZE = 8                       # output.comp's local_size_x and _y
+WAVEFRONT_GROUP = 64                 # error_diffusion.comp's local_size_x
+MAX_TAPS = 12                        # error_diffusion.comp's tap arrays
 LINEAR = Transfer("linear")
-# Bindings, as the GLSL declares them: images 0 (input) and 1 (output), texture unit 0 (the
-# tables), SSBO 1 (blue-noise ranks).
-INPUT_IMAGE, OUTPUT_IMAGE = 0, 1
-TABLES_UNIT, BLUE_NOISE_BUFFER = 0, 1
+# Bindings, as the GLSL declares them: images 0 (input), 1 (output) and 2 (error diffusion's
+# errors), texture units 0 (the tables) and 1 (error diffusion's shares), SSBO 1 (blue-noise
+# ranks).
+INPUT_IMAGE, OUTPUT_IMAGE, ERROR_IMAGE = 0, 1, 2
+TABLES_UNIT, SHARES_UNIT, BLUE_NOISE_BUFFER = 0, 1, 1
 TABLE_ROW_BITS = 12                  # the tables' texture is 2^12 entries wide
 
 
@@ -90,6 +95,8 @@ class OutputPass:
         self._images: dict[tuple, tuple[moderngl.Texture, moderngl.Texture]] = {}
         self._tables: dict[tuple, tuple[moderngl.Texture, dict]] = {}
         self._blue_noise: moderngl.Buffer | None = None
+        self._errors: dict[tuple, moderngl.Texture] = {}
+        self._shares: dict[str, moderngl.Texture] = {}
 
     # -- GL objects, each made once ------------------------------------------------------------
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
@@ -132,10 +139,32 @@ class OutputPass:
             self._blue_noise = self.ctx.buffer(ranks.tobytes())
         return self._blue_noise
 
+    def _error_image(self, width: int, height: int, reach: int) -> moderngl.Texture:
+        """Error diffusion's errors: (W + 2 reach) x (H + reach) rgba32f, made zero; only the
+        image's own pixels are ever written, so the border stays zero."""
+        key = (width, height, reach)
+        image = self._errors.get(key)
+        if image is None:
+            size = (width + 2 * reach, height + reach)
+            image = self._errors[key] = self.ctx.texture(size, 4, dtype="f4")
+            image.write(np.zeros((size[1], size[0], 4), np.float32))
+        return image
+
+    def _shares_texture(self, kernel: str) -> moderngl.Texture:
+        """sender_weights(kernel) as a float texture: the taps along x, the sources' sides
+        (left, right, below) along y, ((left (r + 1) + right) (r + 1) + below)."""
+        texture = self._shares.get(kernel)
+        if texture is None:
+            shares = sender_weights(kernel)
+            texture = self._shares[kernel] = self.ctx.texture(
+                (shares.shape[-1], shares[..., 0].size), 1, shares.tobytes(), dtype="f4")
+        return texture
+
     def gl_objects(self) -> list:
         """Every GL object the pass holds (tests: a repeated apply() adds none)."""
         objects = [*self._programs.values(), *(t for pair in self._images.values() for t in pair),
-                   *(texture for texture, _ in self._tables.values())]
+                   *(texture for texture, _ in self._tables.values()), *self._errors.values(),
+                   *self._shares.values()]
         return objects + ([self._blue_noise] if self._blue_noise is not None else [])
 
     # -- the stage ------------------------------------------------------------------------------
@@ -174,14 +203,34 @@ class OutputPass:
             if settings.dither == "blue-noise":
                 self._blue_noise_buffer().bind_to_storage_buffer(BLUE_NOISE_BUFFER)
                 values["u_blue_noise_size"] = blue_noise_ranks().shape[0]
+            if settings.halftone is not None:
+                program["u_screen"].write(screen_basis(settings.halftone))
         for name, value in values.items():
             uniform = program.get(name, None)     # the compiler drops what a variant never reads
             if uniform is not None:
                 uniform.value = value
 
     def _diffuse(self, program, settings: OutputSettings, width: int, height: int) -> None:
-        """Error diffusion: one dispatch per wavefront (glsl/output/error_diffusion.comp)."""
-        raise NotImplementedError(f"--dither {settings.dither}: not yet on the GPU")
+        """Error diffusion: one dispatch per wavefront t = x + s y, in order, with a memory
+        barrier between them (the next reads what this one wrote), W + s (H - 1) dispatches
+        (glsl/output/error_diffusion.comp; renderer/core/error_kernels.py)."""
+        kernel = KERNELS[settings.dither]
+        taps = pull_taps(settings.dither)
+        tap_offsets = np.zeros((MAX_TAPS, 2), np.int32)
+        tap_offsets[:len(taps)] = taps
+        program["u_tap_offset"].write(tap_offsets)
+        program["u_taps"].value = len(taps)
+        self._shares_texture(settings.dither).use(SHARES_UNIT)
+        program["u_shares"].value = SHARES_UNIT
+        program["u_skew"].value = kernel.skew
+        program["u_reach"].value = kernel.reach
+        self._error_image(width, height, kernel.reach).bind_to_image(ERROR_IMAGE, read=True,
+                                                                     write=True)
+        wavefront = program["u_wavefront"]
+        for t, first, last in wavefronts(width, height, kernel.skew):
+            wavefront.value = (t, first, last)
+            program.run((last - first) // WAVEFRONT_GROUP + 1)
+            self.ctx.memory_barrier()
 
     def release(self) -> None:
         activate(self.ctx)
@@ -190,4 +239,6 @@ class OutputPass:
         self._programs.clear()
         self._images.clear()
         self._tables.clear()
+        self._errors.clear()
+        self._shares.clear()
         self._blue_noise = None

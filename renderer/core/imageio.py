@@ -25,7 +25,8 @@ transaction, `outputs()`, so that a command's files are written all or none, nev
 
 `image` writes the format a user's file name asks for (`renderer render -o out.jpg`,
 screenshots) and `image_format` refuses, before any work, a name whose format Pillow cannot
-write; `png` writes PNG whatever the name (goldens, compare's images). `write_png`,
+write; `png` writes PNG whatever the name (goldens, compare's images); `png_codes` and `exr`
+write the output stage's N-bit codes and float images (renderer/core/image_formats.py). `write_png`,
 `write_image`, `write_npy`, `write_text` and `write_bytes` are one-file transactions.
 """
 from __future__ import annotations
@@ -42,6 +43,7 @@ from pathlib import Path
 import numpy as np
 from PIL import Image
 
+from renderer.core import image_formats
 from renderer.errors import SystemFault, UserError
 
 # Pillow's defaults are for photographs (JPEG at quality 75 with halved chroma, lossy WebP);
@@ -229,6 +231,15 @@ class Outputs:
         """An (H, W, 3|4) uint8 array, row 0 at the top, as PNG whatever the suffix."""
         image = np.ascontiguousarray(image)
         return self._write(path, lambda handle: Image.fromarray(image).save(handle, format="PNG"))
+
+    def png_codes(self, path, codes: np.ndarray, bits: int, container_bits: int) -> Path:
+        """(H, W, 1|2|3|4) codes of `bits` bits as a PNG of `container_bits` (8 or 16) bits
+        per sample, whatever the suffix (renderer/core/image_formats.py: scaling, sBIT)."""
+        return self._write(path, lambda handle: image_formats.write_png(handle, codes, bits, container_bits))
+
+    def exr(self, path, array: np.ndarray) -> Path:
+        """float32 (H, W, 3|4) colour or an (H, W) plane as OpenEXR (image_formats.write_exr)."""
+        return self._write(path, lambda handle: image_formats.write_exr(handle, array))
 
     def npy(self, path, array: np.ndarray) -> Path:
         return self._write(path, lambda handle: np.save(handle, array))

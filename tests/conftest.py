@@ -176,7 +176,7 @@ def cli():
 @pytest.fixture
 def gpu_stand_in(monkeypatch):
     """gpu_stand_in(frame): from now on, in this test, the command line's GPU render
-    (renderer.cli._render_gpu, which `render --backend gpu` and `compare` call) hands back
+    (renderer.cli._render_gpu, which `compare` calls) hands back
     `frame` instead of drawing, so that `renderer.cli.main([...])` can be run in-process on a
     frame made to order (e.g. a reference frame with some pixels changed)."""
     from renderer import cli
@@ -290,3 +290,16 @@ class TracedReferences:
 def traced_references():
     """A TracedReferences: the NumPy ray tracer's scenes and frames, made once per test run."""
     return TracedReferences()
+
+
+# -- the output stage ---------------------------------------------------------------------------
+
+@pytest.fixture(scope="session")
+def output_passes(gl_contexts):
+    """{"egl": OutputPass, "osmesa": OutputPass}: the GPU output stage on each context, made
+    once per test run (its programs and tables are kept across tests, as in a viewer)."""
+    from renderer.gpu.output import OutputPass
+    passes = {kind: OutputPass(ctx) for kind, ctx in gl_contexts.items()}
+    yield passes
+    for output_pass in passes.values():
+        output_pass.release()

@@ -331,7 +331,8 @@ def test_render_refuses_depth_that_is_not_npy(tmp_path, capsys):
     depth = tmp_path / "d.png"
     assert render_in_process(tmp_path, "sphere", "-o", tmp_path / "o.png", "--depth", depth) == 2
     assert capsys.readouterr().err.splitlines() == [
-        f"renderer: {depth}: --depth writes a NumPy array; name the file with .npy, e.g. depth.npy"]
+        f"renderer: {depth}: --depth writes float32 depth as .npy (NumPy) or .exr (OpenEXR); name the "
+        "file e.g. depth.npy"]
     assert list(tmp_path.iterdir()) == []
 
 

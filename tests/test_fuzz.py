@@ -630,7 +630,7 @@ def gen_mesh_mutation(rng, seed) -> Case:
 def gen_options(rng, seed) -> Case:
     argv = command_for(rng, rng.choice(("sphere", "hierarchy", "spher", "sphere.toml")))
     for _ in range(rng.randint(1, 2)):
-        op = rng.randrange(7)
+        op = rng.randrange(8)
         if op == 0 and "--size" in argv:
             argv[argv.index("--size") + 1] = rng.choice(
                 ("0x0", "-5x5", "8x", "x6", "axb", "8X6", " 8x6", "8x6x2", "1x16384", "16385x1",
@@ -648,7 +648,19 @@ def gen_options(rng, seed) -> Case:
             argv[0] = rng.choice(("rendr", "", "scenes", "render", "shaders"))
         elif op == 6 and "--depth" not in argv and argv[0] == "render":
             argv += ["--depth", rng.choice(("{D}/w/d.NPY", "{D}/w/d", "{D}/w/d.npz", "{D}/w/d.npy"))]
+        elif op == 7 and argv[0] == "render":       # the output stage's (PNG when taken)
+            option, values = rng.choice(OUTPUT_OPTION_VALUES)
+            argv += [option, rng.choice(values)]
     return Case(seed, "options", argv)
+
+
+OUTPUT_OPTION_VALUES = (      # taken or refused; a taken one writes a PNG (_check_image opens it)
+    ("--bits", ("0", "1", "3", "8", "12", "16", "17", "-1", "1.5", "", "x", "1e1")),
+    ("--transfer", ("srgb", "linear", "gamma:2.2", "gamma:0", "gamma:nan", "gamma:", "gamma:1e400", "", "sRGB")),
+    ("--dither", ("none", "bayer2", "bayer8", "blue-noise", "bayer3", "", "\0")),
+    ("--halftone", ("1", "1.99", "nan", "6:inf", "-6", "6:x", "", "1e400")),
+    ("--format", ("png8", "png16", "exr", "npy", "tiff", "", "PNG8")),
+)
 
 
 CLASSES = {                  # name: (generator, weight)

@@ -129,6 +129,7 @@ DEFINITIONS = [
     ("texture filter and wrap enums", "renderer/core/gl_rules.py",
      r"\b0x(2701|2703|8370|84FE)\b|\b(9985|9987|33648|34046)\b"),
     ("unorm8 texel to float", "renderer/core/gl_rules.py", r"(float32|f32)\(1 ?/ ?255(\.0)?\)"),
+    ("sRGB framebuffer enums", "renderer/core/gl_rules.py", r"\b0x(8C43|8DB9)\b|\b(35907|36281)\b"),
     ("texel weight bits", "renderer/core/gl_rules.py", r"\b(TEXEL|MIP)_WEIGHT_BITS = \d"),
     ("fast log2", "renderer/core/gl_rules.py", r"\b(0x3[fF]800000|1065353216)\b"),
     ("max anisotropy", "renderer/core/gl_rules.py", r"ANISOTROPY_RANGE = \(2, 16\)|MAX_ANISOTROPY = \d"),
@@ -180,6 +181,7 @@ def test_the_search_finds_the_literals_it_replaced():
                                     "target.clear(r, g, b, 0.0, depth=0.0 if reversed_z else 1.0)\n"
                                     "ctx.depth_func = '>' if reversed_z else '<'\n",
         "reference/framebuffer.py": "u = np.floor(np.clip(c, 0.0, 1.0) * 255.0 + 0.5)\n",
+        "tests/test_y.py": "ctx.enable_direct(0x8DB9)\n",
         "tests/test_x.py": "RAW_MISMATCH_LIMIT = 0.001\n",
         "reference/sampler.py": "TEXEL_WEIGHT_BITS = 8\nc = c.astype(np.float32) * np.float32(1 / 255)\n"
                                 "m = (bits & 8388607 | 0x3F800000).view(np.float32)\nF = 0x2703\n"
@@ -188,7 +190,8 @@ def test_the_search_finds_the_literals_it_replaced():
     }
     rules = sorted({line.split(": ")[1].split(" (")[0] for line in redefinitions(old)})
     assert rules == ["EWA weight table", "clip control modes", "depth clear value", "depth compare",
-                     "fast log2", "fill rule", "max anisotropy", "pipeline tolerance", "sub-pixel bits",
+                     "fast log2", "fill rule", "max anisotropy", "pipeline tolerance", "sRGB framebuffer enums",
+                     "sub-pixel bits",
                      "texel weight bits", "texture filter and wrap enums", "unorm8", "unorm8 texel to float",
                      "window depth", "window depth inverse"]
     assert not any(line.startswith("reference/depth_buffer.py") for line in redefinitions(old))

@@ -150,6 +150,17 @@ def to_unorm8(c: np.ndarray) -> np.ndarray:
     return np.floor(scaled, out=scaled).astype(np.uint8)
 
 
+# GL's sRGB framebuffer (GL 4.5 core, "sRGB Conversion"; EXT_texture_sRGB): with
+# GL_FRAMEBUFFER_SRGB enabled, RGB written to an SRGB8_ALPHA8 target is encoded by the sRGB
+# curve, then converted to unorm8 (alpha is not encoded). EXT_texture_sRGB allows 0.6 of a
+# level of error, so a GL may store one level off the exactly rounded code, and llvmpipe does
+# on 5 % of inputs (docs/llvmpipe/output.md). The output stage therefore encodes by exact
+# decision points instead (renderer/core/quantise.py); tests/test_gl_srgb.py measures the rule.
+GL_SRGB8_ALPHA8 = 0x8C43
+GL_FRAMEBUFFER_SRGB = 0x8DB9
+SRGB_FRAMEBUFFER_LEVELS = 1              # GL's code within this many levels of the exact one
+
+
 
 # --- textures ----------------------------------------------------------------------------------
 

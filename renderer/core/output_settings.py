@@ -34,6 +34,15 @@ INTEGER_FORMATS = {"png8": 8, "png16": 16}  # format -> container bits per chann
 FLOAT_FORMATS = ("exr", "npy")
 
 
+def format_for(suffix: str, bits: int | None = None) -> str | None:
+    """The format a file name's suffix names (case aside): .png is png8, or png16 for more
+    than 8 bits per channel; .exr, .npy. None for any other suffix."""
+    suffix = suffix.lower()
+    if suffix == ".png":
+        return "png16" if bits is not None and bits > INTEGER_FORMATS["png8"] else "png8"
+    return next((name for name, known in FORMATS.items() if known == suffix), None)
+
+
 @dataclass(frozen=True)
 class Transfer:
     """The display's transfer curve from linear light L to the encoded value V, both in

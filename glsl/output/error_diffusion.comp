@@ -1,0 +1,47 @@
+// Twin: reference/output/error_diffusion.py
+#version 430 core
+// Error diffusion (Floyd-Steinberg, Jarvis-Judice-Ninke) in linear light, one dispatch per
+// wavefront t = x + s y (renderer/core/error_kernels.py): every pixel of the wavefront pulls
+// the errors its kernel's earlier neighbours left in the error image, which earlier dispatches
+// wrote (the pass puts a memory barrier between dispatches). One invocation per pixel of the
+// wavefront, rows u_wavefront.y .. u_wavefront.z. The rule, op for op, is in the twin's
+// docstring; the error image has a zero border u_reach wide (left, right, top), so no tap
+// needs a test. Alpha is the plain nearest code of the linear transfer, as in output.comp.
+layout(local_size_x = 64) in;
+
+layout(rgba32f, binding = 0) uniform readonly image2D u_linear;
+layout(rgba16ui, binding = 1) uniform writeonly uimage2D u_codes;
+layout(rgba32f, binding = 2) uniform image2D u_error;
+#include "quantise.glsl"
+
+const int MAX_TAPS = 12;              // Jarvis-Judice-Ninke's
+uniform ivec3 u_wavefront;            // (t, first row, last row)
+uniform int u_skew;                   // s
+uniform int u_reach;                  // the error image's border
+uniform int u_taps;
+uniform ivec2 u_tap_offset[MAX_TAPS]; // pull form: the sources, in the order they are added
+uniform float u_tap_weight[MAX_TAPS];
+
+void main() {
+    int y = u_wavefront.y + int(gl_GlobalInvocationID.x);
+    if (y > u_wavefront.z) {
+        return;
+    }
+    ivec2 p = ivec2(u_wavefront.x - u_skew * y, y);
+    ivec2 here = p + ivec2(u_reach);
+    vec3 incoming = vec3(0.0);
+    for (int k = 0; k < u_taps; ++k) {
+        incoming = incoming + u_tap_weight[k] * imageLoad(u_error, here + u_tap_offset[k]).rgb;
+    }
+    vec4 linear = imageLoad(u_linear, p);
+    vec3 target = vec3(clamp_light(linear.r), clamp_light(linear.g), clamp_light(linear.b)) + incoming;
+    uvec4 code;
+    code.r = bracketed_code(target.r, 0.5);
+    code.g = bracketed_code(target.g, 0.5);
+    code.b = bracketed_code(target.b, 0.5);
+    code.a = nearest_code(linear.a, u_alpha_points);
+    vec3 chosen = vec3(tables[u_code_values + code.r], tables[u_code_values + code.g],
+                       tables[u_code_values + code.b]);
+    imageStore(u_error, here, vec4(target - chosen, 0.0));
+    imageStore(u_codes, p, code);
+}

@@ -236,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
                         metavar="K,K", help="only these knob families (default all): raster: "
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
-                        "(textured scenes); raytrace: antialiasing, max_depth, precision")
+                        "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 

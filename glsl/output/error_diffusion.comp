@@ -6,7 +6,9 @@
 // wrote (the pass puts a memory barrier between dispatches). One invocation per pixel of the
 // wavefront, rows u_wavefront.y .. u_wavefront.z. The rule, op for op, is in the twin's
 // docstring; the error image has a zero border u_reach wide (left, right, top), so no tap
-// needs a test. Alpha is the plain nearest code of the linear transfer, as in output.comp.
+// needs a test, and a source's share of its error comes from a table by its distances to
+// the image's edges (renormalised there: error_kernels.sender_weights). Alpha is the plain
+// nearest code of the linear transfer, as in output.comp.
 layout(local_size_x = 64) in;
 
 layout(rgba32f, binding = 0) uniform readonly image2D u_linear;
@@ -14,13 +16,23 @@ layout(rgba16ui, binding = 1) uniform writeonly uimage2D u_codes;
 layout(rgba32f, binding = 2) uniform image2D u_error;
 #include "quantise.glsl"
 
+// sender_weights[((left (r + 1) + right) (r + 1) + below) u_taps + k], r = u_reach
+layout(std430, binding = 2) readonly buffer SenderWeights { float sender_weights[]; };
+
 const int MAX_TAPS = 12;              // Jarvis-Judice-Ninke's
 uniform ivec3 u_wavefront;            // (t, first row, last row)
 uniform int u_skew;                   // s
-uniform int u_reach;                  // the error image's border
+uniform int u_reach;                  // r: how far an error travels, the border's width
 uniform int u_taps;
 uniform ivec2 u_tap_offset[MAX_TAPS]; // pull form: the sources, in the order they are added
-uniform float u_tap_weight[MAX_TAPS];
+
+// The share of its error the source pixel s sends along tap k (error_kernels.sender_sides).
+float share(ivec2 s, int k) {
+    ivec2 size = imageSize(u_linear);
+    ivec3 sides = clamp(ivec3(s.x, size.x - 1 - s.x, size.y - 1 - s.y), 0, u_reach);
+    int side = u_reach + 1;
+    return sender_weights[((sides.x * side + sides.y) * side + sides.z) * u_taps + k];
+}
 
 void main() {
     int y = u_wavefront.y + int(gl_GlobalInvocationID.x);
@@ -31,7 +43,8 @@ void main() {
     ivec2 here = p + ivec2(u_reach);
     vec3 incoming = vec3(0.0);
     for (int k = 0; k < u_taps; ++k) {
-        incoming = incoming + u_tap_weight[k] * imageLoad(u_error, here + u_tap_offset[k]).rgb;
+        ivec2 source = p + u_tap_offset[k];
+        incoming = incoming + share(source, k) * imageLoad(u_error, source + ivec2(u_reach)).rgb;
     }
     vec4 linear = imageLoad(u_linear, p);
     vec3 target = vec3(clamp_light(linear.r), clamp_light(linear.g), clamp_light(linear.b)) + incoming;

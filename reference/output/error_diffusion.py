@@ -4,7 +4,8 @@ Error diffusion (Floyd-Steinberg, Jarvis-Judice-Ninke) in linear light, in raste
 "pull" form of renderer/core/error_kernels.py, vectorised within each wavefront t = x + s y (a
 Python loop over the W + s (H - 1) wavefronts, none over pixels). Per pixel and channel, float32
 op for op as the GLSL:
-    incoming = sum over the taps, in their fixed order, of f32(w_k e_k)   (from 0, one add each)
+    incoming = sum over the taps, in their fixed order, of f32(w_k e_k)   (from 0, one add each;
+               w_k the share the source sends, sender_weights: renormalised at the edges)
     L'       = f32(clamp_light(L) + incoming)          clamp_light: to [0, 1], NaN -> 0
     code     = bracketed_code(L', 1/2): of the two codes whose linear values bracket
                clamp_light(L'), c0 + 1 iff f32(clamp_light(L') - l_c0) > f32(0.5 f32(l_c0+1 - l_c0))
@@ -22,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from renderer.core.error_kernels import KERNELS, pull_taps, wavefronts
+from renderer.core.error_kernels import KERNELS, pull_taps, sender_sides, sender_weights, wavefronts
 from renderer.core.output_settings import OutputSettings, Transfer
 from renderer.core.quantise import code_values
 from reference.output.quantise import bracketed_code, clamp_light
@@ -37,22 +38,31 @@ def diffuse(rgb: np.ndarray, kernel: str, transfer: Transfer, bits: int):
     reach + x] is pixel (x, y)'s; the border stays 0."""
     height, width = rgb.shape[:2]
     skew, reach = KERNELS[kernel].skew, KERNELS[kernel].reach
-    offsets, weights = pull_taps(kernel)
+    taps = pull_taps(kernel)
     values = code_values(transfer, bits)
-    light = clamp_light(rgb)
-    error = np.zeros((height + reach, width + 2 * reach, 3), dtype=np.float32)
-    codes = np.zeros((height, width, 3), dtype=np.int64)
+    light = clamp_light(rgb).reshape(-1, 3)
+    # Pixel (x, y) is y W + x in `light`, `shares` and `codes`, and (reach + y) stride + reach
+    # + x in the bordered error image, where each tap's source is a fixed step away from it.
+    stride = width + 2 * reach
+    steps = taps[:, 1] * stride + taps[:, 0]
+    error = np.zeros(((height + reach) * stride, 3), dtype=np.float32)
+    columns, rows = np.arange(width)[None, :, None], np.arange(height)[:, None, None]
+    sides = sender_sides(columns + taps[:, 0], rows + taps[:, 1], width, height, reach)
+    shares = sender_weights(kernel)[(*sides, np.arange(len(taps)))].reshape(-1, len(taps), 1)
+    codes = np.zeros((height * width, 3), dtype=np.int64)
     for t, first, last in wavefronts(width, height, skew):
         y = np.arange(first, last + 1)
         x = t - skew * y
-        incoming = np.zeros((y.size, 3), dtype=np.float32)
-        for (dx, dy), weight in zip(offsets, weights):
-            incoming = incoming + weight * error[reach + y + dy, reach + x + dx]
-        target = light[y, x] + incoming
+        pixel = y * width + x
+        here = (reach + y) * stride + reach + x
+        terms = np.zeros((y.size, len(taps) + 1, 3), dtype=np.float32)     # 0, then each tap
+        terms[:, 1:] = shares[pixel] * error[here[:, None] + steps]
+        incoming = np.add.accumulate(terms, axis=1)[:, -1]                 # in the taps' order
+        target = light[pixel] + incoming
         code = bracketed_code(target, HALF, transfer, bits)
-        error[reach + y, reach + x] = target - values[code]
-        codes[y, x] = code
-    return codes, error
+        error[here] = target - values[code]
+        codes[pixel] = code
+    return codes.reshape(height, width, 3), error.reshape(height + reach, stride, 3)
 
 
 def diffused(rgb: np.ndarray, settings: OutputSettings) -> np.ndarray:

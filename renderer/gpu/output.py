@@ -11,10 +11,11 @@ so the shader's y is the image row from the top, the dither patterns' y. Quantis
 give codes in [0, 2^N - 1], N = settings.code_bits; float formats give encode(L) per RGB
 channel and alpha as it is.
 
-GL objects are made on first use and kept: a program per set of defines (settings.defines():
-a program holds only the method it runs), the input and output images per size and kind,
+GL objects are made on first use and kept: a program per set of defines (program_defines:
+settings.defines(), so that a program holds only the method it runs, less the transfer of
+codes, which the tables carry), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (one SSBO, renderer/core/quantise.py), the
-blue-noise ranks once, error diffusion's error image per size. A second apply() with settings
+blue-noise ranks once, error diffusion's error image per size and shares per kernel. A second apply() with settings
 and a size seen before makes no GL object. Error diffusion runs its own program in wavefronts
 (`_diffuse`).
 """
@@ -27,7 +28,7 @@ import moderngl
 import numpy as np
 
 from renderer.core.blue_noise import blue_noise_ranks
-from renderer.core.error_kernels import KERNELS, pull_taps, wavefronts
+from renderer.core.error_kernels import KERNELS, pull_taps, sender_weights, wavefronts
 from renderer.core.halftone_screen import screen_basis
 from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Transfer
 from renderer.core.quantise import (SRGB_A, SRGB_EXPONENT, SRGB_LINEAR_LIMIT, SRGB_SLOPE,
@@ -40,9 +41,9 @@ WAVEFRONT_GROUP = 64                 # error_diffusion.comp's local_size_x
 MAX_TAPS = 12                        # error_diffusion.comp's tap arrays
 LINEAR = Transfer("linear")
 # Bindings, as the GLSL declares them: images 0 (input), 1 (output) and 2 (error diffusion's
-# errors); SSBOs 0 (tables), 1 (blue-noise ranks).
+# errors); SSBOs 0 (tables), 1 (blue-noise ranks), 2 (error diffusion's shares).
 INPUT_IMAGE, OUTPUT_IMAGE, ERROR_IMAGE = 0, 1, 2
-TABLES_BUFFER, BLUE_NOISE_BUFFER = 0, 1
+TABLES_BUFFER, BLUE_NOISE_BUFFER, WEIGHTS_BUFFER = 0, 1, 2
 
 
 def table_layout(transfer: Transfer, bits: int) -> tuple[np.ndarray, dict[str, int]]:
@@ -64,6 +65,15 @@ def transfer_uniforms(transfer: Transfer) -> dict:
                             (SRGB_LINEAR_LIMIT, SRGB_SLOPE, 1.0 + SRGB_A, SRGB_A))}
 
 
+def program_defines(settings: OutputSettings) -> dict[str, str]:
+    """settings.defines() less the transfer's where the output is quantised: codes come from
+    the tables of (transfer, bits), so the define would only compile the same program again."""
+    defines = settings.defines()
+    if settings.quantised:
+        defines = {name: value for name, value in defines.items() if not name.startswith("TRANSFER_")}
+    return defines
+
+
 class OutputPass:
     """The GPU output stage of one context; see the module docstring."""
 
@@ -75,12 +85,13 @@ class OutputPass:
         self._tables: dict[tuple, tuple[moderngl.Buffer, dict]] = {}
         self._blue_noise: moderngl.Buffer | None = None
         self._errors: dict[tuple, moderngl.Texture] = {}
+        self._weights: dict[str, moderngl.Buffer] = {}
 
     # -- GL objects, each made once ------------------------------------------------------------
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
         """The compiled program that runs `settings` (made on first use)."""
         activate(self.ctx)              # another context may be current: compile on ours
-        defines = settings.defines()
+        defines = program_defines(settings)
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
         if program is None:
@@ -130,10 +141,16 @@ class OutputPass:
             image.write(np.zeros((size[1], size[0], 4), np.float32))
         return image
 
+    def _weights_buffer(self, kernel: str) -> moderngl.Buffer:
+        buffer = self._weights.get(kernel)
+        if buffer is None:
+            buffer = self._weights[kernel] = self.ctx.buffer(sender_weights(kernel).tobytes())
+        return buffer
+
     def gl_objects(self) -> list:
         """Every GL object the pass holds (tests: a repeated apply() adds none)."""
         objects = [*self._programs.values(), *(t for pair in self._images.values() for t in pair),
-                   *(buffer for buffer, _ in self._tables.values()), *self._errors.values()]
+                   *(buffer for buffer, _ in self._tables.values()), *self._errors.values(), *self._weights.values()]
         return objects + ([self._blue_noise] if self._blue_noise is not None else [])
 
     # -- the stage ------------------------------------------------------------------------------
@@ -186,13 +203,12 @@ class OutputPass:
         barrier between them (the next reads what this one wrote), W + s (H - 1) dispatches
         (glsl/output/error_diffusion.comp; renderer/core/error_kernels.py)."""
         kernel = KERNELS[settings.dither]
-        offsets, weights = pull_taps(settings.dither)
+        taps = pull_taps(settings.dither)
         tap_offsets = np.zeros((MAX_TAPS, 2), np.int32)
-        tap_weights = np.zeros(MAX_TAPS, np.float32)
-        tap_offsets[:len(weights)], tap_weights[:len(weights)] = offsets, weights
+        tap_offsets[:len(taps)] = taps
         program["u_tap_offset"].write(tap_offsets)
-        program["u_tap_weight"].write(tap_weights)
-        program["u_taps"].value = len(weights)
+        program["u_taps"].value = len(taps)
+        self._weights_buffer(settings.dither).bind_to_storage_buffer(WEIGHTS_BUFFER)
         program["u_skew"].value = kernel.skew
         program["u_reach"].value = kernel.reach
         self._error_image(width, height, kernel.reach).bind_to_image(ERROR_IMAGE, read=True,
@@ -211,4 +227,5 @@ class OutputPass:
         self._images.clear()
         self._tables.clear()
         self._errors.clear()
+        self._weights.clear()
         self._blue_noise = None

@@ -253,7 +253,7 @@ def output_plot_png(rows: list[dict], title: str) -> bytes:
     from matplotlib.figure import Figure
     figure = Figure(figsize=(13.0, 4.4), dpi=100)
     FigureCanvasAgg(figure)
-    panels = figure.subplots(1, 3, gridspec_kw={"left": 0.05, "right": 0.84, "wspace": 0.28,
+    panels = figure.subplots(1, 3, gridspec_kw={"left": 0.05, "right": 0.85, "wspace": 0.28,
                                                 "bottom": 0.13, "top": 0.88})
     table = _by_setting(rows)
     for index, method in enumerate(dict.fromkeys(m for m, _ in table)):
@@ -281,7 +281,8 @@ def output_plot_png(rows: list[dict], title: str) -> bytes:
         axes.grid(True, which="both", linewidth=0.3)
     panels[1].set_yscale("log")
     panels[2].set_yscale("log")
-    figure.legend(*panels[0].get_legend_handles_labels(), loc="center right", fontsize=7)
+    figure.legend(*panels[0].get_legend_handles_labels(), loc="center left",
+                  bbox_to_anchor=(0.86, 0.5), fontsize=7)
     figure.suptitle(title, fontsize=10)
     buffer = io.BytesIO()
     figure.savefig(buffer, format="png", metadata={"Software": None})

@@ -13,11 +13,11 @@ of 1/255. Pixels are shown 1:1 (a scaled view averages the pattern away). Determ
 
 from __future__ import annotations
 
-import io
-import math
 from pathlib import Path
 
 import numpy as np
+
+from contact_sheet import contact_sheet, write_figure
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "images" / "output-methods.png"
@@ -60,29 +60,8 @@ def panels() -> list[tuple[str, np.ndarray]]:
     return out
 
 
-def figure(images: list[tuple[str, np.ndarray]]) -> bytes:
-    """PNG bytes: the panels in rows of COLUMNS, each under its label, 1:1."""
-    from PIL import Image, ImageDraw, ImageFont
-
-    width, height = SIZE
-    rows = math.ceil(len(images) / COLUMNS)
-    sheet = Image.new("RGB", (COLUMNS * width, rows * (height + LABEL_HEIGHT)), (255, 255, 255))
-    draw = ImageDraw.Draw(sheet)
-    font = ImageFont.load_default(size=12)
-    for k, (label, image) in enumerate(images):
-        x, y = (k % COLUMNS) * width, (k // COLUMNS) * (height + LABEL_HEIGHT)
-        draw.multiline_text((x + 5, y + 3), label, fill=(0, 0, 0), font=font, spacing=2)
-        sheet.paste(Image.fromarray(np.ascontiguousarray(image), "RGB"), (x, y + LABEL_HEIGHT))
-    buffer = io.BytesIO()
-    sheet.save(buffer, format="PNG", optimize=True)
-    return buffer.getvalue()
-
-
 def main() -> None:
-    data = figure(panels())
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_bytes(data)
-    print(f"{OUT.relative_to(ROOT)}: {len(data):,} bytes")
+    write_figure(OUT, contact_sheet(panels(), COLUMNS, LABEL_HEIGHT, font_size=12), ROOT)
 
 
 if __name__ == "__main__":

@@ -88,6 +88,9 @@ def test_png_files_round_trip_every_code(bits):
         assert back.container_bits == container and back.bits == (bits,) * 4
         assert np.array_equal(back.codes, codes)
         assert chunk(data, b"sBIT") == (bytes([bits] * 4) if bits < container else None)
+        width, height, rows, info = png.Reader(bytes=data).asDirect()     # a reader honouring sBIT
+        assert info["bitdepth"] == bits
+        assert np.array_equal(np.vstack([np.asarray(row) for row in rows]).reshape(codes.shape), codes)
 
 
 @pytest.mark.parametrize("bits", range(1, 17))

@@ -14,8 +14,9 @@ v / r lies within 1 / (2 r) <= 1/2 of c, and the half is reached only at r = 1, 
 (No tie arises on the way up either: 2 c (2^M - 1) is even and (2k + 1)(2^N - 1) odd.)
 pypng's own writer at bitdepth=N writes these very bytes (tests/test_image_formats.py);
 we scale in NumPy because it scales value by value in Python and always puts N <= 8 in an
-8-bit container. pypng's reader would undo sBIT by a right shift, not by the rule above,
-so `read_png` reads the raw samples and the sBIT chunk itself.
+8-bit container. pypng's reader undoes sBIT by a right shift, v >> (M - N), which gives the
+same codes back for samples scaled so (the tests check every N and code) but is not the
+rounding inverse for other samples; `read_png` applies the rule above.
 
 OpenEXR: float32 channels, ZIP compression (lossless: every bit pattern, inf, NaN and
 negatives included, comes back); colour as R, G, B(, A), a depth plane as Z.

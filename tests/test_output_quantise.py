@@ -36,6 +36,45 @@ def test_bracketed_code_rounds_up_past_the_threshold():
     assert bracketed_code(np.float32(0.3), np.float32(0.31), SRGB, 1) == 0
 
 
+@pytest.mark.parametrize("kind", ("egl", "osmesa"))
+def test_the_gpu_search_is_exact_whatever_its_guess(gl_contexts, kind):
+    """quantise.glsl counts from the transfer curve's guess (one off at most, in practice);
+    any guess, however wrong, must still end at the exact count: each lane of a SIMD vector
+    then walks a different distance, as a NaN or a denormal's guess might make it."""
+    from pathlib import Path
+    from renderer.gpu.context import activate
+    from renderer.gpu.output import table_texture
+    from renderer.gpu.shaders import shader_source
+    ctx = gl_contexts[kind]
+    activate(ctx)
+    rng = np.random.default_rng(5)
+    points = decision_points(SRGB, 8)
+    light = np.concatenate([points, np.nextafter(points, np.float32(0)),
+                            rng.random(4096 - 2 * points.size, dtype=np.float32)])
+    exact = count_at_or_below(light, points)
+    guess = exact + rng.choice([-300, -40, -2, -1, 0, 0, 0, 1, 2, 40, 300], light.size)
+    probes = np.stack([light, guess.astype(np.float32)], axis=-1).reshape(64, 64, 2)
+    source = shader_source("output_count.comp", directory=Path(__file__).parent / "glsl")
+    program = ctx.compute_shader(source.text)
+    tables, uniforms = table_texture(ctx, SRGB, 8)
+    inputs = ctx.texture((64, 64), 2, probes.astype(np.float32).tobytes(), dtype="f4")
+    counts = ctx.texture((64, 64), 1, dtype="u4")
+    try:
+        for name, value in {**uniforms, "u_bits": 8, "u_tables": 0}.items():
+            if name in program:
+                program[name].value = value
+        tables.use(0)
+        inputs.bind_to_image(0, read=True, write=False)
+        counts.bind_to_image(1, read=False, write=True)
+        program.run(8, 8)
+        ctx.memory_barrier()
+        got = np.frombuffer(counts.read(), np.uint32).reshape(-1)
+    finally:
+        for thing in (program, tables, inputs, counts):
+            thing.release()
+    np.testing.assert_array_equal(got, exact)
+
+
 def rule_edges(transfer: Transfer, bits: int, width: int = 256) -> np.ndarray:
     """(H, width, 4) float32 frame of every decision point and the float just below it."""
     points = decision_points(transfer, bits)

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import reference.output
-from renderer.core.output_settings import OutputSettings
+from renderer.core.output_settings import Halftone, OutputSettings
 from output_cases import TRANSFERS, linear_frame
 
 
@@ -35,7 +35,8 @@ def test_the_pass_makes_its_gl_objects_once(output_passes, kind, monkeypatch):
     stage = output_passes[kind]
     frame = linear_frame(24, 16)
     runs = [OutputSettings(transfer=TRANSFERS[1], bits=2, dither="blue-noise"),
-            OutputSettings(bits=4, dither="bayer8"), OutputSettings(transfer=TRANSFERS[2], format="exr")]
+            OutputSettings(bits=4, dither="bayer8"), OutputSettings(transfer=TRANSFERS[2], format="exr"),
+            OutputSettings(bits=1, dither="jarvis-judice-ninke"), OutputSettings(halftone=Halftone(6, 15))]
     for settings in runs:
         stage.apply(frame, settings)
     made = []
@@ -62,14 +63,19 @@ def test_a_program_holds_only_what_its_settings_use(output_passes):
         "srgb float": OutputSettings(transfer=TRANSFERS[1], format="npy"),
         "linear float": OutputSettings(format="npy"),
     }
+    programs |= {"half-tone": OutputSettings(halftone=Halftone(6)),
+                 "floyd-steinberg": OutputSettings(dither="floyd-steinberg")}
     active = {name: {u for u in ("u_decision_points", "u_code_values", "u_blue_noise_size",
-                                 "u_exponent", "u_bits") if stage.program(s).get(u, None) is not None}
+                                 "u_exponent", "u_bits", "u_screen", "u_shares")
+                     if stage.program(s).get(u, None) is not None}
               for name, s in programs.items()}
     assert active == {"none": {"u_decision_points", "u_bits"},
                       "bayer4": {"u_code_values", "u_bits"},
                       "blue-noise": {"u_code_values", "u_blue_noise_size", "u_bits"},
                       "srgb float": {"u_exponent"},
-                      "linear float": set()}
+                      "linear float": set(),
+                      "half-tone": {"u_screen", "u_bits"},
+                      "floyd-steinberg": {"u_code_values", "u_bits", "u_shares"}}
     assert stage.program(OutputSettings(dither="bayer4")) is stage.program(OutputSettings(dither="bayer4"))
 
 

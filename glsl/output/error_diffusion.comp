@@ -16,8 +16,10 @@ layout(rgba16ui, binding = 1) uniform writeonly uimage2D u_codes;
 layout(rgba32f, binding = 2) uniform image2D u_error;
 #include "quantise.glsl"
 
-// sender_weights[((left (r + 1) + right) (r + 1) + below) u_taps + k], r = u_reach
-layout(std430, binding = 2) readonly buffer SenderWeights { float sender_weights[]; };
+// The shares (error_kernels.sender_weights): tap k of a source at `left`, `right` and `below`
+// pixels from the edges at texel (k, (left (r + 1) + right) (r + 1) + below), r = u_reach. A
+// texture, not an SSBO: renderer/gpu/output.py says why.
+uniform sampler2D u_shares;
 
 const int MAX_TAPS = 12;              // Jarvis-Judice-Ninke's
 uniform ivec3 u_wavefront;            // (t, first row, last row)
@@ -31,7 +33,7 @@ float share(ivec2 s, int k) {
     ivec2 size = imageSize(u_linear);
     ivec3 sides = clamp(ivec3(s.x, size.x - 1 - s.x, size.y - 1 - s.y), 0, u_reach);
     int side = u_reach + 1;
-    return sender_weights[((sides.x * side + sides.y) * side + sides.z) * u_taps + k];
+    return texelFetch(u_shares, ivec2(k, (sides.x * side + sides.y) * side + sides.z), 0).r;
 }
 
 void main() {
@@ -52,9 +54,9 @@ void main() {
     code.r = bracketed_code(target.r, 0.5);
     code.g = bracketed_code(target.g, 0.5);
     code.b = bracketed_code(target.b, 0.5);
-    code.a = nearest_code(linear.a, u_alpha_points);
-    vec3 chosen = vec3(tables[u_code_values + code.r], tables[u_code_values + code.g],
-                       tables[u_code_values + code.b]);
+    code.a = alpha_code(linear.a);
+    vec3 chosen = vec3(table(u_code_values + code.r), table(u_code_values + code.g),
+                       table(u_code_values + code.b));
     imageStore(u_error, here, vec4(target - chosen, 0.0));
     imageStore(u_codes, p, code);
 }

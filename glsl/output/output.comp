@@ -14,9 +14,9 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(rgba32f, binding = 0) uniform readonly image2D u_linear;
+#include "transfer.glsl"
 #if defined(FLOAT_OUTPUT)
 layout(rgba32f, binding = 1) uniform writeonly image2D u_encoded;
-#include "transfer.glsl"
 #else
 layout(rgba16ui, binding = 1) uniform writeonly uimage2D u_codes;
 #include "quantise.glsl"
@@ -44,11 +44,11 @@ void main() {
     code.g = bracketed_code(linear.g, threshold);
     code.b = bracketed_code(linear.b, threshold);
 #else
-    code.r = nearest_code(linear.r, u_decision_points);
-    code.g = nearest_code(linear.g, u_decision_points);
-    code.b = nearest_code(linear.b, u_decision_points);
+    code.r = nearest_code(linear.r);
+    code.g = nearest_code(linear.g);
+    code.b = nearest_code(linear.b);
 #endif
-    code.a = nearest_code(linear.a, u_alpha_points);
+    code.a = alpha_code(linear.a);
     imageStore(u_codes, p, code);
 #endif
 }

@@ -1,6 +1,7 @@
 // Twin: reference/output/transfer.py
-// Float output (exr, npy): the encoded value V(L) of each RGB channel, unquantised
-// (renderer/core/quantise.py, encode): linear keeps L >= 0 unclamped; sRGB and gamma apply
+// The transfer curve in float32: float output's value (exr, npy: each RGB channel's V(L),
+// unquantised), and where the output is quantised, the guess its exact search starts from
+// (quantise.glsl). renderer/core/quantise.py's encode: linear keeps L >= 0 unclamped; sRGB and gamma apply
 // the curve to max(L, 0), above 1 too. Negative L and NaN become 0. GLSL's pow is llvmpipe's
 // exp2(log2(x) y) (docs/llvmpipe/output.md, section 2): a few ulps from the float64 curve,
 // not bit for bit; tests/test_output_transfer.py states the bound.

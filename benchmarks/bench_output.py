@@ -1,0 +1,101 @@
+"""What the output stage costs (issue 18): ms per frame of each method on the GPU
+(renderer/gpu/output.py, OutputPass.apply: upload, dispatch, read-back) and in the NumPy twin
+(reference.output.apply), what error diffusion's wavefront dispatches cost by themselves, and
+what making the blue-noise mask costs, printed.
+
+    .venv/bin/python benchmarks/bench_output.py [--size 640x480] [--frames 15] [--context egl]
+
+The input is the linear colour of a rendered frame (--scene, default sphere). For each case in
+CASES (a method at a bit depth, sRGB transfer; float output too), the GPU and the twin are
+called in turn (common.alternating_ms) after one warm-up call each (the program's compile, the
+tables), and the medians printed. Error diffusion's dispatches: the same W + s (H - 1)
+dispatches, uniform writes and memory barriers as OutputPass._diffuse with every wavefront's
+rows left empty (each invocation returns at once), against the whole pass, alternating. The
+mask: renderer/core/blue_noise.py's void-and-cluster, its cache cleared, made --frames // 5 + 1
+times, the median.
+Not a test: this machine is shared and noisy; the load average is printed.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+
+import reference.output
+from renderer.core.blue_noise import blue_noise_ranks
+from renderer.core.error_kernels import KERNELS, wavefronts
+from renderer.core.output_settings import ERROR_DIFFUSION, Halftone, OutputSettings, Transfer
+from renderer.core.scene_file import load_scene
+from renderer.gpu import GpuRenderer
+from renderer.gpu.context import make_context
+from renderer.gpu.output import WAVEFRONT_GROUP, OutputPass
+
+from common import alternating_ms, machine, parser         # benchmarks/common.py
+
+SRGB = Transfer("srgb")
+# (label, settings): each method at 1 and 8 bits; more methods add their rows here.
+CASES = [(f"{dither} {bits}-bit", OutputSettings(transfer=SRGB, bits=bits, dither=dither))
+         for dither in ("none", "bayer2", "bayer4", "bayer8", "blue-noise", *ERROR_DIFFUSION)
+         for bits in (1, 8)]
+CASES += [(f"half-tone {halftone}", OutputSettings(halftone=halftone))
+          for halftone in (Halftone(6, 0), Halftone(6, 7.5))]
+CASES += [("none 16-bit (png16)", OutputSettings(transfer=SRGB, format="png16")),
+          ("float (exr)", OutputSettings(transfer=SRGB, format="exr"))]
+
+
+def mask_ms(repeats: int) -> float:
+    times = []
+    for _ in range(repeats):
+        blue_noise_ranks.cache_clear()
+        start = time.perf_counter()
+        blue_noise_ranks()
+        times.append((time.perf_counter() - start) * 1000.0)
+    return statistics.median(times)
+
+
+def empty_wavefronts(stage: OutputPass, settings: OutputSettings, width: int, height: int):
+    """A callable running error diffusion's dispatches with nothing to do (OutputPass._diffuse's
+    loop, each wavefront's row range empty), and how many there are."""
+    program = stage.program(settings)
+    wavefront = program["u_wavefront"]
+    fronts = list(wavefronts(width, height, KERNELS[settings.dither].skew))
+
+    def run():
+        for t, first, last in fronts:
+            wavefront.value = (t, 1, 0)            # rows 1 .. 0: none
+            program.run((last - first) // WAVEFRONT_GROUP + 1)
+            stage.ctx.memory_barrier()
+        stage.ctx.finish()
+    return run, len(fronts)
+
+
+def main() -> None:
+    args = parser(__doc__, "frames", 15)
+    args.add_argument("--scene", default="sphere")
+    args = args.parse_args()
+    width, height = args.size
+    ctx = make_context(args.context)
+    with GpuRenderer(load_scene(args.scene), width, height, context=ctx) as gpu:
+        linear = gpu.render(linear=True, depth=False).linear
+    stage = OutputPass(ctx)
+    print(machine())
+    print(f"output stage, {args.scene} at {width}x{height}, {args.context}, median of {args.frames} frames")
+    print(f"{'case':24s} {'GPU ms':>8s} {'twin ms':>8s} {'twin/GPU':>9s}")
+    for label, settings in CASES:
+        stage.apply(linear, settings)
+        reference.output.apply(linear, settings)
+        gpu_ms, twin_ms = alternating_ms([lambda: stage.apply(linear, settings),
+                                          lambda: reference.output.apply(linear, settings)], args.frames)
+        print(f"{label:24s} {gpu_ms:8.2f} {twin_ms:8.2f} {twin_ms / gpu_ms:9.1f}")
+    for kernel in ERROR_DIFFUSION:
+        settings = OutputSettings(transfer=SRGB, bits=1, dither=kernel)
+        empty, count = empty_wavefronts(stage, settings, width, height)
+        pass_ms, empty_ms = alternating_ms([lambda: stage.apply(linear, settings), empty], args.frames)
+        print(f"{kernel}: {count} dispatches alone {empty_ms:.1f} ms ({1000 * empty_ms / count:.0f} us "
+              f"each), {100 * empty_ms / pass_ms:.0f} % of the pass's {pass_ms:.1f} ms")
+    print(f"blue-noise mask (void-and-cluster, 64 x 64): {mask_ms(args.frames // 5 + 1):.0f} ms")
+    stage.release()
+
+
+if __name__ == "__main__":
+    main()

@@ -87,8 +87,10 @@ def test_blue_noise_has_little_power_at_low_frequencies():
 
 # -- GPU against twin -------------------------------------------------------------------------
 
+# gamma's tables are searched as sRGB's are: the full run holds it (about 0.5 s)
 @pytest.mark.parametrize("kind", ("egl", "osmesa"))
-@pytest.mark.parametrize("transfer", TRANSFERS, ids=str)
+@pytest.mark.parametrize("transfer", [pytest.param(t, marks=[pytest.mark.slow] if t.kind == "gamma" else [])
+                                      for t in TRANSFERS], ids=str)
 @pytest.mark.parametrize("dither", DITHERS)
 def test_dithered_codes_on_the_gpu_are_the_twins(output_passes, kind, transfer, dither):
     frame = linear_frame(width=72, height=20, seed=len(dither))     # wider than a Bayer tile

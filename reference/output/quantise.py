@@ -4,8 +4,9 @@ Codes from linear light by exact comparisons with the tables of renderer/core/qu
 (the rule, written once there), in float32 operation for operation with the GLSL:
 
 - `count_at_or_below(L, table)`: how many entries of an ascending float32 table are <= L
-  (np.searchsorted(table, L, 'right'); the GLSL's binary search finds the same count). A
-  comparison with NaN is false, so NaN counts 0.
+  (np.searchsorted(table, L, 'right'); the GLSL walks to the same count from the transfer
+  curve's guess). A comparison with NaN is false, so NaN counts 0; L and L clamped to
+  [0, 1] have the same count (the tables lie in [0, 1]).
 - the undithered code (the baseline): `nearest_code(L) = count_at_or_below(L, t)` over the
   decision points t of the transfer; alpha always over the linear transfer's.
 - `bracketed_code(L, T)`, dithering's choice, in linear light: L' = L clamped to [0, 1] (NaN

@@ -17,7 +17,7 @@ The method, on a torus (the mask tiles the image, so its energy wraps around):
   up to size^2 - 1. (Ulichney's phase 3 seeks the tightest cluster of 0s under the inverted
   pattern; on a torus that energy is sum(kernel) - energy, so it is the largest void too.)
 Ties go to the first pixel in row-major order (np.argmin / np.argmax), so the mask is the
-same on every run. Made in about 0.1 s at 64 x 64 (tests/test_output_dither.py times it).
+same on every run. Made in about 0.1 s at 64 x 64 (benchmarks/bench_output.py prints it).
 """
 
 from __future__ import annotations

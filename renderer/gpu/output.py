@@ -18,12 +18,13 @@ the quantisation tables per (transfer, bits) (renderer/core/quantise.py; one flo
 and its shares per kernel (a float texture). A second apply() with settings and a size seen
 before makes no GL object. Error diffusion runs its own program in wavefronts (`_diffuse`).
 
-Why the tables are a texture and not an SSBO: on llvmpipe (Mesa 22.3.6) an SSBO read that
-follows a loop whose iterations differ between the lanes of a SIMD vector returned 0 for
-some lanes (found here: the search of quantise.glsl read 0.0 for l_c0 in 34 of 1440 pixels;
-the same search reading a texture is exact), and texelFetch gathers the table entries about
-2.2 times faster (measured: a 640 x 480 binary search of 8 steps per channel, 84 ms from an
-SSBO, 38 ms from a texture).
+Why the tables are a texture and not an SSBO: on llvmpipe (Mesa 22.3.6, EGL and OSMesa) the
+read of l_c0 that follows quantise.glsl's search loops, from an SSBO, read the wrong entry in
+34 of 1440 pixels (0.0, or with one invocation per work group the entry after it) though the
+count it used was right: a driver fault with SSBO loads after such loops (a plain loop with
+an SSBO read in its condition did not show it). The same search reading a texture is exact
+on every test, and texelFetch gathers about 2.2 times faster (measured: a 640 x 480 binary
+search of 8 steps per channel, 84 ms from an SSBO, 38 ms from a texture).
 """
 
 from __future__ import annotations

@@ -7,8 +7,9 @@ thresholds to the encoded value V = encode(L) instead, c = floor(V (2^N - 1)) + 
 fraction above that code exceeds T, averages the codes to V, and the light shown to the
 mean of decode(code / (2^N - 1)): not L, since the curve is not linear. At 1 bit the light
 shown averages V itself, which sRGB puts above L everywhere in (0, 1): mid-grey L = 0.214
-shows as 0.5, so the picture brightens (R. Ulichney, "Digital Halftoning", MIT Press 1987,
-dithers the quantity the device then reproduces linearly; for a display that is light).
+shows as 0.5, so the picture brightens. The eye averages the light of neighbouring pixels,
+not their codes, so the average a dither keeps must be light's (on dithering and what it
+averages: R. Ulichney, "Digital Halftoning", MIT Press 1987).
 """
 
 from __future__ import annotations

@@ -142,7 +142,8 @@ def luminance_png(luminance: np.ndarray, title: str) -> bytes:
     figure = _figure((6.4, 4.0))
     axes = figure.add_subplot()
     top = max(1.0, float(luminance.max())) if len(luminance) else 1.0
-    axes.hist(luminance, bins=LUMINANCE_BINS, range=(0.0, top), color="0.4", log=True)
+    axes.hist(luminance, bins=LUMINANCE_BINS, range=(0.0, top), color="0.4",
+              log=bool(len(luminance)))           # no pixels: nothing to put on a log scale
     if len(luminance):
         mean = float(luminance.mean())
         axes.axvline(mean, color="C3", linewidth=1, label=f"mean Y = {mean:.4f}")

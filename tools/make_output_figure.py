@@ -1,8 +1,9 @@
 """Write docs/images/output-methods.png, the README's one scene at 1 bit per channel in each
 output method: the built-in scene SCENE drawn on the GPU path (EGL, llvmpipe) at 256 x 192, one
 sample per pixel, its linear colour through the GPU output stage (renderer/gpu/output.py) with
-the sRGB transfer at 1 bit per channel by each method, and beside them the frame at 8 bits
-(what the file would hold without the output options) and the mistake the stage avoids,
+the sRGB transfer at 1 bit per channel by each method, and beside them the same light at 8
+bits with the sRGB transfer (what the 1-bit panels approximate on an sRGB display: the frame's
+own rgba8, the linear transfer, would look darker) and the mistake the stage avoids,
 blue noise applied to the encoded values (renderer/study/code_value_dither.py). Each panel is
 labelled with the report's measures of it (renderer/study/output_report.py): the PSNR of its
 luminance after the eye's low-pass and the bias of its 8 x 8 blocks' mean luminance, in levels
@@ -31,6 +32,7 @@ COLUMNS = 5
 
 def panels() -> list[tuple[str, np.ndarray]]:
     """(label, (H, W, 3) uint8 sRGB-encoded image) per panel."""
+    from renderer.core.output_settings import OutputSettings, Transfer
     from renderer.core.scene_file import load_scene
     from renderer.gpu import GpuRenderer
     from renderer.gpu.output import OutputPass
@@ -41,7 +43,8 @@ def panels() -> list[tuple[str, np.ndarray]]:
         frame = gpu.render(linear=True, depth=False)
         stage = OutputPass(gpu.ctx)
         try:
-            shown = [("8 bits per channel (no output options)", frame.rgba8[..., :3])]
+            eight_bits = stage.apply(frame.linear, OutputSettings(transfer=Transfer("srgb"), bits=8))
+            shown = [("8 bits per channel, sRGB transfer", eight_bits[..., :3].astype(np.uint8))]
             for method in METHODS:
                 variant = ("output", "stage", method, 1)
                 codes = stage.apply(frame.linear, output_settings(variant))

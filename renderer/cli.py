@@ -1,5 +1,5 @@
-"""The command line: `renderer render | view | compare | shaders | report | scenes | extremes`
-(also `python -m renderer`).
+"""The command line: `renderer render | view | compare | shaders | report | scenes | extremes |
+colour` (also `python -m renderer`).
 
 A user's mistake (bad scene, bad output name, no GL) is one line on stderr and exit status
 2, with nothing written; an option argparse refuses is its reason on one line and the
@@ -30,6 +30,7 @@ from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
+COLOUR_SIZE = (320, 240)             # `renderer colour`'s frame of a scene
 
 
 def parse_size(text: str) -> tuple[int, int]:
@@ -235,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
                         metavar="K,K", help="only these knob families (default all): raster: "
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
-                        "(textured scenes); raytrace: antialiasing, max_depth, precision")
+                        "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -254,6 +255,22 @@ def build_parser() -> argparse.ArgumentParser:
     extremes.add_argument("--no-sweep", action="store_true",
                           help="leave out the light-elevation sweep of shadow maps (measured "
                                "with the rasterised cases otherwise)")
+    colour = sub.add_parser("colour", help="CIE chromaticity diagram, luminance histogram and "
+                                           "Munsell table of an image or a scene's frame")
+    colour.add_argument("source", metavar="IMAGE-or-SCENE",
+                        help="an image file (PNG 8/16-bit, other formats Pillow reads, .exr, .npy) "
+                             "or a scene file or built-in scene name")
+    colour.add_argument("--out", type=output_path, required=True,
+                        help="folder for chromaticity.png, luminance.png, munsell.md, colour.json")
+    colour.add_argument("--backend", choices=("gpu", "reference"), default="gpu",
+                        help="the colour pass (and a scene's renderer): gpu (default) or reference")
+    colour.add_argument("--colorspace", choices=("srgb", "linear"),
+                        help="an image's RGB: srgb-encoded (default for integer images) or linear "
+                             "light (default for .exr and .npy)")
+    colour.add_argument("--size", type=parse_size, metavar="WxH",
+                        help=f"a scene's frame size (default {COLOUR_SIZE[0]}x{COLOUR_SIZE[1]})")
+    colour.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
+                        help="headless GL context (default: EGL, then OSMesa)")
     for name in ("render", "view", "compare", "shaders", "report", "extremes"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
@@ -835,6 +852,31 @@ def cmd_report(args) -> int:
     return 0
 
 
+def cmd_colour(args) -> int:
+    """chromaticity.png, luminance.png, munsell.md and colour.json in --out (renderer/study/
+    colour_report.py), all or none."""
+    from renderer.core.imageio import check_folder, check_outputs
+    from renderer.study.colour_report import COLOUR_FILES, write_colour_report
+    from renderer.study.colour_source import image_source, is_image_name, scene_source
+    out = check_folder(args.out)
+    check_outputs(*(out / name for name in COLOUR_FILES))
+    if is_image_name(args.source):
+        if args.size is not None:
+            args.parser.error("--size sets a scene's frame; an image has its own size")
+        source = image_source(args.source, args.colorspace, args.backend, args.context)
+    else:
+        if args.colorspace is not None:
+            args.parser.error("--colorspace says how an image is encoded; a scene's frame is linear")
+        scene = _load(args.source)
+        size = args.size or COLOUR_SIZE
+        check_memory(scene, size, [args.backend])
+        source = scene_source(scene, size, args.backend, args.context)
+    written = write_colour_report(source, out)
+    pixels = int(source.covered.sum())
+    print(f"wrote {', '.join(str(path) for path in written)} ({pixels} pixels, {args.backend})")
+    return 0
+
+
 def cmd_scenes(args) -> int:
     from renderer.core.builtin import builtin_scenes, describe
     for name in builtin_scenes():
@@ -891,7 +933,7 @@ def _check_paths(args) -> None:
 
 
 COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
-            "scenes": cmd_scenes, "extremes": cmd_extremes}
+            "scenes": cmd_scenes, "extremes": cmd_extremes, "colour": cmd_colour}
 
 
 def main(argv=None) -> int:

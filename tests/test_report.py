@@ -75,7 +75,8 @@ def test_every_knob_runs_on_its_backends():
                         ("shading", "gpu"), ("shading", "reference"), ("precision", "reference"),
                         *((f"shadows-{knob}", b) for knob in ("resolution", "filter", "bias")
                           for b in ("gpu", "reference")),
-                        *((knob, b) for knob in ("filter", "texture_resolution") for b in ("gpu", "reference"))}
+                        *((knob, b) for knob in ("filter", "texture_resolution", "output")
+                          for b in ("gpu", "reference"))}
     assert {s.setting for s in plan if s.pattern == "msaa"} == {"msaa 1", "msaa 4"}
     assert {s.setting for s in plan if s.pattern == "regular" and s.knob == "antialiasing"} == \
         {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
@@ -94,7 +95,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     assert len(rows) == len([s for s in settings(QUICK, [1, 4]) if s.variant[0] != "texture"])
     assert {row["scene"] for row in rows} == {"point_light_plane"}
     assert all(int(row["runs"]) >= 5 and float(row["median_ms"]) > 0 for row in rows)
-    image_rows = [row for row in rows if not row["knob"].startswith("shadows-")]
+    image_rows = [row for row in rows if not row["knob"].startswith(("shadows-", "output"))]
     assert all(0 <= float(row["rmse"]) <= float(row["max_abs"]) <= 1 for row in image_rows)
     # More samples, smaller error: jittered 16 beats one sample on both backends.
     error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in image_rows}
@@ -102,13 +103,13 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
         assert error[("jittered 16", backend)] < error[("jittered 1", backend)]
     plots = sorted(path.name for path in (out / "plots").iterdir())
     assert plots == [f"point_light_plane-{knob}.png"
-                     for knob in ("antialiasing", "precision", "shading", "shadows-bias",
+                     for knob in ("antialiasing", "output", "precision", "shading", "shadows-bias",
                                   "shadows-filter", "shadows-resolution", "tessellation")]
     assert all((out / "plots" / name).read_bytes().startswith(b"\x89PNG") for name in plots)
     report = (out / "report.md").read_text()
     for heading in ("# Error against run time", "## Method", "## Convergence of the sampling patterns",
                     "## Cheapest setting reaching RMSE <= 0.01 ", "## Cheapest setting reaching RMSE <= 0.003 ",
-                    "## Plots"):
+                    "## Output: quantisation, dithering and half-toning", "## Plots"):
         assert heading in report
     for name in plots:
         assert f"](plots/{name})" in report

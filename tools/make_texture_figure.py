@@ -13,11 +13,12 @@ about a minute).
 
 from __future__ import annotations
 
-import io
 import math
 from pathlib import Path
 
 import numpy as np
+
+from contact_sheet import contact_sheet, write_figure
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "images" / "texture-filters.png"
@@ -49,31 +50,10 @@ def panels() -> list[tuple[str, np.ndarray]]:
     return out
 
 
-def figure(images: list[tuple[str, np.ndarray]], columns: int = 3) -> bytes:
-    """PNG bytes: the panels in rows of `columns`, each under its label."""
-    from PIL import Image, ImageDraw, ImageFont
-
-    from renderer.core.gl_rules import to_unorm8
-
-    width, height = SIZE
-    rows = math.ceil(len(images) / columns)
-    sheet = Image.new("RGB", (columns * width, rows * (height + LABEL_HEIGHT)), (255, 255, 255))
-    draw = ImageDraw.Draw(sheet)
-    font = ImageFont.load_default(size=14)
-    for k, (label, image) in enumerate(images):
-        x, y = (k % columns) * width, (k // columns) * (height + LABEL_HEIGHT)
-        draw.text((x + 6, y + 3), label, fill=(0, 0, 0), font=font)
-        sheet.paste(Image.fromarray(to_unorm8(image), "RGB"), (x, y + LABEL_HEIGHT))
-    buffer = io.BytesIO()
-    sheet.save(buffer, format="PNG", optimize=True)
-    return buffer.getvalue()
-
-
 def main() -> None:
-    data = figure(panels())
-    OUT.parent.mkdir(parents=True, exist_ok=True)
-    OUT.write_bytes(data)
-    print(f"{OUT.relative_to(ROOT)}: {len(data):,} bytes")
+    from renderer.core.gl_rules import to_unorm8
+    sheet = [(label, to_unorm8(image)) for label, image in panels()]
+    write_figure(OUT, contact_sheet(sheet, columns=3, label_height=LABEL_HEIGHT, font_size=14), ROOT)
 
 
 if __name__ == "__main__":

@@ -26,3 +26,17 @@ def flip_error(expected_rgba8: np.ndarray, actual_rgba8: np.ndarray) -> tuple[fl
     actual = np.ascontiguousarray(actual_rgba8[..., :3], dtype=np.float32) / 255.0
     error_map, mean, _ = flip_evaluator.evaluate(expected, actual, "LDR")
     return float(mean), to_unorm8(np.asarray(error_map))
+
+
+def flip_mean(expected_srgb: np.ndarray, actual_srgb: np.ndarray,
+              pixels_per_degree: float | None = None) -> float:
+    """The mean ꟻLIP error of two sRGB-encoded float images (H, W, 3) in [0, 1] (LDR), not
+    quantised to 8 bits first (the report's output section compares 8-bit outputs with the
+    float image), at ꟻLIP's default viewing condition or `pixels_per_degree`."""
+    import flip_evaluator
+
+    parameters = {} if pixels_per_degree is None else {"ppd": float(pixels_per_degree)}
+    _, mean, _ = flip_evaluator.evaluate(np.ascontiguousarray(expected_srgb, dtype=np.float32),
+                                         np.ascontiguousarray(actual_srgb, dtype=np.float32),
+                                         "LDR", applyMagma=False, parameters=parameters)
+    return float(mean)

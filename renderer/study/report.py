@@ -19,6 +19,9 @@ image against the ground truth (renderer/study/ground_truth.py) make one row of 
     filter,         the texture filter; the textures resampled to R       as authored, one
     texture_        texels on their long side (texture_report.py;         sample per pixel
     resolution      textured scenes)
+    output          the output stage's methods at 1 to 8 bits per         as authored, one
+                    channel (output_report.py): against the undithered    sample per pixel
+                    linear image, not the truth; the stage's time alone
 
 Errors are on the float image in [0, 1] (renderer/study/supersample.py) against the float truth:
 rmse, max_abs, psnr (dB, peak 1), flip_mean (ꟻLIP on both images quantised to 8 bits) and
@@ -49,6 +52,7 @@ from renderer.core.imageio import outputs
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
 from renderer.study.metrics import metrics
+from renderer.study import output_report
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, QUICK_SIZE,
                                             SHADOW_RESOLUTIONS)
 from renderer.study.shadow_report import (fits, plot_axis, shadow_errors, shadow_variants,
@@ -69,6 +73,10 @@ class Sweep:
     shadow_biases: tuple = BIAS_RULES
     texture_filters: tuple = FILTER_SETTINGS
     texture_resolutions: tuple = TEXTURE_RESOLUTIONS
+    output_methods: tuple = output_report.METHODS
+    output_bits: tuple = output_report.BITS
+    output_halftone: bool = True
+    output_code_value: tuple = output_report.CODE_VALUE
     runs: int = 5
 
 
@@ -76,9 +84,10 @@ FULL = Sweep()
 QUICK = Sweep(adaptive=((4, 16, 0.05),), levels=(0.25, 1.0, FINEST), shadow_resolutions=(256, 1024),
               shadow_filters=("hard", "pcf2x2"), shadow_biases=("auto", "none"),
               texture_filters=(("nearest", 1), ("trilinear", 1), ("anisotropic", 16)),
-              texture_resolutions=(64, 256))
+              texture_resolutions=(64, 256),
+              output_methods=("none", "bayer4", "blue-noise", "floyd-steinberg"), output_bits=(1, 8))
 KNOB_FAMILIES = ("antialiasing", "tessellation", "shading", "precision", "shadows", "filter",
-                 "texture_resolution")
+                 "texture_resolution", output_report.KNOB)
 
 
 @dataclass(frozen=True)
@@ -90,7 +99,8 @@ class Setting:
     pattern: str                     # a sampling pattern, "adaptive", "msaa", or "regular"
     variant: tuple                   # ("truth",) | ("level", L) | ("shading", mode) |
                                      # ("shadow", field, value): shadow_report.py |
-                                     # ("texture", field, value): texture_report.py
+                                     # ("texture", field, value): texture_report.py |
+                                     # ("output", kind, method, bits): output_report.py
     sampling: tuple                  # ("pattern", name, N) | ("adaptive", first, total, t) | ("msaa", N)
     dtype: str = "float64"
 
@@ -128,6 +138,10 @@ def settings(sweep: Sweep, msaa_counts: list[int]) -> list[Setting]:
         out += [Setting(knob, name, b, "regular", variant, ("pattern", "regular", 1)) for b in both]
     for knob, name, variant in texture_variants(sweep.texture_filters, sweep.texture_resolutions):
         out += [Setting(knob, name, b, "regular", variant, ("pattern", "regular", 1)) for b in both]
+    for name, variant, backends in output_report.output_variants(
+            sweep.output_methods, sweep.output_bits, sweep.output_halftone, sweep.output_code_value):
+        out += [Setting(output_report.KNOB, name, b, "regular", variant, ("pattern", "regular", 1))
+                for b in backends]
     return out
 
 
@@ -141,6 +155,7 @@ class SceneRun:
         self._scenes: dict[tuple, object] = {}
         self._gpus: dict[tuple, object] = {}
         self._shadow_errors: dict[tuple, dict] = {}
+        self._output = None                       # output_report.OutputRun, made on first use
 
     def drawn(self, variant: tuple):
         if variant not in self._scenes:
@@ -150,6 +165,7 @@ class SceneRun:
                 scene_at_level(self.scene.with_shading("phong"), variant[1]) if kind == "level" else
                 with_shadow_setting(self.scene, *variant[1:]) if kind == "shadow" else
                 with_texture_setting(self.scene, *variant[1:]) if kind == "texture" else
+                self.scene if kind == "output" else
                 self.scene.with_shading(variant[1]))
         return self._scenes[variant]
 
@@ -160,8 +176,17 @@ class SceneRun:
                                               context=self.ctx)
         return self._gpus[variant]
 
+    def output(self) -> output_report.OutputRun:
+        """The output settings' frame and stage: the scene as authored, drawn once."""
+        if self._output is None:
+            self._output = output_report.OutputRun(self.gpu(("output",)))
+        return self._output
+
     def render(self, setting: Setting) -> tuple[np.ndarray, float]:
-        """(image (H, W, 3) float64 in [0, 1], samples per pixel spent)."""
+        """(image (H, W, 3) float64 in [0, 1], samples per pixel spent); an output setting's
+        (H, W, 4) codes of its stage alone, the frame drawn before."""
+        if setting.variant[0] == output_report.KNOB:
+            return self.output().codes(setting.variant, setting.backend), 1.0
         kind, *args = setting.sampling
         if kind == "msaa":
             return msaa_image(self.gpu(setting.variant), args[0]), float(args[0])
@@ -176,14 +201,18 @@ class SceneRun:
         return supersample(pass_, sampling.pattern(name, n)), float(n)
 
     def timed(self, setting: Setting, runs: int) -> tuple[np.ndarray, float, float]:
-        """(image, samples per pixel, median ms of `runs` runs of the whole setting; timing.py)."""
-        (image, samples), ms = median_timed(lambda: self.render(setting), runs,
-                                            warm_up=setting.backend == "gpu")
+        """(image, samples per pixel, median ms of `runs` runs of the whole setting; timing.py).
+        An output setting's first run (its frame, tables, masks, program) is not timed either."""
+        (image, samples), ms = median_timed(lambda: self.render(setting), runs, warm_up=(
+            setting.backend == "gpu" or setting.variant[0] == output_report.KNOB))
         return image, samples, ms
 
     def errors(self, setting: Setting, image: np.ndarray, truth: np.ndarray | None) -> dict:
         """A row's errors: a shadow setting's against ray-cast truth (one measurement for both
-        backends: shadow_report.py), any other's image against the ground truth (metrics)."""
+        backends: shadow_report.py), an output setting's against the linear frame it shows
+        (output_report.py), any other's image against the ground truth (metrics)."""
+        if setting.variant[0] == output_report.KNOB:
+            return self.output().errors(setting.variant, image)
         if setting.variant[0] != "shadow":
             return metrics(image, truth)
         if setting.variant not in self._shadow_errors:
@@ -192,6 +221,9 @@ class SceneRun:
         return self._shadow_errors[setting.variant]
 
     def release(self) -> None:
+        if self._output is not None:
+            self._output.release()
+            self._output = None
         for gpu in self._gpus.values():
             gpu.release()
         self._gpus.clear()
@@ -228,8 +260,9 @@ class RasterStudy:
                 and (s.variant[0] != "texture" or is_textured(scene))]
 
     def needs_truth(self, plan: list[Setting]) -> bool:
-        """Whether some setting's error is against the ground truth image (not a shadow knob's)."""
-        return any(s.variant[0] != "shadow" for s in plan)
+        """Whether some setting's error is against the ground truth image (not a shadow or an
+        output knob's)."""
+        return any(s.variant[0] not in ("shadow", output_report.KNOB) for s in plan)
 
     def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
         return ground_truth(scene, width, height, cache_dir)
@@ -333,8 +366,10 @@ def write_outputs(result: ReportResult, out: Path, runner, size, sweep, quick: b
             for knob in dict.fromkeys(row["knob"] for row in result.rows if row["scene"] == scene):
                 rows = [row for row in result.rows if row["scene"] == scene and row["knob"] == knob]
                 plots[(scene, knob)] = f"plots/{scene}-{knob}.png"
-                written.bytes(out / plots[(scene, knob)], plot_png(rows, f"{scene}: {knob}",
-                                                                   **plot_axis(knob)))
+                png = (output_report.output_plot_png(rows, f"{scene}: {knob}")
+                       if knob == output_report.KNOB else
+                       plot_png(rows, f"{scene}: {knob}", **plot_axis(knob)))
+                written.bytes(out / plots[(scene, knob)], png)
         written.text(out / "results.csv", csv_text(result.rows, runner.columns))
         written.text(out / "report.md", runner.markdown(result, plots, size, sweep, quick))
     result.files = ["report.md", "results.csv", *plots.values()]

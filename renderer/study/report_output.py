@@ -18,7 +18,7 @@ from renderer.core import sampling
 from renderer.study.ground_truth import TRUTH_GRID
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, MISMATCH_LEVELS,
                                             PATTERN_KNOBS, TARGETS_RMSE, TEXTBOOK_SLOPES)
-from renderer.study import texture_report
+from renderer.study import output_report, texture_report
 from renderer.study.shadow_report import method_bullet, shadow_sections
 
 BACKENDS = ("gpu", "reference")
@@ -245,13 +245,29 @@ def plots_section(scenes: list[str], plots: dict) -> list[str]:
              "RMSE against the median time per image, log-log (the shadow knobs: the fraction "
              "of pixels wrong outside the 1-texel band, linear below 0.01 %, so that 0 shows); "
              "circled points joined by the dashed staircase are the Pareto front (no other "
-             "setting is both faster and more accurate).", ""]
+             "setting is both faster and more accurate). The output knob's plots are its "
+             "errors and times against the bits per channel, a line per method.", ""]
     for scene in scenes:
         lines += [f"### {scene}", ""]
         for (plot_scene, knob), path in plots.items():
             if plot_scene == scene:
                 lines += [f"![{scene}: {knob}]({path})", ""]
     return lines
+
+
+def truth_bullets(result, sweep, families: set) -> list[str]:
+    """The Method section's lines on the ground truth and the errors against it."""
+    return [
+        f"- **Ground truth**: the NumPy reference in float64, Phong shading on every object, every "
+        f"curved primitive at the finest tessellation (x{sweep.levels[-1]:g} of the authored "
+        f"segment counts), {TRUTH_GRID}x{TRUTH_GRID} regular-grid supersampling per pixel "
+        "(rendered once at 16W x 16H and box-filtered), clamped linear colour in [0, 1]. It is "
+        "cached on disk by a hash of the scene's content, the size and these parameters.",
+        *([texture_report.truth_bullet()] if any(textures for *_, textures in result.scenes.values()) else []),
+        errors_bullet() + (" MSAA resolves into an 8-bit buffer, so its error has a 1/255 "
+                           "quantisation floor (RMSE about 0.001) that the float accumulation "
+                           "does not." if "antialiasing" in families else ""),
+    ]
 
 
 def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
@@ -275,15 +291,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         "",
         "## Method",
         "",
-        f"- **Ground truth**: the NumPy reference in float64, Phong shading on every object, every "
-        f"curved primitive at the finest tessellation (x{sweep.levels[-1]:g} of the authored "
-        f"segment counts), {TRUTH_GRID}x{TRUTH_GRID} regular-grid supersampling per pixel "
-        "(rendered once at 16W x 16H and box-filtered), clamped linear colour in [0, 1]. It is "
-        "cached on disk by a hash of the scene's content, the size and these parameters.",
-        *([texture_report.truth_bullet()] if any(textures for *_, textures in result.scenes.values()) else []),
-        errors_bullet() + (" MSAA resolves into an 8-bit buffer, so its error has a 1/255 "
-                           "quantisation floor (RMSE about 0.001) that the float accumulation "
-                           "does not." if "antialiasing" in families else ""),
+        *(truth_bullets(result, sweep, families)
+          if families - {"shadows", output_report.KNOB} else []),   # some knob against the truth
     ]
     if "antialiasing" in families:
         lines += [
@@ -312,6 +321,8 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
         lines.append(method_bullet())
     if families & set(texture_report.KNOBS):
         lines.append(texture_report.method_bullet())
+    if output_report.KNOB in families:
+        lines.append(output_report.method_bullet())
     if "antialiasing" in families:
         lines += [
             "",
@@ -334,6 +345,7 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     if any(r.get("rmse") is not None for r in rows):
         lines += cheapest_sections(rows, scenes, "which draw the truth's geometry and shading")
     lines += texture_sections(rows)
+    lines += output_report.output_sections(rows)
     lines += shadow_sections(rows, scenes) + [""]
     lines += plots_section(scenes, plots)
     return "\n".join(lines)

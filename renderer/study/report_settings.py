@@ -16,8 +16,12 @@ BASE_SAMPLES = 4                     # regular grid for the knobs other than ant
 # the other knobs' rows, whose image errors (rmse .. mismatched_fraction) are empty in theirs.
 SHADOW_COLUMNS = ("wrong_outside_band_fraction", "wrong_fraction", "acne_pixels",
                   "peter_panning_max_texels")
+# The output knob's (renderer/study/output_report.py): against the linear frame, not the truth.
+OUTPUT_COLUMNS = ("method", "bits", "block_mean_abs", "block_p95_abs", "block_max_abs",
+                  "block_bias", "lowpass_psnr")
 CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "runs", "median_ms",
-               "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction", *SHADOW_COLUMNS)
+               "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction", *SHADOW_COLUMNS,
+               *OUTPUT_COLUMNS)
 
 
 @dataclass(frozen=True)

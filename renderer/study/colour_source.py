@@ -1,0 +1,152 @@
+"""What `renderer colour` measures: an image file's pixels, or a scene's frame rendered, as
+linear RGB with coverage, then each pixel's CIE XYZ and chromaticity from the chosen backend's
+colour pass (renderer/gpu/colour.py on "gpu", reference/output/colour.py on "reference").
+
+Images: a PNG's codes are read exactly, 8 or 16 bits and sBIT honoured (renderer/core/
+image_formats.py); other formats Pillow reads come as 8-bit RGBA; OpenEXR and .npy hold float
+colour. `colorspace` says what the RGB values are: "srgb" (encoded: the IEC 61966-2-1 curve is
+undone, renderer/core/quantise.py `decode`) or "linear" (light as it is); by default "srgb"
+for integer images and "linear" for float ones. Alpha is never encoded. Pixels of alpha 0 (a
+scene's background, a transparent image's empty parts) are not counted.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from renderer.core.output_settings import Transfer
+from renderer.core.quantise import decode
+from renderer.errors import UserError
+
+FLOAT_SUFFIXES = (".exr", ".npy")
+COLORSPACES = ("srgb", "linear")
+
+
+@dataclass
+class ColourSource:
+    """A source's pixels measured: `linear` (H, W, 4) float32 RGB and coverage, `xyz`
+    (H, W, 4) XYZ and coverage, `chromaticity` (H, W, 3) x, y, z (from the backend's pass),
+    the `scene` for a scene (None for an image) and what to say about it (`details`: kind,
+    source, colorspace or backend and size, milliseconds)."""
+    name: str
+    linear: np.ndarray
+    xyz: np.ndarray
+    chromaticity: np.ndarray
+    scene: object = None
+    details: dict = field(default_factory=dict)
+
+    @property
+    def covered(self) -> np.ndarray:
+        """(H, W) bool: the pixels counted (alpha > 0)."""
+        return self.linear[..., 3] > 0
+
+    @property
+    def lit(self) -> np.ndarray:
+        """(H, W) bool: counted pixels with light, so a chromaticity (X + Y + Z > 0)."""
+        return self.covered & (self.xyz[..., :3].sum(axis=-1) > 0)
+
+
+def is_image_name(text: str) -> bool:
+    """Whether a command-line argument names an image (by its suffix) rather than a scene."""
+    from PIL import Image
+    Image.init()
+    suffix = Path(text).suffix.lower()
+    return suffix in FLOAT_SUFFIXES or suffix in Image.registered_extensions()
+
+
+def _read_pixels(path: Path) -> tuple[np.ndarray, bool]:
+    """(H, W, 4) RGBA values in [0, 1] (or float colour as stored), and whether it was float."""
+    suffix = path.suffix.lower()
+    if suffix == ".exr":
+        from renderer.core.image_formats import read_exr
+        return _as_rgba(read_exr(path)), True
+    if suffix == ".npy":
+        return _as_rgba(np.load(path, allow_pickle=False)), True
+    if suffix == ".png":
+        from renderer.core.image_formats import read_png
+        codes, bits, _ = read_png(path)
+        return _as_rgba(codes / np.array([(1 << b) - 1 for b in bits], np.float64)), False
+    from PIL import Image
+    with Image.open(path) as image:
+        return np.asarray(image.convert("RGBA"), np.float64) / 255.0, False
+
+
+def _as_rgba(values: np.ndarray) -> np.ndarray:
+    """Grey, grey + alpha, RGB or RGBA (H, W[, C]) -> (H, W, 4) float64 (opaque if no alpha)."""
+    if values.dtype.kind not in "fiu" or values.ndim not in (2, 3) or (
+            values.ndim == 3 and values.shape[2] not in (1, 2, 3, 4)):
+        raise ValueError(f"expected (H, W) or (H, W, 1|2|3|4) numbers, got {values.dtype} "
+                         f"{values.shape}")
+    values = np.asarray(values, np.float64).reshape(*values.shape[:2], -1)
+    channels = values.shape[2]
+    colour = values[..., :3] if channels >= 3 else np.repeat(values[..., :1], 3, axis=2)
+    alpha = values[..., -1:] if channels in (2, 4) else np.ones_like(values[..., :1])
+    return np.concatenate([colour, alpha], axis=2)
+
+
+def read_image(path, colorspace: str | None = None) -> tuple[np.ndarray, str]:
+    """(linear (H, W, 4) float32, the colorspace it was read as); a file that is missing or
+    cannot be read is a one-line UserError naming it."""
+    path = Path(path)
+    if not path.exists():
+        raise UserError("no such image file", file=str(path))
+    if path.is_dir():
+        raise UserError("is a folder, not an image", file=str(path))
+    import png
+    try:
+        pixels, is_float = _read_pixels(path)
+    # pypng's errors are png.Error, OpenEXR's RuntimeError, Pillow's OSError (and, for a
+    # damaged file, ValueError, SyntaxError or EOFError), a wrong .npy's ValueError
+    except (png.Error, RuntimeError, OSError, ValueError, SyntaxError, EOFError) as error:
+        raise UserError(f"cannot read it as an image: {error}", file=str(path)) from None
+    if not np.isfinite(pixels).all():
+        raise UserError("holds NaN or infinite values, which have no colour", file=str(path))
+    colorspace = colorspace or ("linear" if is_float else "srgb")
+    if colorspace == "srgb":
+        pixels[..., :3] = decode(pixels[..., :3], Transfer("srgb"))
+    return pixels.astype(np.float32), colorspace
+
+
+def measure_colour(linear: np.ndarray, backend: str, ctx=None, context_kind: str = "auto"):
+    """(xyz, chromaticity, milliseconds) of the backend's colour pass; on "gpu" in `ctx`, or
+    a context of `context_kind` made for it."""
+    if backend == "reference":
+        import time
+
+        from reference.output.colour import colour_planes as reference_planes
+        start = time.perf_counter()
+        xyz, chromaticity = reference_planes(linear)
+        return xyz, chromaticity, (time.perf_counter() - start) * 1000.0
+    from renderer.gpu.colour import ColourPass
+    with ColourPass(ctx, context_kind=context_kind) as colour_pass:
+        xyz, chromaticity = colour_pass.apply(linear)
+        return xyz, chromaticity, colour_pass.last_milliseconds
+
+
+def image_source(path, colorspace: str | None, backend: str, context_kind: str) -> ColourSource:
+    linear, colorspace = read_image(path, colorspace)
+    xyz, chromaticity, ms = measure_colour(linear, backend, context_kind=context_kind)
+    return ColourSource(Path(path).name, linear, xyz, chromaticity, None, {
+        "kind": "image", "source": str(path), "colorspace": colorspace, "backend": backend,
+        "size": [linear.shape[1], linear.shape[0]], "colour_pass_ms": round(ms, 3)})
+
+
+def scene_source(scene, size, backend: str, context_kind: str) -> ColourSource:
+    """The scene rasterised at `size` with its linear colour (unclamped), then measured."""
+    width, height = size
+    if backend == "gpu":
+        from renderer.gpu.pipeline import GpuRenderer
+        with GpuRenderer(scene, width, height, context_kind=context_kind) as gpu:
+            frame = gpu.render(linear=True, depth=False)
+            xyz, chromaticity, ms = measure_colour(frame.linear, backend, gpu.ctx)
+    else:
+        import reference
+        frame = reference.render(scene, width, height, linear=True, depth=False)
+        xyz, chromaticity, ms = measure_colour(frame.linear, backend)
+    return ColourSource(scene.name, frame.linear, xyz, chromaticity, scene, {
+        "kind": "scene", "source": scene.source or scene.name, "backend": backend,
+        "size": [width, height], "render_ms": round(frame.milliseconds, 3),
+        "colour_pass_ms": round(ms, 3)})

@@ -657,8 +657,9 @@ def gen_options(rng, seed) -> Case:
 OUTPUT_OPTION_VALUES = (      # taken or refused; a taken one writes a PNG (_check_image opens it)
     ("--bits", ("0", "1", "3", "8", "12", "16", "17", "-1", "1.5", "", "x", "1e1")),
     ("--transfer", ("srgb", "linear", "gamma:2.2", "gamma:0", "gamma:nan", "gamma:", "gamma:1e400", "", "sRGB")),
-    ("--dither", ("none", "bayer2", "bayer8", "blue-noise", "bayer3", "", "\0")),
-    ("--halftone", ("1", "1.99", "nan", "6:inf", "-6", "6:x", "", "1e400")),
+    ("--dither", ("none", "bayer2", "bayer8", "blue-noise", "floyd-steinberg", "jarvis-judice-ninke",
+                  "bayer3", "", "\0")),
+    ("--halftone", ("6", "6:15", "1", "1.99", "nan", "6:inf", "-6", "6:x", "", "1e400")),
     ("--format", ("png8", "png16", "exr", "npy", "tiff", "", "PNG8")),
 )
 

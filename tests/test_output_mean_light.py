@@ -13,11 +13,14 @@ every block's mean within 0.5/255 at 1 bit; what holds is:
     error_kernels.py): 0.00/255 on these scenes. A half-tone's inks overlap only nearly at
     random and its screens sample their cells on the pixel grid: with no screen on the grid
     (angle 7.5: inks at 22.5, 82.5, 7.5, 52.5 degrees; angle 22.5) within 0.33/255 on these
-    scenes, not held to 0.5/255 by construction; a screen on the grid (angle 0 puts yellow at
-    0 degrees) shows a flat background at one of its cell's few levels
-    (tests/test_output_halftone.py): up to 6.1/255 (cell 6, blue of shadow_plane), measured
-    2026-12-02. Dithering code values instead brightens every scene by tens of levels
-    (renderer/study/code_value_dither.py): the test can fail.
+    scenes, not held to 0.5/255 by construction. A screen on the grid (angle 0 puts yellow
+    at 0 degrees, -45 black) is a threshold array of cell^2 + 1 levels
+    (tests/test_output_halftone.py), so like Bayer its ink's flat regions are within half a
+    level, 1/(2 cell^2) (cell 8: 2/255); measured at angle 0, cells 4, 6 and 8, up to
+    0.87/255 (cell 6, blue of shadow_plane; thresholding the diamond itself gave 7.0, 6.1,
+    1.3/255 at cells 4, 6, 8), black on the grid (cell 8, angle -45) 1.49/255 (13.5/255 from
+    the diamond), measured 2026-12-02. Dithering code values instead brightens every scene
+    by tens of levels (renderer/study/code_value_dither.py): the test can fail.
 (b) flat fields, at 1, 2 and 4 bits: every aligned block within its bound of the code step at
     L (l_c0+1 - l_c0): Bayer n, whose blocks hold whole tiles, 1/(2 n^2) (Bayer 8: 1/128);
     blue noise 0.061, the worst of the mask's 64 blocks over all levels (a white-noise mask's
@@ -95,6 +98,20 @@ def test_a_halftone_off_the_pixel_grid_nearly_keeps_the_mean_light(scene_frames,
     for halftone in (Halftone(6, 7.5), Halftone(4, 22.5)):
         codes = reference.output.apply(linear, OutputSettings(halftone=halftone))
         assert np.abs(bias(linear, codes)).max() <= HALFTONE_BIAS_LIMIT, halftone
+
+
+HALFTONE_GRID_BIAS_LIMIT = 1.0 / 255  # yellow on the grid: measured 0.87/255 (module docstring)
+
+
+@pytest.mark.parametrize("name", SCENES)
+def test_a_halftone_on_the_pixel_grid_keeps_the_mean_light_within_half_a_cell_level(scene_frames, name):
+    linear = scene_frames[name]
+    for halftone in (Halftone(4, 0), Halftone(6, 0), Halftone(8, 0)):
+        codes = reference.output.apply(linear, OutputSettings(halftone=halftone))
+        assert np.abs(bias(linear, codes)).max() <= HALFTONE_GRID_BIAS_LIMIT, halftone
+    black = Halftone(8, -45)                 # black on the grid: all three channels
+    codes = reference.output.apply(linear, OutputSettings(halftone=black))
+    assert np.abs(bias(linear, codes)).max() <= 1 / (2 * black.cell ** 2)
 
 
 @pytest.mark.parametrize("name", SCENES)

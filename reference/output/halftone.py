@@ -19,18 +19,26 @@ paper (up to the pixel grid's sampling), the spot grows from the cell's centre a
 neighbouring spots meet at a = 1/2. (A round dot's threshold needs acos, which llvmpipe does
 not round exactly; the diamond's needs only products and sums.)
 
+A screen on the pixel grid (an angle that is a multiple of 90 degrees, a whole-pixel cell:
+renderer/core/halftone_screen.py, grid_turns) samples every cell at the same points, where S
+ties on each diamond: it uses its threshold array T (grid_thresholds: the cell's samples
+ranked by S, ties broken, T = (rank + 1/2) / cell^2) in place of S, so a flat coverage a inks
+round(a cell^2) samples of each cell: cell^2 + 1 levels. Other screens sample their cells
+everywhere and keep S.
+
 An ink is printed where its coverage exceeds the threshold: K where k > S_K; C where
 c' = (c - k) / (1 - k) > S_C, written without the division as c - k > S_C (1 - k). Were the
 screens independent, a pixel's expected reflectance would be (1 - c')(1 - k) = 1 - c: the mean
 light is kept. The screens' angles differ (C 15, M 75, Y 0, K 45 degrees), so their dots overlap
-nearly, not exactly, at random: the bias that leaves is measured (tests/test_output_halftone.py).
+nearly, not exactly, at random: the bias that leaves is measured (tests/test_output_halftone.py,
+tests/test_output_mean_light.py).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from renderer.core.halftone_screen import INKS, screen_basis
+from renderer.core.halftone_screen import INKS, grid_screens, screen_basis
 from renderer.core.output_settings import Halftone, OutputSettings
 from reference.output.quantise import clamp_light
 
@@ -58,7 +66,14 @@ def inks(rgb: np.ndarray, halftone: Halftone) -> dict[str, np.ndarray]:
     k = np.minimum(np.minimum(c, m), y)
     px = np.arange(width, dtype=np.float32)[None, :] + _F(0.5)
     py = np.arange(height, dtype=np.float32)[:, None] + _F(0.5)
-    spots = {ink: spot_threshold(px, py, cs, sn) for ink, (cs, sn) in zip(INKS, screen_basis(halftone))}
+    cells, arrays = grid_screens(halftone)
+    spots = {}
+    for row, (ink, (cs, sn), cell) in enumerate(zip(INKS, screen_basis(halftone), cells)):
+        if cell:                                 # on the pixel grid: its threshold array
+            array = arrays[row * cell:(row + 1) * cell]
+            spots[ink] = array[np.arange(height)[:, None] % cell, np.arange(width)[None, :] % cell]
+        else:
+            spots[ink] = spot_threshold(px, py, cs, sn)
     paper = _F(1.0) - k                          # what the black ink leaves for the colours
     printed = {ink: (coverage - k) > spots[ink] * paper
                for ink, coverage in (("c", c), ("m", m), ("y", y))}

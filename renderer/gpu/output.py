@@ -15,8 +15,10 @@ GL objects are made on first use and kept: a program per set of defines (setting
 a program holds only the method it runs), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (renderer/core/quantise.py; one float texture,
 `table_texture`), the blue-noise ranks once (an SSBO), error diffusion's error image per size
-and its shares per kernel (a float texture). A second apply() with settings and a size seen
-before makes no GL object. Error diffusion runs its own program in wavefronts (`_diffuse`).
+and its shares per kernel (a float texture), a half-tone's threshold arrays per cell and
+turns of its screens on the pixel grid (a float texture). A second apply() with settings and
+a size seen before makes no GL object. Error diffusion runs its own program in wavefronts
+(`_diffuse`).
 
 Why the tables are a texture and not an SSBO: on llvmpipe (Mesa 22.3.6, EGL and OSMesa) the
 read of l_c0 that follows quantise.glsl's search loops, from an SSBO, read the wrong entry in
@@ -36,7 +38,7 @@ import numpy as np
 
 from renderer.core.blue_noise import blue_noise_ranks
 from renderer.core.error_kernels import KERNELS, pull_taps, sender_weights, wavefronts
-from renderer.core.halftone_screen import screen_basis
+from renderer.core.halftone_screen import grid_screens, grid_turns, screen_basis
 from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Transfer
 from renderer.core.quantise import (SRGB_A, SRGB_EXPONENT, SRGB_LINEAR_LIMIT, SRGB_SLOPE,
                                     code_values, decision_points)
@@ -48,10 +50,10 @@ WAVEFRONT_GROUP = 64                 # error_diffusion.comp's local_size_x
 MAX_TAPS = 12                        # error_diffusion.comp's tap arrays
 LINEAR = Transfer("linear")
 # Bindings, as the GLSL declares them: images 0 (input), 1 (output) and 2 (error diffusion's
-# errors), texture units 0 (the tables) and 1 (error diffusion's shares), SSBO 1 (blue-noise
-# ranks).
+# errors), texture units 0 (the tables), 1 (error diffusion's shares) and 2 (the half-tone's
+# threshold arrays), SSBO 1 (blue-noise ranks).
 INPUT_IMAGE, OUTPUT_IMAGE, ERROR_IMAGE = 0, 1, 2
-TABLES_UNIT, SHARES_UNIT, BLUE_NOISE_BUFFER = 0, 1, 1
+TABLES_UNIT, SHARES_UNIT, GRID_THRESHOLDS_UNIT, BLUE_NOISE_BUFFER = 0, 1, 2, 1
 TABLE_ROW_BITS = 12                  # the tables' texture is 2^12 entries wide
 
 
@@ -97,6 +99,7 @@ class OutputPass:
         self._blue_noise: moderngl.Buffer | None = None
         self._errors: dict[tuple, moderngl.Texture] = {}
         self._shares: dict[str, moderngl.Texture] = {}
+        self._grid_thresholds: dict[tuple, moderngl.Texture] = {}
 
     # -- GL objects, each made once ------------------------------------------------------------
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
@@ -160,11 +163,24 @@ class OutputPass:
                 (shares.shape[-1], shares[..., 0].size), 1, shares.tobytes(), dtype="f4")
         return texture
 
+    def _grid_thresholds_texture(self, halftone) -> tuple[np.ndarray, moderngl.Texture | None]:
+        """(cells, texture): grid_screens(halftone), its arrays as a float texture (texel
+        (x, y) = array[y, x]), None when no ink's screen lies on the pixel grid."""
+        cells, thresholds = grid_screens(halftone)
+        if thresholds is None:
+            return cells, None
+        key = (thresholds.shape[1], grid_turns(halftone))
+        texture = self._grid_thresholds.get(key)
+        if texture is None:
+            texture = self._grid_thresholds[key] = self.ctx.texture(
+                thresholds.shape[::-1], 1, thresholds.tobytes(), dtype="f4")
+        return cells, texture
+
     def gl_objects(self) -> list:
         """Every GL object the pass holds (tests: a repeated apply() adds none)."""
         objects = [*self._programs.values(), *(t for pair in self._images.values() for t in pair),
                    *(texture for texture, _ in self._tables.values()), *self._errors.values(),
-                   *self._shares.values()]
+                   *self._shares.values(), *self._grid_thresholds.values()]
         return objects + ([self._blue_noise] if self._blue_noise is not None else [])
 
     # -- the stage ------------------------------------------------------------------------------
@@ -205,6 +221,11 @@ class OutputPass:
                 values["u_blue_noise_size"] = blue_noise_ranks().shape[0]
             if settings.halftone is not None:
                 program["u_screen"].write(screen_basis(settings.halftone))
+                cells, texture = self._grid_thresholds_texture(settings.halftone)
+                program["u_grid_cell"].write(cells)
+                if texture is not None:         # else no ink reads it
+                    texture.use(GRID_THRESHOLDS_UNIT)
+                values["u_grid_thresholds"] = GRID_THRESHOLDS_UNIT
         for name, value in values.items():
             uniform = program.get(name, None)     # the compiler drops what a variant never reads
             if uniform is not None:
@@ -241,4 +262,5 @@ class OutputPass:
         self._tables.clear()
         self._errors.clear()
         self._shares.clear()
+        self._grid_thresholds.clear()
         self._blue_noise = None

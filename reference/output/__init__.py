@@ -42,10 +42,7 @@ def apply(linear: np.ndarray, settings: OutputSettings) -> np.ndarray:
         raise ValueError(f"the output stage takes (H, W, 4) linear colour, got {linear.shape}")
     if not settings.quantised:
         return transfer.encoded(linear, settings.transfer)
-    method = METHODS.get(method_name(settings))
-    if method is None:
-        raise NotImplementedError(f"the output method {method_name(settings)!r} has no twin yet")
     codes = np.empty(linear.shape, dtype=np.uint16)
-    codes[..., :3] = method(linear[..., :3], settings)
+    codes[..., :3] = METHODS[method_name(settings)](linear[..., :3], settings)
     codes[..., 3] = quantise.nearest_code(linear[..., 3], LINEAR, settings.code_bits)
     return codes

@@ -15,8 +15,9 @@ input is clamped first so that light beyond the display's range (a highlight abo
 spread as error over its neighbourhood.
 
 The error image has a zero border `reach` pixels wide (left, right and top), so every tap reads
-without a test: the error a pixel would send out of the image is dropped (the kernel's weights
-are not renormalised at the edges), and a tap outside adds f32(w 0) = 0.
+without a test: a tap outside the image adds f32(w 0) = 0. No error leaves the image: a source
+near an edge sends its whole error to the receivers it has inside (sender_weights renormalises
+its shares), so the frame keeps its light but for the last pixel's error.
 """
 
 from __future__ import annotations

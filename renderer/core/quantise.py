@@ -11,7 +11,8 @@ The code of L at N bits (the undithered baseline, the nearest code in the encode
     srgb, gamma: floor(V(clamp(L, 0, 1)) (2^N - 1) + 0.5), V in float64 of the float32 L
 Neither twin evaluates a curve per pixel: `decision_points` lists, for k = 1 .. 2^N - 1, the
 smallest float32 L whose code is at least k, so that code(L) = #{k : L >= t_k}, a count of
-exact comparisons (a binary search in GLSL, np.searchsorted in NumPy). GPU, twin and the
+exact comparisons (in GLSL a walk from the curve's float32 estimate to the exact count;
+np.searchsorted in NumPy). GPU, twin and the
 float64 curve then agree on every input, on any GL implementation: llvmpipe's own sRGB
 encoding is off by one level on 5 % of inputs (docs/llvmpipe/output.md), which GL allows.
 

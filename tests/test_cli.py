@@ -1,4 +1,9 @@
-"""The command line as a user types it."""
+"""The command line as a user types it.
+
+Which cases run where: tests that start `python -m renderer` (the `cli` fixture, about 1.3 s
+each) are in the default run where the process is what they hold; the two whose path another
+test holds in the default run are the full run's (--all), each marked with the test that
+holds it."""
 
 import json
 import re
@@ -20,6 +25,9 @@ def test_render_default_scene_writes_png_and_depth(tmp_path, cli):
     assert np.isinf(d).any() and np.isfinite(d).any()
 
 
+# The default run holds this path in this process: the next test (the default name and the
+# "wrote" line on stderr, stdout empty).
+@pytest.mark.slow
 def test_render_without_output_names_the_file_after_the_scene(tmp_path, cli):
     result = cli("render", "--size", "32x24", "--backend", "reference", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
@@ -110,6 +118,10 @@ def test_an_argument_error_names_the_program_once_then_gives_the_usage(argv, rea
     assert list(tmp_path.iterdir()) == []
 
 
+# The default run holds this in a process of its own too, with more asserted (one line,
+# nothing written): tests/test_scene_file.py,
+# test_cli_unknown_scene_name_exits_2_and_lists_builtins.
+@pytest.mark.slow
 def test_unknown_scene_names_the_built_in_ones(tmp_path, cli):
     result = cli("render", "no_such_scene", "-o", str(tmp_path / "x.png"))
     assert result.returncode == 2

@@ -4,6 +4,15 @@ byte, on both EGL and OSMesa.
 
 Run as a script, this module is the other process: it renders every built-in scene once on
 each context and prints {"scene/context": sha256 of the frame's RGBA8 bytes} as one JSON line.
+
+Which cases run where: the full run (--all) holds every rasteriser scene on both contexts, in
+this process and in the two workers. The default run holds the repetition rule (one renderer
+drawing again, new renderers on the same context) with hierarchy, the scene that draws every
+shading variant (flat with its geometry stage, Gouraud, Phong) and both kinds of shadow map,
+on EGL and on OSMesa; the other processes are the full run's, since the default run already
+holds each scene's EGL frame (Phong, and as authored where its modes mix), drawn in this
+process, bit for bit to its golden, made in another process (tests/test_goldens.py,
+test_gpu_matches_golden, on the GL implementation that made the goldens: this machine's).
 """
 
 import functools
@@ -89,8 +98,13 @@ def in_process_digest(name, kind, ctx):
 
 # -- one process ----------------------------------------------------------------------------
 
-@pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
-@pytest.mark.parametrize("name", raster_scene_params(SCENE_NAMES))
+DEFAULT_RUN_SCENE = "hierarchy"     # the rest in the full run: the module's docstring says why
+REPEATED = [pytest.param(*p.values, kind, id=f"{p.id}-{kind}", marks=[*p.marks, *(
+    [] if p.values[0] == DEFAULT_RUN_SCENE else [pytest.mark.slow])])
+    for p in raster_scene_params(SCENE_NAMES, SCENE_NAMES) for kind in CONTEXT_KINDS]
+
+
+@pytest.mark.parametrize("name, context_kind", REPEATED)
 def test_every_frame_of_a_scene_is_byte_identical(name, context_kind, gl_contexts):
     frames = render_repeatedly(name, gl_contexts[context_kind])
     (_, first), later = frames[0], frames[1:]
@@ -131,12 +145,15 @@ def worker_digests():
     return results
 
 
+# The full run's (--all): the module's docstring says what holds this in the default run.
+@pytest.mark.slow
 def test_other_processes_render_every_case(worker_digests):
     expected = {case_key(name, kind) for name in SCENE_NAMES for kind in CONTEXT_KINDS}
     for number, digests in enumerate(worker_digests, start=1):
         assert set(digests) == expected, f"worker {number}"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("context_kind", CONTEXT_KINDS)
 @pytest.mark.parametrize("name", raster_scene_params(SCENE_NAMES))
 def test_other_processes_render_the_same_bytes(name, context_kind, worker_digests, gl_contexts):

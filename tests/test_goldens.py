@@ -26,7 +26,7 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import load_scene
 
-from conftest import RAYTRACE_SCENES, raster_scene_params
+from conftest import RAYTRACE_SCENES, SHADOW_SCENES, raster_scene_params
 
 SIZE = (256, 256)
 RAYTRACE_SIZE = (160, 120)
@@ -56,16 +56,30 @@ VARIANTS = variants()
 IDS = [f"{name}-{mode}" for name, mode in VARIANTS]
 RENDERED = raster_scene_params(VARIANTS, IDS)       # the ray-tracing scenes' in the full run
 # The default run holds each scene's Phong golden (and its as-authored one, where modes mix)
-# to the GPU's image and the Phong one to the reference; the full run (--all) every golden,
-# every mode (flat and Gouraud are held to the reference in the default run by
-# tests/test_shadow_shading.py, on scenes made for it).
+# to the GPU's image, and the Phong one to the reference but for two kinds of scene: the
+# shadow scenes, which it holds GPU against reference directly (at 320x240:
+# tests/test_gpu_vs_reference.py), and those whose Phong image draws nothing the others' lack
+# (NOT_REFERENCE_CHECKED_BY_DEFAULT: sphere's Phong sphere under a directional and a point
+# light is coloured_lights' too; gouraud_vs_phong and flat_shading are made for the modes that
+# tests/test_shadow_shading.py holds to the reference in the default run, on scenes made for
+# it). The full run (--all) holds every golden, every mode, both ways.
 DEFAULT_MODES = ("phong", AS_AUTHORED)
+NOT_REFERENCE_CHECKED_BY_DEFAULT = SHADOW_SCENES | {"sphere", "gouraud_vs_phong", "flat_shading"}
 GPU_CHECKED = [pytest.param(*p.values, id=p.id, marks=[*p.marks, *(
     [] if p.values[1] in DEFAULT_MODES else [pytest.mark.slow])]) for p in RENDERED]
 REFERENCE_CHECKED = [pytest.param(*p.values, id=p.id, marks=[*p.marks, *(
-    [] if p.values[1] == "phong" else [pytest.mark.slow])]) for p in RENDERED]
+    [] if p.values[1] == "phong" and p.values[0] not in NOT_REFERENCE_CHECKED_BY_DEFAULT
+    else [pytest.mark.slow])]) for p in RENDERED]
 TRACED = sorted(RAYTRACE_SCENES)
 TRACED_IDS = [f"{name}-{RAYTRACE}" for name in TRACED]
+# Every ray-traced golden is held to the GPU's frame in the default run (EGL); to the NumPy
+# ray tracer only classic's and cornell_box's (mirror, glass, hard shadows, a closed room),
+# the others in the full run: the default run holds each of these scenes GPU against the NumPy
+# ray tracer at 64x48 (tests/test_raytrace_scenes.py) and each effect's samples on its own
+# (tests/test_raytrace_distributed.py, _area_lights, _lens, _motion, _glossy).
+TRACED_AGAINST_REFERENCE_BY_DEFAULT = ("classic", "cornell_box")
+TRACED_REFERENCE_CHECKED = [pytest.param(name, id=f"{name}-{RAYTRACE}", marks=(
+    [] if name in TRACED_AGAINST_REFERENCE_BY_DEFAULT else [pytest.mark.slow])) for name in TRACED]
 # One regular sample is a pinhole, a still, a mirror and a point light: the effects' scenes are
 # traced with 4 jittered samples (soft_shadows: and 4 points per area light and hit).
 EFFECT_SAMPLES = {"samples": 4, "pattern": "jittered"}
@@ -136,7 +150,7 @@ def test_ray_tracer_matches_golden(name, context_kind, gl_contexts, golden):
     assert_exact_where_made(f"{name}-{RAYTRACE}", frame)
 
 
-@pytest.mark.parametrize("name", TRACED, ids=TRACED_IDS)
+@pytest.mark.parametrize("name", TRACED_REFERENCE_CHECKED)
 def test_ray_traced_golden_matches_reference(name, traced_references):
     png = golden_png(f"{name}-{RAYTRACE}")
     assert_matches_reference(png, traced_references.frame(name, *RAYTRACE_SIZE,

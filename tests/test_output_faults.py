@@ -13,6 +13,11 @@ temporary left behind.
 Tests run as root, which a chmod-ed folder does not stop: read-only folders and file
 systems are injected (os.open / os.replace raising the errno); a full disk is a real small
 tmpfs where the sandbox lets us mount one.
+
+Which cases run where: the two that start `python -m renderer` (about 1.5 s each) are the full
+run's (--all): the real full disk (the default run injects ENOSPC at each step instead) and
+the temporary of a killed render (the default run removes a dead process's temporary in
+test_a_temporary_of_a_live_process_is_left_alone, once its process has ended).
 """
 
 import errno
@@ -159,6 +164,7 @@ def test_a_refused_write_is_one_line_status_1_and_touches_nothing(err_no, reason
     assert leftovers(tmp_path) == []
 
 
+@pytest.mark.slow                  # the full run's: the module's docstring says why
 def test_a_real_full_disk(tmp_path, cli):
     """A 64 KiB tmpfs: the PNG fits, the depth (300 KiB) does not. Status 1, one line, the old
     files untouched, no temporary."""
@@ -248,6 +254,7 @@ KILLED_WRITER = textwrap.dedent("""
 """)
 
 
+@pytest.mark.slow                  # the full run's: the module's docstring says why
 def test_a_temporary_left_by_a_killed_render_is_removed_by_the_next(tmp_path, cli):
     image = tmp_path / "img.png"
     killed = subprocess.run([sys.executable, "-c", KILLED_WRITER, str(image)], capture_output=True)

@@ -895,8 +895,13 @@ CLI_CASES = [
 RENDER_SMALL = ("--backend", "reference", "--size", "32x24")      # `renderer render` options
 
 
-@pytest.mark.parametrize("text, expected", [case[1:] for case in CLI_CASES],
-                         ids=[case[0] for case in CLI_CASES])
+# The first case in a process of its own is the full run's (--all): in the default run a
+# refusal in a real process is held by test_cli_unknown_scene_name_exits_2_and_lists_builtins
+# below and by tests/test_refusals.py (a corrupt mesh file), and a TOML syntax error's line by
+# test_toml_syntax_error_names_the_line above.
+@pytest.mark.parametrize("text, expected", [
+    pytest.param(*case[1:], id=case[0], marks=[pytest.mark.slow] if index == 0 else [])
+    for index, case in enumerate(CLI_CASES)])
 def test_cli_bad_scene_exits_2_with_one_line(tmp_path, text, expected, request):
     """The first case as a user types it, in a process of its own; the others through
     renderer.cli.main in this process (cli_here: the same code, a second less each)."""
@@ -1012,6 +1017,10 @@ def test_cli_nan_is_not_rendered_even_when_unused(tmp_path, cli_here):
 
 
 
+# The full run's (--all): in the default run test_bad_scene_message holds each case's line
+# and test_cli_bad_scene_exits_2_with_one_line how the command line turns a SceneError into
+# it (one line, status 2, nothing written), the same code for every case.
+@pytest.mark.slow
 @pytest.mark.parametrize("text, expected", [case[1:] for case in BAD_SCENES],
                          ids=[case[0] for case in BAD_SCENES])
 def test_every_bad_scene_through_the_command_line(tmp_path, capsys, text, expected):

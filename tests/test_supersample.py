@@ -70,8 +70,11 @@ def as_rgba8(image):
     return np.dstack([to_unorm8(image), np.full(image.shape[:2], 255, np.uint8)])
 
 
+# The default run holds the rule with hierarchy on EGL (every shading variant, shadow maps);
+# the full run (--all) adds coloured_lights and OSMesa, the same llvmpipe.
 @pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
-@pytest.mark.parametrize("name", ("coloured_lights", "hierarchy"))
+@pytest.mark.parametrize("name", (pytest.param("coloured_lights", marks=pytest.mark.slow),
+                                  "hierarchy"))
 def test_gpu_and_reference_accumulate_the_same_samples(name, context_kind, gl_contexts):
     scene = scene_named(name)
     offsets = jittered(8, seed=3)
@@ -128,6 +131,9 @@ def test_adaptive_spends_nothing_more_where_nothing_varies():
     assert (samples, flat_pass.calls) == (4.0, 4)
 
 
+# The full run's (--all): the default run holds its parts, the adaptive rule by hand (the two
+# tests above) and GPU and reference accumulating the same samples to within the tolerance.
+@pytest.mark.slow
 def test_adaptive_agrees_between_gpu_and_reference(gl_contexts):
     scene = scene_named("coloured_lights")
     with GpuRenderer(scene, *SIZE, context=gl_contexts["egl"]) as gpu:

@@ -782,6 +782,58 @@ def test_second_check_without_a_name_fails_asking_for_one(spec):
     assert sorted(p.name for p in spec.goldens.glob("*.png")) == ["left.png", "right.png", "test_twice.png"]
 
 
+# --- 12b: under pytest-xdist (CI runs `pytest --all -n auto`) -------------------------------
+
+# Eight checks: six goldens that the "after" phase breaks, two it keeps, one name checked twice.
+SPREAD = """
+@pytest.mark.parametrize("k", range(6))
+def test_broken(golden, k):
+    golden.check(frame(after=[(np.s_[k, k], 10)]), f"broken{k}")
+
+def test_kept(golden):
+    golden.check(frame(), "kept")
+
+@pytest.mark.parametrize("context", ["egl", "osmesa"])
+def test_shared(golden, context):
+    golden.check(frame(after=[(np.s_[0, 0], 10)]), "shared")
+"""
+
+
+@pytest.mark.slow          # two worker processes: about 2 s
+def test_under_xdist_the_controller_reports_every_worker_s_failures(spec):
+    """Workers write their failures' images; the controller, which emptied the folder once
+    before they started, lists all of them on one page and prints the summary."""
+    spec.write(SPREAD)
+    spec.run("--update-goldens").assert_outcomes(passed=9)
+    (spec.results / "stale").mkdir()                        # an earlier run's entry
+
+    result = spec.run("-n", "2", phase="after")
+    result.assert_outcomes(failed=8, passed=1)
+    result.stdout.fnmatch_lines(["goldens: 8 failed, 1 passed", "results: golden-results/index.html"])
+    folders = [f"broken{k}" for k in range(6)] + ["shared", "shared-2"]
+    assert sorted(p.name for p in spec.results.iterdir() if p.is_dir()) == sorted(folders)
+    for folder in folders:
+        assert sorted(p.name for p in (spec.results / folder).iterdir()) == [
+            "actual.png", "diff.png", "expected.png", "figures.json", "flip.png"]
+    page = (spec.results / "index.html").read_text()
+    assert "8 failing, 0 written" in page
+    for folder in folders:
+        assert f'src="{folder}/diff.png"' in page
+    shared = {json.loads((spec.results / f / "figures.json").read_text())["test"] for f in ("shared", "shared-2")}
+    assert shared == {"test_spec.py::test_shared[egl]", "test_spec.py::test_shared[osmesa]"}
+
+
+def test_under_xdist_update_goldens_runs_in_one_process(spec):
+    """--update-goldens turns -n off: a golden one test writes is what a later test of the
+    same name is compared with, whichever worker would have run it."""
+    spec.write(TWO_TESTS_ONE_NAME)
+    result = spec.run("-n", "2", "--update-goldens")
+    result.stdout.fnmatch_lines(["goldens: --update-goldens runs the tests in one process*"])
+    assert outcomes(result) == {"test_first": "passed", "test_second": "failed"}
+    result.stdout.fnmatch_lines(["goldens: 1 created, 1 failed"])
+    assert np.array_equal(read_golden(spec.goldens / "shared.png"), GREY)
+
+
 # --- 13: inert when unused ------------------------------------------------------------------
 
 def test_plugin_is_inert_when_no_test_uses_golden(spec):

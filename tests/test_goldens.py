@@ -118,7 +118,7 @@ def golden_png(name):
 
 
 # Defined first so that under --update-goldens the goldens are written before the reference
-# checks below read them.
+# checks below read them (one process even under -n: the plugin turns pytest-xdist off).
 # OSMesa in the full run: the same llvmpipe as EGL, drawing the same bits.
 @pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
 @pytest.mark.parametrize("name, mode", GPU_CHECKED)

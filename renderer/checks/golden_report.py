@@ -9,13 +9,19 @@ The page is rewritten after each entry, so it is there even if the run is interr
 The folder is the plugin's own: a marker file says so, and a run empties it before its
 first entry so that nothing stale is shown. A non-empty folder without the marker is
 refused rather than emptied.
+
+Under pytest-xdist one run is several processes sharing the folder. A worker's folder
+(`worker=True`) writes its entries' images and figures, each in a folder of its own claimed
+with an atomic mkdir, but never empties the folder nor writes the page: the controller
+empties it once before the workers start (`empty`), takes each worker's entries as plain
+data (`Entry.as_dict`, `collect`) and writes the one page.
 """
 
 from __future__ import annotations
 
 import html
 import shutil
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from renderer.checks.compare import channel_difference, heat_map, position_deviation_mismatch
@@ -49,72 +55,107 @@ def figures_of(outcome: Outcome, mean_flip: float) -> dict:
 
 @dataclass
 class Entry:
+    """One comparison on the page, as plain data (a worker sends it to the controller)."""
     test: str                 # the pytest node id (or whatever named the comparison)
-    outcome: Outcome
+    name: str                 # the golden's
+    status: str               # the Outcome's
     folder: str               # relative to the results folder
+    compared: bool            # whether there was a golden of the frame's size (and so its images)
+    notes: list[str] = field(default_factory=list)
     figures: dict = field(default_factory=dict)
+
+    def as_dict(self) -> dict:
+        return asdict(self)
 
 
 class ResultsFolder:
-    def __init__(self, root: Path):
+    def __init__(self, root: Path, *, worker: bool = False):
         self.root = Path(root)
+        self.worker = worker      # a pytest-xdist worker's: never empties, never writes the page
         self.entries: list[Entry] = []
         self._prepared = False
+        self._emptied = False
 
     @property
     def index(self) -> Path:
         return self.root / INDEX
 
+    def empty(self) -> None:
+        """Empty the folder of an earlier run if it is ours (once per run), keeping the marker;
+        anything else is left for `prepare` to refuse when an entry is written."""
+        if not self._emptied and self.root.is_dir() and (self.root / MARKER).exists():
+            for child in self.root.iterdir():
+                if child.name != MARKER:
+                    shutil.rmtree(child) if child.is_dir() and not child.is_symlink() else child.unlink()
+        self._emptied = True
+
     def prepare(self) -> None:
-        """Empty the folder of an earlier run (once per run), or refuse a folder not ours."""
+        """Make the folder ready for entries (once per run): empty it of an earlier run
+        (not in a worker), or refuse a folder not ours."""
         if self._prepared:
             return
         if self.root.exists():
             if not self.root.is_dir():
                 raise GoldenError("is not a folder", file=str(self.root), key="--goldens-results")
-            if (self.root / MARKER).exists():
-                for child in self.root.iterdir():
-                    shutil.rmtree(child) if child.is_dir() and not child.is_symlink() else child.unlink()
-            elif any(self.root.iterdir()):
+            # Non-empty first, then no marker: another process of this run writes the marker
+            # before anything else, so the folder it has begun is never taken for a stranger's.
+            if any(self.root.iterdir()) and not (self.root / MARKER).exists():
                 raise GoldenError("exists, is not empty and was not made by the golden plugin (it has no "
                                   f"{MARKER} marker); name a new or empty folder", file=str(self.root),
                                   key="--goldens-results")
+            if not self.worker:
+                self.empty()
         self.root.mkdir(parents=True, exist_ok=True)
         (self.root / MARKER).write_text("made by checked-renderer's golden plugin; emptied on each run\n")
         self._prepared = True
-        self.write_index()
+        if not self.worker:
+            self.write_index()
 
     def add(self, test: str, outcome: Outcome) -> Entry:
-        """Write the entry's images and figures, then the page. Returns the entry."""
+        """Write the entry's images and figures, then the page (not in a worker). Returns the entry."""
         self.prepare()
-        folder = self._free_folder(outcome.name)
-        entry = Entry(test, outcome, folder)
-        path = self.root / folder
-        write_png(path / "actual.png", outcome.actual)
-        if _compared(entry):
+        expected, actual = outcome.expected, outcome.actual
+        compared = expected is not None and expected.shape == actual.shape
+        entry = Entry(test, outcome.name, outcome.status, self._new_folder(outcome.name), compared,
+                      list(outcome.notes))
+        path = self.root / entry.folder
+        write_png(path / "actual.png", actual)
+        if compared:
             threshold, deviation = outcome.policy.marking()
-            write_png(path / "expected.png", outcome.expected)
-            write_png(path / "diff.png", heat_map(outcome.actual, outcome.expected, threshold, deviation))
-            mean_flip, flip_map = flip_error(outcome.expected, outcome.actual)
+            write_png(path / "expected.png", expected)
+            write_png(path / "diff.png", heat_map(actual, expected, threshold, deviation))
+            mean_flip, flip_map = flip_error(expected, actual)
             write_png(path / "flip.png", flip_map)
             entry.figures = figures_of(outcome, mean_flip)
         entry.figures.update(test=test, golden=str(outcome.png), status=outcome.status, notes=outcome.notes)
         write_json(path / "figures.json", entry.figures, indent=2)
-        self.entries.append(entry)
-        self.write_index()
+        if self.worker:
+            self.entries.append(entry)
+        else:
+            self.collect(entry)
         return entry
 
-    def _free_folder(self, name: str) -> str:
-        taken = {entry.folder for entry in self.entries}
+    def collect(self, entry: Entry) -> None:
+        """List an entry whose files are written (by this process or a worker) and rewrite the page."""
+        self.prepare()
+        self.entries.append(entry)
+        self.write_index()
+
+    def _new_folder(self, name: str) -> str:
+        """NAME, or NAME-2, NAME-3, ...: the first that mkdir creates, so that two processes
+        writing into the folder at once never share one."""
         folder, n = name, 1
-        while folder in taken:
-            n += 1
-            folder = f"{name}-{n}"
-        return folder
+        while True:
+            try:
+                (self.root / folder).mkdir()
+                return folder
+            except FileExistsError:
+                n += 1
+                folder = f"{name}-{n}"
 
     def write_index(self) -> None:
-        failed = [e for e in self.entries if e.outcome.status in ("failed", "missing")]
-        updated = [e for e in self.entries if e.outcome.status not in ("failed", "missing")]
+        failed = [e for e in self.entries if e.status in ("failed", "missing")]
+        updated = [e for e in self.entries if e.status not in ("failed", "missing")]
         parts = [_HEAD, f"<h1>Golden images: {len(failed)} failing, {len(updated)} written</h1>"]
         if failed:
             parts.append("<p>Each row: the golden, the new frame, their difference (magenta: pixels "
@@ -146,18 +187,12 @@ def _entry_html(entry: Entry) -> str:
         f'alt="{name}"></a><figcaption>{caption}</figcaption></figure>'
         for name, caption in (("expected", "golden (expected)"), ("actual", "frame (actual)"),
                               ("diff", "difference"), ("flip", "ꟻLIP error"))
-        if name == "actual" or _compared(entry))
+        if name == "actual" or entry.compared)
     rows = "".join(f"<tr><td>{e(key)}</td><td>{e(_show(value))}</td></tr>"
                    for key, value in entry.figures.items() if key not in ("notes", "test"))
-    notes = "".join(f'<p class="note">{e(note)}</p>' for note in entry.outcome.notes)
-    return (f"<section><h3>{e(entry.outcome.name)} — {e(entry.outcome.status)}</h3>"
+    notes = "".join(f'<p class="note">{e(note)}</p>' for note in entry.notes)
+    return (f"<section><h3>{e(entry.name)} — {e(entry.status)}</h3>"
             f"<p><code>{e(entry.test)}</code></p>{notes}<div>{images}</div><table>{rows}</table></section>")
-
-
-def _compared(entry: Entry) -> bool:
-    """Whether there was a golden of the frame's size to compare with (and so its images)."""
-    expected = entry.outcome.expected
-    return expected is not None and expected.shape == entry.outcome.actual.shape
 
 
 def _show(value) -> str:

@@ -13,7 +13,16 @@ sidecar (renderer/checks/goldens.py); NAME defaults to the test's name. Policies
 the default is "threshold", or the ini option `goldens_policy`. docs/goldens.md has the rest.
 
 The plugin is inert until a test asks for the `golden` fixture: it imports no GL at start-up
-and touches no folder.
+and touches no folder (under pytest-xdist the controller empties a results folder of ours
+when the run starts; see the next paragraph).
+
+Under pytest-xdist (`-n`) each worker checks its tests' goldens and writes their images, but
+never empties the results folder nor writes its page: it attaches what it found to each test
+report (`report.goldens`, a list of plain dicts; pytest carries a report's extra attributes
+to the controller), and the controller, which emptied the folder before starting the workers,
+counts them, writes index.html and prints the summary, as one process would.
+--update-goldens runs in one process (it turns -n off): a golden written by one test is read
+by later ones (two tests of one golden name; tests/test_goldens.py's reference checks).
 """
 
 from __future__ import annotations
@@ -68,21 +77,89 @@ class GoldenSession:
         self.claimed: dict[Path, str] = {}       # golden PNG -> the first test that checked it under
                                                  # --update-goldens in this run (written or not)
         self.changed: list[Path] = []            # goldens created or updated in this run
+        self.worker = hasattr(config, "workerinput")                 # a pytest-xdist worker
+        self.notice = None                       # a line for the report header
         self._results = None
 
     @property
     def results(self):
         if self._results is None:
             from renderer.checks.golden_report import ResultsFolder
-            self._results = ResultsFolder(self.results_root)
+            self._results = ResultsFolder(self.results_root, worker=self.worker)
         return self._results
+
+    def record(self, status: str, png: Path) -> None:
+        """Count one check and note a golden written (in the process that made the check, or
+        in the controller from a worker's report)."""
+        self.counts[status] += 1
+        if status in ("created", "updated"):
+            self.changed.append(png)
+
+    def take_report(self, records: list[dict]) -> None:
+        """The controller: the checks a worker made for one test report."""
+        from renderer.checks.golden_report import Entry
+        from renderer.errors import UserError
+
+        for record in records:
+            self.record(record["status"], Path(record["png"]))
+            if record["entry"] is not None:
+                try:
+                    self.results.collect(Entry(**record["entry"]))
+                except UserError:       # a folder not ours: the worker's test already failed saying so
+                    pass
 
 
 _SESSION = pytest.StashKey[GoldenSession]()
+_PENDING = pytest.StashKey[list]()       # a worker's checks not yet attached to a report
 
 
 def pytest_configure(config):
-    config.stash[_SESSION] = GoldenSession(config)
+    session = config.stash[_SESSION] = GoldenSession(config)
+    # Before pytest-xdist's own pytest_configure (trylast), which starts the distributed
+    # session only while "dist" is on.
+    if session.update and not session.worker and config.getoption("dist", "no") != "no":
+        config.option.dist, config.option.tx, config.option.numprocesses = "no", [], 0
+        session.notice = ("goldens: --update-goldens runs the tests in one process (pytest-xdist's "
+                          "-n is off): a golden written by one test is read by later ones")
+
+
+def pytest_report_header(config):
+    session = config.stash.get(_SESSION, None)
+    return session.notice if session is not None else None
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_sessionstart(session):
+    """pytest-xdist's controller empties the results folder before its workers start (its own
+    pytest_sessionstart, trylast, starts them) and listens to their reports; workers and a
+    plain run empty it lazily, at their first check."""
+    config = session.config
+    if config.pluginmanager.has_plugin("dsession"):
+        golden_session = config.stash[_SESSION]
+        golden_session.results.empty()
+        config.pluginmanager.register(_Controller(golden_session), "golden-controller")
+
+
+class _Controller:
+    """pytest-xdist's controller: takes the golden checks its workers attach to their reports."""
+
+    def __init__(self, session: GoldenSession):
+        self.session = session
+
+    def pytest_runtest_logreport(self, report):
+        records = getattr(report, "goldens", None)
+        if records:
+            self.session.take_report(records)
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """A worker: attach the checks made in this phase of the test to its report."""
+    outcome = yield
+    pending = item.stash.get(_PENDING, None)
+    if pending:
+        outcome.get_result().goldens = pending[:]
+        pending.clear()
 
 
 @pytest.fixture
@@ -151,26 +228,31 @@ class GoldenChecker:
                                    scene=scene, gl_info=gl_info, update=update)
         except UserError as error:
             _fail_plainly(error)
-        session.counts[outcome.status] += 1
+        session.record(outcome.status, png)
         if update:               # "unchanged" and "passed" too: a later test of the same name must not rewrite it
             session.claimed[png] = nodeid
+        entry = trouble = None
         if outcome.status in ("created", "updated"):
-            session.changed.append(png)
-            session.results.add(nodeid, outcome)           # for review before committing
-        elif outcome.status == "passed":
+            entry = session.results.add(nodeid, outcome)   # for review before committing
+        elif outcome.status in ("failed", "missing"):
+            try:
+                entry = session.results.add(nodeid, outcome)
+            except Exception as error:         # the report must not hide the failure itself
+                trouble = error
+        if session.worker:                     # for the controller (pytest_runtest_makereport)
+            self._request.node.stash.setdefault(_PENDING, []).append(
+                {"status": outcome.status, "png": str(png), "entry": entry and entry.as_dict()})
+        if outcome.status == "passed":
             for note in outcome.notes:
                 warnings.warn(GoldenWarning(f"golden {name!r}: {note}"), stacklevel=2)
         elif outcome.status in ("failed", "missing"):
-            self._fail(outcome)
+            self._fail(outcome, entry, trouble)
         return outcome
 
-    def _fail(self, outcome):
-        session, nodeid = self._session, self._request.node.nodeid
-        try:
-            entry = session.results.add(nodeid, outcome)
-        except Exception as error:             # the report must not hide the failure itself
-            entry = None
-            report = f"(the results folder could not be written: {error})"
+    def _fail(self, outcome, entry, trouble):
+        session = self._session
+        if entry is None:
+            report = f"(the results folder could not be written: {trouble})"
         else:
             report = (f"images: {_shown(session.results.root / entry.folder)}/; "
                       f"all failures: {_shown(session.results.index)}")

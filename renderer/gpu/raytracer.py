@@ -325,6 +325,20 @@ class RayTracer:
             texture.write(texels(array).tobytes())
         self._write_uniforms(rs)
 
+    def reseed(self, seed: int) -> None:
+        """Trace with another sampling seed from now on: the frames are then, bit for bit,
+        those of a RayTracer made with `seed` (a batch's items). The seed and the table
+        patterns' offsets drawn from it are uniforms, so nothing is compiled or rebuilt.
+        ValueError (one line) for a seed that is not a uint32."""
+        if self._released:
+            raise RuntimeError("this RayTracer was released")
+        s = self.sampling
+        self.sampling = ray_sampling(s.pattern, s.samples, seed, s.threshold, s.light_samples)
+        activate(self.ctx)
+        for name, value in self.sampling.uniforms().items():
+            if name in self.program:
+                self.program[name].write(value.tobytes())
+
     def _surfaces_now(self) -> list[tuple]:
         """What update() must find unchanged: each object, its mesh and its shape (identity)."""
         return [(obj, obj.mesh, obj.shape) for obj in self.scene.objects]

@@ -23,7 +23,7 @@ textures through renderer/gpu/textures.py's TextureCache (each uploaded once, on
 slot, after the float textures' units). A viewer moving
 the camera calls update() (and resize()), which keeps all of them and writes new contents: the
 same image as a RayTracer made afresh, without the BVH build or (unless the light counts
-changed) the compile.
+changed) the compile. reseed(seed) likewise changes the sampling seed (a batch's items).
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and

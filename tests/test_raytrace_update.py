@@ -80,3 +80,19 @@ def test_update_refuses_other_objects(egl):
         shown.objects = [replace(obj) for obj in shown.objects]
         with pytest.raises(ValueError, match="make a new one"):
             tracer.update()
+
+
+@pytest.mark.parametrize("pattern", ["random", "poisson"])    # poisson: its table is the seed's
+def test_reseed_gives_the_frame_of_a_tracer_made_with_that_seed(egl, pattern):
+    scene = classic_with_a_torus()
+    options = {"samples": 4, "pattern": pattern, "context": egl}
+    with RayTracer(scene, 24, 18, seed=1, **options) as tracer:
+        first = tracer.render()
+        tracer.reseed(7)
+        reseeded = tracer.render()
+        with pytest.raises(ValueError, match="the seed must be a whole number"):
+            tracer.reseed(-1)
+    with RayTracer(scene, 24, 18, seed=7, **options) as fresh_tracer:
+        expected = fresh_tracer.render()
+    assert (reseeded.linear != first.linear).any()
+    assert_same(reseeded, expected)

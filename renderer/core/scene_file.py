@@ -1,6 +1,7 @@
 """Scene files: TOML in, a checked `Scene` out, every mistake one `SceneError` line.
 
     load_scene("sphere") or load_scene("my_scene.toml") -> Scene   (a built-in name or a path)
+    read_scene(...) -> (parsed dict, path); with_overrides(data, {"camera.aperture": 0.1}, source)
     scene_from_dict({"camera": {...}, "objects": [...]}, source="<dict>", base_dir=".")
 
 docs/scene-format.md documents every key with its unit and default. The reader is strict:
@@ -12,6 +13,7 @@ count list entries from 0: `objects[2].material.kd` is the third [[objects]] tab
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import difflib
 import inspect
@@ -114,7 +116,15 @@ TOO_LARGE = f"too large for the GPU's float32 arithmetic; numbers must satisfy |
 def load_scene(scene) -> Scene:
     """Read a TOML scene file, given by its path or, from any folder, a built-in scene by its
     name ("sphere", "hierarchy", ...: what `renderer scenes` lists). Mesh files it names are
-    found relative to its folder.
+    found relative to its folder. `read_scene` then `scene_from_dict`, for callers that
+    change the parsed data in between (`with_overrides`).
+    """
+    data, path = read_scene(scene)
+    return scene_from_dict(data, source=str(path), base_dir=path.parent)
+
+
+def read_scene(scene) -> tuple[dict, Path]:
+    """A scene file's parsed TOML and its path; "name" defaults to the file's stem.
 
     An existing file wins over a built-in name spelt the same. A bare name (no folder, no
     `.toml` suffix) that is neither gives the command line's one-line error
@@ -141,10 +151,60 @@ def load_scene(scene) -> Scene:
     except RecursionError:               # tomllib recurses once per level of nesting
         raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
                          f"nests at most {MAX_NESTING} levels", file=source) from None
-    scene = scene_from_dict(data, source=source, base_dir=path.parent)
-    if "name" not in data:
-        scene.name = path.stem
-    return scene
+    data.setdefault("name", path.stem)
+    return data, path
+
+
+# One step of a key path: a table key (letters, digits, _) or a list index `[i]`.
+_KEY_STEP = re.compile(r"(?:^|\.)([A-Za-z_][A-Za-z0-9_]*)|\[(\d+)\]")
+
+
+def with_overrides(data: dict, overrides: dict, source: str) -> dict:
+    """A deep copy of parsed scene data with each key path in `overrides` set to its value:
+    {"objects[0].material.kd": [1, 0, 0], "camera.aperture": 0.1}. Missing tables on the
+    way are made (the reader then refuses a key it does not know, with its suggestion); a
+    list index past the end, a step into a value that is not a table or list, or a path
+    that is not a key path is a SceneError naming `source` and the path. The values are
+    checked later, by `scene_from_dict`, exactly as a file's are."""
+    data = copy.deepcopy(data)
+    for path, value in overrides.items():
+        steps = _key_steps(path, source)
+        node, where = data, ""
+        for i, (key, index) in enumerate(steps):
+            last = i == len(steps) - 1
+            if key is not None:
+                if not isinstance(node, dict):
+                    raise SceneError(f"cannot set {key!r} in {describe_value(node)}",
+                                     file=source, key=where)
+                where = _join(where, key)
+                if last:
+                    node[key] = value
+                else:
+                    node = node.setdefault(key, {})
+            else:
+                if not isinstance(node, list) or index >= len(node):
+                    got = (f"the list has {len(node)} item{'' if len(node) == 1 else 's'}"
+                           if isinstance(node, list) else f"got {describe_value(node)}")
+                    raise SceneError(f"no entry [{index}]: {got}", file=source, key=where)
+                where = f"{where}[{index}]"
+                if last:
+                    node[index] = value
+                else:
+                    node = node[index]
+    return data
+
+
+def _key_steps(path: str, source: str) -> list[tuple[str | None, int | None]]:
+    """'objects[0].material.kd' -> [("objects", None), (None, 0), ("material", None), ...]."""
+    steps, end = [], 0
+    for match in _KEY_STEP.finditer(path):
+        if match.start() != end:
+            break
+        steps.append((match[1], None) if match[1] else (None, int(match[2])))
+        end = match.end()
+    if not steps or end != len(path) or steps[0][0] is None or path.startswith("."):
+        raise SceneError("not a key path like objects[0].material.kd", file=source, key=path)
+    return steps
 
 
 def scene_from_dict(data: dict, source: str = "<dict>", base_dir=None) -> Scene:

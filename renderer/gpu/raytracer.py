@@ -23,7 +23,7 @@ textures through renderer/gpu/textures.py's TextureCache (each uploaded once, on
 slot, after the float textures' units). A viewer moving
 the camera calls update() (and resize()), which keeps all of them and writes new contents: the
 same image as a RayTracer made afresh, without the BVH build or (unless the light counts
-changed) the compile.
+changed) the compile. reseed(seed) likewise changes the sampling seed (a batch's items).
 
 `specialise=False` (benchmarks/bench_raytrace.py measures what specialising saves) compiles
 every feature in whatever the scene uses: SPECULAR, SHADOWS (where there are lights and
@@ -324,6 +324,20 @@ class RayTracer:
         for (_, texture), array in zip(self._textures, self._texture_arrays(rs).values()):
             texture.write(texels(array).tobytes())
         self._write_uniforms(rs)
+
+    def reseed(self, seed: int) -> None:
+        """Trace with another sampling seed from now on: the frames are then, bit for bit,
+        those of a RayTracer made with `seed` (a batch's items). The seed and the table
+        patterns' offsets drawn from it are uniforms, so nothing is compiled or rebuilt.
+        ValueError (one line) for a seed that is not a uint32."""
+        if self._released:
+            raise RuntimeError("this RayTracer was released")
+        s = self.sampling
+        self.sampling = ray_sampling(s.pattern, s.samples, seed, s.threshold, s.light_samples)
+        activate(self.ctx)
+        for name, value in self.sampling.uniforms().items():
+            if name in self.program:
+                self.program[name].write(value.tobytes())
 
     def _surfaces_now(self) -> list[tuple]:
         """What update() must find unchanged: each object, its mesh and its shape (identity)."""

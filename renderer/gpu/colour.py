@@ -19,7 +19,7 @@ import numpy as np
 
 from renderer.core.colour import D65_CHROMATICITY, RGB_TO_XYZ
 from renderer.gpu.context import activate, make_context, release_context
-from renderer.gpu.shaders import shader_source
+from renderer.gpu.shaders import compute_program
 
 GROUP = 8                                 # colour.comp's local_size_x and local_size_y
 
@@ -34,7 +34,7 @@ class ColourPass:
         self.last_milliseconds = 0.0
         try:
             activate(self.ctx)
-            self.program = self.ctx.compute_shader(shader_source("output/colour.comp").text)
+            self.program = compute_program(self.ctx, "output/colour.comp")
             # GL reads a mat3 column by column: the columns of M are the rows of M's transpose.
             self.program["rgb_to_xyz_matrix"].write(RGB_TO_XYZ.T.astype(np.float32).tobytes())
             self.program["white_chromaticity"].value = tuple(D65_CHROMATICITY.astype(np.float32))

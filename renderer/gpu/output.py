@@ -43,7 +43,7 @@ from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Trans
 from renderer.core.quantise import (SRGB_A, SRGB_EXPONENT, SRGB_LINEAR_LIMIT, SRGB_SLOPE,
                                     code_values, decision_points)
 from renderer.gpu.context import activate
-from renderer.gpu.shaders import ShaderSourceError, shader_source
+from renderer.gpu.shaders import compute_program
 
 GROUP_SIZE = 8                       # output.comp's local_size_x and _y
 WAVEFRONT_GROUP = 64                 # error_diffusion.comp's local_size_x
@@ -111,14 +111,7 @@ class OutputPass:
         if program is None:
             filename = ("output/error_diffusion.comp" if settings.dither in ERROR_DIFFUSION
                         else "output/output.comp")
-            source = shader_source(filename, defines)
-            try:
-                program = self.ctx.compute_shader(source.text)
-            except moderngl.Error as exc:
-                files = ", ".join(f"{i}={name}" for i, name in enumerate(source.files))
-                raise ShaderSourceError(f"{filename} with {defines} does not compile "
-                                        f"(source strings {files}):\n{exc}") from None
-            self._programs[key] = program
+            program = self._programs[key] = compute_program(self.ctx, filename, defines)
         return program
 
     def _image_pair(self, width: int, height: int, quantised: bool):

@@ -112,6 +112,19 @@ def shader_source(filename: str, defines: Mapping[str, object] | None = None,
     return _shader_source(filename, items, str(directory or glsl_dir()))
 
 
+def compute_program(ctx: moderngl.Context, filename: str,
+                    defines: Mapping[str, object] | None = None) -> moderngl.ComputeShader:
+    """glsl/`filename` with `defines` compiled as a compute shader on `ctx` (current), or a
+    ShaderSourceError naming the file, the defines and which source string is which file."""
+    source = shader_source(filename, defines)
+    try:
+        return ctx.compute_shader(source.text)
+    except moderngl.Error as exc:
+        files = ", ".join(f"{i}={name}" for i, name in enumerate(source.files))
+        raise ShaderSourceError(f"{filename} with {dict(defines or {})} does not compile "
+                                f"(source strings {files}):\n{exc}") from None
+
+
 @functools.lru_cache(maxsize=256)
 def _shader_source(filename: str, defines: tuple, directory: str) -> ShaderSource:
     path = (Path(directory) / filename).resolve()

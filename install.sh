@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets up everything from nothing: the system GL libraries (Mesa's EGL and OSMesa, which run
 # on the CPU when there is no GPU), a virtual environment in .venv, and this package in it
-# with its test dependencies. Safe to run again: a step already done is skipped (the pip step
+# with its test dependencies and Ray (the `cluster` extra, which the batch tests use). Safe to run again: a step already done is skipped (the pip step
 # when .venv was installed from this very pyproject.toml; delete .venv/.install-stamp to
 # force it). Quiet unless something goes wrong, when the step's whole output is shown.
 set -euo pipefail
@@ -40,5 +40,5 @@ echo "install.sh: installing the package and its dependencies into .venv (pip)"
 [ -x .venv/bin/python ] || quietly python3 -m venv .venv
 rm -f "$stamp"
 quietly .venv/bin/python -m pip install -q --upgrade pip
-quietly .venv/bin/python -m pip install -q -e '.[test]'
+quietly .venv/bin/python -m pip install -q -e '.[test,cluster]'
 echo "$want" > "$stamp"

@@ -4,8 +4,10 @@
     core        errors
     reference   core, errors                     (the twin shares the scene model and matrices only)
     gpu         core, errors
+    cluster     core, gpu, reference, errors     (where work runs: in-process or Ray)
     checks      core, gpu, reference, errors
-    study       core, gpu, checks, reference, errors
+    study       core, gpu, checks, reference, cluster, errors
+    batch       core, gpu, checks, reference, cluster, errors
     viewer      core, gpu, checks, reference, errors
     cli         anything (only the command line imports the viewer)
 
@@ -29,10 +31,13 @@ ALLOWED = {
     "core": {"core", "errors"},
     "reference": {"reference", "core", "errors"},
     "gpu": {"gpu", "core", "errors"},
+    "cluster": {"cluster", "core", "gpu", "reference", "errors"},
     "checks": {"checks", "core", "gpu", "reference", "errors"},
-    "study": {"study", "core", "gpu", "checks", "reference", "errors"},
+    "study": {"study", "core", "gpu", "checks", "reference", "cluster", "errors"},
+    "batch": {"batch", "core", "gpu", "checks", "reference", "cluster", "errors"},
     "viewer": {"viewer", "core", "gpu", "checks", "reference", "errors"},
-    "cli": {"cli", "core", "gpu", "checks", "study", "viewer", "reference", "errors"},
+    "cli": {"cli", "core", "gpu", "checks", "study", "viewer", "reference", "cluster", "batch",
+            "errors"},
 }
 ALLOWED = {group: allowed | {"renderer"} for group, allowed in ALLOWED.items()}
 

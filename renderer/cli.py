@@ -1,5 +1,5 @@
-"""The command line: `renderer render | view | compare | shaders | report | scenes | extremes |
-colour` (also `python -m renderer`).
+"""The command line: `renderer render | view | compare | shaders | report | batch | scenes |
+extremes | colour` (also `python -m renderer`).
 
 A user's mistake (bad scene, bad output name, no GL) is one line on stderr and exit status
 2, with nothing written; an option argparse refuses is its reason on one line and the
@@ -237,6 +237,30 @@ def build_parser() -> argparse.ArgumentParser:
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
                         "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
+
+    batch = sub.add_parser(
+        "batch", help="render a job file's items (scenes x cameras x sweeps x settings) into a "
+                      "folder with a manifest; on Ray's workers when installed (docs/batch-format.md)",
+        description="Render every item of a job file once into --out, each item's files written "
+                    "whole and recorded in --out/manifest.jsonl (SHA-256 of every file); a re-run "
+                    "with the same --out skips the items already complete. Exit status: 0 when "
+                    "every item was written, 1 when some failed (a re-run tries them again), 2 "
+                    "for bad input, with nothing written.")
+    batch.add_argument("job", metavar="JOB.toml", help="the job file (docs/batch-format.md)")
+    batch.add_argument("--out", type=output_path, required=True, metavar="DIR",
+                       help="folder for the items' files and manifest.jsonl")
+    batch.add_argument("--address", metavar="auto|HOST:PORT",
+                       help="a running Ray cluster (auto: the one `ray start` made on this "
+                            "machine); default: a local Ray started for this job, or this process "
+                            "when Ray is not installed")
+    batch.add_argument("--workers", type=positive_int, metavar="N",
+                       help="workers of a local Ray (default: one per core)")
+    batch.add_argument("--compare", action="store_true",
+                       help="also render each item with the NumPy reference and compare, as "
+                            "`renderer compare` does (gpu.png, reference.png, diff.png in the "
+                            "item's compare/ folder, the figures in its record)")
+    batch.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
+                       help="the workers' headless GL context (default: EGL, then OSMesa)")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -721,13 +745,10 @@ def cmd_compare_shadows(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    import reference
-    from renderer.checks.compare import (compare_frames, depth_tie_pixels, either_precision, heat_map,
-                                         shadow_tie_pixels)
-    from renderer.checks.texture_bounds import accepted_colours
+    from renderer.checks.against_reference import against_reference
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.paths import output_stem
-    from renderer.core.jsonio import finite_or_none, to_json
+    from renderer.core.jsonio import to_json
     if args.out is not None:
         check_folder(args.out)
     if args.shadows_vs_truth:
@@ -744,57 +765,26 @@ def cmd_compare(args) -> int:
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
-    tie, tie_depth, grazing, envelope_renders = None, None, 0, 0
     if args.method == "raytrace":
-        from reference.raytrace.pipeline import render as reference_raytrace
-        gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
-                                                   _raytrace_options(args), frames=3)
-        from renderer.core.raytrace_scene import ray_scene
-        start = time.perf_counter()
-        rs = ray_scene(scene)                    # the BVH built once, for both precisions
-        ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args), rs=rs)
-        reference_ms = (time.perf_counter() - start) * 1000.0
-        # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
-        # elsewhere the adaptive pattern's other decision, rgba8_tie).
-        truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64", rs=rs)
-        tie, tie_depth, grazing = either_precision(ref_frame, truth)
-        expected = ref_frame.rgba8
+        options = _raytrace_options(args)
+        gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context, options, frames=3)
+        subpixel_bits = None
     else:
+        options = None
         gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
-        start = time.perf_counter()
-        ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
-        reference_ms = (time.perf_counter() - start) * 1000.0
-        # Anisotropic lookups: the twin's range over the texture verifier's coordinate bound.
-        accepted = accepted_colours(scene, ref_frame, *args.size, subpixel_bits=subpixel_bits)
-        expected, tie, envelope_renders = accepted.rgba8, accepted.tie, accepted.displaced_renders
+    check = against_reference(scene, args.size, gpu_frame, method=args.method, options=options,
+                              subpixel_bits=subpixel_bits, threshold=args.threshold)
     warn_if_nothing_drawn(scene, gpu_frame)
-    tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
-    result = compare_frames(gpu_frame.rgba8, expected, gpu_frame.depth, ref_frame.depth,
-                            threshold=tolerance.threshold, deviation=tolerance.deviation,
-                            reference_tie=tie, reference_tie_depth=tie_depth)
     with outputs(*names) as written:             # all three or none
         written.png(names[0], gpu_frame.rgba8)
-        written.png(names[1], ref_frame.rgba8)
-        written.png(names[2], heat_map(gpu_frame.rgba8, expected, tolerance.threshold,
-                                       tolerance.deviation, reference_tie=tie))
-    figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
-               "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
-               "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
-               "shadow_tie_pixels": shadow_tie_pixels(ref_frame) if args.method == "raster" else 0,
-               "grazing_ray_pixels": grazing, "anisotropic_envelope_renders": envelope_renders,
-               "gpu_ms": gpu_ms, "reference_ms": reference_ms,
-               "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
-    if args.method == "raytrace":        # adaptive: the samples traced, and where the twins chose differently
-        figures |= {"gpu_samples_per_pixel": float(gpu_frame.samples.mean()),
-                    "reference_samples_per_pixel": float(ref_frame.samples.mean()),
-                    "refined_differently_pixels": int((gpu_frame.samples != ref_frame.samples).sum()),
-                    "adaptive_tie_pixels": depth_tie_pixels(ref_frame)}
-    failures = tolerance.failures(result)
-    figures["passes"] = not failures
+        written.png(names[1], check.reference.rgba8)
+        written.png(names[2], check.heat)
+    figures = check.figures | {"gpu_ms": gpu_ms, "gl_renderer": gl_info["GL_RENDERER"],
+                               "context": gl_info["context"], "passes": check.figures["passes"]}
     print(to_json(figures))
-    if failures:
-        print(f"renderer compare: {output_stem(scene)} fails the pipeline tolerance: {'; '.join(failures)}",
-              file=sys.stderr)
+    if check.failures:
+        print(f"renderer compare: {output_stem(scene)} fails the pipeline tolerance: "
+              f"{'; '.join(check.failures)}", file=sys.stderr)
         return 1
     return 0
 
@@ -877,6 +867,20 @@ def cmd_colour(args) -> int:
     return 0
 
 
+def cmd_batch(args) -> int:
+    """`renderer batch`: everything checked (job file, scenes, outputs, --out's manifest)
+    before the executor starts (renderer/batch/run.py); the summary on stderr."""
+    from renderer.batch.job_file import read_job
+    from renderer.batch.run import plan_job, run_plan
+    from renderer.cluster.executor import open_executor
+    plan = plan_job(read_job(args.job), args.out, compare=args.compare)
+    with open_executor(args.address, args.workers) as executor:
+        summary = run_plan(plan, executor, context_kind=args.context)
+    for line in summary.lines():
+        print(f"renderer {line}", file=sys.stderr)
+    return 1 if summary.failed else 0
+
+
 def cmd_scenes(args) -> int:
     from renderer.core.builtin import builtin_scenes, describe
     for name in builtin_scenes():
@@ -933,7 +937,7 @@ def _check_paths(args) -> None:
 
 
 COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
-            "scenes": cmd_scenes, "extremes": cmd_extremes, "colour": cmd_colour}
+            "batch": cmd_batch, "scenes": cmd_scenes, "extremes": cmd_extremes, "colour": cmd_colour}
 
 
 def main(argv=None) -> int:

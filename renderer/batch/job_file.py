@@ -29,7 +29,7 @@ from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS, ray_sampling
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import (MAX_NUMBER, TableReader, describe_value, read_scene,
-                                      scene_from_dict, with_overrides)
+                                      scene_from_dict, toml_syntax_reason, with_overrides)
 from renderer.errors import SceneError, UserError
 
 TOP_KEYS = ("name", "description", "seed", "size", "scenes", "settings")
@@ -72,7 +72,7 @@ def read_job(path) -> Job:
     except OSError as exc:
         raise UserError(f"cannot read: {exc.strerror or exc}", file=source) from None
     except tomllib.TOMLDecodeError as exc:
-        raise UserError(f"TOML syntax error: {exc}", file=source) from None
+        raise UserError(toml_syntax_reason(exc), file=source) from None
     return _JobReader(path).job(data)
 
 

@@ -23,7 +23,8 @@ bytes: render_item.pixels_sha256), which stays the same where another zlib would
 same pixels to other bytes. Paths are relative to DIR, with '/'.
 
 Resume (`read_manifest`): a record counts when its key is one of the job's items, its
-outputs are the item's files, and every file exists with that SHA-256; the other items are
+outputs start with the item's files (with --compare, the comparison's too), and every file
+it lists exists with that SHA-256; the other items are
 rendered again. A line that is not whole JSON (the last one, cut by a kill) is ignored, and
 `Manifest.begin` rewrites the file with the header and the records that count. A manifest
 whose header is another job's (or not a batch manifest at all) is a UserError naming
@@ -126,12 +127,14 @@ def read_manifest(out: Path, header: dict, wanted: dict[str, list[str]]) -> Resu
 
 
 def _counts(out: Path, record: dict, wanted: dict[str, list[str]]) -> bool:
+    """Whether the record lists the item's files first (then maybe more: a record made with
+    --compare counts for a run without) and every file it lists is as recorded."""
     files = wanted.get(record.get("key"))
     listed = record.get("outputs")
-    if files is None or not isinstance(listed, list) or \
-            [o.get("path") if isinstance(o, dict) else None for o in listed] != files:
+    if files is None or not isinstance(listed, list) or not all(isinstance(o, dict) for o in listed) \
+            or [o.get("path") for o in listed][:len(files)] != files:
         return False
-    return all(file_sha256(out / o["path"]) == o.get("sha256") for o in listed)
+    return all(file_sha256(out / str(o["path"])) == o.get("sha256") for o in listed)
 
 
 class Manifest:

@@ -147,7 +147,7 @@ def read_scene(scene) -> tuple[dict, Path]:
     except OSError as exc:
         raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(_toml_syntax_reason(exc), file=source) from None
+        raise SceneError(toml_syntax_reason(exc), file=source) from None
     except RecursionError:               # tomllib recurses once per level of nesting
         raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
                          f"nests at most {MAX_NESTING} levels", file=source) from None
@@ -246,7 +246,7 @@ def _check_nesting(data: Any, reader: "_Reader") -> None:
         stack.extend((v, p, depth + 1) for v, p in children)
 
 
-def _toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
+def toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
     """tomllib says "Invalid value (at line 3, column 7)"; we say where first."""
     message = str(exc)
     match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)

@@ -27,6 +27,7 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
+from renderer.core.memory import check_raytrace_render, check_render
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -295,7 +296,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help=f"a scene's frame size (default {COLOUR_SIZE[0]}x{COLOUR_SIZE[1]})")
     colour.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
                         help="headless GL context (default: EGL, then OSMesa)")
-    for name in ("render", "view", "compare", "shaders", "report", "extremes"):
+    for name in ("render", "view", "compare", "shaders", "report", "extremes", "batch"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
             help="refuse, before any work, what would need more memory than this (512M, 4G, ...; "
@@ -336,17 +337,6 @@ def memory_size(text: str) -> int:
         return parse_memory(text)
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
-
-
-def check_memory(scene, size, backends) -> None:
-    """One line, before any rendering, when the estimated memory (renderer/core/memory.py) of
-    drawing `scene` at `size` on each of `backends` is over the limit."""
-    from renderer.core import memory
-    triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
-    estimate = {"gpu": memory.gpu_bytes, "reference": memory.reference_bytes}
-    needed = sum(estimate[backend](*size, triangles) for backend in backends)
-    memory.check(needed, f"rendering {scene.name} at {size[0]}x{size[1]} ({triangles:,} triangles) "
-                         f"on {' and '.join(backends)}")
 
 
 def _load(scene_arg):
@@ -440,15 +430,6 @@ def samples_fired(frame) -> str:
     """What an adaptive frame traced: 'mean 4.72 spp, 6.0% of pixels refined'."""
     from renderer.core.ray_sampling import FIRST_SET
     return f"mean {frame.samples.mean():.2f} spp, {(frame.samples > FIRST_SET).mean():.1%} of pixels refined"
-
-
-def check_raytrace_memory(scene, size, backends, samples) -> None:
-    from renderer.core import memory
-    triangles = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is None)
-    estimate = {"gpu": memory.raytrace_gpu_bytes, "reference": memory.raytrace_reference_bytes}
-    needed = sum(estimate[backend](*size, triangles, samples=samples) for backend in backends)
-    memory.check(needed, f"ray tracing {scene.name} at {size[0]}x{size[1]}, {samples} spp "
-                         f"({triangles:,} triangles) on {' and '.join(backends)}")
 
 
 def _raytrace_gpu(scene, size, context_kind, options, frames=1):
@@ -619,9 +600,9 @@ def cmd_render(args) -> int:
     check_raytrace_options(args)
     scene = _load_traced(args)
     if args.method == "raytrace":
-        check_raytrace_memory(scene, args.size, [args.backend], args.spp)
+        check_raytrace_render(scene, args.size, [args.backend], args.spp)
     else:
-        check_memory(scene, args.size, [args.backend])
+        check_render(scene, args.size, [args.backend])
     suffix = ".png" if settings is None else FORMATS[settings.format]
     output = args.output or Path(f"{output_stem(scene)}{suffix}")
     check_outputs(output, args.depth, args.alpha)
@@ -648,9 +629,9 @@ def cmd_view(args) -> int:
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
-    check_memory(scene, args.size, ["gpu"])
+    check_render(scene, args.size, ["gpu"])
     if args.method == "raytrace":
-        check_raytrace_memory(scene, args.size, ["gpu"], 1)
+        check_raytrace_render(scene, args.size, ["gpu"], 1)
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
@@ -693,8 +674,8 @@ def cmd_compare_methods(args) -> int:
     from renderer.core.jsonio import json_text
     from renderer.core.paths import output_stem
     scene = _load_traced(args)
-    check_memory(scene, args.size, ["gpu"])
-    check_raytrace_memory(scene, args.size, ["gpu"], args.spp)
+    check_render(scene, args.size, ["gpu"])
+    check_raytrace_render(scene, args.size, ["gpu"], args.spp)
     out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
     names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
     check_outputs(*names)
@@ -730,7 +711,7 @@ def cmd_compare_shadows(args) -> int:
         raise UserError("the scene has no shadow maps to hold against ray-cast truth (no light "
                         "with shadows on, nothing that casts or nothing that receives)",
                         file=scene.source or scene.name)
-    check_memory(scene, args.size, ["reference"])
+    check_render(scene, args.size, ["reference"])
     out = check_folder(args.out or Path(f"compare-shadows-{output_stem(scene)}"))
     names = [out / "shadow_truth.png", out / "shadow_truth.json"]
     check_outputs(*names)
@@ -758,9 +739,9 @@ def cmd_compare(args) -> int:
         return cmd_compare_methods(args)
     scene = _load_traced(args)
     if args.method == "raytrace":
-        check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)
+        check_raytrace_render(scene, args.size, ["gpu", "reference"], args.spp)
     else:
-        check_memory(scene, args.size, ["gpu", "reference"])
+        check_render(scene, args.size, ["gpu", "reference"])
     out = check_folder(args.out or Path(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
@@ -859,7 +840,7 @@ def cmd_colour(args) -> int:
             args.parser.error("--colorspace says how an image is encoded; a scene's frame is linear")
         scene = _load(args.source)
         size = args.size or COLOUR_SIZE
-        check_memory(scene, size, [args.backend])
+        check_render(scene, size, [args.backend])
         source = scene_source(scene, size, args.backend, args.context)
     written = write_colour_report(source, out)
     pixels = int(source.covered.sum())
@@ -872,9 +853,11 @@ def cmd_batch(args) -> int:
     before the executor starts (renderer/batch/run.py); the summary on stderr."""
     from renderer.batch.job_file import read_job
     from renderer.batch.run import plan_job, run_plan
-    from renderer.cluster.executor import open_executor
+    from renderer.cluster.executor import InProcessExecutor, open_executor
     plan = plan_job(read_job(args.job), args.out, compare=args.compare)
-    with open_executor(args.address, args.workers) as executor:
+    # Nothing left to render (a finished job run again): no workers to start.
+    opened = open_executor(args.address, args.workers) if plan.todo else InProcessExecutor()
+    with opened as executor:
         summary = run_plan(plan, executor, context_kind=args.context)
     for line in summary.lines():
         print(f"renderer {line}", file=sys.stderr)

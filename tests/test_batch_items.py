@@ -1,6 +1,7 @@
 """A job's items (renderer/batch/items.py): expansion in file order, stable keys, seeds from
 (job seed, key) only, the job's identity; read from job files (renderer/batch/job_file.py)."""
 
+import re
 from pathlib import Path
 
 import pytest
@@ -141,3 +142,13 @@ def test_the_example_job_is_small_and_expands(tmp_path):
     job = read_job(REPO / "assets" / "jobs" / "orbit.toml")
     assert len(expand(job)) == 16
     assert {item.setting.method for item in expand(job)} == {"raster", "raytrace"}
+
+
+def test_docs_batch_format_lists_every_key_the_reader_knows_and_no_other():
+    from renderer.batch import job_file
+    text = (REPO / "docs" / "batch-format.md").read_text()
+    cells = re.findall(r"^\| `([^|]*?)` ", text, re.M)          # first cells of table rows
+    documented = {re.match(r"\[*(?:[a-z]+\.)?([a-z_]+)", cell)[1] for cell in cells}
+    known = {*job_file.TOP_KEYS, *job_file.SCENE_KEYS, *job_file.CAMERA_KINDS, *job_file.SETTING_KEYS,
+             *job_file.OUTPUT_KEYS, *job_file.DEPTH_KEYS}
+    assert documented == known

@@ -23,6 +23,7 @@ from typing import Any
 from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSource, Setting,
                                   default_output_name)
 from renderer.core import output_settings as stage
+from renderer.core.memory import check_raytrace_render, check_render
 from renderer.core.motion import declares_motion
 from renderer.core.paths import checked_path, output_stem
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
@@ -74,6 +75,15 @@ def read_job(path) -> Job:
     except tomllib.TOMLDecodeError as exc:
         raise UserError(toml_syntax_reason(exc), file=source) from None
     return _JobReader(path).job(data)
+
+
+def check_memory(scene, setting: Setting, backends) -> None:
+    """A UserError when drawing `scene` with `setting` on `backends` would need more memory
+    than the limit (renderer/core/memory.py)."""
+    if setting.traced:
+        check_raytrace_render(scene, setting.size, backends, setting.samples * setting.light_samples)
+    else:
+        check_render(scene, setting.size, backends)
 
 
 def _name(reader: TableReader, value: Any, key: str) -> str:
@@ -140,7 +150,17 @@ class _JobReader(TableReader):
                   for overrides in self.sweep(raw.get("sweep"), f"{key}.sweep")]
         name = _name(self, raw["name"], f"{key}.name") if "name" in raw else output_stem(points[0][1])
         cameras = self.cameras(raw.get("cameras"), f"{key}.cameras", points[0][1], settings)
+        for _, scene in points:
+            for setting in settings:
+                self.memory(scene, setting, key)
         return SceneEntry(name, tuple(source for source, _ in points), cameras)
+
+    def memory(self, scene, setting: Setting, key: str) -> None:
+        """The GPU's memory for the scene and setting, under the limit (core/memory.py)."""
+        try:
+            check_memory(scene, setting, ["gpu"])
+        except UserError as error:
+            self.fail(key, f"setting {setting.name!r}: {error.reason}")
 
     def read_scene(self, value: Any, key: str) -> tuple[dict, Path]:
         text = self.string(value, key)

@@ -32,7 +32,8 @@ from pathlib import Path
 
 from renderer.batch.items import ITEMS_FOLDER, Item, Job, expand, job_identity
 from renderer.batch.manifest import MANIFEST, Manifest, Resume, header_for, read_manifest
-from renderer.batch.render_item import ItemResult, ItemWorker, reference_item
+from renderer.batch.job_file import check_memory
+from renderer.batch.render_item import ItemResult, ItemWorker, item_scene, load_source, reference_item
 from renderer.cluster.executor import batch_size, batches_of, note
 from renderer.core.imageio import check_folder, check_outputs, outputs
 
@@ -71,6 +72,9 @@ def plan_job(job: Job, out, *, compare: bool = False) -> Plan:
     UserError); the items whose records do not count are the ones to do."""
     out = check_folder(out)
     items = expand(job)
+    if compare:                      # the reference's memory too (job_file checked the GPU's)
+        for item in {(item.scene.digest, item.setting.name): item for item in items}.values():
+            check_memory(item_scene(load_source(item.scene), item), item.setting, ["gpu", "reference"])
     wanted = {item.key: [*item.files, *(compare_files(item) if compare else ())] for item in items}
     check_outputs(out / MANIFEST, *(out / path for paths in wanted.values() for path in paths))
     header = header_for(job, job_identity(job, items), len(items))

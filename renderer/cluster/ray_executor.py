@@ -155,19 +155,12 @@ class RayExecutor:
         import ray
         remote = ray.remote(function).options(num_cpus=1, max_retries=CALL_RETRIES)
         args = list(args)
-        failures: Counter[int] = Counter()
-        pending = {remote.remote(*arguments): index for index, arguments in enumerate(args)}
-        while pending:
-            [ref], _ = ray.wait(list(pending), num_returns=1)
-            index = pending.pop(ref)
-            try:
-                value = _get(ref)
-            except ray.exceptions.RayTaskError:
-                raise                       # the function's own error: a bug, not a fault
-            except ray.exceptions.RayError as exc:
-                _count_failure(failures, index, "task", exc)
-                pending[remote.remote(*args[index])] = index
-                continue
+        pending = {remote.remote(*arguments): (index, None) for index, arguments in enumerate(args)}
+
+        def again(tag) -> None:
+            pending[remote.remote(*args[tag[0]])] = tag
+
+        for (index, _), value in _as_finished(pending, "task", again):
             yield index, value
 
     def describe(self) -> str:
@@ -193,33 +186,51 @@ class RayExecutor:
 
 
 def _schedule(actors: list, batches: list[list]) -> Iterator[tuple[int, list]]:
-    """The ray.wait loop: IN_FLIGHT calls per actor, a failed batch queued again (first)."""
-    import ray
+    """IN_FLIGHT calls per actor; an actor that answers gets the next batch, and a batch
+    lost to a fault goes back to the front of the queue."""
     queue = deque(range(len(batches)))
-    pending: dict = {}                   # ObjectRef -> (actor, batch index)
-    failures: Counter[int] = Counter()
+    pending: dict = {}                   # ObjectRef -> (batch index, actor)
 
     def submit(actor) -> None:
         if queue:
             index = queue.popleft()
-            pending[actor.run.remote(batches[index])] = (actor, index)
+            pending[actor.run.remote(batches[index])] = (index, actor)
+
+    def again(tag) -> None:
+        queue.appendleft(tag[0])
+        submit(tag[1])
 
     for _ in range(IN_FLIGHT):
         for actor in actors:
             submit(actor)
+    for (index, actor), results in _as_finished(pending, "batch", again):
+        yield index, results
+        submit(actor)
+
+
+def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tuple, Any]]:
+    """(tag, result) for each call of `pending` ({ObjectRef: (index, ...)}, which grows as
+    the caller submits more) as it finishes: the ray.wait loop. A call lost to a fault
+    (its process died, and Ray's retries with it) is handed to again(tag) to be submitted
+    once more, MAX_ATTEMPTS times per index at most (then BatchFailed); an exception
+    raised by the work itself is raised here (_get)."""
+    import ray
+    failures: Counter[int] = Counter()
     while pending:
         [ref], _ = ray.wait(list(pending), num_returns=1)
-        actor, index = pending.pop(ref)
+        tag = pending.pop(ref)
         try:
-            results = _get(ref)
+            result = _get(ref)
         except ray.exceptions.RayTaskError:
-            raise                           # the worker's own error: a bug, not a fault
+            raise                           # the work's own error: a bug, not a fault
         except ray.exceptions.RayError as exc:
-            _count_failure(failures, index, "batch", exc)
-            queue.appendleft(index)
-        else:
-            yield index, results
-        submit(actor)
+            failures[tag[0]] += 1
+            if failures[tag[0]] >= MAX_ATTEMPTS:
+                raise BatchFailed(f"{what} {tag[0]} failed {MAX_ATTEMPTS} times on Ray; the "
+                                  f"last error: {type(exc).__name__}") from exc
+            again(tag)
+            continue
+        yield tag, result
 
 
 def _get(ref):
@@ -233,13 +244,6 @@ def _get(ref):
         if isinstance(exc.cause, UserError):
             raise exc.cause from None
         raise
-
-
-def _count_failure(failures: Counter, index: int, what: str, exc: BaseException) -> None:
-    failures[index] += 1
-    if failures[index] >= MAX_ATTEMPTS:
-        raise BatchFailed(f"{what} {index} failed {MAX_ATTEMPTS} times on Ray; the last "
-                          f"error: {type(exc).__name__}") from exc
 
 
 def _workers_for(resources: dict, asked: int | None) -> tuple[int, bool]:

@@ -45,7 +45,7 @@ samples = 2
 pattern = "random"
 """
 KILL_AFTER = 8                      # records in the manifest before the kill
-WORKER_TITLE = b"ray::WorkerHost"   # an actor's process title (renderer/cluster/ray_executor.py)
+WORKER_TITLE = b"ray::WorkerHost"   # an actor's process title (ray_executor.WorkerHost)
 
 
 def records(out: Path) -> dict:
@@ -70,14 +70,21 @@ def assert_same_job(out: Path, undisturbed: Path) -> None:
     assert files_in(out) == listed | {MANIFEST}, "a file the manifest does not list"
 
 
+def parent_of(pid) -> int:
+    # /proc/PID/stat: "PID (COMMAND) STATE PPID ...", COMMAND may hold spaces and brackets.
+    return int(Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[1])
+
+
 def pids_of_workers() -> list[int]:
-    """The processes of this machine's RayExecutor actors (the module's Ray only runs ours)."""
+    """The processes of the RayExecutor actors on this module's Ray: their raylet is a child
+    of this process (LocalRay started it), unlike other Rays running on the machine."""
     pids = []
-    for entry in os.listdir("/proc"):
+    for entry in filter(str.isdigit, os.listdir("/proc")):
         try:
-            if entry.isdigit() and Path(f"/proc/{entry}/cmdline").read_bytes().startswith(WORKER_TITLE):
+            if Path(f"/proc/{entry}/cmdline").read_bytes().startswith(WORKER_TITLE) and \
+                    parent_of(parent_of(entry)) == os.getpid():
                 pids.append(int(entry))
-        except OSError:
+        except (OSError, ValueError, IndexError):
             continue                # gone meanwhile
     return pids
 

@@ -23,6 +23,7 @@ from typing import Any
 from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSource, Setting,
                                   default_output_name)
 from renderer.core import output_settings as stage
+from renderer.core.builtin import is_scene_name
 from renderer.core.memory import check_raytrace_render, check_render
 from renderer.core.motion import declares_motion
 from renderer.core.paths import checked_path, output_stem
@@ -166,7 +167,7 @@ class _JobReader(TableReader):
         text = self.string(value, key)
         beside = self.path.parent / text           # a path is relative to the job file
         try:
-            return read_scene(beside if beside.is_file() else text)
+            return read_scene(text if is_scene_name(text) and not beside.is_file() else beside)
         except SceneError as error:
             self.fail(key, error.line())
 

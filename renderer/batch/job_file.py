@@ -16,7 +16,6 @@ import hashlib
 import itertools
 import json
 import re
-import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -31,7 +30,7 @@ from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS, ray_sampling
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import (MAX_NUMBER, TableReader, describe_value, read_scene,
-                                      scene_from_dict, toml_syntax_reason, with_overrides)
+                                      read_toml, scene_from_dict, with_overrides)
 from renderer.errors import SceneError, UserError
 
 TOP_KEYS = ("name", "description", "seed", "size", "scenes", "settings")
@@ -62,19 +61,7 @@ NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 def read_job(path) -> Job:
     """The job file at `path`, read and checked (module docstring)."""
     path = checked_path(path, error=UserError)
-    source = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise UserError("job file not found", file=source) from None
-    except IsADirectoryError:
-        raise UserError("is a directory, not a job file", file=source) from None
-    except UnicodeDecodeError as exc:
-        raise UserError(f"not UTF-8 text (byte {exc.start}); a job file is TOML", file=source) from None
-    except OSError as exc:
-        raise UserError(f"cannot read: {exc.strerror or exc}", file=source) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(toml_syntax_reason(exc), file=source) from None
+    data = read_toml(path, "job file", UserError)
     return _JobReader(path).job(data)
 
 

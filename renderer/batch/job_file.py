@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import json
 import re
 from pathlib import Path
 from typing import Any
@@ -23,6 +22,7 @@ from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSour
                                   default_output_name)
 from renderer.core import output_settings as stage
 from renderer.core.builtin import is_scene_name
+from renderer.core.jsonio import canonical_json
 from renderer.core.memory import check_raytrace_render, check_render
 from renderer.core.motion import declares_motion
 from renderer.core.paths import checked_path, output_stem
@@ -193,10 +193,10 @@ class _JobReader(TableReader):
             changed = with_overrides(data, overrides, str(path))
             scene = scene_from_dict(changed, source=str(path), base_dir=path.parent)
         except SceneError as error:
-            shown = ", ".join(f"{k} = {json.dumps(v)}" for k, v in overrides.items())
+            shown = ", ".join(f"{k} = {v!r}" for k, v in overrides.items())
             self.fail(key if overrides else key.rsplit(".", 1)[0] + ".scene",
                       f"{shown + ': ' if shown else ''}{error.line()}")
-        digest = hashlib.sha256(json.dumps(changed, sort_keys=True, default=str).encode()).hexdigest()
+        digest = hashlib.sha256(canonical_json(changed).encode()).hexdigest()
         return SceneSource(str(path.resolve()), tuple(overrides.items()), digest), scene
 
     def cameras(self, raw: Any, key: str, scene, settings) -> tuple[CameraSpec, ...]:

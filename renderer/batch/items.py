@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from renderer.core.camera_paths import orbit_cameras
@@ -147,7 +147,6 @@ class CameraSpec:
         return numbered(self.kind, self.index)
 
     def camera(self, base: Camera) -> Camera:
-        from dataclasses import replace
         if self.kind == "orbit":
             return orbit_cameras(base, self.views, self.elevation)[self.index]
         if self.kind == "pose":

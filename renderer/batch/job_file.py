@@ -112,9 +112,8 @@ class _JobReader(TableReader):
         count = sum(len(s.points) * len(s.cameras) for s in scenes) * len(settings)
         if count > MAX_ITEMS:
             self.fail("scenes", f"the job has {count:,} items; at most {MAX_ITEMS:,}")
-        job = Job(str(self.path), name, seed, scenes, settings,
-                  self.string(data.get("description", ""), "description"))
-        return job
+        return Job(str(self.path), name, seed, scenes, settings,
+                   self.string(data.get("description", ""), "description"))
 
     def entries(self, value: Any, key: str) -> list:
         entries = self.list_of_tables(value, key, key)

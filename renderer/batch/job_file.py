@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+import math
 import re
 from pathlib import Path
 from typing import Any
@@ -166,6 +167,9 @@ class _JobReader(TableReader):
         axes = list(self.flat_sweep(raw, key).items())
         if not axes:
             self.fail(key, "expected at least one key path = [values]")
+        points = math.prod(len(values) for _, values in axes)
+        if points > MAX_ITEMS:                 # before building any of them
+            self.fail(key, f"{points:,} sweep points; a job has at most {MAX_ITEMS:,} items")
         return [dict(zip((path for path, _ in axes), values))
                 for values in itertools.product(*(values for _, values in axes))]
 

@@ -2,6 +2,7 @@
 
     load_scene("sphere") or load_scene("my_scene.toml") -> Scene   (a built-in name or a path)
     read_scene(...) -> (parsed dict, path); with_overrides(data, {"camera.aperture": 0.1}, source)
+    read_toml(path, "job file", UserError) -> dict     (any TOML file, its failures one line)
     scene_from_dict({"camera": {...}, "objects": [...]}, source="<dict>", base_dir=".")
 
 docs/scene-format.md documents every key with its unit and default. The reader is strict:
@@ -29,7 +30,7 @@ import numpy as np
 from renderer.core import transforms
 from renderer.core.gl_rules import scene_light_problem, scene_varying_problem
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
-from renderer.errors import SceneError, show_number
+from renderer.errors import SceneError, UserError, show_number
 from renderer.core import memory
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
 from renderer.core.paths import checked_path
@@ -134,25 +135,31 @@ def read_scene(scene) -> tuple[dict, Path]:
     path = checked_path(scene, error=SceneError)
     if not path.is_file() and is_scene_name(str(scene)):
         path = resolve_scene(str(scene))
-    source = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise SceneError("scene file not found", file=source) from None
-    except IsADirectoryError:
-        raise SceneError("is a directory, not a scene file", file=source) from None
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"not UTF-8 text (byte {exc.start}); a scene file is TOML",
-                         file=source) from None
-    except OSError as exc:
-        raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(_toml_syntax_reason(exc), file=source) from None
-    except RecursionError:               # tomllib recurses once per level of nesting
-        raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
-                         f"nests at most {MAX_NESTING} levels", file=source) from None
+    data = read_toml(path)
     data.setdefault("name", path.stem)
     return data, path
+
+
+def read_toml(path: Path, what: str = "scene file", error: type[UserError] = SceneError) -> dict:
+    """A TOML file's parsed tables; each way of failing is one `error` line naming the file
+    (not found, a folder, not UTF-8, unreadable, a syntax error, nested too deeply). `what`
+    names the kind of file in the reasons ("scene file", "job file")."""
+    source = str(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except FileNotFoundError:
+        raise error(f"{what} not found", file=source) from None
+    except IsADirectoryError:
+        raise error(f"is a directory, not a {what}", file=source) from None
+    except UnicodeDecodeError as exc:
+        raise error(f"not UTF-8 text (byte {exc.start}); a {what} is TOML", file=source) from None
+    except OSError as exc:
+        raise error(f"cannot read: {exc.strerror or exc}", file=source) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise error(_toml_syntax_reason(exc), file=source) from None
+    except RecursionError:               # tomllib recurses once per level of nesting
+        raise error(f"arrays or tables nested too deeply for the TOML parser; a {what} "
+                    f"nests at most {MAX_NESTING} levels", file=source) from None
 
 
 # One step of a key path: a table key (letters, digits, _) or a list index `[i]`.
@@ -289,7 +296,7 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
-def _unknown_choice(what: str, value: str, known) -> str:
+def unknown_choice(what: str, value: str, known) -> str:
     """'unknown shading 'smooth'; expected one of: flat, gouraud, phong' (+ a suggestion)."""
     known = list(known)
     close = difflib.get_close_matches(value, known, n=1, cutoff=0.6)
@@ -297,7 +304,7 @@ def _unknown_choice(what: str, value: str, known) -> str:
     return f"unknown {what} {value!r}; {hint}expected one of: {', '.join(known)}"
 
 
-def _unknown_key(key: str, known) -> str:
+def unknown_key(key: str, known) -> str:
     known = list(known)
     close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
     if close:
@@ -319,17 +326,17 @@ def _join(path: str, key: str) -> str:
 
 # --------------------------------------------------------------------------- the reader
 
-class _Reader:
-    """Turns parsed TOML into scene dataclasses; every check raises through `fail`."""
+class TableReader:
+    """Checks of parsed TOML's tables and values, each failing as one line: `error(reason,
+    file=source, key=KEY.PATH)` (SceneError for scenes; renderer/batch/job_file.py reads job
+    files with it too)."""
 
-    def __init__(self, source: str, base_dir: Path):
+    def __init__(self, source: str, error: type[UserError] = SceneError):
         self.source = source
-        self.base_dir = base_dir
-        self.primitive_triangles = 0      # so far, for the memory check before building more
-        self.textures: dict = {}          # each image, checker and mesh file's texture, made once
+        self.error = error
 
     def fail(self, key: str | None, reason: str) -> NoReturn:
-        raise SceneError(reason, file=self.source, key=key or None)
+        raise self.error(reason, file=self.source, key=key or None)
 
     # ---- tables and scalars
 
@@ -339,7 +346,7 @@ class _Reader:
             self.fail(path, f"expected a table, got {describe_value(value)}")
         for key in value:
             if key not in known:
-                self.fail(_join(path, str(key)), _unknown_key(str(key), known))
+                self.fail(_join(path, str(key)), unknown_key(str(key), known))
         return value
 
     def list_of_tables(self, value: Any, path: str, toml_name: str) -> list:
@@ -421,13 +428,23 @@ class _Reader:
     def choice(self, value: Any, path: str, what: str, known) -> str:
         text = self.string(value, path)
         if text not in known:
-            self.fail(path, _unknown_choice(what, text, known))
+            self.fail(path, unknown_choice(what, text, known))
         return text
 
     def boolean(self, value: Any, path: str) -> bool:
         if not isinstance(value, bool):
             self.fail(path, f"expected true or false, got {describe_value(value)}")
         return value
+
+
+class _Reader(TableReader):
+    """Turns parsed TOML into scene dataclasses; every check raises through `fail`."""
+
+    def __init__(self, source: str, base_dir: Path):
+        super().__init__(source)
+        self.base_dir = base_dir
+        self.primitive_triangles = 0      # so far, for the memory check before building more
+        self.textures: dict = {}          # each image, checker and mesh file's texture, made once
 
     # ---- the scene
 

@@ -12,7 +12,9 @@ Printed: per run kind the median wall seconds of the job (actors started, contex
 shaders compiled, every file written), items/s, the batch size run_plan chose and the
 worker-measured ms per item (render + encode); the scaling efficiency rate(2) / (2 rate(1));
 the driver's ms per item (writing the files and the manifest record: the one serial part,
-so the ceiling of a cluster of any size); a call's round trip on an actor, alone and with
+so the ceiling of a cluster of any size); CPU ms per item after the first batch (CpuClock), which stays
+put where wall time grows because other work shares the cores, and how many of the machine's
+cores were busy meanwhile (all processes, /proc/stat: other sessions' work shows here); a call's round trip on an actor, alone and with
 IN_FLIGHT calls queued; and whether all runs' manifests hold the same SHA-256 per file.
 """
 
@@ -20,6 +22,7 @@ from __future__ import annotations
 
 import functools
 import json
+import os
 import shutil
 import statistics
 import tempfile
@@ -90,15 +93,58 @@ class DriverClock:
         batch_run._Writer.write = self._write
 
 
+def cpu_seconds(pid: int) -> float:
+    """User + system CPU seconds of a process, all its threads (/proc/PID/stat)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def machine_busy() -> tuple[float, float]:
+    """(busy CPU seconds of the whole machine, perf_counter) from /proc/stat's cpu line."""
+    ticks = [int(x) for x in Path("/proc/stat").read_text().split("\n", 1)[0].split()[1:]]
+    idle = ticks[3] + ticks[4]                      # idle, iowait
+    return (sum(ticks[:8]) - idle) / os.sysconf("SC_CLK_TCK"), time.perf_counter()
+
+
+class CpuClock:
+    """The executor, and the CPU seconds per item its workers spent between the first and
+    the last batch handed on (start-up left out): on Ray read from the actors' processes
+    (all threads; the map ends them after its last batch), in-process from this process
+    (the driver's writing included)."""
+
+    def __init__(self, executor):
+        self.executor, self.per_item, self.busy_cores = executor, None, None
+        self.kind, self.workers, self.describe = executor.kind, executor.workers, executor.describe
+
+    def _now(self) -> float:
+        if self.executor.kind == "ray":
+            return sum(map(cpu_seconds, self.executor.worker_pids))
+        return time.process_time()
+
+    def map(self, factory, batches):
+        first = None
+        for count, (index, results) in enumerate(self.executor.map(factory, batches), 1):
+            if count == 1:
+                first, first_items, busy = self._now(), len(results), machine_busy()
+            elif count == len(batches):
+                total = sum(map(len, batches))
+                self.per_item = (self._now() - first) / (total - first_items)
+                (busy_end, end), (busy_start, start) = machine_busy(), busy
+                self.busy_cores = (busy_end - busy_start) / (end - start)
+            yield index, results
+
+
 def run_once(job, out: Path, executor) -> dict:
     """The job's figures: wall seconds, seconds to the first item written (actors, contexts,
     shaders), items/s after it (steady), worker and driver ms per item, the files' hashes."""
+    clock = CpuClock(executor)
     with DriverClock() as driver:
         start = time.perf_counter()
-        summary = batch_run.run_job(job, out, executor, progress=False, say=lambda line: None)
+        summary = batch_run.run_job(job, out, clock, progress=False, say=lambda line: None)
     assert not summary.failed, summary.failed
     records = manifest(out)
     return {"seconds": summary.seconds, "items": summary.done, "first_s": driver.first - start,
+            "cpu_ms": clock.per_item * 1e3, "busy_cores": clock.busy_cores,
             "steady": (summary.done - 1) / (driver.last - driver.first),
             "driver_ms": driver.seconds * 1e3 / summary.done,
             "item_ms": statistics.median(r["render_ms"] + r["encode_ms"] for r in records),
@@ -163,16 +209,19 @@ def main() -> None:
 def report(runs: dict, job, ray_start: float, alone: float, queued: float) -> None:
     items = runs["in-process"][0]["items"]
     print(f"{'run':15s} {'wall s':>6s} {'items/s':>7s} {'1st item s':>10s} {'steady/s':>8s} "
-          f"{'batch':>5s} {'worker ms/item':>14s} {'driver ms/item':>14s}")
+          f"{'batch':>5s} {'worker ms/item':>14s} {'CPU ms/item':>11s} {'driver ms/item':>14s} "
+          f"{'machine busy':>12s}")
     rates, steady = {}, {}
     for kind, results in runs.items():
         median = {name: statistics.median(r[name] for r in results)
-                  for name in ("seconds", "first_s", "steady", "item_ms", "driver_ms")}
+                  for name in ("seconds", "first_s", "steady", "item_ms", "cpu_ms", "driver_ms",
+                               "busy_cores")}
         rates[kind], steady[kind] = items / median["seconds"], median["steady"]
         workers = 2 if "2" in kind else 1
         size = batch_size(max(map(batch_run.item_seconds, expand(job))), items, workers)
         print(f"{kind:15s} {median['seconds']:6.2f} {rates[kind]:7.1f} {median['first_s']:10.2f} "
-              f"{steady[kind]:8.1f} {size:5d} {median['item_ms']:14.1f} {median['driver_ms']:14.1f}")
+              f"{steady[kind]:8.1f} {size:5d} {median['item_ms']:14.1f} {median['cpu_ms']:11.1f} "
+              f"{median['driver_ms']:14.1f} {median['busy_cores']:7.2f} cores")
     one, two = "ray, 1 worker", "ray, 2 workers"
     print(f"scaling efficiency rate(2) / (2 x rate(1)) = {rates[two] / (2 * rates[one]):.2f} "
           f"(steady: {steady[two] / (2 * steady[one]):.2f}); "

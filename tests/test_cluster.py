@@ -266,6 +266,12 @@ def test_tasks_answer_every_argument_once(ray_executor):
         assert "a local Ray" not in executor.describe()     # the module's Ray, not its own
 
 
+def test_more_workers_than_the_cluster_has_cpus_is_one_line(ray_executor):
+    with pytest.raises(UserError) as caught:        # the extra actors would wait for ever
+        ray_executor(workers=3)
+    assert caught.value.line() == "--workers: 3 workers, but the Ray cluster has 2 CPUs"
+
+
 def test_a_cluster_by_its_address(ray_executor):
     code = (
         "import os, sys\n"
@@ -280,6 +286,24 @@ def test_a_cluster_by_its_address(ray_executor):
     assert done.stdout.splitlines() == [
         f"the Ray cluster at {ray_executor.address}, 1 workers (Ray actors, one CPU each)",
         "[0, 1, 2]"]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.path.exists("/tmp/ray/ray_current_cluster"), reason="`ray start` ran here")
+def test_auto_without_a_cluster_is_one_line_at_once():
+    # "auto" is also any Ray running on the machine (Ray finds their processes): such as
+    # other test sessions' own. Here Ray is made to find none.
+    code = ("import functools, sys, ray._private.services as services\n"
+            "services._cached_find_gcs_addresses = functools.lru_cache()(lambda: set())\n"
+            "from renderer.cluster.executor import open_executor\n"
+            "from renderer.errors import UserError\n"
+            "try: open_executor('auto', 1)\n"
+            "except UserError as e: print(e.line())\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, timeout=60, env={**os.environ, "RAY_ADDRESS": ""})
+    assert (done.stdout, done.stderr) == ("--address: auto: no Ray cluster runs on this machine "
+                                          "(start one with `ray start --head`, or give its "
+                                          "HOST:PORT)\n", "")
 
 
 @pytest.mark.slow

@@ -2,7 +2,7 @@
 
     with RayExecutor(workers=2) as ex:                  # a local Ray, 2 actors (default: cores)
         for index, results in ex.map(factory, batches): ...
-    RayExecutor(address="auto")                          # the cluster `ray start` runs here
+    RayExecutor(address="auto")                          # the Ray running on this machine
     RayExecutor(address="head.example:6379")             # a cluster's head (GCS) address
 
 Start. A local Ray is `ray.init(address="local")`: always a fresh one for this run, never a
@@ -14,7 +14,8 @@ socket first (address.py): nobody answering is one line at once; where something
 that is not a Ray head, Ray's own connection attempts are bounded (CONNECT_BOUNDS, ~5 s)
 and its C++ log lines on fd 2 hidden: one line too. A process
 already connected to Ray (ray.init called by the program, or a test's cluster) is used as it
-is and left connected.
+is and left connected. "auto" is Ray's own rule: $RAY_ADDRESS, else the cluster `ray start`
+made here, else any Ray running on this machine (one another `renderer batch` started too).
 
 Workers. One actor per worker, each holding one worker object (factory(), made on its first
 batch). CPU nodes: one actor per CPU (num_cpus=1), with LP_NUM_THREADS=1 set before the

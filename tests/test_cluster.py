@@ -243,11 +243,12 @@ def test_a_batch_that_always_kills_its_worker_fails_the_map(ray_executor, monkey
     with ray_executor(workers=1) as executor:
         # The batches waiting on the actor (IN_FLIGHT) die with it: any of them may be the
         # first to fail MAX_ATTEMPTS times.
-        with pytest.raises(BatchFailed, match=f"failed {executor_module.MAX_ATTEMPTS} times"):
+        with pytest.raises(BatchFailed, match=f"failed {executor_module.MAX_ATTEMPTS} times") as caught:
             for index, results in executor.map(DyingWorker, batches_of(list(range(20)), 2)):
                 done.append(index)
                 assert [value for _, value, _ in results] == [n * n for n in (2 * index, 2 * index + 1)]
     assert 6 not in done and len(done) >= 4
+    assert caught.value.status == 1 and "process was lost" in caught.value.line()
 
 
 def test_the_workers_own_errors_are_raised_as_in_process(ray_executor):

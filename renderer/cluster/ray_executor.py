@@ -11,11 +11,11 @@ dashboard, worker output not forwarded, Ray's log lines at ERROR) and keeps its 
 in a short temporary folder that close() removes: Ray's socket paths must fit in 107 bytes,
 and its default /tmp/ray/session_* folders are never deleted. An --address is checked with a
 socket first (address.py): nobody answering is one line at once; where something answers
-that is not a Ray head, Ray's own connection attempts are bounded (CONNECT_BOUNDS, ~5 s)
-and its C++ log lines on fd 2 hidden: one line too. A process
-already connected to Ray (ray.init called by the program, or a test's cluster) is used as it
-is and left connected. "auto" is Ray's own rule: $RAY_ADDRESS, else the cluster `ray start`
-made here, else any Ray running on this machine (one another `renderer batch` started too).
+that is not a Ray head, Ray's own connection attempts are bounded (CONNECT_BOUNDS, ~5 s) and
+its C++ log lines on fd 2 hidden: one line too. "auto" is Ray's own rule: $RAY_ADDRESS, else
+the cluster `ray start` made here, else any Ray running on this machine (also one another
+`renderer batch` started). A process already connected to Ray (ray.init called by the
+program, or a test's cluster) is used as it is and left connected.
 
 Workers. One actor per worker, each holding one worker object (factory(), made on its first
 batch). CPU nodes: one actor per CPU (num_cpus=1), with LP_NUM_THREADS=1 set before the
@@ -24,16 +24,17 @@ share the cores (at 320x240 most of a frame's time is serial anyway: one actor w
 llvmpipe threads used one core). GPU nodes: one actor per GPU (num_gpus=1), its EGL device
 the GPU Ray gave it (GLCONTEXT_DEVICE_INDEX, which glcontext reads when it makes an EGL
 context). The GPU path is untested: no machine here has a GPU, and it assumes that the EGL
-device order matches Ray's GPU ids (true when a node's EGL devices are its NVIDIA GPUs in
-CUDA order; Mesa adds a software device at the end).
+devices are numbered as Ray numbers the GPUs (CUDA's order; EGL_NV_device_cuda could map
+them where they are not).
 
-Scheduling. A ray.wait loop with IN_FLIGHT calls queued on each actor, so an actor finishes
-a batch and finds the next one waiting (a call costs ~3 ms here, hidden this way). Faults:
-actors restart without limit (max_restarts=-1) and retry their calls (max_task_retries=3);
-a batch whose call still fails is queued again here, and a batch failing MAX_ATTEMPTS times
-raises BatchFailed (a batch that kills its process every time takes the batch queued behind
-it on the same actor down with it each time, so BatchFailed may name either). An exception raised by the worker's own code is not a fault but a bug (or
-a UserError): it is raised here at once, as in-process.
+Scheduling. A ray.wait loop with IN_FLIGHT calls queued on each actor, so that an actor
+finishing a batch finds the next one waiting (a call's round trip, ~1 ms here, is hidden
+this way). Faults: actors restart without limit (max_restarts=-1) and retry their calls
+(max_task_retries=3); a batch whose call still fails is queued again here, and a batch
+failing MAX_ATTEMPTS times raises BatchFailed (a batch that kills its process every time
+takes the batch queued behind it on the same actor down with it, so BatchFailed may name
+either). An exception raised by the worker's own code is not a fault but a bug (or a
+UserError): it is raised here at once, as in-process.
 """
 
 from __future__ import annotations
@@ -227,8 +228,9 @@ def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tu
         except ray.exceptions.RayError as exc:
             failures[tag[0]] += 1
             if failures[tag[0]] >= MAX_ATTEMPTS:
-                raise BatchFailed(f"{what} {tag[0]} failed {MAX_ATTEMPTS} times on Ray; the "
-                                  f"last error: {type(exc).__name__}") from exc
+                raise BatchFailed(f"{what} {tag[0]} failed {MAX_ATTEMPTS} times on Ray: its "
+                                  f"worker's process was lost each time ({type(exc).__name__}; "
+                                  f"out of memory, or a crash in the GL driver?)") from exc
             again(tag)
             continue
         yield tag, result

@@ -1,7 +1,7 @@
 """`renderer batch` on a local Ray (the module's `ray_executor`, tests/conftest.py; slow):
 the same files with 1 worker, 2 workers or none; a worker killed with SIGKILL mid-job
 costs a retry and nothing else (the issue's test); a killed command resumes to the same
-result. "The same" is the manifest's SHA-256 of every file, and the folder holding exactly
+result; --compare's reference in Ray's tasks gives this process's figures. "The same" is the manifest's SHA-256 of every file, and the folder holding exactly
 the files the manifest lists (no temporary, no half-written file)."""
 
 import json
@@ -132,6 +132,24 @@ def test_any_number_of_workers_writes_the_same_job(ray_executor, job_file, undis
     assert not summary.failed
     assert_same_job(out, undisturbed)
     assert len({record["worker"]["pid"] for record in records(out).values()}) == workers
+
+
+def test_compare_on_ray_gives_the_figures_of_this_process(ray_executor, tmp_path):
+    # The reference runs in Ray's plain tasks (executor.tasks), after the GPU's map.
+    path = tmp_path / "small.toml"
+    path.write_text(JOB.replace(f"views = {VIEWS}", "views = 2") + TRACED)
+    outs = {}
+    for name, executor in (("here", InProcessExecutor()), ("ray", ray_executor(2))):
+        outs[name] = tmp_path / name
+        with executor:
+            summary = run_job(read_job(path), outs[name], executor, compare=True, progress=False)
+        assert summary.done == 8 and not summary.failed
+    assert_same_job(outs["ray"], outs["here"])
+    figures = {name: {key: {figure: value for figure, value in record["compare"].items()
+                            if not figure.endswith("_ms")}          # but the timings
+                      for key, record in records(out).items()} for name, out in outs.items()}
+    assert figures["ray"] == figures["here"]
+    assert all(item["passes"] for item in figures["ray"].values())
 
 
 def test_a_worker_killed_mid_job_costs_only_a_retry(ray_executor, job_file, undisturbed, tmp_path):

@@ -8,14 +8,19 @@ each. One local Ray with 2 CPUs serves every Ray run (its start is timed once, a
 the runs take turns (in-process, Ray 1 worker, Ray 2 workers, then again), so that all see
 the same load, and each writes a fresh folder with `run_job`, as `renderer batch` does.
 
-Printed: per run kind the median wall seconds of the job (actors started, contexts made,
-shaders compiled, every file written), items/s, the batch size run_plan chose and the
-worker-measured ms per item (render + encode); the scaling efficiency rate(2) / (2 rate(1));
-the driver's ms per item (writing the files and the manifest record: the one serial part,
-so the ceiling of a cluster of any size); CPU ms per item after the first batch (CpuClock), which stays
-put where wall time grows because other work shares the cores, and how many of the machine's
-cores were busy meanwhile (all processes, /proc/stat: other sessions' work shows here); a call's round trip on an actor, alone and with
-IN_FLIGHT calls queued; and whether all runs' manifests hold the same SHA-256 per file.
+Printed per run kind (medians of the repeats):
+- wall s and items/s of the whole job (actors started, contexts made, shaders compiled);
+- 1st item s (until the first item is written) and steady items/s (after it);
+- the batch size run_plan chose (executor.batch_size);
+- worker ms per item (render + encode, wall, measured on the worker) and CPU ms per item
+  (CpuClock: the workers' processes, all threads, after the first batch), which stays put
+  where the wall time grows because other work shares the cores;
+- driver ms per item (writing the files and the manifest record: the one serial part, so
+  the ceiling of a cluster of any size);
+- the machine's busy cores meanwhile (/proc/stat, every process: other sessions' work too).
+Then the scaling efficiency rate(2) / (2 x rate(1)), the local Ray's start, a call's round
+trip on an actor (alone, and with IN_FLIGHT queued), and whether all runs' manifests hold
+the same SHA-256 for every file.
 """
 
 from __future__ import annotations
@@ -51,8 +56,8 @@ class NoWork:
 
 
 def job_text(width: int, height: int, views: int) -> str:
-    scenes = "".join(f'[[scenes]]\nscene = "{name}"\ncameras = {{ orbit = {{ views = {views} }} }}\n\n'
-                     for name in SCENES)
+    orbit = f"cameras = {{ orbit = {{ views = {views} }} }}"
+    scenes = "".join(f'[[scenes]]\nscene = "{name}"\n{orbit}\n\n' for name in SCENES)
     return (f'name = "bench-batch"\nseed = 7\nsize = [{width}, {height}]\n\n{scenes}'
             '[[settings]]\nname = "raster"\noutputs = [{ format = "png8", transfer = "srgb" }]\n')
 
@@ -188,13 +193,14 @@ def main() -> None:
         local = LocalRay(CPUS)
         ray_start = time.perf_counter() - start
         try:
-            kinds = {"in-process": InProcessExecutor, "ray, 1 worker": lambda: RayExecutor(workers=1),
+            kinds = {"in-process": InProcessExecutor,
+                     "ray, 1 worker": lambda: RayExecutor(workers=1),
                      "ray, 2 workers": lambda: RayExecutor(workers=2)}
             runs = {kind: [] for kind in kinds}
             for repeat in range(args.repeats):
                 for kind, make in kinds.items():
                     with make() as executor:
-                        out = folder / f"out-{len(runs[kind])}-{kind.replace(' ', '').replace(',', '')}"
+                        out = folder / f"out-{repeat}-{kind.replace(' ', '').replace(',', '')}"
                         runs[kind].append(run_once(job, out, executor))
                     shutil.rmtree(out)
             alone, queued = call_overhead_ms()
@@ -230,8 +236,9 @@ def report(runs: dict, job, ray_start: float, alone: float, queued: float) -> No
     print(f"a call's round trip (empty batch): {alone:.2f} ms alone, {queued:.2f} ms with "
           f"{IN_FLIGHT} in flight")
     every = [r["hashes"] for results in runs.values() for r in results]
+    same = all(hashes == every[0] for hashes in every)
     print(f"manifests: {len(every)} runs, {items} items each: "
-          f"{'the same SHA-256 for every file' if all(h == every[0] for h in every) else 'HASHES DIFFER'}")
+          f"{'the same SHA-256 for every file' if same else 'HASHES DIFFER'}")
 
 
 if __name__ == "__main__":

@@ -1,8 +1,9 @@
 """`renderer batch` on a local Ray (the module's `ray_executor`, tests/conftest.py; slow):
 the same files with 1 worker, 2 workers or none; a worker killed with SIGKILL mid-job
 costs a retry and nothing else (the issue's test); a killed command resumes to the same
-result; --compare's reference in Ray's tasks gives this process's figures. "The same" is the manifest's SHA-256 of every file, and the folder holding exactly
-the files the manifest lists (no temporary, no half-written file)."""
+result; --compare's reference in Ray's tasks gives this process's figures. "The same" is
+the manifest's SHA-256 of every file, and the folder holding exactly the files the
+manifest lists (no temporary, no half-written file)."""
 
 import json
 import os
@@ -89,7 +90,7 @@ def pids_of_workers() -> list[int]:
     return pids
 
 
-def wait_for_records(out: Path, count: int, process: subprocess.Popen, timeout: float = 120) -> None:
+def wait_for_records(out: Path, count: int, process: subprocess.Popen, timeout=120.0) -> None:
     end = time.monotonic() + timeout
     while time.monotonic() < end and process.poll() is None:
         try:

@@ -97,14 +97,27 @@ def square_task(n):
     return n * n
 
 
-def by_unit(mapped) -> dict:
-    """{unit: (value, pid)} from map's (index, results), every batch seen exactly once."""
+def open_elsewhere(address: str, before: str = "") -> subprocess.CompletedProcess:
+    """open_executor(address) in a new process (Ray's connection bounds hold only where ray
+    is imported afterwards; this process holds the module's Ray): stdout is the UserError's
+    line. `before`: Python run first."""
+    code = (f"import sys\n{before}\n"
+            "from renderer.cluster.executor import open_executor\n"
+            "from renderer.errors import UserError\n"
+            "try: open_executor(sys.argv[1], 1)\n"
+            "except UserError as e: print(e.line())\n")
+    return subprocess.run([sys.executable, "-c", code, address], capture_output=True, text=True,
+                          cwd=ROOT, timeout=60, env={**os.environ, "RAY_ADDRESS": ""})
+
+
+def by_unit(mapped, batches: int) -> dict:
+    """{unit: (value, pid)} from map's (index, results), each of the batches seen once."""
     seen, results = [], {}
     for index, batch_results in mapped:
         seen.append(index)
         for unit, value, pid in batch_results:
             results[unit] = (value, pid)
-    assert sorted(seen) == list(range(len(seen))), "a batch came back twice or not at all"
+    assert sorted(seen) == list(range(batches)), "a batch came back twice or not at all"
     return results
 
 
@@ -206,10 +219,10 @@ def test_in_process_map_is_the_order_of_the_batches():
 # -- on a local Ray (slow: the module's ray_executor) ----------------------------------------
 
 def test_ray_renders_what_this_process_renders_in_any_order(ray_executor):
-    here = by_unit(InProcessExecutor().map(OrbitWorker, batches_of(list(range(VIEWS)), 5)))
+    here = by_unit(InProcessExecutor().map(OrbitWorker, batches_of(list(range(VIEWS)), 5)), 3)
     views = list(range(VIEWS))[::-1]                        # other batches, another order
     with ray_executor(workers=2) as executor:
-        there = by_unit(executor.map(OrbitWorker, batches_of(views, 2)))
+        there = by_unit(executor.map(OrbitWorker, batches_of(views, 2)), VIEWS // 2)
         pids = set(executor.worker_pids)
     assert {view: value for view, (value, _) in there.items()} == \
         {view: value for view, (value, _) in here.items()}
@@ -230,7 +243,7 @@ def test_a_worker_killed_mid_map_costs_only_a_retry(ray_executor):
         first = next(mapped)
         killed = executor.worker_pids[0]
         os.kill(killed, signal.SIGKILL)
-        results = by_unit([first, *mapped])
+        results = by_unit([first, *mapped], len(units) // 2)
     assert {unit: value for unit, (value, _) in results.items()} == {n: n * n for n in units}
     pids = {pid for _, pid in results.values()}
     assert pids - {killed} - set(executor.worker_pids), "no batch ran on the restarted actor"
@@ -243,10 +256,12 @@ def test_a_batch_that_always_kills_its_worker_fails_the_map(ray_executor, monkey
     with ray_executor(workers=1) as executor:
         # The batches waiting on the actor (IN_FLIGHT) die with it: any of them may be the
         # first to fail MAX_ATTEMPTS times.
-        with pytest.raises(BatchFailed, match=f"failed {executor_module.MAX_ATTEMPTS} times") as caught:
+        attempts = executor_module.MAX_ATTEMPTS
+        with pytest.raises(BatchFailed, match=f"failed {attempts} times") as caught:
             for index, results in executor.map(DyingWorker, batches_of(list(range(20)), 2)):
                 done.append(index)
-                assert [value for _, value, _ in results] == [n * n for n in (2 * index, 2 * index + 1)]
+                units = (2 * index, 2 * index + 1)
+                assert [value for _, value, _ in results] == [n * n for n in units]
     assert 6 not in done and len(done) >= 4
     assert caught.value.status == 1 and "process was lost" in caught.value.line()
 
@@ -285,7 +300,7 @@ def test_a_cluster_by_its_address(ray_executor):
                           capture_output=True, text=True, cwd=ROOT, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines() == [
-        f"the Ray cluster at {ray_executor.address}, 1 workers (Ray actors, one CPU each)",
+        f"the Ray cluster at {ray_executor.address}, 1 worker (a Ray actor on one CPU)",
         "[0, 1, 2]"]
 
 
@@ -294,14 +309,8 @@ def test_a_cluster_by_its_address(ray_executor):
 def test_auto_without_a_cluster_is_one_line_at_once():
     # "auto" is also any Ray running on the machine (Ray finds their processes): such as
     # other test sessions' own. Here Ray is made to find none.
-    code = ("import functools, sys, ray._private.services as services\n"
-            "services._cached_find_gcs_addresses = functools.lru_cache()(lambda: set())\n"
-            "from renderer.cluster.executor import open_executor\n"
-            "from renderer.errors import UserError\n"
-            "try: open_executor('auto', 1)\n"
-            "except UserError as e: print(e.line())\n")
-    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                          cwd=ROOT, timeout=60, env={**os.environ, "RAY_ADDRESS": ""})
+    done = open_elsewhere("auto", "import functools, ray._private.services as services\n"
+                          "services._cached_find_gcs_addresses = functools.lru_cache()(set)")
     assert (done.stdout, done.stderr) == ("--address: auto: no Ray cluster runs on this machine "
                                           "(start one with `ray start --head`, or give its "
                                           "HOST:PORT)\n", "")
@@ -314,15 +323,10 @@ def test_an_address_that_answers_but_is_no_ray_is_one_line_in_seconds():
         server.listen(16)
         threading.Thread(target=lambda: [server.accept()[0].close() for _ in range(64)],
                          daemon=True).start()
-        code = ("import sys\n"
-                "from renderer.cluster.executor import open_executor\n"
-                "from renderer.errors import UserError\n"
-                "try: open_executor(sys.argv[1], 1)\n"
-                "except UserError as e: print(e.line())\n")
         start = time.perf_counter()
-        done = subprocess.run([sys.executable, "-c", code, f"127.0.0.1:{server.getsockname()[1]}"],
-                              capture_output=True, text=True, cwd=ROOT, timeout=60)
+        done = open_elsewhere(f"127.0.0.1:{server.getsockname()[1]}")
         seconds = time.perf_counter() - start
-    assert done.stdout.startswith("--address: 127.0.0.1:") and "Ray could not connect" in done.stdout
+    assert done.stdout.startswith("--address: 127.0.0.1:")
+    assert "Ray could not connect" in done.stdout
     assert len(done.stdout.splitlines()) == 1 and done.stderr == ""
     assert seconds < 15, f"{seconds:.1f} s"

@@ -167,6 +167,8 @@ class RayExecutor:
 
     def describe(self) -> str:
         unit = "GPU" if self.gpu else "CPU"
+        if self.workers == 1:
+            return f"{self.where}, 1 worker (a Ray actor on one {unit})"
         return f"{self.where}, {self.workers} workers (Ray actors, one {unit} each)"
 
     def close(self) -> None:

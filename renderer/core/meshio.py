@@ -164,6 +164,10 @@ def _read_with_trimesh(path: Path):
     process=False keeps the file's vertices and normals as written (no merging, no repair).
     """
     kind = path.suffix.lower()[1:].upper()
+    if _neither_binary_nor_text(path, kind):
+        # Said before trimesh sees the file: with charset_normalizer installed (Ray's extra
+        # brings it) trimesh "decodes" any bytes as some code page and reads what it can.
+        raise _MeshProblem(_neither(kind))
     try:
         loaded = trimesh.load_scene(str(path), process=False)
     except ImportError:
@@ -182,10 +186,7 @@ def _read_with_trimesh(path: Path):
         if isinstance(geometry, trimesh.Trimesh):
             parts.append((np.asarray(transform, dtype=float), geometry))
     if not parts:
-        # With charset_normalizer installed (Ray's extra brings it), trimesh "decodes" any
-        # bytes as some code page and finds nothing in them: the same file, the same line.
-        raise _MeshProblem(_neither(kind) if _neither_binary_nor_text(path, kind)
-                           else "mesh has no triangles")
+        raise _MeshProblem("mesh has no triangles")
 
     positions, faces, normals, uvs, offset = [], [], [], [], 0
     all_have_normals = all(_has_file_normals(g) for _, g in parts)

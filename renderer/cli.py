@@ -63,6 +63,16 @@ def channel_threshold(text: str) -> int:
     return value
 
 
+def cluster_options(parser, what: str) -> None:
+    """--address and --workers: where a command's work runs (renderer/cluster/executor.py
+    open_executor); `what` says what goes there."""
+    parser.add_argument("--address", metavar="auto|HOST:PORT",
+                        help=f"a running Ray cluster ('auto': the one this machine is part of): {what}")
+    parser.add_argument("--workers", type=positive_int, metavar="N",
+                        help="workers on Ray (default: one per core); without --address, a Ray "
+                             "started on this machine for the run")
+
+
 def output_path(text: str) -> Path:
     """An output file or folder name. An empty one is refused with one line (a UserError,
     which argparse lets through), before any work: Path('') would be the current folder."""
@@ -237,6 +247,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
                         "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
+    cluster_options(report, "the settings run on Ray workers, (scene, setting) units longest first, "
+                            "the ground truths here; results.csv is the in-process one apart from "
+                            "the times and their `worker` column")
 
     sub.add_parser("scenes", help="list the built-in scenes")
 
@@ -846,7 +859,8 @@ def cmd_report(args) -> int:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")
     result = run_report(scenes, args.out, method=args.method, quick=args.quick, size=args.size,
-                        cache_dir=args.cache, context_kind=args.context, knobs=args.knobs)
+                        cache_dir=args.cache, context_kind=args.context, knobs=args.knobs,
+                        address=args.address, workers=args.workers)
     print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "
           f"{len(result.files) - 2} plots in {result.seconds:.0f} s")
     return 0

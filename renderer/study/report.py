@@ -52,6 +52,7 @@ from renderer.core.imageio import outputs
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
 from renderer.study.metrics import metrics
+from renderer.study.report_units import SceneWork, gl_facts, run_units
 from renderer.study import output_report
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, QUICK_SIZE,
                                             SHADOW_RESOLUTIONS)
@@ -299,16 +300,20 @@ class ReportResult:
     gl_renderer: str = ""
     files: list = field(default_factory=list)
     knobs: tuple = ()                                 # the families swept, when not all
+    where: str = "in this process"                    # the executor's describe()
 
 
 def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool = False,
                size=None, cache_dir=None, context_kind: str = "auto", sweep=None,
-               knobs=None) -> ReportResult:
+               knobs=None, address: str | None = None, workers: int | None = None) -> ReportResult:
     """Sweep `scenes` (Scene objects) with `method`'s study (study()), write results.csv,
     plots/ and report.md under `out`. `knobs`: the knob families to sweep (default all of the
-    study's `knobs`; a setting's family is its knob up to a "-")."""
+    study's `knobs`; a setting's family is its knob up to a "-"). `address`, `workers`: the
+    settings run on Ray (renderer/cluster/executor.py open_executor; report_units.py), else
+    in this process; the ground truths are made here, where their cache is."""
     from tqdm import tqdm
 
+    from renderer.cluster.executor import open_executor
     from renderer.errors import UserError
     from renderer.gpu.context import make_context, release_context
     runner = study(method)
@@ -323,35 +328,31 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     sweep = sweep or runner.sweep(quick)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
     start = time.perf_counter()
-    ctx = make_context(context_kind)
+    ctx = make_context(context_kind)                # the plan's GL facts: the workers' must match
     try:
         result.gl_renderer = ctx.info["GL_RENDERER"]
+        facts = gl_facts(ctx)
         plan = [s for s in runner.settings(sweep, ctx) if s.knob.split("-")[0] in knobs]
-        plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
-        with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
-                  mininterval=0.5, dynamic_ncols=True) as bar:
-            for scene, scene_plan in zip(scenes, plans):
-                truth = None
-                if runner.needs_truth(scene_plan):
-                    bar.set_description(f"{scene.name}: ground truth")
-                    truth, hit = runner.truth(scene, width, height, cache_dir)
-                    result.truth_hits += hit
-                result.scenes[scene.name] = runner.describe(scene)
-                bar.update()
-                run = runner.scene_run(scene, width, height, ctx)
-                try:
-                    for setting in scene_plan:
-                        bar.set_description(f"{scene.name}: {setting.knob} {setting.setting} "
-                                            f"({setting.backend})")
-                        image, samples, ms = run.timed(setting, sweep.runs)
-                        result.rows.append({
-                            "scene": scene.name, **setting.columns(), "samples": samples,
-                            "runs": sweep.runs, "median_ms": ms, **run.errors(setting, image, truth)})
-                        bar.update()
-                finally:
-                    run.release()
     finally:
         release_context(ctx)
+    plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
+    with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
+              mininterval=0.5, dynamic_ncols=True) as bar:
+        work = []
+        for index, (scene, scene_plan) in enumerate(zip(scenes, plans)):
+            truth = None
+            if runner.needs_truth(scene_plan):
+                bar.set_description(f"{scene.name}: ground truth")
+                truth, hit = runner.truth(scene, width, height, cache_dir)
+                result.truth_hits += hit
+            result.scenes[scene.name] = runner.describe(scene)
+            work.append(SceneWork(index, scene, tuple(scene_plan), truth))
+            bar.update()
+        with open_executor(address, workers, use_ray=address is not None or workers is not None) \
+                as executor:
+            result.where = executor.describe()
+            result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
+                                    context_kind, bar)
     result.seconds = time.perf_counter() - start
     write_outputs(result, Path(out), runner, (width, height), sweep, quick)
     return result

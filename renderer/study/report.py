@@ -47,7 +47,8 @@ import numpy as np
 from renderer.core import sampling
 from renderer.core.shadow_settings import BIAS_RULES, FILTERS
 from renderer.study.report_output import csv_text, plot_png, report_markdown
-from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
+from renderer.study.ground_truth import (MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir,
+                                         ground_truths, truth_scene)
 from renderer.core.imageio import outputs
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
@@ -265,9 +266,6 @@ class RasterStudy:
         output knob's)."""
         return any(s.variant[0] not in ("shadow", output_report.KNOB) for s in plan)
 
-    def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
-        return ground_truth(scene, width, height, cache_dir)
-
     def describe(self, scene) -> tuple:
         """The Scenes table's cells: triangles as authored, at the finest tessellation; the
         textures as authored."""
@@ -309,8 +307,8 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     """Sweep `scenes` (Scene objects) with `method`'s study (study()), write results.csv,
     plots/ and report.md under `out`. `knobs`: the knob families to sweep (default all of the
     study's `knobs`; a setting's family is its knob up to a "-"). `address`, `workers`: the
-    settings run on Ray (renderer/cluster/executor.py open_executor; report_units.py), else
-    in this process; the ground truths are made here, where their cache is."""
+    settings and the ground truths missing from the cache run on Ray (renderer/cluster/
+    executor.py open_executor; report_units.py), else in this process; the cache is here."""
     from tqdm import tqdm
 
     from renderer.cluster.executor import open_executor
@@ -336,23 +334,24 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     finally:
         release_context(ctx)
     plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
+    result.scenes = {scene.name: runner.describe(scene) for scene in scenes}
+    traced = [i for i, scene_plan in enumerate(plans) if runner.needs_truth(scene_plan)]
+    truths = [None] * len(scenes)
     with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
-              mininterval=0.5, dynamic_ncols=True) as bar:
-        work = []
-        for index, (scene, scene_plan) in enumerate(zip(scenes, plans)):
-            truth = None
-            if runner.needs_truth(scene_plan):
-                bar.set_description(f"{scene.name}: ground truth")
-                truth, hit = runner.truth(scene, width, height, cache_dir)
-                result.truth_hits += hit
-            result.scenes[scene.name] = runner.describe(scene)
-            work.append(SceneWork(index, scene, tuple(scene_plan), truth))
-            bar.update()
-        with open_executor(address, workers, use_ray=address is not None or workers is not None) \
-                as executor:
-            result.where = executor.describe()
-            result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
-                                    context_kind, bar)
+              mininterval=0.5, dynamic_ncols=True) as bar, \
+            open_executor(address, workers, use_ray=address is not None or workers is not None) \
+            as executor:
+        result.where = executor.describe()
+        bar.set_description("ground truths")
+        for i, (truth, hit) in zip(traced, ground_truths(
+                [scenes[i] for i in traced], width, height, cache_dir, runner.method,
+                tasks=executor.tasks)):
+            truths[i] = truth
+            result.truth_hits += hit
+        bar.update(len(scenes))
+        work = [SceneWork(i, scene, tuple(plans[i]), truths[i]) for i, scene in enumerate(scenes)]
+        result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
+                                context_kind, bar)
     result.seconds = time.perf_counter() - start
     write_outputs(result, Path(out), runner, (width, height), sweep, quick)
     return result

@@ -1,5 +1,5 @@
-"""The command line: `renderer render | view | compare | shaders | report | scenes | extremes |
-colour` (also `python -m renderer`).
+"""The command line: `renderer render | view | compare | shaders | report | batch | scenes |
+extremes | colour` (also `python -m renderer`).
 
 A user's mistake (bad scene, bad output name, no GL) is one line on stderr and exit status
 2, with nothing written; an option argparse refuses is its reason on one line and the
@@ -27,6 +27,7 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import BACKGROUNDS
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
+from renderer.core.memory import check_raytrace_render, check_render
 from renderer.errors import UsageError, UserError, escaped
 
 DEFAULT_SIZE = (640, 480)
@@ -251,6 +252,30 @@ def build_parser() -> argparse.ArgumentParser:
                             "the ground truths here; results.csv is the in-process one apart from "
                             "the times and their `worker` column")
 
+    batch = sub.add_parser(
+        "batch", help="render a job file's items (scenes x cameras x sweeps x settings) into a "
+                      "folder with a manifest; on Ray's workers when installed (docs/batch-format.md)",
+        description="Render every item of a job file once into --out, each item's files written "
+                    "whole and recorded in --out/manifest.jsonl (SHA-256 of every file); a re-run "
+                    "with the same --out skips the items already complete. Exit status: 0 when "
+                    "every item was written, 1 when some failed (a re-run tries them again), 2 "
+                    "for bad input, with nothing written.")
+    batch.add_argument("job", metavar="JOB.toml", help="the job file (docs/batch-format.md)")
+    batch.add_argument("--out", type=output_path, required=True, metavar="DIR",
+                       help="folder for the items' files and manifest.jsonl")
+    batch.add_argument("--address", metavar="auto|HOST:PORT",
+                       help="a running Ray cluster (auto: the one `ray start` made on this "
+                            "machine); default: a local Ray started for this job, or this process "
+                            "when Ray is not installed")
+    batch.add_argument("--workers", type=positive_int, metavar="N",
+                       help="workers of a local Ray (default: one per core)")
+    batch.add_argument("--compare", action="store_true",
+                       help="also render each item with the NumPy reference and compare, as "
+                            "`renderer compare` does (gpu.png, reference.png, diff.png in the "
+                            "item's compare/ folder, the figures in its record)")
+    batch.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
+                       help="the workers' headless GL context (default: EGL, then OSMesa)")
+
     sub.add_parser("scenes", help="list the built-in scenes")
 
     extremes = sub.add_parser("extremes", help="render the extreme scenes (assets/extreme/) through "
@@ -284,7 +309,7 @@ def build_parser() -> argparse.ArgumentParser:
                         help=f"a scene's frame size (default {COLOUR_SIZE[0]}x{COLOUR_SIZE[1]})")
     colour.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
                         help="headless GL context (default: EGL, then OSMesa)")
-    for name in ("render", "view", "compare", "shaders", "report", "extremes"):
+    for name in ("render", "view", "compare", "shaders", "report", "extremes", "batch"):
         sub.choices[name].add_argument(
             "--max-memory", type=memory_size, metavar="SIZE",
             help="refuse, before any work, what would need more memory than this (512M, 4G, ...; "
@@ -325,17 +350,6 @@ def memory_size(text: str) -> int:
         return parse_memory(text)
     except ValueError as error:
         raise argparse.ArgumentTypeError(str(error)) from None
-
-
-def check_memory(scene, size, backends) -> None:
-    """One line, before any rendering, when the estimated memory (renderer/core/memory.py) of
-    drawing `scene` at `size` on each of `backends` is over the limit."""
-    from renderer.core import memory
-    triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
-    estimate = {"gpu": memory.gpu_bytes, "reference": memory.reference_bytes}
-    needed = sum(estimate[backend](*size, triangles) for backend in backends)
-    memory.check(needed, f"rendering {scene.name} at {size[0]}x{size[1]} ({triangles:,} triangles) "
-                         f"on {' and '.join(backends)}")
 
 
 def _load(scene_arg):
@@ -429,15 +443,6 @@ def samples_fired(frame) -> str:
     """What an adaptive frame traced: 'mean 4.72 spp, 6.0% of pixels refined'."""
     from renderer.core.ray_sampling import FIRST_SET
     return f"mean {frame.samples.mean():.2f} spp, {(frame.samples > FIRST_SET).mean():.1%} of pixels refined"
-
-
-def check_raytrace_memory(scene, size, backends, samples) -> None:
-    from renderer.core import memory
-    triangles = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is None)
-    estimate = {"gpu": memory.raytrace_gpu_bytes, "reference": memory.raytrace_reference_bytes}
-    needed = sum(estimate[backend](*size, triangles, samples=samples) for backend in backends)
-    memory.check(needed, f"ray tracing {scene.name} at {size[0]}x{size[1]}, {samples} spp "
-                         f"({triangles:,} triangles) on {' and '.join(backends)}")
 
 
 def _raytrace_gpu(scene, size, context_kind, options, frames=1):
@@ -608,9 +613,9 @@ def cmd_render(args) -> int:
     check_raytrace_options(args)
     scene = _load_traced(args)
     if args.method == "raytrace":
-        check_raytrace_memory(scene, args.size, [args.backend], args.spp)
+        check_raytrace_render(scene, args.size, [args.backend], args.spp)
     else:
-        check_memory(scene, args.size, [args.backend])
+        check_render(scene, args.size, [args.backend])
     suffix = ".png" if settings is None else FORMATS[settings.format]
     output = args.output or Path(f"{output_stem(scene)}{suffix}")
     check_outputs(output, args.depth, args.alpha)
@@ -637,9 +642,9 @@ def cmd_view(args) -> int:
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     scene = _load(args.scene)
-    check_memory(scene, args.size, ["gpu"])
+    check_render(scene, args.size, ["gpu"])
     if args.method == "raytrace":
-        check_raytrace_memory(scene, args.size, ["gpu"], 1)
+        check_raytrace_render(scene, args.size, ["gpu"], 1)
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB
@@ -682,8 +687,8 @@ def cmd_compare_methods(args) -> int:
     from renderer.core.jsonio import json_text
     from renderer.core.paths import output_stem
     scene = _load_traced(args)
-    check_memory(scene, args.size, ["gpu"])
-    check_raytrace_memory(scene, args.size, ["gpu"], args.spp)
+    check_render(scene, args.size, ["gpu"])
+    check_raytrace_render(scene, args.size, ["gpu"], args.spp)
     out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
     names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
     check_outputs(*names)
@@ -719,7 +724,7 @@ def cmd_compare_shadows(args) -> int:
         raise UserError("the scene has no shadow maps to hold against ray-cast truth (no light "
                         "with shadows on, nothing that casts or nothing that receives)",
                         file=scene.source or scene.name)
-    check_memory(scene, args.size, ["reference"])
+    check_render(scene, args.size, ["reference"])
     out = check_folder(args.out or Path(f"compare-shadows-{output_stem(scene)}"))
     names = [out / "shadow_truth.png", out / "shadow_truth.json"]
     check_outputs(*names)
@@ -734,13 +739,10 @@ def cmd_compare_shadows(args) -> int:
 
 
 def cmd_compare(args) -> int:
-    import reference
-    from renderer.checks.compare import (compare_frames, depth_tie_pixels, either_precision, heat_map,
-                                         shadow_tie_pixels)
-    from renderer.checks.texture_bounds import accepted_colours
+    from renderer.checks.against_reference import against_reference
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.paths import output_stem
-    from renderer.core.jsonio import finite_or_none, to_json
+    from renderer.core.jsonio import to_json
     if args.out is not None:
         check_folder(args.out)
     if args.shadows_vs_truth:
@@ -750,64 +752,33 @@ def cmd_compare(args) -> int:
         return cmd_compare_methods(args)
     scene = _load_traced(args)
     if args.method == "raytrace":
-        check_raytrace_memory(scene, args.size, ["gpu", "reference"], args.spp)
+        check_raytrace_render(scene, args.size, ["gpu", "reference"], args.spp)
     else:
-        check_memory(scene, args.size, ["gpu", "reference"])
+        check_render(scene, args.size, ["gpu", "reference"])
     out = check_folder(args.out or Path(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.
-    tie, tie_depth, grazing, envelope_renders = None, None, 0, 0
     if args.method == "raytrace":
-        from reference.raytrace.pipeline import render as reference_raytrace
-        gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context,
-                                                   _raytrace_options(args), frames=3)
-        from renderer.core.raytrace_scene import ray_scene
-        start = time.perf_counter()
-        rs = ray_scene(scene)                    # the BVH built once, for both precisions
-        ref_frame = reference_raytrace(scene, *args.size, **_raytrace_options(args), rs=rs)
-        reference_ms = (time.perf_counter() - start) * 1000.0
-        # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
-        # elsewhere the adaptive pattern's other decision, rgba8_tie).
-        truth = reference_raytrace(scene, *args.size, **_raytrace_options(args), dtype="float64", rs=rs)
-        tie, tie_depth, grazing = either_precision(ref_frame, truth)
-        expected = ref_frame.rgba8
+        options = _raytrace_options(args)
+        gpu_frame, gpu_ms, gl_info = _raytrace_gpu(scene, args.size, args.context, options, frames=3)
+        subpixel_bits = None
     else:
+        options = None
         gpu_frame, gpu_ms, gl_info, subpixel_bits = _render_gpu(scene, args.size, args.context, frames=3)
-        start = time.perf_counter()
-        ref_frame = reference.render(scene, *args.size, subpixel_bits=subpixel_bits)
-        reference_ms = (time.perf_counter() - start) * 1000.0
-        # Anisotropic lookups: the twin's range over the texture verifier's coordinate bound.
-        accepted = accepted_colours(scene, ref_frame, *args.size, subpixel_bits=subpixel_bits)
-        expected, tie, envelope_renders = accepted.rgba8, accepted.tie, accepted.displaced_renders
+    check = against_reference(scene, args.size, gpu_frame, method=args.method, options=options,
+                              subpixel_bits=subpixel_bits, threshold=args.threshold)
     warn_if_nothing_drawn(scene, gpu_frame)
-    tolerance = replace(PIPELINE_TOLERANCE, threshold=args.threshold)
-    result = compare_frames(gpu_frame.rgba8, expected, gpu_frame.depth, ref_frame.depth,
-                            threshold=tolerance.threshold, deviation=tolerance.deviation,
-                            reference_tie=tie, reference_tie_depth=tie_depth)
     with outputs(*names) as written:             # all three or none
         written.png(names[0], gpu_frame.rgba8)
-        written.png(names[1], ref_frame.rgba8)
-        written.png(names[2], heat_map(gpu_frame.rgba8, expected, tolerance.threshold,
-                                       tolerance.deviation, reference_tie=tie))
-    figures = {"scene": scene.name, "size": list(args.size), "method": args.method, **result.as_dict(),
-               "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
-               "depth_tie_pixels": depth_tie_pixels(ref_frame) if args.method == "raster" else 0,
-               "shadow_tie_pixels": shadow_tie_pixels(ref_frame) if args.method == "raster" else 0,
-               "grazing_ray_pixels": grazing, "anisotropic_envelope_renders": envelope_renders,
-               "gpu_ms": gpu_ms, "reference_ms": reference_ms,
-               "gl_renderer": gl_info["GL_RENDERER"], "context": gl_info["context"]}
-    if args.method == "raytrace":        # adaptive: the samples traced, and where the twins chose differently
-        figures |= {"gpu_samples_per_pixel": float(gpu_frame.samples.mean()),
-                    "reference_samples_per_pixel": float(ref_frame.samples.mean()),
-                    "refined_differently_pixels": int((gpu_frame.samples != ref_frame.samples).sum()),
-                    "adaptive_tie_pixels": depth_tie_pixels(ref_frame)}
-    failures = tolerance.failures(result)
-    figures["passes"] = not failures
+        written.png(names[1], check.reference.rgba8)
+        written.png(names[2], check.heat)
+    figures = check.figures | {"gpu_ms": gpu_ms, "gl_renderer": gl_info["GL_RENDERER"],
+                               "context": gl_info["context"], "passes": check.figures["passes"]}
     print(to_json(figures))
-    if failures:
-        print(f"renderer compare: {output_stem(scene)} fails the pipeline tolerance: {'; '.join(failures)}",
-              file=sys.stderr)
+    if check.failures:
+        print(f"renderer compare: {output_stem(scene)} fails the pipeline tolerance: "
+              f"{'; '.join(check.failures)}", file=sys.stderr)
         return 1
     return 0
 
@@ -883,12 +854,28 @@ def cmd_colour(args) -> int:
             args.parser.error("--colorspace says how an image is encoded; a scene's frame is linear")
         scene = _load(args.source)
         size = args.size or COLOUR_SIZE
-        check_memory(scene, size, [args.backend])
+        check_render(scene, size, [args.backend])
         source = scene_source(scene, size, args.backend, args.context)
     written = write_colour_report(source, out)
     pixels = int(source.covered.sum())
     print(f"wrote {', '.join(str(path) for path in written)} ({pixels} pixels, {args.backend})")
     return 0
+
+
+def cmd_batch(args) -> int:
+    """`renderer batch`: everything checked (job file, scenes, outputs, --out's manifest)
+    before the executor starts (renderer/batch/run.py); the summary on stderr."""
+    from renderer.batch.job_file import read_job
+    from renderer.batch.run import plan_job, run_plan
+    from renderer.cluster.executor import InProcessExecutor, open_executor
+    plan = plan_job(read_job(args.job), args.out, compare=args.compare)
+    # Nothing left to render (a finished job run again): no workers to start.
+    opened = open_executor(args.address, args.workers) if plan.todo else InProcessExecutor()
+    with opened as executor:
+        summary = run_plan(plan, executor, context_kind=args.context)
+    for line in summary.lines():
+        print(f"renderer {line}", file=sys.stderr)
+    return 1 if summary.failed else 0
 
 
 def cmd_scenes(args) -> int:
@@ -947,7 +934,7 @@ def _check_paths(args) -> None:
 
 
 COMMANDS = {"render": cmd_render, "view": cmd_view, "compare": cmd_compare, "shaders": cmd_shaders, "report": cmd_report,
-            "scenes": cmd_scenes, "extremes": cmd_extremes, "colour": cmd_colour}
+            "batch": cmd_batch, "scenes": cmd_scenes, "extremes": cmd_extremes, "colour": cmd_colour}
 
 
 def main(argv=None) -> int:

@@ -16,8 +16,9 @@ run: `raster_scene_params(names)` marks them.
 Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_display` and
 `on_x_display` (Xvfb), `cli` (the command line in a new process), `gpu_stand_in` (the command
 line's GPU frames replaced, in this process), `reference_frames` (NumPy reference frames,
-each rendered once per test run) and `traced_references` (the NumPy ray tracer's frames of the
-built-in scenes, likewise).
+each rendered once per test run), `traced_references` (the NumPy ray tracer's frames of the
+built-in scenes, likewise) and `ray_executor` (a local Ray for the test module; a test using it
+is marked slow and put in the xdist group "ray").
 """
 
 import os
@@ -34,6 +35,10 @@ from renderer.gpu.context import make_context
 CONTEXT_KINDS = ("egl", "osmesa")
 DEFAULT_LEFT_OUT = ("slow", "window")
 CLI_TIMEOUT_S = 120
+RAY_TEST_CPUS = 2                # the test Ray's CPUs: 2 workers at most, as on this machine
+# Under pytest-xdist with --dist loadgroup (.ci/run) every Ray test runs in one xdist worker,
+# so a test module starts one Ray, not one per xdist worker (each ~4 s and ~630 MiB).
+RAY_XDIST_GROUP = "ray"
 _LEFT_OUT = pytest.StashKey[int]()
 
 
@@ -46,10 +51,14 @@ def pytest_addoption(parser):
 
 
 def pytest_itemcollected(item):
-    # Every test on the virtual X display opens a window: marked here, so none is missed
-    # (and before `-m` chooses, so that `-m window` finds them).
+    # Every test on the virtual X display opens a window, and every test on a local Ray is
+    # slow (the Ray alone starts in ~4 s): marked here, so none is missed (and before `-m`
+    # chooses, so that `-m window` finds them).
     if "x_display" in item.fixturenames:
         item.add_marker(pytest.mark.window)
+    if "ray_executor" in item.fixturenames:
+        item.add_marker(pytest.mark.slow)
+        item.add_marker(pytest.mark.xdist_group(RAY_XDIST_GROUP))
 
 
 @pytest.hookimpl(trylast=True)          # after -k: only what it kept counts as left out here
@@ -216,6 +225,34 @@ def cli_here(monkeypatch):
             warnings.formatwarning(w.message, w.category, w.filename, w.lineno) for w in caught)
         return subprocess.CompletedProcess(argv, status, out.getvalue(), stderr)
     return run
+
+
+# -- Ray ----------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def ray_executor(request):
+    """ray_executor(workers=RAY_TEST_CPUS): a RayExecutor on the test module's own local Ray,
+    started once for the module (~4 s, ~630 MiB) and stopped after its last test; each
+    executor's close() leaves that Ray running. `ray_executor.address` is its HOST:PORT, for
+    a command line in another process (`--address`). The test module's own classes and
+    functions travel to the actors by value (a Ray worker process cannot import a test
+    module). Tests using it are marked slow (pytest_itemcollected). Ray is imported here,
+    never at the top of this file: `import ray` alone takes ~0.6 s."""
+    import ray
+    from renderer.cluster.ray_executor import LocalRay, RayExecutor
+
+    local = LocalRay(RAY_TEST_CPUS)
+    ray.cloudpickle.register_pickle_by_value(request.module)
+
+    def executor(workers: int = RAY_TEST_CPUS) -> RayExecutor:
+        return RayExecutor(workers=workers)
+
+    executor.address = local.address
+    try:
+        yield executor
+    finally:
+        ray.cloudpickle.unregister_pickle_by_value(request.module)
+        local.stop()
 
 
 # -- reference frames ---------------------------------------------------------------------------

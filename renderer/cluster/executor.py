@@ -28,15 +28,12 @@ import math
 import sys
 from typing import Any, Callable, Iterable, Iterator, Protocol
 
-MAX_ATTEMPTS = 3            # a batch failing this many times fails the job (BatchFailed)
+from renderer.cluster.faults import MAX_ATTEMPTS, BatchFailed  # noqa: F401 (named here too)
+
 TARGET_BATCH_SECONDS = 0.25 # batch size: this much work per call (batch_size)
 MAX_BATCH = 64
 BATCHES_PER_WORKER = 4      # at least this many batches per worker, for balance at the end
 RAY_EXTRA = "pip install 'checked-renderer[cluster]'"
-
-
-class BatchFailed(RuntimeError):
-    """A batch failed MAX_ATTEMPTS times (its last error chained)."""
 
 
 def batch_size(item_seconds: float, items: int, workers: int) -> int:

@@ -156,3 +156,22 @@ def check(needed: int, what: str, *, file: str | None = None) -> None:
     reason = over_limit(needed)
     if reason:
         raise UserError(f"{what} {reason}", file=file)
+
+
+def check_render(scene, size, backends) -> None:
+    """One line, before any rendering, when rasterising `scene` at `size` on each of
+    `backends` ("gpu", "reference") would need more than the limit."""
+    triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
+    estimate = {"gpu": gpu_bytes, "reference": reference_bytes}
+    needed = sum(estimate[backend](*size, triangles) for backend in backends)
+    check(needed, f"rendering {scene.name} at {size[0]}x{size[1]} ({triangles:,} triangles) "
+                  f"on {' and '.join(backends)}")
+
+
+def check_raytrace_render(scene, size, backends, samples) -> None:
+    """check_render for the ray tracer at `samples` per pixel (its triangles: meshes only)."""
+    triangles = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is None)
+    estimate = {"gpu": raytrace_gpu_bytes, "reference": raytrace_reference_bytes}
+    needed = sum(estimate[backend](*size, triangles, samples=samples) for backend in backends)
+    check(needed, f"ray tracing {scene.name} at {size[0]}x{size[1]}, {samples} spp "
+                  f"({triangles:,} triangles) on {' and '.join(backends)}")

@@ -29,7 +29,7 @@ import numpy as np
 from renderer.core import transforms
 from renderer.core.gl_rules import scene_light_problem, scene_varying_problem
 from renderer.core.builtin import assets_dir, is_scene_name, resolve_scene
-from renderer.errors import SceneError, show_number
+from renderer.errors import SceneError, UserError, show_number
 from renderer.core import memory
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
 from renderer.core.paths import checked_path
@@ -147,7 +147,7 @@ def read_scene(scene) -> tuple[dict, Path]:
     except OSError as exc:
         raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(_toml_syntax_reason(exc), file=source) from None
+        raise SceneError(toml_syntax_reason(exc), file=source) from None
     except RecursionError:               # tomllib recurses once per level of nesting
         raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
                          f"nests at most {MAX_NESTING} levels", file=source) from None
@@ -246,7 +246,7 @@ def _check_nesting(data: Any, reader: "_Reader") -> None:
         stack.extend((v, p, depth + 1) for v, p in children)
 
 
-def _toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
+def toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
     """tomllib says "Invalid value (at line 3, column 7)"; we say where first."""
     message = str(exc)
     match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)
@@ -289,7 +289,7 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, numbers.Real) and not isinstance(value, bool)
 
 
-def _unknown_choice(what: str, value: str, known) -> str:
+def unknown_choice(what: str, value: str, known) -> str:
     """'unknown shading 'smooth'; expected one of: flat, gouraud, phong' (+ a suggestion)."""
     known = list(known)
     close = difflib.get_close_matches(value, known, n=1, cutoff=0.6)
@@ -297,7 +297,7 @@ def _unknown_choice(what: str, value: str, known) -> str:
     return f"unknown {what} {value!r}; {hint}expected one of: {', '.join(known)}"
 
 
-def _unknown_key(key: str, known) -> str:
+def unknown_key(key: str, known) -> str:
     known = list(known)
     close = difflib.get_close_matches(key, known, n=1, cutoff=0.6)
     if close:
@@ -319,17 +319,17 @@ def _join(path: str, key: str) -> str:
 
 # --------------------------------------------------------------------------- the reader
 
-class _Reader:
-    """Turns parsed TOML into scene dataclasses; every check raises through `fail`."""
+class TableReader:
+    """Checks of parsed TOML's tables and values, each failing as one line: `error(reason,
+    file=source, key=KEY.PATH)` (SceneError for scenes; renderer/batch/job_file.py reads job
+    files with it too)."""
 
-    def __init__(self, source: str, base_dir: Path):
+    def __init__(self, source: str, error: type[UserError] = SceneError):
         self.source = source
-        self.base_dir = base_dir
-        self.primitive_triangles = 0      # so far, for the memory check before building more
-        self.textures: dict = {}          # each image, checker and mesh file's texture, made once
+        self.error = error
 
     def fail(self, key: str | None, reason: str) -> NoReturn:
-        raise SceneError(reason, file=self.source, key=key or None)
+        raise self.error(reason, file=self.source, key=key or None)
 
     # ---- tables and scalars
 
@@ -339,7 +339,7 @@ class _Reader:
             self.fail(path, f"expected a table, got {describe_value(value)}")
         for key in value:
             if key not in known:
-                self.fail(_join(path, str(key)), _unknown_key(str(key), known))
+                self.fail(_join(path, str(key)), unknown_key(str(key), known))
         return value
 
     def list_of_tables(self, value: Any, path: str, toml_name: str) -> list:
@@ -421,13 +421,23 @@ class _Reader:
     def choice(self, value: Any, path: str, what: str, known) -> str:
         text = self.string(value, path)
         if text not in known:
-            self.fail(path, _unknown_choice(what, text, known))
+            self.fail(path, unknown_choice(what, text, known))
         return text
 
     def boolean(self, value: Any, path: str) -> bool:
         if not isinstance(value, bool):
             self.fail(path, f"expected true or false, got {describe_value(value)}")
         return value
+
+
+class _Reader(TableReader):
+    """Turns parsed TOML into scene dataclasses; every check raises through `fail`."""
+
+    def __init__(self, source: str, base_dir: Path):
+        super().__init__(source)
+        self.base_dir = base_dir
+        self.primitive_triangles = 0      # so far, for the memory check before building more
+        self.textures: dict = {}          # each image, checker and mesh file's texture, made once
 
     # ---- the scene
 

@@ -208,7 +208,8 @@ _MAKERS = {"egl": _make_egl, "osmesa": _make_osmesa}
 PROBE_ENVIRONMENT = ("GALLIUM_DRIVER", "LIBGL_ALWAYS_SOFTWARE", "MESA_LOADER_DRIVER_OVERRIDE",
                      "EGL_PLATFORM", "LIBGL_DRIVERS_PATH", "__EGL_VENDOR_LIBRARY_FILENAMES",
                      "__EGL_VENDOR_LIBRARY_DIRS", "LD_LIBRARY_PATH", "LD_PRELOAD",
-                     "MESA_GL_VERSION_OVERRIDE", "PYOPENGL_OSMESA_LIBRARY", "OSMESA_LIBRARY")
+                     "MESA_GL_VERSION_OVERRIDE", "PYOPENGL_OSMESA_LIBRARY", "OSMESA_LIBRARY",
+                     "GLCONTEXT_DEVICE_INDEX")
 PROBE_TIMEOUT_S = 30
 
 # The child imports moderngl and, for OSMesa, renderer/gpu/osmesa.py by its path (it imports

@@ -1,0 +1,369 @@
+"""Job files: TOML in, a checked `Job` out (renderer/batch/items.py), every mistake one line.
+
+    job = read_job("job.toml")        # UserError "job.toml: scenes[1].cameras.orbit.views: ..."
+
+docs/batch-format.md documents every key. The reader is as strict as the scene reader (it
+uses its TableReader): an unknown key is an error with the closest known key suggested, and
+values are checked where they stand. Every scene is read and every sweep point's overrides
+applied and built here, on the driver, before anything is rendered: a bad scene, a bad
+override value, an animation of a still scene or an output the output stage refuses fails
+the job before its first frame, naming the job file and the key.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import re
+import tomllib
+from pathlib import Path
+from typing import Any
+
+from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSource, Setting,
+                                  default_output_name)
+from renderer.core import output_settings as stage
+from renderer.core.memory import check_raytrace_render, check_render
+from renderer.core.motion import declares_motion
+from renderer.core.paths import checked_path, output_stem
+from renderer.core.ray_depth import MAX_DEPTH_LIMIT
+from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS, ray_sampling
+from renderer.core.scene import SHADING_MODES
+from renderer.core.scene_file import (MAX_NUMBER, TableReader, describe_value, read_scene,
+                                      scene_from_dict, toml_syntax_reason, with_overrides)
+from renderer.errors import SceneError, UserError
+
+TOP_KEYS = ("name", "description", "seed", "size", "scenes", "settings")
+SCENE_KEYS = ("scene", "name", "cameras", "sweep")
+CAMERA_KINDS = ("orbit", "poses", "animation")
+ORBIT_KEYS = ("views", "elevation")
+POSE_KEYS = ("eye", "look", "up")
+ANIMATION_KEYS = ("frames", "step", "exposure")
+SETTING_KEYS = ("name", "method", "size", "background", "shading", "samples", "pattern",
+                "adaptive_threshold", "max_depth", "light_samples", "outputs")
+TRACER_KEYS = ("samples", "pattern", "adaptive_threshold", "max_depth", "light_samples")
+OUTPUT_KEYS = ("name", "format", "transfer", "bits", "dither", "halftone")
+DEPTH_KEYS = ("name", "depth")
+DEPTH_FORMATS = ("npy", "exr")
+METHODS = ("raster", "raytrace")
+BACKGROUNDS = ("opaque", "transparent")
+
+DEFAULT_SIZE = (640, 480)            # as `renderer render`
+MAX_SIDE = 16384                     # pixels, as --size
+MAX_COUNT = 100_000                  # orbit views, animation frames, sweep values per key
+MAX_ITEMS = 1_000_000                # a typo should not plan a billion frames
+SEED_LIMIT = 2 ** 64
+MAX_ELEVATION = 89.0                 # degrees: camera_paths keeps the eye 1 degree off the poles
+# A name that is one path component: scenes' and settings' names are parts of item keys.
+NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
+
+
+def read_job(path) -> Job:
+    """The job file at `path`, read and checked (module docstring)."""
+    path = checked_path(path, error=UserError)
+    source = str(path)
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except FileNotFoundError:
+        raise UserError("job file not found", file=source) from None
+    except IsADirectoryError:
+        raise UserError("is a directory, not a job file", file=source) from None
+    except UnicodeDecodeError as exc:
+        raise UserError(f"not UTF-8 text (byte {exc.start}); a job file is TOML", file=source) from None
+    except OSError as exc:
+        raise UserError(f"cannot read: {exc.strerror or exc}", file=source) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise UserError(toml_syntax_reason(exc), file=source) from None
+    return _JobReader(path).job(data)
+
+
+def check_memory(scene, setting: Setting, backends) -> None:
+    """A UserError when drawing `scene` with `setting` on `backends` would need more memory
+    than the limit (renderer/core/memory.py)."""
+    if setting.traced:
+        check_raytrace_render(scene, setting.size, backends, setting.samples * setting.light_samples)
+    else:
+        check_render(scene, setting.size, backends)
+
+
+def _name(reader: TableReader, value: Any, key: str) -> str:
+    text = reader.string(value, key)
+    if not NAME.fullmatch(text):
+        reader.fail(key, f"{text!r} cannot name a folder: use letters, digits, '.', '_' and '-' "
+                         "(at most 100, starting with a letter or digit)")
+    return text
+
+
+def _unique(reader: TableReader, names: list[tuple[str, str]], what: str) -> None:
+    """Each (name, key) once: a second use of a name is an error at its key."""
+    seen = {}
+    for name, key in names:
+        if name in seen:
+            reader.fail(key, f"{what} {name!r} is already {seen[name]}'s; give each its own name")
+        seen[name] = key.rsplit(".", 1)[0]
+
+
+class _JobReader(TableReader):
+    def __init__(self, path: Path):
+        super().__init__(str(path), error=UserError)
+        self.path = path
+
+    def job(self, data: dict) -> Job:
+        data = self.table(data, "", TOP_KEYS)
+        name = self.string(data.get("name", self.path.stem), "name")
+        seed = self.integer(data.get("seed", 0), "seed", 0, SEED_LIMIT - 1)
+        size = self.size(data["size"], "size") if "size" in data else DEFAULT_SIZE
+        if "scenes" not in data:
+            self.fail("scenes", "a job needs at least one [[scenes]] table (scene = NAME or FILE)")
+        raw_settings = self.entries(data.get("settings", [{}]), "settings")
+        settings = tuple(self.setting(raw, f"settings[{i}]", size) for i, raw in enumerate(raw_settings))
+        _unique(self, [(s.name, f"settings[{i}].name") for i, s in enumerate(settings)], "the setting name")
+        scenes = tuple(self.scene_entry(raw, f"scenes[{i}]", settings)
+                       for i, raw in enumerate(self.entries(data["scenes"], "scenes")))
+        _unique(self, [(s.name, f"scenes[{i}].name") for i, s in enumerate(scenes)], "the scene name")
+        count = sum(len(s.points) * len(s.cameras) for s in scenes) * len(settings)
+        if count > MAX_ITEMS:
+            self.fail("scenes", f"the job has {count:,} items; at most {MAX_ITEMS:,}")
+        job = Job(str(self.path), name, seed, scenes, settings,
+                  self.string(data.get("description", ""), "description"))
+        return job
+
+    def entries(self, value: Any, key: str) -> list:
+        entries = self.list_of_tables(value, key, key)
+        if not entries:
+            self.fail(key, f"expected at least one [[{key}]] table")
+        return entries
+
+    def size(self, value: Any, key: str) -> tuple[int, int]:
+        if not isinstance(value, list) or len(value) != 2:
+            self.fail(key, f"expected [WIDTH, HEIGHT] in pixels, got {describe_value(value)}")
+        return tuple(self.integer(v, f"{key}[{i}]", 1, MAX_SIDE) for i, v in enumerate(value))
+
+    # ---- [[scenes]]
+
+    def scene_entry(self, raw: dict, key: str, settings: tuple[Setting, ...]) -> SceneEntry:
+        raw = self.table(raw, key, SCENE_KEYS)
+        if "scene" not in raw:
+            self.fail(key, "needs scene = NAME (a built-in scene) or FILE (relative to the job file)")
+        data, path = self.read_scene(raw["scene"], f"{key}.scene")
+        points = [self.point(data, path, overrides, f"{key}.sweep")
+                  for overrides in self.sweep(raw.get("sweep"), f"{key}.sweep")]
+        name = _name(self, raw["name"], f"{key}.name") if "name" in raw else output_stem(points[0][1])
+        cameras = self.cameras(raw.get("cameras"), f"{key}.cameras", points[0][1], settings)
+        for _, scene in points:
+            for setting in settings:
+                self.memory(scene, setting, key)
+        return SceneEntry(name, tuple(source for source, _ in points), cameras)
+
+    def memory(self, scene, setting: Setting, key: str) -> None:
+        """The GPU's memory for the scene and setting, under the limit (core/memory.py)."""
+        try:
+            check_memory(scene, setting, ["gpu"])
+        except UserError as error:
+            self.fail(key, f"setting {setting.name!r}: {error.reason}")
+
+    def read_scene(self, value: Any, key: str) -> tuple[dict, Path]:
+        text = self.string(value, key)
+        beside = self.path.parent / text           # a path is relative to the job file
+        try:
+            return read_scene(beside if beside.is_file() else text)
+        except SceneError as error:
+            self.fail(key, error.line())
+
+    def sweep(self, raw: Any, key: str) -> list[dict]:
+        """The sweep's points: one dict of overrides each, the first key varying slowest."""
+        if raw is None:
+            return [{}]
+        if not isinstance(raw, dict):
+            self.fail(key, f"expected a table of key paths = [values], got {describe_value(raw)}")
+        axes = list(self.flat_sweep(raw, key).items())
+        if not axes:
+            self.fail(key, "expected at least one key path = [values]")
+        return [dict(zip((path for path, _ in axes), values))
+                for values in itertools.product(*(values for _, values in axes))]
+
+    def flat_sweep(self, raw: dict, key: str, prefix: str = "") -> dict[str, list]:
+        """Key paths to their values; TOML's dotted keys (camera.aperture = [...]) arrive as
+        nested tables and are joined again."""
+        flat = {}
+        for name, value in raw.items():
+            path = f"{prefix}.{name}" if prefix else name
+            if isinstance(value, dict):
+                flat |= self.flat_sweep(value, key, path)
+            elif not isinstance(value, list) or not value:
+                self.fail(f"{key}.{path}", f"expected a list of the values to sweep, got "
+                                           f"{describe_value(value)}")
+            elif len(value) > MAX_COUNT:
+                self.fail(f"{key}.{path}", f"{len(value)} values; at most {MAX_COUNT}")
+            else:
+                flat[path] = value
+        return flat
+
+    def point(self, data: dict, path: Path, overrides: dict, key: str):
+        """A sweep point's SceneSource and Scene, built here so a bad value fails now."""
+        try:
+            changed = with_overrides(data, overrides, str(path))
+            scene = scene_from_dict(changed, source=str(path), base_dir=path.parent)
+        except SceneError as error:
+            shown = ", ".join(f"{k} = {json.dumps(v)}" for k, v in overrides.items())
+            self.fail(key if overrides else key.rsplit(".", 1)[0] + ".scene",
+                      f"{shown + ': ' if shown else ''}{error.line()}")
+        digest = hashlib.sha256(json.dumps(changed, sort_keys=True, default=str).encode()).hexdigest()
+        return SceneSource(str(path.resolve()), tuple(overrides.items()), digest), scene
+
+    def cameras(self, raw: Any, key: str, scene, settings) -> tuple[CameraSpec, ...]:
+        if raw is None:
+            return (CameraSpec("camera"),)
+        raw = self.table(raw, key, CAMERA_KINDS)
+        if len(raw) != 1:
+            self.fail(key, f"expected one of {', '.join(CAMERA_KINDS)}, got "
+                           f"{', '.join(raw) or 'none'}")
+        kind, value = next(iter(raw.items()))
+        where = f"{key}.{kind}"
+        if kind == "orbit":
+            value = self.table(value, where, ORBIT_KEYS)
+            if "views" not in value:
+                self.fail(where, "needs views = N (cameras evenly round the look point)")
+            views = self.integer(value["views"], f"{where}.views", 1, MAX_COUNT)
+            elevation = None
+            if "elevation" in value:
+                elevation = self.number(value["elevation"], f"{where}.elevation")
+                if abs(elevation) > MAX_ELEVATION:
+                    self.fail(f"{where}.elevation", f"must be between -{MAX_ELEVATION:g} and "
+                                                    f"{MAX_ELEVATION:g} degrees, got {elevation:g}")
+            return tuple(CameraSpec("orbit", k, views=views, elevation=elevation) for k in range(views))
+        if kind == "poses":
+            poses = self.entries(value, where)
+            return tuple(self.pose(pose, f"{where}[{k}]", k) for k, pose in enumerate(poses))
+        return self.animation(value, where, scene, settings)
+
+    def pose(self, raw: dict, key: str, index: int) -> CameraSpec:
+        raw = self.table(raw, key, POSE_KEYS)
+        for needed in ("eye", "look"):
+            if needed not in raw:
+                self.fail(key, f"needs {needed} = [x, y, z]")
+        eye, look = self.vec3(raw["eye"], f"{key}.eye"), self.vec3(raw["look"], f"{key}.look")
+        up = self.vec3(raw["up"], f"{key}.up") if "up" in raw else None
+        if eye == look:                      # the camera rules of scene_file's [camera]
+            self.fail(f"{key}.look", f"is the same point as {key}.eye; the camera needs "
+                                     "eye - look to be a direction")
+        if up is not None and not any(up):
+            self.fail(f"{key}.up", "must not be zero length; up says which way is up in the image")
+        return CameraSpec("pose", index, eye=eye, look=look, up=up)
+
+    def animation(self, raw: Any, key: str, scene, settings) -> tuple[CameraSpec, ...]:
+        raw = self.table(raw, key, ANIMATION_KEYS)
+        if "frames" not in raw:
+            self.fail(key, "needs frames = N")
+        frames = self.integer(raw["frames"], f"{key}.frames", 1, MAX_COUNT)
+        step = self.number(raw.get("step", 1.0), f"{key}.step", above=0.0)
+        exposure = self.number(raw.get("exposure", 0.0), f"{key}.exposure", minimum=0.0)
+        raster = [s.name for s in settings if not s.traced]
+        if raster:
+            self.fail(key, f"an animation is the ray tracer's (motion during the shutter; the "
+                           f"rasteriser draws time 0), but setting {raster[0]!r} is method raster")
+        if not declares_motion(scene):
+            self.fail(key, "nothing in the scene moves (no object has a velocity or "
+                           "angular_velocity): every frame would be the same")
+        last = (frames - 1) * step + exposure
+        if last > MAX_NUMBER:
+            self.fail(key, f"the last frame's shutter closes at {last:g}, past {MAX_NUMBER:g}")
+        return tuple(CameraSpec("frame", t, shutter=(t * step, t * step + exposure))
+                     for t in range(frames))
+
+    # ---- [[settings]]
+
+    def setting(self, raw: dict, key: str, size: tuple[int, int]) -> Setting:
+        raw = self.table(raw, key, SETTING_KEYS)
+        method = self.choice(raw.get("method", "raster"), f"{key}.method", "method", METHODS)
+        name = _name(self, raw.get("name", method), f"{key}.name")
+        background = self.choice(raw.get("background", "opaque"), f"{key}.background",
+                                 "background", BACKGROUNDS)
+        outputs = self.outputs(raw.get("outputs"), f"{key}.outputs", background)
+        common = {"name": name, "method": method, "outputs": outputs, "background": background,
+                  "size": self.size(raw["size"], f"{key}.size") if "size" in raw else size}
+        if method == "raster":
+            for option in TRACER_KEYS:
+                if option in raw:
+                    self.fail(f"{key}.{option}", "is for method = \"raytrace\"")
+            shading = None
+            if "shading" in raw:
+                shading = self.choice(raw["shading"], f"{key}.shading", "shading", SHADING_MODES)
+            return Setting(**common, shading=shading)
+        if "shading" in raw:
+            self.fail(f"{key}.shading", "is for method = \"raster\" (the ray tracer shades "
+                                        "every hit per pixel)")
+        options = {"samples": self.integer(raw.get("samples", 1), f"{key}.samples", 1, None),
+                   "pattern": self.choice(raw.get("pattern", "regular"), f"{key}.pattern",
+                                          "pattern", RAY_PATTERNS),
+                   "max_depth": self.integer(raw.get("max_depth", 4), f"{key}.max_depth", 0,
+                                             MAX_DEPTH_LIMIT),
+                   "light_samples": self.integer(raw.get("light_samples", 1), f"{key}.light_samples",
+                                                 1, MAX_LIGHT_SAMPLES),
+                   "adaptive_threshold": None}
+        if "adaptive_threshold" in raw:
+            if options["pattern"] != "adaptive":
+                self.fail(f"{key}.adaptive_threshold", f"is for pattern = \"adaptive\", not "
+                                                       f"{options['pattern']!r}")
+            options["adaptive_threshold"] = self.number(raw["adaptive_threshold"],
+                                                        f"{key}.adaptive_threshold", minimum=0.0)
+        try:
+            ray_sampling(options["pattern"], options["samples"], 0, options["adaptive_threshold"],
+                         options["light_samples"])
+        except ValueError as error:
+            self.fail(f"{key}.samples", str(error))
+        return Setting(**common, **options)
+
+    def outputs(self, raw: Any, key: str, background: str) -> tuple[Output, ...]:
+        if raw is None:
+            raw = [{}]
+        outputs = tuple(self.output(entry, f"{key}[{i}]", background)
+                        for i, entry in enumerate(self.entries(raw, key)))
+        _unique(self, [(o.name, f"{key}[{i}].name") for i, o in enumerate(outputs)], "the file name")
+        return outputs
+
+    def output(self, raw: dict, key: str, background: str) -> Output:
+        if isinstance(raw, dict) and "depth" in raw:
+            raw = self.table(raw, key, DEPTH_KEYS)
+            depth = self.choice(raw["depth"], f"{key}.depth", "depth format", DEPTH_FORMATS)
+            return Output(self.file_name(raw, key, f".{depth}", default_output_name(None, depth)),
+                          depth=depth)
+        raw = self.table(raw, key, OUTPUT_KEYS)
+
+        def parsed(option, parse, default=None):
+            if option not in raw:
+                return default
+            value = raw[option]
+            if isinstance(value, bool) or not isinstance(value, (str, int, float)):
+                self.fail(f"{key}.{option}", f"expected a string or number, got {describe_value(value)}")
+            try:
+                return parse(str(value))
+            except ValueError as error:
+                self.fail(f"{key}.{option}", str(error))
+
+        bits = parsed("bits", stage.parse_bits)
+        output_format = self.choice(raw.get("format", stage.format_for(".png", bits)),
+                                    f"{key}.format", "format", stage.FORMATS)
+        dither = self.choice(raw.get("dither", "none"), f"{key}.dither", "dither", stage.DITHERS)
+        try:
+            settings = stage.OutputSettings(transfer=parsed("transfer", stage.parse_transfer, stage.Transfer()),
+                                            bits=bits, dither=dither,
+                                            halftone=parsed("halftone", stage.parse_halftone),
+                                            format=output_format)
+        except ValueError as error:                # its line names options as --option
+            self.fail(key, str(error).replace("--", ""))
+        if output_format == "exr" and background == "transparent":
+            self.fail(f"{key}.format", "exr with background = \"transparent\": OpenEXR's alpha is "
+                                       "premultiplied; write format = \"npy\" (straight RGBA)")
+        suffix = stage.FORMATS[output_format]
+        return Output(self.file_name(raw, key, suffix, default_output_name(settings, None)), settings)
+
+    def file_name(self, raw: dict, key: str, suffix: str, default: str) -> str:
+        if "name" not in raw:
+            return default
+        name = _name(self, raw["name"], f"{key}.name")
+        if Path(name).suffix.lower() != suffix:
+            self.fail(f"{key}.name", f"{name!r} is written as {suffix}; name it "
+                                     f"{Path(name).stem}{suffix}")
+        return name
+

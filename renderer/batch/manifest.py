@@ -1,0 +1,168 @@
+"""DIR/manifest.jsonl: what a batch job has finished, and how a re-run resumes it.
+
+JSON Lines, one object per line (renderer/core/jsonio.py `to_json`). Line 1 is the header:
+
+    {"manifest": "renderer batch", "format": 1, "job": JOB_SHA256, "job_file": "orbit.toml",
+     "name": "orbit", "renderer": "0.9.0", "items": 48}
+
+`job` is items.job_identity: the SHA-256 of the canonical expanded items (keys, seeds, the
+scenes' parsed contents after overrides, cameras, settings). Then one record per finished
+item, appended by the driver (never a worker) after the item's files are in place:
+
+    {"key": "hierarchy/orbit-007/sweep-000/raster", "seed": 2795193123,
+     "setting": {...Setting.describe()}, "camera": {...CameraSpec.describe()},
+     "overrides": {"objects[0].material.kd": [1, 0, 0]},
+     "outputs": [{"path": "items/hierarchy/orbit-007/sweep-000/raster/image.png",
+                  "sha256": FILE_BYTES_SHA256, "pixels_sha256": PIXELS_SHA256}],
+     "render_ms": 12.5, "encode_ms": 3.1,
+     "worker": {"host": "node1", "pid": 4242, "gl_renderer": "llvmpipe (LLVM 15.0.6, 256 bits)"},
+     "compare": {...figures, as `renderer compare` prints them}}          (with --compare)
+
+`sha256` is of the file's bytes, `pixels_sha256` of the array written (shape, dtype and
+bytes: render_item.pixels_sha256), which stays the same where another zlib would compress the
+same pixels to other bytes. Paths are relative to DIR, with '/'.
+
+Resume (`read_manifest`): a record counts when its key is one of the job's items, its
+outputs start with the item's files (with --compare, the comparison's too), and every file
+it lists exists with that SHA-256; the other items are
+rendered again. A line that is not whole JSON (the last one, cut by a kill) is ignored, and
+`Manifest.begin` rewrites the file with the header and the records that count. A manifest
+whose header is another job's (or not a batch manifest at all) is a UserError naming
+DIR/manifest.jsonl, exit status 2, before anything is written: a job never mixes its files
+with another's.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from renderer import __version__
+from renderer.core.imageio import outputs, remove_stale_temporaries
+from renderer.core.jsonio import to_json
+from renderer.errors import SystemFault, UserError
+
+MANIFEST = "manifest.jsonl"
+KIND = "renderer batch"
+FORMAT = 1
+
+
+def file_sha256(path: Path) -> str | None:
+    """SHA-256 of a file's bytes, None when it cannot be read."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()
+    except OSError:
+        return None
+
+
+def header_for(job, identity: str, count: int) -> dict:
+    return {"manifest": KIND, "format": FORMAT, "job": identity,
+            "job_file": Path(job.path).name, "name": job.name, "renderer": __version__,
+            "items": count}
+
+
+@dataclass
+class Resume:
+    """What DIR holds of this job: the header to keep, the records that count (by key),
+    and whether the file must be rewritten (lines dropped) before records are appended."""
+    path: Path
+    header: dict
+    records: dict[str, dict] = field(default_factory=dict)
+    rewrite: bool = True             # no manifest yet, or lines to drop
+
+
+def _lines(path: Path) -> list[str] | None:
+    try:
+        return path.read_text(encoding="utf-8").split("\n")
+    except FileNotFoundError:
+        return None
+    except (OSError, UnicodeDecodeError) as error:
+        raise UserError(f"cannot read it as a batch manifest ({error}); give another --out",
+                        file=str(path)) from None
+
+
+def _parsed(line: str):
+    try:
+        return json.loads(line)
+    except ValueError:
+        return None
+
+
+def _check_header(path: Path, found, header: dict) -> None:
+    if not isinstance(found, dict) or found.get("manifest") != KIND:
+        raise UserError("is not a renderer batch manifest; give another --out (a new folder, "
+                        "or this job's own)", file=str(path))
+    if found.get("job") != header["job"]:
+        raise UserError(f"holds another job's manifest ({found.get('name')!r} from "
+                        f"{found.get('job_file')}, {found.get('items')} items); give another "
+                        f"--out, or remove that folder to start again", file=str(path))
+    if found.get("format") != FORMAT or found.get("renderer") != header["renderer"]:
+        raise UserError(f"was written by renderer {found.get('renderer')} (manifest format "
+                        f"{found.get('format')}), not {header['renderer']}; its files may "
+                        f"differ from this version's: give another --out", file=str(path))
+
+
+def read_manifest(out: Path, header: dict, wanted: dict[str, list[str]]) -> Resume:
+    """The manifest in `out` for this job's `header`, nothing written: `wanted` maps each
+    item's key to the paths (under `out`) its record must list. Records that do not count
+    are left out (module docstring)."""
+    path = out / MANIFEST
+    lines = _lines(path)
+    if lines is None or lines == [""]:
+        return Resume(path, header)
+    _check_header(path, _parsed(lines[0]), header)
+    body, dropped = lines[1:], lines[-1] != ""      # whole lines end with a line break
+    records = {}
+    for line in body[:-1] if not dropped else body:
+        record = _parsed(line)
+        if isinstance(record, dict) and _counts(out, record, wanted):
+            dropped |= record["key"] in records      # a later record of a key wins
+            records[record["key"]] = record
+        else:
+            dropped = True
+    return Resume(path, header, records, rewrite=dropped)
+
+
+def _counts(out: Path, record: dict, wanted: dict[str, list[str]]) -> bool:
+    """Whether the record lists the item's files first (then maybe more: a record made with
+    --compare counts for a run without) and every file it lists is as recorded."""
+    files = wanted.get(record.get("key"))
+    listed = record.get("outputs")
+    if files is None or not isinstance(listed, list) or not all(isinstance(o, dict) for o in listed) \
+            or [o.get("path") for o in listed][:len(files)] != files:
+        return False
+    return all(file_sha256(out / str(o["path"])) == o.get("sha256") for o in listed)
+
+
+class Manifest:
+    """The manifest being written: `begin` puts the header and the kept records in place
+    (atomically, when lines must go), `append` adds one record, flushed and fsync'd."""
+
+    def __init__(self, resume: Resume):
+        self.path = resume.path
+        self.records = dict(resume.records)
+        self._resume = resume
+
+    def begin(self) -> "Manifest":
+        remove_stale_temporaries(self.path)
+        if self._resume.rewrite:
+            text = "".join(to_json(line) + "\n" for line in
+                           [self._resume.header, *self.records.values()])
+            with outputs() as out:
+                out.text(self.path, text)
+        return self
+
+    def append(self, record: dict) -> None:
+        line = to_json(record) + "\n"
+        try:
+            with open(self.path, "a", encoding="utf-8") as handle:
+                handle.write(line)
+                handle.flush()
+                os.fsync(handle.fileno())
+        except OSError as error:
+            raise SystemFault(f"cannot write: {(error.strerror or str(error)).lower()}",
+                              file=str(self.path)) from None
+        self.records[record["key"]] = record

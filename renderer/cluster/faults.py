@@ -1,0 +1,11 @@
+"""What a lost batch costs: how often one is tried, and the error when that is not enough.
+
+Its own module so that executor.py (which opens a RayExecutor) and ray_executor.py (which
+retries batches) share it without importing each other.
+"""
+
+MAX_ATTEMPTS = 3            # a batch failing this many times fails the job (BatchFailed)
+
+
+class BatchFailed(RuntimeError):
+    """A batch failed MAX_ATTEMPTS times (its last error chained)."""

@@ -1,0 +1,244 @@
+"""Executors (renderer/cluster/): the Ray executor gives what the in-process one gives, in any
+order and through a killed worker; a wrong --address is one line, at once; without Ray the
+work runs in this process with one note; and the command line does not import Ray.
+
+Tests on a local Ray take the module's `ray_executor` (tests/conftest.py: one Ray for this
+module, the tests marked slow). The toy workers below travel to the actors by value.
+"""
+
+import functools
+import hashlib
+import os
+import signal
+import socket
+import subprocess
+import sys
+import threading
+import time
+
+import pytest
+
+from renderer.cluster import executor as executor_module
+from renderer.cluster.address import check_address, split_address
+from renderer.cluster.executor import BatchFailed, InProcessExecutor, batches_of, open_executor
+from renderer.errors import UserError
+
+VIEWS = 12                  # orbit views of the toy GL worker
+SIZE = (32, 24)
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+class OrbitWorker:
+    """A toy GL worker as the batch runner's: one context and one GpuRenderer per process,
+    reused; unit k is orbit view k of the sphere, answered (k, SHA-256 of its pixels, pid)."""
+
+    def __init__(self):
+        from renderer.core.camera_paths import orbit_cameras
+        from renderer.core.scene_file import load_scene
+        from renderer.gpu.pipeline import GpuRenderer
+        self.gpu = GpuRenderer(load_scene("sphere"), *SIZE)
+        self.cameras = orbit_cameras(self.gpu.scene.camera, VIEWS, 30.0)
+
+    def run(self, batch):
+        results = []
+        for view in batch:
+            self.gpu.scene.camera = self.cameras[view]
+            self.gpu.update()
+            pixels = self.gpu.render().rgba8
+            results.append((view, hashlib.sha256(pixels.tobytes()).hexdigest(), os.getpid()))
+        return results
+
+    def close(self):
+        self.gpu.release()
+
+
+class SquareWorker:
+    """Unit n -> (n, n * n, pid), `seconds` per batch, so that a kill lands mid-map."""
+
+    def __init__(self, seconds=0.0):
+        self.seconds = seconds
+
+    def run(self, batch):
+        time.sleep(self.seconds)
+        return [(n, n * n, os.getpid()) for n in batch]
+
+
+class DyingWorker:
+    """Unit 13 kills its own process, every time it is run (a crash Ray cannot retry away)."""
+
+    def run(self, batch):
+        if 13 in batch:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return [(n, n * n, os.getpid()) for n in batch]
+
+
+class FailingWorker:
+    def __init__(self, error):
+        self.error = error
+
+    def run(self, batch):
+        raise self.error
+
+
+def square_task(n):
+    return n * n
+
+
+def by_unit(mapped) -> dict:
+    """{unit: (value, pid)} from map's (index, results), every batch seen exactly once."""
+    seen, results = [], {}
+    for index, batch_results in mapped:
+        seen.append(index)
+        for unit, value, pid in batch_results:
+            results[unit] = (value, pid)
+    assert sorted(seen) == list(range(len(seen))), "a batch came back twice or not at all"
+    return results
+
+
+# -- without a Ray ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("address, reason", [
+    ("localhost", "is not auto or HOST:PORT"),
+    ("localhost:", "is not auto or HOST:PORT"),
+    (":6379", "is not auto or HOST:PORT"),
+    ("localhost:0", "is not auto or HOST:PORT"),
+    ("localhost:65536", "is not auto or HOST:PORT"),
+    ("127.0.0.1:1", "no Ray head answers at 127.0.0.1:1 (Connection refused)"),
+    ("nonexistent.invalid:6379", "cannot resolve the host 'nonexistent.invalid'"),
+])
+def test_a_wrong_address_is_one_line_before_ray_is_asked(address, reason):
+    start = time.perf_counter()
+    with pytest.raises(UserError) as caught:
+        open_executor(address, 2)               # the address checked before Ray is imported
+    assert time.perf_counter() - start < 5
+    assert caught.value.key == "--address" and reason in caught.value.line()
+    assert "\n" not in caught.value.line()
+
+
+def test_an_address_that_answers_passes_the_check():
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen()
+        check_address(f"127.0.0.1:{server.getsockname()[1]}")
+    assert split_address("[::1]:6379") == ("::1", 6379)
+
+
+def test_without_ray_the_work_runs_here_with_one_note(monkeypatch):
+    monkeypatch.setattr(executor_module, "ray_available", lambda: False)
+    said = []
+    executor = open_executor(None, 2, say=said.append)
+    assert isinstance(executor, InProcessExecutor)
+    assert len(said) == 1 and "Ray is not installed" in said[0] and "[cluster]" in said[0]
+    with pytest.raises(UserError) as caught:               # a cluster cannot be had without it
+        open_executor("auto", None, say=said.append)
+    assert caught.value.key == "--address" and len(said) == 1
+
+
+def test_the_command_line_does_not_import_ray():
+    code = ("import sys, renderer.cli, renderer.cluster.ray_executor; "
+            "print('ray' in sys.modules)")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "False"
+
+
+def test_in_process_map_is_the_order_of_the_batches():
+    mapped = list(InProcessExecutor().map(SquareWorker, batches_of(list(range(7)), 3)))
+    assert mapped == [(0, [(0, 0, os.getpid()), (1, 1, os.getpid()), (2, 4, os.getpid())]),
+                      (1, [(3, 9, os.getpid()), (4, 16, os.getpid()), (5, 25, os.getpid())]),
+                      (2, [(6, 36, os.getpid())])]
+
+
+# -- on a local Ray (slow: the module's ray_executor) ----------------------------------------
+
+def test_ray_renders_what_this_process_renders_in_any_order(ray_executor):
+    here = by_unit(InProcessExecutor().map(OrbitWorker, batches_of(list(range(VIEWS)), 5)))
+    views = list(range(VIEWS))[::-1]                        # other batches, another order
+    with ray_executor(workers=2) as executor:
+        there = by_unit(executor.map(OrbitWorker, batches_of(views, 2)))
+        pids = set(executor.worker_pids)
+    assert {view: value for view, (value, _) in there.items()} == \
+        {view: value for view, (value, _) in here.items()}
+    assert len(set(here.values())) == VIEWS                 # twelve different frames
+    assert {pid for _, pid in there.values()} == pids and len(pids) == 2
+
+
+def test_a_worker_killed_mid_map_costs_only_a_retry(ray_executor):
+    units = list(range(40))
+    with ray_executor(workers=2) as executor:
+        mapped = executor.map(functools.partial(SquareWorker, 0.1), batches_of(units, 2))
+        first = next(mapped)
+        killed = executor.worker_pids[0]
+        os.kill(killed, signal.SIGKILL)
+        results = by_unit([first, *mapped])
+    assert {unit: value for unit, (value, _) in results.items()} == {n: n * n for n in units}
+    pids = {pid for _, pid in results.values()}
+    assert pids - {killed} - set(executor.worker_pids), "no batch ran on the restarted actor"
+
+
+def test_a_batch_that_always_kills_its_worker_fails_the_map(ray_executor, monkeypatch):
+    from renderer.cluster import ray_executor as module
+    monkeypatch.setattr(module, "CALL_RETRIES", 0)          # the executor's own attempts only
+    done = []
+    with ray_executor(workers=1) as executor:
+        # The batches waiting on the actor (IN_FLIGHT) die with it: any of them may be the
+        # first to fail MAX_ATTEMPTS times.
+        with pytest.raises(BatchFailed, match=f"failed {executor_module.MAX_ATTEMPTS} times"):
+            for index, results in executor.map(DyingWorker, batches_of(list(range(20)), 2)):
+                done.append(index)
+                assert [value for _, value, _ in results] == [n * n for n in (2 * index, 2 * index + 1)]
+    assert 6 not in done and len(done) >= 4
+
+
+def test_the_workers_own_errors_are_raised_as_in_process(ray_executor):
+    with ray_executor(workers=1) as executor:
+        with pytest.raises(UserError, match="^scene.toml: a reason$"):
+            list(executor.map(lambda: FailingWorker(UserError("a reason", file="scene.toml")),
+                              [[1]]))
+        with pytest.raises(ZeroDivisionError, match="a bug"):   # a bug keeps its traceback
+            list(executor.map(lambda: FailingWorker(ZeroDivisionError("a bug")), [[1]]))
+
+
+def test_tasks_answer_every_argument_once(ray_executor):
+    with ray_executor() as executor:
+        answers = dict(executor.tasks(square_task, [(n,) for n in range(10)]))
+        assert answers == {n: n * n for n in range(10)}
+        assert "a local Ray" not in executor.describe()     # the module's Ray, not its own
+
+
+def test_a_cluster_by_its_address(ray_executor):
+    code = (
+        "import os, sys\n"
+        "from renderer.cluster.executor import open_executor\n"
+        "class Pid:\n"
+        "    def run(self, batch): return [os.getpid() for _ in batch]\n"
+        "with open_executor(sys.argv[1], 1) as ex:\n"
+        "    print(ex.describe()); print(sorted(i for i, _ in ex.map(Pid, [[1], [2], [3]])))\n")
+    done = subprocess.run([sys.executable, "-c", code, ray_executor.address],
+                          capture_output=True, text=True, cwd=ROOT, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.splitlines() == [
+        f"the Ray cluster at {ray_executor.address}, 1 workers (Ray actors, one CPU each)",
+        "[0, 1, 2]"]
+
+
+@pytest.mark.slow
+def test_an_address_that_answers_but_is_no_ray_is_one_line_in_seconds():
+    with socket.socket() as server:
+        server.bind(("127.0.0.1", 0))
+        server.listen(16)
+        threading.Thread(target=lambda: [server.accept()[0].close() for _ in range(64)],
+                         daemon=True).start()
+        code = ("import sys\n"
+                "from renderer.cluster.executor import open_executor\n"
+                "from renderer.errors import UserError\n"
+                "try: open_executor(sys.argv[1], 1)\n"
+                "except UserError as e: print(e.line())\n")
+        start = time.perf_counter()
+        done = subprocess.run([sys.executable, "-c", code, f"127.0.0.1:{server.getsockname()[1]}"],
+                              capture_output=True, text=True, cwd=ROOT, timeout=60)
+        seconds = time.perf_counter() - start
+    assert done.stdout.startswith("--address: 127.0.0.1:") and "Ray could not connect" in done.stdout
+    assert len(done.stdout.splitlines()) == 1 and done.stderr == ""
+    assert seconds < 15, f"{seconds:.1f} s"

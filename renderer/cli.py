@@ -64,16 +64,6 @@ def channel_threshold(text: str) -> int:
     return value
 
 
-def cluster_options(parser, what: str) -> None:
-    """--address and --workers: where a command's work runs (renderer/cluster/executor.py
-    open_executor); `what` says what goes there."""
-    parser.add_argument("--address", metavar="auto|HOST:PORT",
-                        help=f"a running Ray cluster ('auto': the one this machine is part of): {what}")
-    parser.add_argument("--workers", type=positive_int, metavar="N",
-                        help="workers on Ray (default: one per core); without --address, a Ray "
-                             "started on this machine for the run")
-
-
 def output_path(text: str) -> Path:
     """An output file or folder name. An empty one is refused with one line (a UserError,
     which argparse lets through), before any work: Path('') would be the current folder."""
@@ -248,9 +238,13 @@ def build_parser() -> argparse.ArgumentParser:
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
                         "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
-    cluster_options(report, "the settings run on Ray workers, (scene, setting) units longest first, "
-                            "the ground truths here; results.csv is the in-process one apart from "
-                            "the times and their `worker` column")
+    report.add_argument("--address", metavar="auto|HOST:PORT",
+                        help="run the settings on a running Ray cluster's workers (auto: the one "
+                             "`ray start` made on this machine); default: this process. results.csv "
+                             "is the same apart from the times and the `worker` that took them")
+    report.add_argument("--workers", type=positive_int, metavar="N",
+                        help="run the settings on N Ray workers (default with --address: one per "
+                             "CPU); without --address, on a local Ray started for this report")
 
     batch = sub.add_parser(
         "batch", help="render a job file's items (scenes x cameras x sweeps x settings) into a "

@@ -68,6 +68,11 @@ class ShuffledExecutor:
             for worker in workers:
                 worker.close()
 
+    def tasks(self, function, args):
+        args = list(enumerate(args))
+        random.Random(1).shuffle(args)
+        return ((index, function(*arguments)) for index, arguments in args)
+
     def describe(self):
         return "on two workers in a shuffled order"
 
@@ -83,9 +88,9 @@ def _rows(path):
         return [{k: v for k, v in row.items() if k not in TIMING} for row in csv.DictReader(handle)]
 
 
-@pytest.mark.slow                       # about 15 s: two tiny sweeps of every knob family
+@pytest.mark.slow                       # about 25 s: two tiny sweeps of every knob family
 def test_a_report_on_two_workers_in_any_order_has_the_in_process_rows(tmp_path, monkeypatch):
-    scenes = [load_scene("shadow_plane"), load_scene("sphere")]
+    scenes = [load_scene("shadow_plane"), load_scene("point_light_plane")]
     sweep = replace(QUICK, sample_counts=(1, 4), levels=(0.5, 1.0), runs=1,
                     output_methods=("none", "floyd-steinberg"), output_bits=(1,))
     options = dict(size=(16, 12), cache_dir=tmp_path / "cache", sweep=sweep, context_kind="osmesa")
@@ -97,5 +102,28 @@ def test_a_report_on_two_workers_in_any_order_has_the_in_process_rows(tmp_path, 
     knobs = {row["knob"] for row in _rows(tmp_path / "here" / "results.csv")}
     assert {"antialiasing", "tessellation", "shading", "precision", "shadows-bias", "output"} <= knobs
     assert {row["worker"] for row in spread.rows} == {f"{socket.gethostname()}:{os.getpid()}"}
-    assert "ran on two workers in a shuffled order" in (tmp_path / "spread" / "report.md").read_text()
-    assert "ran in this process" in (tmp_path / "here" / "report.md").read_text()
+    assert "Where the settings ran: on two workers in a shuffled order." in \
+        (tmp_path / "spread" / "report.md").read_text()
+    assert "Where the settings ran: in this process." in (tmp_path / "here" / "report.md").read_text()
+
+
+# Some of the quick sweep's knobs: against the truth, against ray-cast shadows, against the
+# linear frame (antialiasing's 64-sample reference rows take minutes here).
+QUICK_KNOBS = "shading,shadows,output"
+
+
+def test_report_quick_on_ray_workers_has_the_in_process_rows(tmp_path, cli, ray_executor):
+    """`renderer report --quick --address` (the test module's local Ray, 2 workers): the rows
+    and every error of the in-process report; each row timed by one of the two workers."""
+    options = ("report", "--quick", "--knobs", QUICK_KNOBS, "--size", "32x24",
+               "--cache", tmp_path / "cache")
+    here = cli(*options, "--out", tmp_path / "here")
+    assert here.returncode == 0, here.stderr
+    spread = cli(*options, "--out", tmp_path / "ray", "--address", ray_executor.address)
+    assert spread.returncode == 0, spread.stderr
+    assert _rows(tmp_path / "ray" / "results.csv") == _rows(tmp_path / "here" / "results.csv")
+    with open(tmp_path / "ray" / "results.csv", newline="") as handle:
+        workers = {row["worker"] for row in csv.DictReader(handle)}
+    assert len(workers) == 2
+    report = (tmp_path / "ray" / "report.md").read_text()
+    assert f"Where the settings ran: the Ray cluster at {ray_executor.address}, 2 workers" in report

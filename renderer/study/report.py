@@ -326,32 +326,33 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     sweep = sweep or runner.sweep(quick)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
     start = time.perf_counter()
-    ctx = make_context(context_kind)                # the plan's GL facts: the workers' must match
-    try:
-        result.gl_renderer = ctx.info["GL_RENDERER"]
-        facts = gl_facts(ctx)
-        plan = [s for s in runner.settings(sweep, ctx) if s.knob.split("-")[0] in knobs]
-    finally:
-        release_context(ctx)
-    plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
-    result.scenes = {scene.name: runner.describe(scene) for scene in scenes}
-    traced = [i for i, scene_plan in enumerate(plans) if runner.needs_truth(scene_plan)]
-    truths = [None] * len(scenes)
-    with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
-              mininterval=0.5, dynamic_ncols=True) as bar, \
-            open_executor(address, workers, use_ray=address is not None or workers is not None) \
+    # An --address nobody answers is one line before any work (open_executor checks it).
+    with open_executor(address, workers, use_ray=address is not None or workers is not None) \
             as executor:
         result.where = executor.describe()
-        bar.set_description("ground truths")
-        for i, (truth, hit) in zip(traced, ground_truths(
-                [scenes[i] for i in traced], width, height, cache_dir, runner.method,
-                tasks=executor.tasks)):
-            truths[i] = truth
-            result.truth_hits += hit
-        bar.update(len(scenes))
-        work = [SceneWork(i, scene, tuple(plans[i]), truths[i]) for i, scene in enumerate(scenes)]
-        result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
-                                context_kind, bar)
+        ctx = make_context(context_kind)            # the plan's GL facts: the workers' must match
+        try:
+            result.gl_renderer = ctx.info["GL_RENDERER"]
+            facts = gl_facts(ctx)
+            plan = [s for s in runner.settings(sweep, ctx) if s.knob.split("-")[0] in knobs]
+        finally:
+            release_context(ctx)
+        plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
+        result.scenes = {scene.name: runner.describe(scene) for scene in scenes}
+        traced = [i for i, scene_plan in enumerate(plans) if runner.needs_truth(scene_plan)]
+        truths = [None] * len(scenes)
+        with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
+                  mininterval=0.5, dynamic_ncols=True) as bar:
+            bar.set_description("ground truths")
+            for i, (truth, hit) in zip(traced, ground_truths(
+                    [scenes[i] for i in traced], width, height, cache_dir, runner.method,
+                    tasks=executor.tasks)):
+                truths[i] = truth
+                result.truth_hits += hit
+            bar.update(len(scenes))
+            work = [SceneWork(i, scene, tuple(plans[i]), truths[i]) for i, scene in enumerate(scenes)]
+            result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
+                                    context_kind, bar)
     result.seconds = time.perf_counter() - start
     write_outputs(result, Path(out), runner, (width, height), sweep, quick)
     return result

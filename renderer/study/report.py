@@ -32,6 +32,8 @@ has finished, each atomically.
 run_report drives a study: RasterStudy, this sweep, or (method="raytrace") renderer/study/
 ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, with the same
 metrics, plots and tables. `knobs` (the command's --knobs) keeps only some knob families.
+The rows run in this process or on Ray workers (--address, --workers: renderer/study/
+report_units.py), with the same results.csv but for the times and the `worker` that took them.
 """
 
 from __future__ import annotations

@@ -108,7 +108,7 @@ class ReportWorker:
 
     def __init__(self, runner, size: tuple[int, int], context_kind: str = "auto"):
         self.runner, self.size, self.context_kind = runner, size, context_kind
-        self.ctx = None
+        self.ctx, self.facts = None, None
         self.runs: OrderedDict[int, object] = OrderedDict()
         self.name = f"{socket.gethostname()}:{os.getpid()}"
 

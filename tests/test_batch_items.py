@@ -9,6 +9,7 @@ import pytest
 from renderer.batch.items import CameraSpec, expand, item_seed, job_identity
 from renderer.batch.job_file import read_job
 from renderer.core.scene import Camera
+from renderer.errors import UserError
 
 REPO = Path(__file__).resolve().parents[1]
 
@@ -152,3 +153,14 @@ def test_docs_batch_format_lists_every_key_the_reader_knows_and_no_other():
     known = {*job_file.TOP_KEYS, *job_file.SCENE_KEYS, *job_file.CAMERA_KINDS, *job_file.SETTING_KEYS,
              *job_file.OUTPUT_KEYS, *job_file.DEPTH_KEYS}
     assert documented == known
+
+
+def test_a_scene_path_is_relative_to_the_job_file_not_the_working_folder(tmp_path, monkeypatch):
+    (tmp_path / "here").mkdir()
+    (tmp_path / "here" / "ball.toml").write_text((REPO / "assets" / "scenes" / "sphere.toml").read_text())
+    (tmp_path / "jobs").mkdir()
+    monkeypatch.chdir(tmp_path / "here")
+    with pytest.raises(UserError) as refused:
+        job_from(tmp_path / "jobs", '[[scenes]]\nscene = "ball.toml"\n')
+    assert refused.value.line() == (f"{tmp_path / 'jobs' / 'job.toml'}: scenes[0].scene: "
+                                    f"{tmp_path / 'jobs' / 'ball.toml'}: scene file not found")

@@ -70,6 +70,9 @@ MISTAKES = {
                      "settings[0].outputs[1].name: the file name 'image.png' is already "
                      "settings[0].outputs[0]'s; give each its own name"),
     "size": ('size = [0, 10]\n' + SPHERE, "size[0]: must be >= 1, got 0"),
+    "too many items": (SPHERE + '[scenes.sweep]\n' + "".join(
+        f'"camera.fov_y{i}" = [{", ".join(["30"] * 100)}]\n' for i in range(4)),
+        "scenes[0].sweep: 100,000,000 sweep points; a job has at most 1,000,000 items"),
 }
 
 

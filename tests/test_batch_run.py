@@ -188,3 +188,19 @@ def test_compare_adds_the_reference_the_difference_and_the_figures(job, finished
         assert records[key]["compare"]["method"] == key.rsplit("/", 1)[1].replace("rt", "raytrace")
     assert hashes(out)[KEYS[0]][:2] == hashes(finished[2])[KEYS[0]]      # the GPU's files unchanged
     assert rerun(job, out).done == 0                 # a compared item also counts without --compare
+
+
+def test_an_item_is_what_renderer_render_writes_for_its_scene_options_and_seed(tmp_path, cli_here):
+    path = tmp_path / "own.toml"
+    path.write_text(JOB.replace('cameras = { orbit = { views = 2 } }\n', ''))   # the scene's camera
+    job = read_job(path)
+    rerun(job, tmp_path / "out")
+    records = manifest(tmp_path / "out")[1]
+    raster, traced = (records[f"sphere/camera-000/sweep-000/{name}"] for name in ("raster", "rt"))
+    common = ("render", "sphere", "--size", "32x24", "--quiet")
+    assert cli_here(*common, "--transfer", "srgb", "-o", tmp_path / "r.png").returncode == 0
+    assert cli_here(*common, "--method", "raytrace", "--spp", "2", "--pattern", "random",
+                    "--seed", traced["seed"], "-o", tmp_path / "t.png").returncode == 0
+    for record, rendered in ((raster, "r.png"), (traced, "t.png")):
+        codes = read_png(tmp_path / rendered).codes
+        assert pixels_sha256(codes[..., :3]) == record["outputs"][0]["pixels_sha256"]

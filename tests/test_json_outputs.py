@@ -57,7 +57,7 @@ def test_no_module_writes_json_but_the_helper():
             if (isinstance(node, ast.Attribute) and node.attr in ("dump", "dumps")
                     and isinstance(node.value, ast.Name) and node.value.id == "json"):
                 found.append(f"{path.relative_to(ROOT)}:{node.lineno}")
-    assert found == ["renderer/core/jsonio.py:22"]
+    assert {place.split(":")[0] for place in found} == {"renderer/core/jsonio.py"}
 
 
 # -- each output ------------------------------------------------------------------------------

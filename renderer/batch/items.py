@@ -28,11 +28,11 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from renderer.core.camera_paths import orbit_cameras
+from renderer.core.jsonio import canonical_json
 from renderer.core.output_settings import FORMATS, OutputSettings
 from renderer.core.scene import Camera
 
@@ -147,7 +147,6 @@ class CameraSpec:
         return numbered(self.kind, self.index)
 
     def camera(self, base: Camera) -> Camera:
-        from dataclasses import replace
         if self.kind == "orbit":
             return orbit_cameras(base, self.views, self.elevation)[self.index]
         if self.kind == "pose":
@@ -221,6 +220,5 @@ def expand(job: Job) -> list[Item]:
 def job_identity(job: Job, items: list[Item]) -> str:
     """SHA-256 of the canonical expanded items (keys, seeds, scenes' contents, cameras,
     settings): a manifest in DIR belongs to this job when its header carries the same."""
-    text = json.dumps({"seed": job.seed, "items": [item.describe() for item in items]},
-                      sort_keys=True, separators=(",", ":"), default=str)
+    text = canonical_json({"seed": job.seed, "items": [item.describe() for item in items]})
     return hashlib.sha256(text.encode()).hexdigest()

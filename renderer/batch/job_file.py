@@ -14,15 +14,16 @@ from __future__ import annotations
 
 import hashlib
 import itertools
-import json
+import math
 import re
-import tomllib
 from pathlib import Path
 from typing import Any
 
 from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSource, Setting,
                                   default_output_name)
 from renderer.core import output_settings as stage
+from renderer.core.builtin import is_scene_name
+from renderer.core.jsonio import canonical_json
 from renderer.core.memory import check_raytrace_render, check_render
 from renderer.core.motion import declares_motion
 from renderer.core.paths import checked_path, output_stem
@@ -30,7 +31,7 @@ from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS, ray_sampling
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import (MAX_NUMBER, TableReader, describe_value, read_scene,
-                                      scene_from_dict, toml_syntax_reason, with_overrides)
+                                      read_toml, scene_from_dict, with_overrides)
 from renderer.errors import SceneError, UserError
 
 TOP_KEYS = ("name", "description", "seed", "size", "scenes", "settings")
@@ -61,19 +62,7 @@ NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9._-]{0,99}")
 def read_job(path) -> Job:
     """The job file at `path`, read and checked (module docstring)."""
     path = checked_path(path, error=UserError)
-    source = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise UserError("job file not found", file=source) from None
-    except IsADirectoryError:
-        raise UserError("is a directory, not a job file", file=source) from None
-    except UnicodeDecodeError as exc:
-        raise UserError(f"not UTF-8 text (byte {exc.start}); a job file is TOML", file=source) from None
-    except OSError as exc:
-        raise UserError(f"cannot read: {exc.strerror or exc}", file=source) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise UserError(toml_syntax_reason(exc), file=source) from None
+    data = read_toml(path, "job file", UserError)
     return _JobReader(path).job(data)
 
 
@@ -124,9 +113,8 @@ class _JobReader(TableReader):
         count = sum(len(s.points) * len(s.cameras) for s in scenes) * len(settings)
         if count > MAX_ITEMS:
             self.fail("scenes", f"the job has {count:,} items; at most {MAX_ITEMS:,}")
-        job = Job(str(self.path), name, seed, scenes, settings,
-                  self.string(data.get("description", ""), "description"))
-        return job
+        return Job(str(self.path), name, seed, scenes, settings,
+                   self.string(data.get("description", ""), "description"))
 
     def entries(self, value: Any, key: str) -> list:
         entries = self.list_of_tables(value, key, key)
@@ -166,7 +154,7 @@ class _JobReader(TableReader):
         text = self.string(value, key)
         beside = self.path.parent / text           # a path is relative to the job file
         try:
-            return read_scene(beside if beside.is_file() else text)
+            return read_scene(text if is_scene_name(text) and not beside.is_file() else beside)
         except SceneError as error:
             self.fail(key, error.line())
 
@@ -179,6 +167,9 @@ class _JobReader(TableReader):
         axes = list(self.flat_sweep(raw, key).items())
         if not axes:
             self.fail(key, "expected at least one key path = [values]")
+        points = math.prod(len(values) for _, values in axes)
+        if points > MAX_ITEMS:                 # before building any of them
+            self.fail(key, f"{points:,} sweep points; a job has at most {MAX_ITEMS:,} items")
         return [dict(zip((path for path, _ in axes), values))
                 for values in itertools.product(*(values for _, values in axes))]
 
@@ -205,10 +196,10 @@ class _JobReader(TableReader):
             changed = with_overrides(data, overrides, str(path))
             scene = scene_from_dict(changed, source=str(path), base_dir=path.parent)
         except SceneError as error:
-            shown = ", ".join(f"{k} = {json.dumps(v)}" for k, v in overrides.items())
+            shown = ", ".join(f"{k} = {v!r}" for k, v in overrides.items())
             self.fail(key if overrides else key.rsplit(".", 1)[0] + ".scene",
                       f"{shown + ': ' if shown else ''}{error.line()}")
-        digest = hashlib.sha256(json.dumps(changed, sort_keys=True, default=str).encode()).hexdigest()
+        digest = hashlib.sha256(canonical_json(changed).encode()).hexdigest()
         return SceneSource(str(path.resolve()), tuple(overrides.items()), digest), scene
 
     def cameras(self, raw: Any, key: str, scene, settings) -> tuple[CameraSpec, ...]:

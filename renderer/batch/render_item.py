@@ -6,10 +6,10 @@ as bytes (the driver writes them: renderer/batch/run.py).
     worker.close()
 
 A worker keeps, made on first use: the context; each scene (by its SceneSource digest); a
-GpuRenderer or RayTracer per (scene, shading, method, size, ray options, motion on/off),
-the last CACHED_RENDERERS of them; and one OutputPass. An item sets the renderer's scene
-camera and calls update(), and the tracer's reseed(item.seed): bit for bit what a renderer
-made afresh for the item draws (tests/test_raytrace_update.py, tests/test_determinism.py),
+GpuRenderer or RayTracer per (scene, shading, method, size, ray options, motion on/off), the
+last CACHED of each (an orbit's views share one renderer; a sweep moves on); and one
+OutputPass. An item sets the renderer's scene camera and calls update(), and the tracer's
+reseed(item.seed): bit for bit what a renderer made afresh for the item draws (tests/test_raytrace_update.py, tests/test_determinism.py),
 in whatever order the items come. Nothing here writes a file.
 
 An item that fails (its scene cannot be drawn, GL fails) gives an ItemResult with `error`
@@ -37,7 +37,7 @@ from renderer.core.output_settings import INTEGER_FORMATS
 from renderer.core.scene import Scene
 from renderer.errors import UserError
 
-CACHED_RENDERERS = 4          # per worker: an orbit's views share one; sweeps move on
+CACHED = 4                    # scenes and renderers kept per worker (least recently used go)
 
 
 def pixels_sha256(array: np.ndarray) -> str:
@@ -132,12 +132,10 @@ class ItemWorker:
                               bug=True)
 
     def _worker(self) -> dict:
-        if self._where is None:
+        """Where items run: host, pid and, once the context exists, its GL renderer."""
+        if self._where is None or self._where["gl_renderer"] is None:
             gl = None if self.ctx is None else self.ctx.info["GL_RENDERER"]
-            where = {"host": socket.gethostname(), "pid": os.getpid(), "gl_renderer": gl}
-            if gl is None:
-                return where
-            self._where = where
+            self._where = {"host": socket.gethostname(), "pid": os.getpid(), "gl_renderer": gl}
         return self._where
 
     def _context(self):
@@ -149,7 +147,7 @@ class ItemWorker:
     def _scene(self, source: SceneSource) -> Scene:
         scene = self._scenes.pop(source.digest, None) or load_source(source)
         self._scenes[source.digest] = scene
-        while len(self._scenes) > CACHED_RENDERERS:
+        while len(self._scenes) > CACHED:
             self._scenes.popitem(last=False)
         return scene
 
@@ -169,13 +167,17 @@ class ItemWorker:
             else:
                 from renderer.gpu.pipeline import GpuRenderer
                 renderer = GpuRenderer(scene, *setting.size, context=ctx)
-            while len(self._renderers) >= CACHED_RENDERERS:
+            while len(self._renderers) >= CACHED:
                 self._renderers.popitem(last=False)[1].release()
         else:
-            renderer.scene.camera = scene.camera
-            renderer.update()
-            if setting.traced:
-                renderer.reseed(item.seed)
+            try:
+                renderer.scene.camera = scene.camera
+                renderer.update()
+                if setting.traced:
+                    renderer.reseed(item.seed)
+            except BaseException:
+                renderer.release()            # out of the cache already: not left holding GL objects
+                raise
         self._renderers[key] = renderer
         return renderer
 

@@ -34,7 +34,7 @@ from renderer.batch.items import ITEMS_FOLDER, Item, Job, expand, job_identity
 from renderer.batch.manifest import MANIFEST, Manifest, Resume, header_for, read_manifest
 from renderer.batch.job_file import check_memory
 from renderer.batch.render_item import ItemResult, ItemWorker, item_scene, load_source, reference_item
-from renderer.cluster.executor import batch_size, batches_of, note
+from renderer.cluster.executor import batch_size, batches_of
 from renderer.core.imageio import check_folder, check_outputs, outputs
 
 COMPARE_FILES = ("gpu.png", "reference.png", "diff.png")
@@ -129,7 +129,7 @@ class _Writer:
     def failed(self, key: str, error: str, bug: bool = False) -> None:
         self.summary.failed.append((key, error))
         if bug:
-            print(error, file=sys.stderr, end="" if error.endswith("\n") else "\n")
+            _above_bar(error.rstrip("\n"))
         self.say(f"{key}: failed: {error.strip().splitlines()[-1]}")
 
     def write(self, item: Item, result: ItemResult, extra: dict[str, bytes] | None = None,
@@ -146,6 +146,17 @@ class _Writer:
         counts[1] += result.render_ms + result.encode_ms
 
 
+def _above_bar(text: str) -> None:
+    """Lines on stderr that a progress bar running there leaves whole."""
+    from tqdm import tqdm
+    tqdm.write(text, file=sys.stderr)
+
+
+def say_above_bar(line: str) -> None:
+    """`renderer: LINE` on stderr, above the progress bar: run_plan's default `say`."""
+    _above_bar(f"renderer: {line}")
+
+
 def _bar(total: int, unit: str, progress: bool):
     from tqdm import tqdm
     return tqdm(total=total, unit=unit, file=sys.stderr, mininterval=0.5, dynamic_ncols=True,
@@ -153,7 +164,7 @@ def _bar(total: int, unit: str, progress: bool):
 
 
 def run_plan(plan: Plan, executor, *, context_kind: str = "auto", progress: bool = True,
-             say=note) -> Summary:
+             say=say_above_bar) -> Summary:
     """Render and write the plan's items on `executor` (renderer/cluster/executor.py)."""
     start = time.perf_counter()
     summary = Summary(len(plan.items), len(plan.items) - len(plan.todo), where=executor.describe())
@@ -195,7 +206,7 @@ def _compare(held, executor, writer: _Writer, progress: bool) -> None:
 
 
 def run_job(job: Job, out, executor, *, compare: bool = False, context_kind: str = "auto",
-            progress: bool = True, say=note) -> Summary:
+            progress: bool = True, say=say_above_bar) -> Summary:
     """plan_job then run_plan: the job's items not yet complete in `out`, rendered and written."""
     return run_plan(plan_job(job, out, compare=compare), executor, context_kind=context_kind,
                     progress=progress, say=say)

@@ -33,6 +33,13 @@ def write_json(path, value, *, indent: int = 1) -> None:
     write_text(path, json_text(value, indent=indent))
 
 
+def canonical_json(value) -> str:
+    """The text a digest is taken of (a batch job's identity, a scene's): keys sorted, no
+    spaces, a value JSON has no word for (a TOML date) as its str(). Not a file's text: NaN
+    and infinities are written as Python writes them, since a scene may hold gloss = inf."""
+    return json.dumps(value, sort_keys=True, separators=(",", ":"), default=str)
+
+
 def finite_or_none(x: float | None) -> float | None:
     """x when it is a finite number, else None (JSON's null)."""
     return x if x is not None and math.isfinite(x) else None

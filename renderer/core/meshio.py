@@ -139,6 +139,24 @@ def _quiet_libraries():
         logger.setLevel(level)
 
 
+def _neither(kind: str) -> str:
+    return f"could not be read as {kind}: not a valid {kind} file (neither binary {kind} nor text)"
+
+
+def _neither_binary_nor_text(path: Path, kind: str) -> bool:
+    """Whether an OBJ (text only) or STL file is neither UTF-8 text nor, for STL, the binary
+    layout (an 84-byte header and count, then 50 bytes per triangle)."""
+    if kind not in ("OBJ", "STL"):
+        return False
+    data = path.read_bytes()
+    try:
+        data.decode("utf-8")
+        return False
+    except UnicodeDecodeError:
+        pass
+    return kind == "OBJ" or len(data) < 84 or len(data) != 84 + 50 * int.from_bytes(data[80:84], "little")
+
+
 def _read_with_trimesh(path: Path):
     """(positions (V, 3), faces (F, 3), normals (V, 3) or None, UVs (V, 2) or None) of every
     triangle mesh in the file.
@@ -151,8 +169,7 @@ def _read_with_trimesh(path: Path):
     except ImportError:
         # trimesh falls back to guessing a text encoding (charset_normalizer, not installed)
         # when a file is neither its binary layout nor UTF-8 text.
-        raise _MeshProblem(f"could not be read as {kind}: not a valid {kind} file (neither "
-                           f"binary {kind} nor text)") from None
+        raise _MeshProblem(_neither(kind)) from None
     except Exception as exc:   # trimesh raises anything from ValueError to IndexError
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         raise _MeshProblem(f"could not be read as {kind}: not a valid {kind} file: {reason}") \
@@ -165,7 +182,10 @@ def _read_with_trimesh(path: Path):
         if isinstance(geometry, trimesh.Trimesh):
             parts.append((np.asarray(transform, dtype=float), geometry))
     if not parts:
-        raise _MeshProblem("mesh has no triangles")
+        # With charset_normalizer installed (Ray's extra brings it), trimesh "decodes" any
+        # bytes as some code page and finds nothing in them: the same file, the same line.
+        raise _MeshProblem(_neither(kind) if _neither_binary_nor_text(path, kind)
+                           else "mesh has no triangles")
 
     positions, faces, normals, uvs, offset = [], [], [], [], 0
     all_have_normals = all(_has_file_normals(g) for _, g in parts)

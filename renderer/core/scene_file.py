@@ -2,6 +2,7 @@
 
     load_scene("sphere") or load_scene("my_scene.toml") -> Scene   (a built-in name or a path)
     read_scene(...) -> (parsed dict, path); with_overrides(data, {"camera.aperture": 0.1}, source)
+    read_toml(path, "job file", UserError) -> dict     (any TOML file, its failures one line)
     scene_from_dict({"camera": {...}, "objects": [...]}, source="<dict>", base_dir=".")
 
 docs/scene-format.md documents every key with its unit and default. The reader is strict:
@@ -134,25 +135,31 @@ def read_scene(scene) -> tuple[dict, Path]:
     path = checked_path(scene, error=SceneError)
     if not path.is_file() and is_scene_name(str(scene)):
         path = resolve_scene(str(scene))
-    source = str(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise SceneError("scene file not found", file=source) from None
-    except IsADirectoryError:
-        raise SceneError("is a directory, not a scene file", file=source) from None
-    except UnicodeDecodeError as exc:
-        raise SceneError(f"not UTF-8 text (byte {exc.start}); a scene file is TOML",
-                         file=source) from None
-    except OSError as exc:
-        raise SceneError(f"cannot read: {exc.strerror or exc}", file=source) from None
-    except tomllib.TOMLDecodeError as exc:
-        raise SceneError(toml_syntax_reason(exc), file=source) from None
-    except RecursionError:               # tomllib recurses once per level of nesting
-        raise SceneError(f"arrays or tables nested too deeply for the TOML parser; a scene file "
-                         f"nests at most {MAX_NESTING} levels", file=source) from None
+    data = read_toml(path)
     data.setdefault("name", path.stem)
     return data, path
+
+
+def read_toml(path: Path, what: str = "scene file", error: type[UserError] = SceneError) -> dict:
+    """A TOML file's parsed tables; each way of failing is one `error` line naming the file
+    (not found, a folder, not UTF-8, unreadable, a syntax error, nested too deeply). `what`
+    names the kind of file in the reasons ("scene file", "job file")."""
+    source = str(path)
+    try:
+        return tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except FileNotFoundError:
+        raise error(f"{what} not found", file=source) from None
+    except IsADirectoryError:
+        raise error(f"is a directory, not a {what}", file=source) from None
+    except UnicodeDecodeError as exc:
+        raise error(f"not UTF-8 text (byte {exc.start}); a {what} is TOML", file=source) from None
+    except OSError as exc:
+        raise error(f"cannot read: {exc.strerror or exc}", file=source) from None
+    except tomllib.TOMLDecodeError as exc:
+        raise error(_toml_syntax_reason(exc), file=source) from None
+    except RecursionError:               # tomllib recurses once per level of nesting
+        raise error(f"arrays or tables nested too deeply for the TOML parser; a {what} "
+                    f"nests at most {MAX_NESTING} levels", file=source) from None
 
 
 # One step of a key path: a table key (letters, digits, _) or a list index `[i]`.
@@ -246,7 +253,7 @@ def _check_nesting(data: Any, reader: "_Reader") -> None:
         stack.extend((v, p, depth + 1) for v, p in children)
 
 
-def toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
+def _toml_syntax_reason(exc: tomllib.TOMLDecodeError) -> str:
     """tomllib says "Invalid value (at line 3, column 7)"; we say where first."""
     message = str(exc)
     match = re.search(r"\s*\(at line (\d+), column (\d+)\)$", message)

@@ -1,7 +1,7 @@
 """`renderer batch` on a local Ray (the module's `ray_executor`, tests/conftest.py; slow):
 the same files with 1 worker, 2 workers or none; a worker killed with SIGKILL mid-job
 costs a retry and nothing else (the issue's test); a killed command resumes to the same
-result. "The same" is the manifest's SHA-256 of every file, and the folder holding exactly
+result; --compare's reference in Ray's tasks gives this process's figures. "The same" is the manifest's SHA-256 of every file, and the folder holding exactly
 the files the manifest lists (no temporary, no half-written file)."""
 
 import json
@@ -45,7 +45,7 @@ samples = 2
 pattern = "random"
 """
 KILL_AFTER = 8                      # records in the manifest before the kill
-WORKER_TITLE = b"ray::WorkerHost"   # an actor's process title (renderer/cluster/ray_executor.py)
+WORKER_TITLE = b"ray::WorkerHost"   # an actor's process title (ray_executor.WorkerHost)
 
 
 def records(out: Path) -> dict:
@@ -70,14 +70,21 @@ def assert_same_job(out: Path, undisturbed: Path) -> None:
     assert files_in(out) == listed | {MANIFEST}, "a file the manifest does not list"
 
 
+def parent_of(pid) -> int:
+    # /proc/PID/stat: "PID (COMMAND) STATE PPID ...", COMMAND may hold spaces and brackets.
+    return int(Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[1])
+
+
 def pids_of_workers() -> list[int]:
-    """The processes of this machine's RayExecutor actors (the module's Ray only runs ours)."""
+    """The processes of the RayExecutor actors on this module's Ray: their raylet is a child
+    of this process (LocalRay started it), unlike other Rays running on the machine."""
     pids = []
-    for entry in os.listdir("/proc"):
+    for entry in filter(str.isdigit, os.listdir("/proc")):
         try:
-            if entry.isdigit() and Path(f"/proc/{entry}/cmdline").read_bytes().startswith(WORKER_TITLE):
+            if Path(f"/proc/{entry}/cmdline").read_bytes().startswith(WORKER_TITLE) and \
+                    parent_of(parent_of(entry)) == os.getpid():
                 pids.append(int(entry))
-        except OSError:
+        except (OSError, ValueError, IndexError):
             continue                # gone meanwhile
     return pids
 
@@ -125,6 +132,24 @@ def test_any_number_of_workers_writes_the_same_job(ray_executor, job_file, undis
     assert not summary.failed
     assert_same_job(out, undisturbed)
     assert len({record["worker"]["pid"] for record in records(out).values()}) == workers
+
+
+def test_compare_on_ray_gives_the_figures_of_this_process(ray_executor, tmp_path):
+    # The reference runs in Ray's plain tasks (executor.tasks), after the GPU's map.
+    path = tmp_path / "small.toml"
+    path.write_text(JOB.replace(f"views = {VIEWS}", "views = 2") + TRACED)
+    outs = {}
+    for name, executor in (("here", InProcessExecutor()), ("ray", ray_executor(2))):
+        outs[name] = tmp_path / name
+        with executor:
+            summary = run_job(read_job(path), outs[name], executor, compare=True, progress=False)
+        assert summary.done == 8 and not summary.failed
+    assert_same_job(outs["ray"], outs["here"])
+    figures = {name: {key: {figure: value for figure, value in record["compare"].items()
+                            if not figure.endswith("_ms")}          # but the timings
+                      for key, record in records(out).items()} for name, out in outs.items()}
+    assert figures["ray"] == figures["here"]
+    assert all(item["passes"] for item in figures["ray"].values())
 
 
 def test_a_worker_killed_mid_job_costs_only_a_retry(ray_executor, job_file, undisturbed, tmp_path):

@@ -15,6 +15,7 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import pytest
 
@@ -80,6 +81,18 @@ class FailingWorker:
         raise self.error
 
 
+class LlvmpipeThreads:
+    """Unit -> how many llvmpipe threads this process has once it has made a GL context."""
+
+    def run(self, batch):
+        from renderer.gpu.context import make_context, release_context
+        ctx = make_context("auto")
+        threads = sum(Path(f"/proc/self/task/{task}/comm").read_text().startswith("llvmpipe")
+                      for task in os.listdir("/proc/self/task"))
+        release_context(ctx)
+        return [threads for _ in batch]
+
+
 def square_task(n):
     return n * n
 
@@ -97,22 +110,62 @@ def by_unit(mapped) -> dict:
 
 # -- without a Ray ----------------------------------------------------------------------------
 
+@pytest.mark.parametrize("address", ["localhost", "localhost:", ":6379", "localhost:0",
+                                     "localhost:65536", "localhost:http", "[::1]"])
+def test_an_address_is_auto_or_host_colon_port(address):
+    with pytest.raises(UserError) as caught:
+        check_address(address)
+    assert caught.value.line() == \
+        f"--address: {address!r} is not auto or HOST:PORT (a port from 1 to 65535)"
+
+
+TINY_JOB = """
+size = [16, 12]
+
+[[scenes]]
+scene = "sphere"
+
+[[settings]]
+name = "raster"
+outputs = [{ format = "png8" }]
+"""
+
+
+@pytest.fixture
+def tiny_job(tmp_path):
+    path = tmp_path / "job.toml"
+    path.write_text(TINY_JOB)
+    return path
+
+
 @pytest.mark.parametrize("address, reason", [
-    ("localhost", "is not auto or HOST:PORT"),
-    ("localhost:", "is not auto or HOST:PORT"),
-    (":6379", "is not auto or HOST:PORT"),
-    ("localhost:0", "is not auto or HOST:PORT"),
-    ("localhost:65536", "is not auto or HOST:PORT"),
     ("127.0.0.1:1", "no Ray head answers at 127.0.0.1:1 (Connection refused)"),
+    ("head.example", "'head.example' is not auto or HOST:PORT (a port from 1 to 65535)"),
     ("nonexistent.invalid:6379", "cannot resolve the host 'nonexistent.invalid'"),
 ])
-def test_a_wrong_address_is_one_line_before_ray_is_asked(address, reason):
+def test_batch_with_a_wrong_address_is_one_line_at_once(cli_here, tiny_job, tmp_path, address,
+                                                       reason):
     start = time.perf_counter()
-    with pytest.raises(UserError) as caught:
-        open_executor(address, 2)               # the address checked before Ray is imported
-    assert time.perf_counter() - start < 5
-    assert caught.value.key == "--address" and reason in caught.value.line()
-    assert "\n" not in caught.value.line()
+    done = cli_here("batch", tiny_job, "--out", tmp_path / "out", "--address", address)
+    assert time.perf_counter() - start < 5                 # not Ray's minutes of retries
+    assert (done.returncode, done.stdout) == (2, "")
+    assert done.stderr.startswith(f"renderer: --address: {reason}")
+    assert len(done.stderr.splitlines()) == 1 and not (tmp_path / "out").exists()
+
+
+@pytest.mark.slow
+def test_batch_without_ray_runs_here_with_one_note(tiny_job, tmp_path):
+    code = ("import sys; sys.modules['ray'] = None\n"            # as if it were not installed
+            "from renderer.cli import main; sys.exit(main(sys.argv[1:]))")
+    done = subprocess.run([sys.executable, "-c", code, "batch", str(tiny_job), "--out",
+                           str(tmp_path / "out")], capture_output=True, text=True, cwd=ROOT,
+                          timeout=120)
+    assert done.returncode == 0, done.stderr
+    notes = [line for line in done.stderr.splitlines() if "Ray" in line]
+    assert notes == ["renderer: Ray is not installed (pip install 'checked-renderer[cluster]'); "
+                     "running in this process"]
+    assert "1 rendered" in done.stderr and "; in this process)" in done.stderr   # the summary
+    assert (tmp_path / "out" / "manifest.jsonl").exists()
 
 
 def test_an_address_that_answers_passes_the_check():
@@ -164,6 +217,12 @@ def test_ray_renders_what_this_process_renders_in_any_order(ray_executor):
     assert {pid for _, pid in there.values()} == pids and len(pids) == 2
 
 
+@pytest.mark.skipif(not os.path.isdir("/proc/self/task"), reason="reads /proc")
+def test_each_worker_draws_on_one_llvmpipe_thread(ray_executor):
+    with ray_executor(workers=2) as executor:      # the actors, not llvmpipe, share the cores
+        assert [threads for _, threads in executor.map(LlvmpipeThreads, [[1], [2]])] == [[1], [1]]
+
+
 def test_a_worker_killed_mid_map_costs_only_a_retry(ray_executor):
     units = list(range(40))
     with ray_executor(workers=2) as executor:
@@ -184,11 +243,12 @@ def test_a_batch_that_always_kills_its_worker_fails_the_map(ray_executor, monkey
     with ray_executor(workers=1) as executor:
         # The batches waiting on the actor (IN_FLIGHT) die with it: any of them may be the
         # first to fail MAX_ATTEMPTS times.
-        with pytest.raises(BatchFailed, match=f"failed {executor_module.MAX_ATTEMPTS} times"):
+        with pytest.raises(BatchFailed, match=f"failed {executor_module.MAX_ATTEMPTS} times") as caught:
             for index, results in executor.map(DyingWorker, batches_of(list(range(20)), 2)):
                 done.append(index)
                 assert [value for _, value, _ in results] == [n * n for n in (2 * index, 2 * index + 1)]
     assert 6 not in done and len(done) >= 4
+    assert caught.value.status == 1 and "process was lost" in caught.value.line()
 
 
 def test_the_workers_own_errors_are_raised_as_in_process(ray_executor):
@@ -207,6 +267,12 @@ def test_tasks_answer_every_argument_once(ray_executor):
         assert "a local Ray" not in executor.describe()     # the module's Ray, not its own
 
 
+def test_more_workers_than_the_cluster_has_cpus_is_one_line(ray_executor):
+    with pytest.raises(UserError) as caught:        # the extra actors would wait for ever
+        ray_executor(workers=3)
+    assert caught.value.line() == "--workers: 3 workers, but the Ray cluster has 2 CPUs"
+
+
 def test_a_cluster_by_its_address(ray_executor):
     code = (
         "import os, sys\n"
@@ -221,6 +287,24 @@ def test_a_cluster_by_its_address(ray_executor):
     assert done.stdout.splitlines() == [
         f"the Ray cluster at {ray_executor.address}, 1 workers (Ray actors, one CPU each)",
         "[0, 1, 2]"]
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(os.path.exists("/tmp/ray/ray_current_cluster"), reason="`ray start` ran here")
+def test_auto_without_a_cluster_is_one_line_at_once():
+    # "auto" is also any Ray running on the machine (Ray finds their processes): such as
+    # other test sessions' own. Here Ray is made to find none.
+    code = ("import functools, sys, ray._private.services as services\n"
+            "services._cached_find_gcs_addresses = functools.lru_cache()(lambda: set())\n"
+            "from renderer.cluster.executor import open_executor\n"
+            "from renderer.errors import UserError\n"
+            "try: open_executor('auto', 1)\n"
+            "except UserError as e: print(e.line())\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, timeout=60, env={**os.environ, "RAY_ADDRESS": ""})
+    assert (done.stdout, done.stderr) == ("--address: auto: no Ray cluster runs on this machine "
+                                          "(start one with `ray start --head`, or give its "
+                                          "HOST:PORT)\n", "")
 
 
 @pytest.mark.slow

@@ -4,8 +4,11 @@ Its own module so that executor.py (which opens a RayExecutor) and ray_executor.
 retries batches) share it without importing each other.
 """
 
+from renderer.errors import SystemFault
+
 MAX_ATTEMPTS = 3            # a batch failing this many times fails the job (BatchFailed)
 
 
-class BatchFailed(RuntimeError):
-    """A batch failed MAX_ATTEMPTS times (its last error chained)."""
+class BatchFailed(SystemFault):
+    """A batch failed MAX_ATTEMPTS times, its worker's process lost each time (the last
+    error chained): the system failed, not the user, so one line and exit status 1."""

@@ -2,7 +2,7 @@
 
     with RayExecutor(workers=2) as ex:                  # a local Ray, 2 actors (default: cores)
         for index, results in ex.map(factory, batches): ...
-    RayExecutor(address="auto")                          # the cluster `ray start` runs here
+    RayExecutor(address="auto")                          # the Ray running on this machine
     RayExecutor(address="head.example:6379")             # a cluster's head (GCS) address
 
 Start. A local Ray is `ray.init(address="local")`: always a fresh one for this run, never a
@@ -11,10 +11,11 @@ dashboard, worker output not forwarded, Ray's log lines at ERROR) and keeps its 
 in a short temporary folder that close() removes: Ray's socket paths must fit in 107 bytes,
 and its default /tmp/ray/session_* folders are never deleted. An --address is checked with a
 socket first (address.py): nobody answering is one line at once; where something answers
-that is not a Ray head, Ray's own connection attempts are bounded (CONNECT_BOUNDS, ~5 s)
-and its C++ log lines on fd 2 hidden: one line too. A process
-already connected to Ray (ray.init called by the program, or a test's cluster) is used as it
-is and left connected.
+that is not a Ray head, Ray's own connection attempts are bounded (CONNECT_BOUNDS, ~5 s) and
+its C++ log lines on fd 2 hidden: one line too. "auto" is Ray's own rule: $RAY_ADDRESS, else
+the cluster `ray start` made here, else any Ray running on this machine (also one another
+`renderer batch` started). A process already connected to Ray (ray.init called by the
+program, or a test's cluster) is used as it is and left connected.
 
 Workers. One actor per worker, each holding one worker object (factory(), made on its first
 batch). CPU nodes: one actor per CPU (num_cpus=1), with LP_NUM_THREADS=1 set before the
@@ -23,16 +24,17 @@ share the cores (at 320x240 most of a frame's time is serial anyway: one actor w
 llvmpipe threads used one core). GPU nodes: one actor per GPU (num_gpus=1), its EGL device
 the GPU Ray gave it (GLCONTEXT_DEVICE_INDEX, which glcontext reads when it makes an EGL
 context). The GPU path is untested: no machine here has a GPU, and it assumes that the EGL
-device order matches Ray's GPU ids (true when a node's EGL devices are its NVIDIA GPUs in
-CUDA order; Mesa adds a software device at the end).
+devices are numbered as Ray numbers the GPUs (CUDA's order; EGL_NV_device_cuda could map
+them where they are not).
 
-Scheduling. A ray.wait loop with IN_FLIGHT calls queued on each actor, so an actor finishes
-a batch and finds the next one waiting (a call costs ~3 ms here, hidden this way). Faults:
-actors restart without limit (max_restarts=-1) and retry their calls (max_task_retries=3);
-a batch whose call still fails is queued again here, and a batch failing MAX_ATTEMPTS times
-raises BatchFailed (a batch that kills its process every time takes the batch queued behind
-it on the same actor down with it each time, so BatchFailed may name either). An exception raised by the worker's own code is not a fault but a bug (or
-a UserError): it is raised here at once, as in-process.
+Scheduling. A ray.wait loop with IN_FLIGHT calls queued on each actor, so that an actor
+finishing a batch finds the next one waiting (a call's round trip, ~1 ms here, is hidden
+this way). Faults: actors restart without limit (max_restarts=-1) and retry their calls
+(max_task_retries=3); a batch whose call still fails is queued again here, and a batch
+failing MAX_ATTEMPTS times raises BatchFailed (a batch that kills its process every time
+takes the batch queued behind it on the same actor down with it, so BatchFailed may name
+either). An exception raised by the worker's own code is not a fault but a bug (or a
+UserError): it is raised here at once, as in-process.
 """
 
 from __future__ import annotations
@@ -155,19 +157,12 @@ class RayExecutor:
         import ray
         remote = ray.remote(function).options(num_cpus=1, max_retries=CALL_RETRIES)
         args = list(args)
-        failures: Counter[int] = Counter()
-        pending = {remote.remote(*arguments): index for index, arguments in enumerate(args)}
-        while pending:
-            [ref], _ = ray.wait(list(pending), num_returns=1)
-            index = pending.pop(ref)
-            try:
-                value = _get(ref)
-            except ray.exceptions.RayTaskError:
-                raise                       # the function's own error: a bug, not a fault
-            except ray.exceptions.RayError as exc:
-                _count_failure(failures, index, "task", exc)
-                pending[remote.remote(*args[index])] = index
-                continue
+        pending = {remote.remote(*arguments): (index, None) for index, arguments in enumerate(args)}
+
+        def again(tag) -> None:
+            pending[remote.remote(*args[tag[0]])] = tag
+
+        for (index, _), value in _as_finished(pending, "task", again):
             yield index, value
 
     def describe(self) -> str:
@@ -193,33 +188,52 @@ class RayExecutor:
 
 
 def _schedule(actors: list, batches: list[list]) -> Iterator[tuple[int, list]]:
-    """The ray.wait loop: IN_FLIGHT calls per actor, a failed batch queued again (first)."""
-    import ray
+    """IN_FLIGHT calls per actor; an actor that answers gets the next batch, and a batch
+    lost to a fault goes back to the front of the queue."""
     queue = deque(range(len(batches)))
-    pending: dict = {}                   # ObjectRef -> (actor, batch index)
-    failures: Counter[int] = Counter()
+    pending: dict = {}                   # ObjectRef -> (batch index, actor)
 
     def submit(actor) -> None:
         if queue:
             index = queue.popleft()
-            pending[actor.run.remote(batches[index])] = (actor, index)
+            pending[actor.run.remote(batches[index])] = (index, actor)
+
+    def again(tag) -> None:
+        queue.appendleft(tag[0])
+        submit(tag[1])
 
     for _ in range(IN_FLIGHT):
         for actor in actors:
             submit(actor)
+    for (index, actor), results in _as_finished(pending, "batch", again):
+        yield index, results
+        submit(actor)
+
+
+def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tuple, Any]]:
+    """(tag, result) for each call of `pending` ({ObjectRef: (index, ...)}, which grows as
+    the caller submits more) as it finishes: the ray.wait loop. A call lost to a fault
+    (its process died, and Ray's retries with it) is handed to again(tag) to be submitted
+    once more, MAX_ATTEMPTS times per index at most (then BatchFailed); an exception
+    raised by the work itself is raised here (_get)."""
+    import ray
+    failures: Counter[int] = Counter()
     while pending:
         [ref], _ = ray.wait(list(pending), num_returns=1)
-        actor, index = pending.pop(ref)
+        tag = pending.pop(ref)
         try:
-            results = _get(ref)
+            result = _get(ref)
         except ray.exceptions.RayTaskError:
-            raise                           # the worker's own error: a bug, not a fault
+            raise                           # the work's own error: a bug, not a fault
         except ray.exceptions.RayError as exc:
-            _count_failure(failures, index, "batch", exc)
-            queue.appendleft(index)
-        else:
-            yield index, results
-        submit(actor)
+            failures[tag[0]] += 1
+            if failures[tag[0]] >= MAX_ATTEMPTS:
+                raise BatchFailed(f"{what} {tag[0]} failed {MAX_ATTEMPTS} times on Ray: its "
+                                  f"worker's process was lost each time ({type(exc).__name__}; "
+                                  f"out of memory, or a crash in the GL driver?)") from exc
+            again(tag)
+            continue
+        yield tag, result
 
 
 def _get(ref):
@@ -233,13 +247,6 @@ def _get(ref):
         if isinstance(exc.cause, UserError):
             raise exc.cause from None
         raise
-
-
-def _count_failure(failures: Counter, index: int, what: str, exc: BaseException) -> None:
-    failures[index] += 1
-    if failures[index] >= MAX_ATTEMPTS:
-        raise BatchFailed(f"{what} {index} failed {MAX_ATTEMPTS} times on Ray; the last "
-                          f"error: {type(exc).__name__}") from exc
 
 
 def _workers_for(resources: dict, asked: int | None) -> tuple[int, bool]:

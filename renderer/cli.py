@@ -238,6 +238,13 @@ def build_parser() -> argparse.ArgumentParser:
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
                         "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
+    report.add_argument("--address", metavar="auto|HOST:PORT",
+                        help="run the settings on a running Ray cluster's workers (auto: the one "
+                             "`ray start` made on this machine); default: this process. results.csv "
+                             "is the same apart from the times and the `worker` that took them")
+    report.add_argument("--workers", type=positive_int, metavar="N",
+                        help="run the settings on N Ray workers (default with --address: one per "
+                             "CPU); without --address, on a local Ray started for this report")
 
     batch = sub.add_parser(
         "batch", help="render a job file's items (scenes x cameras x sweeps x settings) into a "
@@ -817,7 +824,8 @@ def cmd_report(args) -> int:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")
     result = run_report(scenes, args.out, method=args.method, quick=args.quick, size=args.size,
-                        cache_dir=args.cache, context_kind=args.context, knobs=args.knobs)
+                        cache_dir=args.cache, context_kind=args.context, knobs=args.knobs,
+                        address=args.address, workers=args.workers)
     print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "
           f"{len(result.files) - 2} plots in {result.seconds:.0f} s")
     return 0

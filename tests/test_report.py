@@ -126,6 +126,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     (("sphere", "--knobs", "shading,shadow"), "--knobs: shadow: no such knob for --method raster"),
     (("sphere", "--method", "raytrace", "--knobs", "shadows"),
      "--knobs: shadows: no such knob for --method raytrace"),
+    (("sphere", "--address", "127.0.0.1:1"), "--address: no Ray head answers at 127.0.0.1:1"),
 ])
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_here):
     out = tmp_path / "report"

@@ -19,6 +19,7 @@ compared with. A frame at a time bounds the memory (the reference holds a frame'
     truth_scene(scene)                              the scene as the rasteriser's truth draws it
     ground_truth(scene, 160, 120, cache_dir)        ((120, 160, 3) float64 in [0, 1], cache hit?)
     ground_truth(scene, 160, 120, cache_dir, method="raytrace")     the ray tracer's
+    ground_truths(scenes, 160, 120, cache_dir, tasks=executor.tasks)  several, the misses elsewhere
 """
 
 from __future__ import annotations
@@ -136,14 +137,29 @@ def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     return clamped(total / RAY_TRUTH_PASSES)
 
 
+def render_ground_truth(scene: Scene, width: int, height: int, method: str = "raster") -> np.ndarray:
+    """The truth of `method` rendered now, uncached (a plain function: a task elsewhere)."""
+    return (render_truth if method == "raster" else render_ray_truth)(scene, width, height)
+
+
+def ground_truths(scenes: list, width: int, height: int, cache_dir, method: str = "raster",
+                  tasks=None) -> list[tuple[np.ndarray, bool]]:
+    """ground_truth of each of `scenes`; the misses rendered through `tasks(function, args)`
+    ((index, result) pairs in any order: an executor's, renderer/cluster/executor.py, which may
+    render them elsewhere, at once; default here, one after another) and stored here."""
+    paths = [cache_path(scene, width, height, cache_dir, method) for scene in scenes]
+    truths = [(np.load(path), True) if path.is_file() else None for path in paths]
+    missing = [index for index, truth in enumerate(truths) if truth is None]
+    tasks = tasks or (lambda function, args: enumerate(function(*a) for a in args))
+    for k, truth in tasks(render_ground_truth, [(scenes[i], width, height, method) for i in missing]):
+        write_npy(paths[missing[k]], truth)
+        truths[missing[k]] = (truth, False)
+    return truths
+
+
 def ground_truth(scene: Scene, width: int, height: int, cache_dir,
                  method: str = "raster") -> tuple[np.ndarray, bool]:
     """(truth (H, W, 3) float64, whether it came from the cache) of `method` ("raster" or
     "raytrace"). A miss renders it and stores it atomically under `cache_dir`, named after
     the scene, size and content hash."""
-    path = cache_path(scene, width, height, cache_dir, method)
-    if path.is_file():
-        return np.load(path), True
-    truth = (render_truth if method == "raster" else render_ray_truth)(scene, width, height)
-    write_npy(path, truth)
-    return truth, False
+    return ground_truths([scene], width, height, cache_dir, method)[0]

@@ -39,7 +39,7 @@ from renderer.core.scene import Plane, Sphere
 from renderer.study.distributed_report import (distributed_settings,
                                                settings_for_scene)
 from renderer.study.metrics import metrics
-from renderer.study.ground_truth import (RAY_TRUTH_DEPTH, RAY_TRUTH_SAMPLES, ground_truth)
+from renderer.study.ground_truth import RAY_TRUTH_DEPTH, RAY_TRUTH_SAMPLES
 from renderer.study.report_settings import (RAY_BASE_SAMPLES, RAY_CSV_COLUMNS, RAY_DEFAULT_SIZE,
                                             RAY_MAX_SIZE, RAY_QUICK_SIZE)
 from renderer.study.supersample import clamped
@@ -176,9 +176,6 @@ class RayStudy:
 
     def needs_truth(self, plan: list[RaySetting]) -> bool:
         return bool(plan)
-
-    def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
-        return ground_truth(scene, width, height, cache_dir, method="raytrace")
 
     def describe(self, scene) -> tuple:
         """The Scenes table's cells: spheres, planes, triangles, whether some material reflects

@@ -32,6 +32,8 @@ has finished, each atomically.
 run_report drives a study: RasterStudy, this sweep, or (method="raytrace") renderer/study/
 ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, with the same
 metrics, plots and tables. `knobs` (the command's --knobs) keeps only some knob families.
+The rows run in this process or on Ray workers (--address, --workers: renderer/study/
+report_units.py), with the same results.csv but for the times and the `worker` that took them.
 """
 
 from __future__ import annotations
@@ -47,11 +49,13 @@ import numpy as np
 from renderer.core import sampling
 from renderer.core.shadow_settings import BIAS_RULES, FILTERS
 from renderer.study.report_output import csv_text, plot_png, report_markdown
-from renderer.study.ground_truth import MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir, ground_truth, truth_scene
+from renderer.study.ground_truth import (MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir,
+                                         ground_truths, truth_scene)
 from renderer.core.imageio import outputs
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
 from renderer.study.metrics import metrics
+from renderer.study.report_units import SceneWork, gl_facts, run_units
 from renderer.study import output_report
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, QUICK_SIZE,
                                             SHADOW_RESOLUTIONS)
@@ -264,9 +268,6 @@ class RasterStudy:
         output knob's)."""
         return any(s.variant[0] not in ("shadow", output_report.KNOB) for s in plan)
 
-    def truth(self, scene, width: int, height: int, cache_dir) -> tuple[np.ndarray, bool]:
-        return ground_truth(scene, width, height, cache_dir)
-
     def describe(self, scene) -> tuple:
         """The Scenes table's cells: triangles as authored, at the finest tessellation; the
         textures as authored."""
@@ -299,16 +300,20 @@ class ReportResult:
     gl_renderer: str = ""
     files: list = field(default_factory=list)
     knobs: tuple = ()                                 # the families swept, when not all
+    where: str = "in this process"                    # the executor's describe()
 
 
 def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool = False,
                size=None, cache_dir=None, context_kind: str = "auto", sweep=None,
-               knobs=None) -> ReportResult:
+               knobs=None, address: str | None = None, workers: int | None = None) -> ReportResult:
     """Sweep `scenes` (Scene objects) with `method`'s study (study()), write results.csv,
     plots/ and report.md under `out`. `knobs`: the knob families to sweep (default all of the
-    study's `knobs`; a setting's family is its knob up to a "-")."""
+    study's `knobs`; a setting's family is its knob up to a "-"). `address`, `workers`: the
+    settings and the ground truths missing from the cache run on Ray (renderer/cluster/
+    executor.py open_executor; report_units.py), else in this process; the cache is here."""
     from tqdm import tqdm
 
+    from renderer.cluster.executor import open_executor
     from renderer.errors import UserError
     from renderer.gpu.context import make_context, release_context
     runner = study(method)
@@ -323,35 +328,33 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     sweep = sweep or runner.sweep(quick)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
     start = time.perf_counter()
-    ctx = make_context(context_kind)
-    try:
-        result.gl_renderer = ctx.info["GL_RENDERER"]
-        plan = [s for s in runner.settings(sweep, ctx) if s.knob.split("-")[0] in knobs]
+    # An --address nobody answers is one line before any work (open_executor checks it).
+    with open_executor(address, workers, use_ray=address is not None or workers is not None) \
+            as executor:
+        result.where = executor.describe()
+        ctx = make_context(context_kind)            # the plan's GL facts: the workers' must match
+        try:
+            result.gl_renderer = ctx.info["GL_RENDERER"]
+            facts = gl_facts(ctx)
+            plan = [s for s in runner.settings(sweep, ctx) if s.knob.split("-")[0] in knobs]
+        finally:
+            release_context(ctx)
         plans = [runner.scene_settings(plan, scene, width, height) for scene in scenes]
+        result.scenes = {scene.name: runner.describe(scene) for scene in scenes}
+        traced = [i for i, scene_plan in enumerate(plans) if runner.needs_truth(scene_plan)]
+        truths = [None] * len(scenes)
         with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
                   mininterval=0.5, dynamic_ncols=True) as bar:
-            for scene, scene_plan in zip(scenes, plans):
-                truth = None
-                if runner.needs_truth(scene_plan):
-                    bar.set_description(f"{scene.name}: ground truth")
-                    truth, hit = runner.truth(scene, width, height, cache_dir)
-                    result.truth_hits += hit
-                result.scenes[scene.name] = runner.describe(scene)
-                bar.update()
-                run = runner.scene_run(scene, width, height, ctx)
-                try:
-                    for setting in scene_plan:
-                        bar.set_description(f"{scene.name}: {setting.knob} {setting.setting} "
-                                            f"({setting.backend})")
-                        image, samples, ms = run.timed(setting, sweep.runs)
-                        result.rows.append({
-                            "scene": scene.name, **setting.columns(), "samples": samples,
-                            "runs": sweep.runs, "median_ms": ms, **run.errors(setting, image, truth)})
-                        bar.update()
-                finally:
-                    run.release()
-    finally:
-        release_context(ctx)
+            bar.set_description("ground truths")
+            for i, (truth, hit) in zip(traced, ground_truths(
+                    [scenes[i] for i in traced], width, height, cache_dir, runner.method,
+                    tasks=executor.tasks)):
+                truths[i] = truth
+                result.truth_hits += hit
+            bar.update(len(scenes))
+            work = [SceneWork(i, scene, tuple(plans[i]), truths[i]) for i, scene in enumerate(scenes)]
+            result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
+                                    context_kind, bar)
     result.seconds = time.perf_counter() - start
     write_outputs(result, Path(out), runner, (width, height), sweep, quick)
     return result

@@ -222,8 +222,9 @@ def generated_line(result, size, runs: int, command: str) -> str:
             f"{width}x{height} pixels on {platform.machine()} with {os.cpu_count()} CPUs, GL "
             f"renderer `{result.gl_renderer}`; {scenes} scene(s), {len(result.rows)} rows, "
             f"{result.seconds / 60:.1f} minutes ({result.truth_hits} ground truth(s) from the "
-            f"cache). Every time is the median of {runs} runs of the whole setting (all its "
-            "passes); `results.csv` has every figure.")
+            f"cache). Where the settings ran: {result.where}. Every time is the median of {runs} "
+            "runs of the whole setting (all its passes) in the process named in the `worker` "
+            "column of `results.csv`, which has every figure.")
 
 
 def errors_bullet() -> str:

@@ -19,8 +19,10 @@ SHADOW_COLUMNS = ("wrong_outside_band_fraction", "wrong_fraction", "acne_pixels"
 # The output knob's (renderer/study/output_report.py): against the linear frame, not the truth.
 OUTPUT_COLUMNS = ("method", "bits", "block_mean_abs", "block_p95_abs", "block_max_abs",
                   "block_bias", "lowpass_psnr")
+# `worker` (host:pid) names the process that timed the row: the report may run on several
+# (renderer/study/report_units.py), and only the times depend on where a row ran.
 CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "runs", "median_ms",
-               "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction", *SHADOW_COLUMNS,
+               "worker", "rmse", "max_abs", "psnr", "flip_mean", "mismatched_fraction", *SHADOW_COLUMNS,
                *OUTPUT_COLUMNS)
 
 
@@ -61,7 +63,7 @@ RAY_QUICK_SCENES = ("classic",)
 RAY_MAX_SIZE = (320, 240)            # its ground truth traces 1024 rays per pixel in float64
 RAY_BASE_SAMPLES = 16                # jittered, for the knobs other than antialiasing
 RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "light_samples",
-                   "max_depth", "threshold", "runs", "median_ms", "rmse", "max_abs", "psnr", "flip_mean",
+                   "max_depth", "threshold", "runs", "median_ms", "worker", "rmse", "max_abs", "psnr", "flip_mean",
                    "mismatched_fraction")
 RAY_TEXTBOOK_SLOPES = TEXTBOOK_SLOPES | {
     "adaptive": ("none", "N is the mean traced: samples 5..N only where the first 4 disagree "

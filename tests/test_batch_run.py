@@ -92,6 +92,22 @@ def rerun(job, out, say=lambda line: None, **options):
     return batch_run.run_job(job, out, WarmExecutor(), progress=False, say=say, **options)
 
 
+def test_a_finished_job_run_again_renders_nothing_and_starts_no_workers(job, finished, tmp_path, monkeypatch):
+    out = copy(finished, tmp_path)
+    before = hashes(out)
+
+    def no_workers(*args, **kwargs):
+        raise AssertionError("a finished job opened an executor")
+
+    monkeypatch.setattr(executor, "open_executor", no_workers)
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        status = main(["batch", job.path, "--out", str(out)])
+    assert (status, err.getvalue()) == (0, "renderer batch: 4 items: all already complete, "
+                                           "nothing to render\n")
+    assert hashes(out) == before
+
+
 def copy(finished, tmp_path):
     shutil.copytree(finished[2], tmp_path / "out")
     return tmp_path / "out"

@@ -96,12 +96,14 @@ class Summary:
     workers: dict[str, list] = field(default_factory=dict)
 
     def lines(self) -> list[str]:
+        if self.skipped == self.items:
+            return [f"batch: {self.items} items: all already complete, nothing to render"]
         rate = self.done / self.seconds if self.seconds > 0 else 0.0
         lines = [f"batch: {self.items} items: {self.done} rendered, {self.skipped} already "
                  f"complete, {len(self.failed)} failed, in {self.seconds:.1f} s "
                  f"({rate:.1f} items/s; {self.where})"]
         for label, (count, busy_ms) in sorted(self.workers.items()):
-            lines.append(f"  worker {label}: {count} items, "
+            lines.append(f"batch: worker {label}: {count} items, "
                          f"{count / (busy_ms / 1000.0) if busy_ms > 0 else 0.0:.1f} items/s busy")
         return lines
 

@@ -1,9 +1,9 @@
 """The command line as a user types it.
 
 Which cases run where: tests that start `python -m renderer` (the `cli` fixture, about 1.3 s
-each) are in the default run where the process is what they hold; the two whose path another
-test holds in the default run are the full run's (--all), each marked with the test that
-holds it."""
+each) are in the default run where the process is what they hold; the three whose path other
+tests hold in the default run are the full run's (--all), each marked with the tests that
+hold it."""
 
 import json
 import re
@@ -50,6 +50,12 @@ def test_render_says_where_it_wrote_on_stderr_unless_quiet(tmp_path, capsys, mon
         assert (tmp_path / "sphere.png").exists()
 
 
+# The full run's (--all), about 1.5 s: in the default run `renderer compare` with a real GPU
+# frame runs in this process in tests/test_raytrace_trace.py
+# (test_command_line_ray_traces_and_compares) and tests/test_compare_methods.py (OSMesa), its
+# figures and three images in test_compare_exits_1_when_the_pipeline_tolerance_fails below and
+# tests/test_json_outputs.py, and a command in a process of its own in the first test above.
+@pytest.mark.slow
 def test_compare_prints_the_figures_and_writes_three_images(tmp_path, cli):
     result = cli("compare", "sphere", "--size", "80x60", "--context", "osmesa", "--out", str(tmp_path))
     assert result.returncode == 0, result.stderr
@@ -118,9 +124,11 @@ def test_an_argument_error_names_the_program_once_then_gives_the_usage(argv, rea
     assert list(tmp_path.iterdir()) == []
 
 
-# The default run holds this in a process of its own too, with more asserted (one line,
-# nothing written): tests/test_scene_file.py,
-# test_cli_unknown_scene_name_exits_2_and_lists_builtins.
+# The full run's, like tests/test_scene_file.py's
+# test_cli_unknown_scene_name_exits_2_and_lists_builtins (this in a process, with more
+# asserted); the default run holds the refusal through renderer.cli.main there
+# (test_load_scene_unknown_name_is_the_command_lines_line) and a refusal in a process of its
+# own in tests/test_refusals.py.
 @pytest.mark.slow
 def test_unknown_scene_names_the_built_in_ones(tmp_path, cli):
     result = cli("render", "no_such_scene", "-o", str(tmp_path / "x.png"))

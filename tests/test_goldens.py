@@ -62,9 +62,15 @@ RENDERED = raster_scene_params(VARIANTS, IDS)       # the ray-tracing scenes' in
 # (NOT_REFERENCE_CHECKED_BY_DEFAULT: sphere's Phong sphere under a directional and a point
 # light is coloured_lights' too; gouraud_vs_phong and flat_shading are made for the modes that
 # tests/test_shadow_shading.py holds to the reference in the default run, on scenes made for
-# it). The full run (--all) holds every golden, every mode, both ways.
+# it; hierarchy, which tests/test_supersample.py holds GPU against reference in the default
+# run, every shading variant and both kinds of shadow map; open_mesh_inside, whose one- and
+# two-sided lighting tests/test_shadow_shading.py holds GPU against reference in each mode;
+# mesh_file, whose meshes are renderer.core's loaders' triangles, the same for both paths, read
+# by hand in tests/test_meshio.py). The full run (--all) holds every golden, every mode, both
+# ways.
 DEFAULT_MODES = ("phong", AS_AUTHORED)
-NOT_REFERENCE_CHECKED_BY_DEFAULT = SHADOW_SCENES | {"sphere", "gouraud_vs_phong", "flat_shading"}
+NOT_REFERENCE_CHECKED_BY_DEFAULT = SHADOW_SCENES | {"sphere", "gouraud_vs_phong", "flat_shading",
+                                                    "hierarchy", "open_mesh_inside", "mesh_file"}
 GPU_CHECKED = [pytest.param(*p.values, id=p.id, marks=[*p.marks, *(
     [] if p.values[1] in DEFAULT_MODES else [pytest.mark.slow])]) for p in RENDERED]
 REFERENCE_CHECKED = [pytest.param(*p.values, id=p.id, marks=[*p.marks, *(

@@ -29,7 +29,8 @@ def scene_named(name):
 # on EGL, and shadow_room (a point light's six cube faces) on OSMesa too (EGL and
 # OSMesa are the same llvmpipe and draw the same bits); every other rasteriser scene is held to
 # the reference in the default run through its goldens (the GPU's image is its golden exactly,
-# and the golden matches the reference: tests/test_goldens.py). The full run (--all) adds
+# and the golden matches the reference: tests/test_goldens.py, which says which scenes it leaves
+# to other tests, e.g. hierarchy to tests/test_supersample.py). The full run (--all) adds
 # every scene at 320x240 and 640x480 on both contexts, the ray tracer's too.
 OSMESA_DEFAULT_RUN_SCENE = "shadow_room"
 CASES = [pytest.param(name, size, kind, id=f"{name}-{size[0]}x{size[1]}-{kind}",

@@ -7,7 +7,12 @@ pixels after the +-1 px allowance and raw mismatch <= 0.1 %, depth within 1e-3 r
 
 The rule at 320x240 on EGL and OSMesa, 1 and 4 samples per pixel (regular pattern), is the
 full run's (each reference frame traced once per scene and sample count: conftest's
-traced_references); the default run holds each scene at 64x48, 1 sample, on EGL.
+traced_references); the default run holds each scene at 64x48, 1 sample, on EGL, but
+mesh_shadow (its GPU tracer alone takes 0.6 s, the knot's BVH): the default run holds a mesh
+casting shadows GPU against reference in tests/test_raytrace_trace.py (shapes' icosphere above
+spheres and a floor, a mesh ball, EGL and OSMesa), the GLSL BVH traversal against its twin on
+5,120 triangles (tests/test_raytrace_bvh.py), the knot's shadow by hand below and mesh_shadow's
+GPU frame bit for bit against its golden (tests/test_goldens.py).
 """
 
 import tomllib
@@ -176,7 +181,8 @@ def test_the_bubble_reflects_totally_beyond_the_critical_angle(traced_references
 
 # --------------------------------------------------------------------------- GPU against reference
 
-@pytest.mark.parametrize("name", SCENES)
+@pytest.mark.parametrize("name", [pytest.param(name, marks=[pytest.mark.slow] if name == "mesh_shadow"
+                                                else []) for name in SCENES])
 def test_gpu_ray_tracer_matches_the_reference_small(name, gl_contexts, traced_references):
     """The default run's check: 64x48, 1 sample, EGL."""
     from renderer.gpu.raytracer import RayTracer

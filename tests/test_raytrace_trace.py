@@ -150,7 +150,10 @@ def assert_within_tolerance(result, reference):
     assert PIPELINE_TOLERANCE.passes(comparison), PIPELINE_TOLERANCE.failures(comparison)
 
 
-@pytest.mark.parametrize("name,samples", [("shapes", 1), ("shapes", 4), ("mesh", 4)])
+# shapes at 1 sample is the full run's (--all): the same scene at 4 jittered samples stays, and
+# one sample a pixel is held on every ray-traced built-in scene (tests/test_raytrace_scenes.py).
+@pytest.mark.parametrize("name,samples", [pytest.param("shapes", 1, marks=pytest.mark.slow),
+                                          ("shapes", 4), ("mesh", 4)])
 def test_gpu_ray_tracer_against_the_reference(gl_contexts, name, samples):
     from renderer.gpu.raytracer import RayTracer
     s = scene_from_dict(SHAPES if name == "shapes" else MESH)

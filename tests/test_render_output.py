@@ -30,8 +30,12 @@ def reference_linear():
     return frame.linear
 
 
-@pytest.mark.parametrize("backend", ["gpu", "reference"])
-@pytest.mark.parametrize("background", ["opaque", "transparent"])
+# The default run takes each backend and each background once (opaque on the GPU, transparent
+# through the reference); the other two pairings are the full run's (--all).
+@pytest.mark.parametrize("background, backend", [
+    pytest.param(background, backend, id=f"{background}-{backend}", marks=[] if (background, backend) in (
+        ("opaque", "gpu"), ("transparent", "reference")) else [pytest.mark.slow])
+    for background in ("opaque", "transparent") for backend in ("gpu", "reference")])
 def test_linear_8_bits_writes_the_pixels_render_always_wrote(backend, background, tmp_path, cli_here):
     """Without output options a render writes the frame's rgba8 (GL's unorm8 conversion);
     the stage at --transfer linear --bits 8 is that same conversion (renderer/core/quantise.py)."""

@@ -92,8 +92,11 @@ def inside_clip_volume(clip):
     return (w > 0) & (np.abs(clip[:, :3]) <= w[:, None]).all(axis=1)
 
 
+# The second size is the full run's (--all): both are 4:3, so the projection, and with it
+# every clip coordinate checked, is the first size's.
 @pytest.mark.parametrize("name", sorted(BUILTIN_NAMES))
-@pytest.mark.parametrize("size", IMAGE_SIZES)
+@pytest.mark.parametrize("size", [pytest.param(size, marks=[pytest.mark.slow] if index else [])
+                                  for index, size in enumerate(IMAGE_SIZES)])
 def test_every_object_of_a_builtin_scene_is_in_view(name, size):
     scene = load_scene(builtin_scenes()[name])
     shapes = {obj.name: obj.shape for obj in scene.objects}
@@ -896,9 +899,8 @@ RENDER_SMALL = ("--backend", "reference", "--size", "32x24")      # `renderer re
 
 
 # The first case in a process of its own is the full run's (--all): in the default run a
-# refusal in a real process is held by test_cli_unknown_scene_name_exits_2_and_lists_builtins
-# below and by tests/test_refusals.py (a corrupt mesh file), and a TOML syntax error's line by
-# test_toml_syntax_error_names_the_line above.
+# refusal in a real process is held by tests/test_refusals.py (a corrupt mesh file), and a
+# TOML syntax error's line by test_toml_syntax_error_names_the_line above.
 @pytest.mark.parametrize("text, expected", [
     pytest.param(*case[1:], id=case[0], marks=[pytest.mark.slow] if index == 0 else [])
     for index, case in enumerate(CLI_CASES)])
@@ -994,6 +996,11 @@ material = "one"
     assert box_one is one and scene.objects[1].material.kd == (0.5, 0.5, 0.5)
 
 
+# The full run's (--all), about 1.2 s: the default run holds the same refusal through
+# renderer.cli.main (test_load_scene_unknown_name_is_the_command_lines_line: exactly that one
+# line, status 2, the built-in names listed) and a refusal in a process of its own
+# (tests/test_refusals.py, a corrupt mesh file: one line, status 2, no traceback).
+@pytest.mark.slow
 def test_cli_unknown_scene_name_exits_2_and_lists_builtins(tmp_path, cli):
     out_png = tmp_path / "out.png"
     result = cli("render", "no_such_scene", "-o", out_png, *RENDER_SMALL, cwd=REPO)

@@ -17,7 +17,7 @@ Fixtures: `gl_contexts` (one EGL and one OSMesa context for the session), `x_dis
 `on_x_display` (Xvfb), `cli` (the command line in a new process), `gpu_stand_in` (the command
 line's GPU frames replaced, in this process), `reference_frames` (NumPy reference frames,
 each rendered once per test run), `traced_references` (the NumPy ray tracer's frames of the
-built-in scenes, likewise) and `ray_executor` (a local Ray for the test module; a test using it
+built-in scenes, likewise) and `ray_executor` (the run's one local Ray, for a test module; a test using it
 is marked slow and put in the xdist group "ray").
 """
 
@@ -229,30 +229,40 @@ def cli_here(monkeypatch):
 
 # -- Ray ----------------------------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
-def ray_executor(request):
-    """ray_executor(workers=RAY_TEST_CPUS): a RayExecutor on the test module's own local Ray,
-    started once for the module (~4 s, ~630 MiB) and stopped after its last test; each
-    executor's close() leaves that Ray running. `ray_executor.address` is its HOST:PORT, for
-    a command line in another process (`--address`). The test module's own classes and
-    functions travel to the actors by value (a Ray worker process cannot import a test
-    module). Tests using it are marked slow (pytest_itemcollected). Ray is imported here,
-    never at the top of this file: `import ray` alone takes ~0.6 s."""
-    import ray
-    from renderer.cluster.ray_executor import LocalRay, RayExecutor
-
+@pytest.fixture(scope="session")
+def _local_ray():
+    """One local Ray for the whole run (~4 s and ~630 MiB to start, ~1.4 s to stop): every
+    test that uses it is in one xdist group (pytest_itemcollected), so one process holds it."""
+    from renderer.cluster.ray_executor import LocalRay
     local = LocalRay(RAY_TEST_CPUS)
+    try:
+        yield local
+    finally:
+        local.stop()
+
+
+@pytest.fixture(scope="module")
+def ray_executor(request, _local_ray):
+    """ray_executor(workers=RAY_TEST_CPUS): a RayExecutor on the run's local Ray (_local_ray),
+    started once and stopped after the last test that uses it; each executor's close() leaves
+    that Ray running. `ray_executor.address` is its HOST:PORT, for a command line in another
+    process (`--address`). The test module's own classes and functions travel to the actors
+    by value (a Ray worker process cannot import a test module). Tests using it are marked
+    slow (pytest_itemcollected). Ray is imported here, never at the top of this file: `import
+    ray` alone takes ~0.6 s."""
+    import ray
+    from renderer.cluster.ray_executor import RayExecutor
+
     ray.cloudpickle.register_pickle_by_value(request.module)
 
     def executor(workers: int = RAY_TEST_CPUS) -> RayExecutor:
         return RayExecutor(workers=workers)
 
-    executor.address = local.address
+    executor.address = _local_ray.address
     try:
         yield executor
     finally:
         ray.cloudpickle.unregister_pickle_by_value(request.module)
-        local.stop()
 
 
 # -- reference frames ---------------------------------------------------------------------------

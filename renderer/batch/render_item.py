@@ -21,8 +21,6 @@ from __future__ import annotations
 
 import hashlib
 import io
-import os
-import socket
 import time
 import traceback
 from collections import OrderedDict
@@ -31,6 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from renderer.batch.items import Item, Output, SceneSource, Setting
+from renderer.cluster.executor import worker_identity
 from renderer.core import image_formats
 from renderer.core.motion import moves
 from renderer.core.output_settings import INTEGER_FORMATS
@@ -135,7 +134,7 @@ class ItemWorker:
         """Where items run: host, pid and, once the context exists, its GL renderer."""
         if self._where is None or self._where["gl_renderer"] is None:
             gl = None if self.ctx is None else self.ctx.info["GL_RENDERER"]
-            self._where = {"host": socket.gethostname(), "pid": os.getpid(), "gl_renderer": gl}
+            self._where = worker_identity() | {"gl_renderer": gl}
         return self._where
 
     def _context(self):

@@ -34,7 +34,7 @@ from renderer.batch.items import ITEMS_FOLDER, Item, Job, expand, job_identity
 from renderer.batch.manifest import MANIFEST, Manifest, Resume, header_for, read_manifest
 from renderer.batch.job_file import check_memory
 from renderer.batch.render_item import ItemResult, ItemWorker, item_scene, load_source, reference_item
-from renderer.cluster.executor import batch_size, batches_of
+from renderer.cluster.executor import batch_size, batches_of, worker_label
 from renderer.core.imageio import check_folder, check_outputs, outputs
 
 COMPARE_FILES = ("gpu.png", "reference.png", "diff.png")
@@ -142,7 +142,7 @@ class _Writer:
                 written.bytes(self.out / path, data)
         self.manifest.append(_record(item, result, files, compare))
         self.summary.done += 1
-        label = f"{result.worker.get('host')}/{result.worker.get('pid')}"
+        label = worker_label(result.worker)
         counts = self.summary.workers.setdefault(label, [0, 0.0])
         counts[0] += 1
         counts[1] += result.render_ms + result.encode_ms

@@ -25,6 +25,8 @@ so a killed worker leaves nothing half-written anywhere.
 from __future__ import annotations
 
 import math
+import os
+import socket
 import sys
 from typing import Any, Callable, Iterable, Iterator, Protocol
 
@@ -44,6 +46,16 @@ def batch_size(item_seconds: float, items: int, workers: int) -> int:
     by_time = round(TARGET_BATCH_SECONDS / item_seconds) if item_seconds > 0 else MAX_BATCH
     by_balance = math.ceil(items / (BATCHES_PER_WORKER * max(workers, 1)))
     return max(1, min(by_time, MAX_BATCH, by_balance))
+
+
+def worker_identity() -> dict:
+    """This process as a worker, for the records and rows it returns: {"host", "pid"}."""
+    return {"host": socket.gethostname(), "pid": os.getpid()}
+
+
+def worker_label(identity: dict) -> str:
+    """A worker's identity written as HOST:PID (results.csv's `worker`, batch's summary)."""
+    return f"{identity.get('host')}:{identity.get('pid')}"
 
 
 def batches_of(units: list, size: int) -> list[list]:

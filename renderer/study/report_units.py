@@ -20,15 +20,13 @@ while the others compete for its cores).
 
 from __future__ import annotations
 
-import os
-import socket
 from collections import OrderedDict
 from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
-from renderer.cluster.executor import BATCHES_PER_WORKER
+from renderer.cluster.executor import BATCHES_PER_WORKER, worker_identity, worker_label
 from renderer.errors import UserError
 
 CACHED_SCENES = 2           # SceneRuns a worker keeps (each holds a renderer per drawn variant)
@@ -110,7 +108,7 @@ class ReportWorker:
         self.runner, self.size, self.context_kind = runner, size, context_kind
         self.ctx, self.facts = None, None
         self.runs: OrderedDict[int, object] = OrderedDict()
-        self.name = f"{socket.gethostname()}:{os.getpid()}"
+        self.name = worker_label(worker_identity())
 
     def scene_run(self, batch: ReportBatch):
         if batch.scene_index not in self.runs:

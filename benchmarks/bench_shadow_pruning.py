@@ -1,13 +1,15 @@
 """What leaving out the shadow work a scene does not need saves, printed (issue 15).
 
     .venv/bin/python benchmarks/bench_shadow_pruning.py [--size 640x480] [--rounds 15]
-        [--scenes classic,cornell_box,hierarchy,sphere,point_light_plane,shadow_plane,shadow_room]
-        [--context egl]
+        [--scenes every built-in scene by default] [--context egl]
 
-renderer/core/shadows.py plans each frame's shadow passes: a caster that cannot shadow any
-receiver (a convex shape or a planar mesh alone, a floor with everything on its lit side:
-`can_shadow`) is not drawn into a map, a cube face that sees no caster or no receiver is not
-drawn at all (its lookups read as lit), and a light whose map would hold nothing draws no pass.
+renderer/core/shadows.py plans each frame's shadow passes by the pair rule of
+renderer/core/shadow_casting.py: a caster that cannot shadow any receiver (a convex solid lit
+from outside, or around its lamp; a planar mesh with everything on its lit side; a caster
+whose box across a directional light misses every receiver's) is not drawn into a map, a
+cube face whose frustum holds no caster-receiver pair is not drawn at all (its lookups read
+as lit), a light with no pair draws no pass, and a light that no caster can ever shadow gets
+no map at all (the scene's programs then have no shadow code: "none" below).
 For each scene two renderers are timed in turn, round after round (both see the same load):
 GpuRenderer as it is, and GpuRenderer(prune_shadows=False), which draws every caster into
 every map and cube face. Both read back colour and depth as render() does. Without pruning a
@@ -19,21 +21,25 @@ Not a test: this machine is shared and noisy.
 
 from __future__ import annotations
 
+from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context, release_context
 from renderer.gpu.pipeline import GpuRenderer
 
 from common import alternating_ms, machine, parser       # benchmarks/common.py
 
-SCENES = "classic,cornell_box,hierarchy,sphere,point_light_plane,shadow_plane,shadow_room"
+SCENES = ",".join(sorted(builtin_scenes()))
 
 
-def work(gpu: GpuRenderer) -> tuple[int, int]:
-    """(passes, caster draws) of the shadow plan the renderer's last frame drew."""
+def work(gpu: GpuRenderer) -> str:
+    """"passes, caster draws" of the shadow plan the renderer's last frame drew ("none": the
+    scene has no maps at all)."""
+    if gpu.shadow_maps is None:
+        return "none"
     plan = gpu.drawn_shadow_plan
     if plan is None:
-        return 0, 0
-    return len(plan.passes), sum(len(p.casters) for p in plan.passes)
+        return "0, 0"
+    return f"{len(plan.passes)}, {sum(len(p.casters) for p in plan.passes)}"
 
 
 def main() -> None:
@@ -44,7 +50,7 @@ def main() -> None:
     print(f"Shadow pruning at {width}x{height}, median of {args.rounds} frames each, in turn")
     ctx = make_context(args.context)
     print(f"{machine()}; {ctx.info['GL_RENDERER']} ({args.context})")
-    print(f"{'scene':<14} {'passes, draws (pruned)':>23} {'(all)':>9} {'pruned ms':>10} "
+    print(f"{'scene':<16} {'passes, draws (pruned)':>23} {'(all)':>9} {'pruned ms':>10} "
           f"{'all ms':>8} {'saved':>7}")
     try:
         for name in args.scenes.split(","):
@@ -54,8 +60,8 @@ def main() -> None:
                 frames = [pruned.render(), full.render()]
                 calls = [lambda: pruned.render(out=frames[0]), lambda: full.render(out=frames[1])]
                 ms_pruned, ms_full = alternating_ms(calls, args.rounds)
-                (p0, d0), (p1, d1) = work(pruned), work(full)
-            print(f"{name:<14} {f'{p0}, {d0}':>23} {f'{p1}, {d1}':>9} {ms_pruned:>10.1f} "
+                drawn = work(pruned), work(full)
+            print(f"{name:<16} {drawn[0]:>23} {drawn[1]:>9} {ms_pruned:>10.1f} "
                   f"{ms_full:>8.1f} {1 - ms_pruned / ms_full:>7.0%}")
     finally:
         release_context(ctx)

@@ -400,10 +400,17 @@ def test_shadow_case_shows_a_shadow(name, gl_contexts):
     assert (shadowed <= lit + 1).all()
 
 
-def test_a_point_light_at_the_centre_of_a_box_draws_all_six_faces():
+def test_a_point_light_at_the_centre_of_a_box_draws_the_faces_that_hold_a_caster():
+    """The box is a convex solid around the light: it shadows nothing in it and is in no map
+    (renderer/core/shadow_casting.py); the faces that see the ball or the block are drawn,
+    the +z face (only the box there) is not. Unpruned, every face is drawn, the box in each."""
     scene = extreme_scene("shadow_point_in_box")
     plan = plan_shadows(scene, scene.matrices(*SIZE), shadow_layout(scene, *SIZE))
-    assert sorted(p.face for p in plan.passes) == [0, 1, 2, 3, 4, 5]
+    assert sorted(p.face for p in plan.passes) == [0, 1, 2, 3, 5]
+    assert all(0 not in p.casters for p in plan.passes)
+    everything = plan_shadows(scene, scene.matrices(*SIZE), shadow_layout(scene, *SIZE), prune=False)
+    assert sorted(p.face for p in everything.passes) == [0, 1, 2, 3, 4, 5]
+    assert all(0 in p.casters for p in everything.passes)
 
 
 def test_a_light_inside_a_closed_mesh_lights_nothing_outside_it(gl_contexts):

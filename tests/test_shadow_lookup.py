@@ -211,7 +211,7 @@ def tilted_plane_scene(theta_degrees: float, filter_name: str, bias: BiasRule | 
 def self_lookup(scene, dtype):
     """The plane looked up in its own map at 400 points of its inner 90%: ShadowLookup."""
     matrices = scene.matrices(64, 48)
-    plan = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48), prune=False)  # draw the plane
+    plan = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48, prune=False), prune=False)  # draw the plane
     maps = ShadowMaps.from_plan(render_layers(scene, matrices, plan, dtype), plan,
                                 Lights.from_scene(scene, dtype, origin=matrices.origin), dtype)
     model = np.asarray(matrices.objects[0].model)

@@ -33,6 +33,7 @@ import numpy as np
 from renderer.core import transforms
 from renderer.core.shadow_settings import (MAX_SHADOW_TEXELS, RESOLUTIONS, Shadow, auto_resolution,
                                            guard_texels, scene_has_shadows)
+from renderer.core.shadow_casting import Occluders, light_can_shadow, world_geometry
 from renderer.core.visibility import all_outside, corners
 from renderer.errors import SceneError
 
@@ -116,26 +117,41 @@ class ShadowLayout:
 
 
 def has_shadow_maps(scene) -> bool:
-    """Whether shadow_layout(scene, ...) has maps, at any image size: something casts,
-    something receives and some light has shadows on."""
-    lights = [*scene.directional_lights, *scene.point_lights]
-    return scene_has_shadows(scene) and any(light.shadow.enabled for light in lights)
+    """Whether shadow_layout(scene, ...) has maps, at any image size: some light with shadows
+    on can darken some receiver (`shadow_lights`)."""
+    return bool(shadow_lights(scene))
 
 
-def shadow_layout(scene, width: int, height: int) -> ShadowLayout:
-    """The shadow maps of `scene` rendered at width x height: a layer per light with shadows
-    on (six for a point light), none at all when nothing casts or nothing receives. Together
+def shadow_lights(scene, prune: bool = True) -> list[tuple[str, int]]:
+    """(kind, index) of each light that gets a map: its shadows are on, and some caster can
+    shadow some receiver under it from some camera (renderer/core/shadow_casting.py; the
+    receivers are every one the scene has, seen or not). Kinds in the order directional,
+    point. A light that nothing can shadow gets no map, and when no light has one the programs
+    compile no shadow code: the image and the cost are those with its shadows off. `prune`
+    False: every light with shadows on, when something casts and something receives (as
+    plan_shadows(prune=False) draws every caster)."""
+    if not scene_has_shadows(scene):
+        return []
+    enabled = [(kind, i) for kind, lights in (("directional", scene.directional_lights),
+                                                ("point", scene.point_lights))
+               for i, light in enumerate(lights) if light.shadow.enabled]
+    if not enabled or not prune:
+        return enabled
+    occluders = Occluders(scene, *world_geometry(scene))
+    return [(kind, i) for kind, i in enabled if light_can_shadow(scene, occluders, kind, i)]
+
+
+def shadow_layout(scene, width: int, height: int, prune: bool = True) -> ShadowLayout:
+    """The shadow maps of `scene` rendered at width x height: a layer for each light of
+    `shadow_lights(scene, prune)` (six for a point light), none at all when it has none. Together
     they hold at most MAX_SHADOW_TEXELS: automatic resolutions are halved, the largest first,
     until they fit (a large image with several lights); a SceneError when the resolutions the
     file sets do not fit even so."""
-    if not scene_has_shadows(scene):
-        return ShadowLayout(0, 0, ())
     wanted = []
-    for kind, lights in (("directional", scene.directional_lights), ("point", scene.point_lights)):
-        for i, light in enumerate(lights):
-            if light.shadow.enabled:
-                resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
-                wanted.append([kind, i, light.shadow, resolution])
+    for kind, i in shadow_lights(scene, prune):
+        light = (scene.directional_lights if kind == "directional" else scene.point_lights)[i]
+        resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
+        wanted.append([kind, i, light.shadow, resolution])
     if not wanted:
         return ShadowLayout(0, 0, ())
     layers = sum(6 if kind == "point" else 1 for kind, *_ in wanted)
@@ -236,102 +252,68 @@ def _map_from_clip(tile: Tile, side: int) -> np.ndarray:
     return m
 
 
-def _plan_directional(index, light, light_map, layout, points, receivers, casters,
+def _light_frame(points: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """(V, 3) points in a directional light's frame: x, y across the light, depth along it."""
+    return (points @ rotation[:3, :3].T) * np.array([1.0, 1.0, -1.0])
+
+
+def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
                       frustum) -> tuple[ShadowPass | None, np.ndarray, np.ndarray, float]:
-    """The light's orthographic view, fitted to the part of the map that can hold a shadow:
-    the receivers' box across the light, within the camera's view volume's box and within the
-    casters' boxes (a parallel light's shadow falls within its caster's box across the light,
-    so a receiver point outside every caster's box is lit: the lookup says so outside the map);
-    in depth, from the nearest caster to the farthest receiver. Square texels; the centre snapped
-    to whole texels so that the map does not shimmer as the camera moves."""
+    """The light's orthographic view, fitted to where a visible shadow can fall: across the
+    light, the union over the pairs (caster c, receiver r) that can interact (`pairs`: c -> its
+    receivers) of c's box, r's box and the camera's view volume's box, intersected (a parallel
+    light's shadow falls within its caster's box across the light, on the receiver, in view);
+    a receiver point outside the map reads as lit. Square texels; the centre snapped to whole
+    texels so that the map does not shimmer as the camera moves. In depth, from the nearest
+    caster drawn to the deepest visible receiver whose box meets the region (a receiver point
+    past the far plane would compare as shadowed)."""
     rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light.direction, (0.0, 1.0, 0.0))
-    to_light = lambda p: p @ rotation[:3, :3].T            # noqa: E731  light-space x, y, -depth
     params = np.zeros(4)
-    if not receivers or not casters:
+    if not pairs:
         return None, np.eye(4), params, 0.0
-    box = np.vstack([to_light(points[i]) for i in receivers])
-    cast = [to_light(points[i]) for i in casters]
-    f_light = to_light(frustum)
-    lo = np.maximum.reduce([box[:, :2].min(axis=0), f_light[:, :2].min(axis=0),
-                            np.min([c[:, :2].min(axis=0) for c in cast], axis=0)])
-    hi = np.minimum.reduce([box[:, :2].max(axis=0), f_light[:, :2].max(axis=0),
-                            np.max([c[:, :2].max(axis=0) for c in cast], axis=0)])
-    if np.any(lo > hi):
+    box = {i: _box(_light_frame(points[i], rotation)) for i in {*receivers, *pairs}}
+    view = _box(_light_frame(frustum, rotation))
+    pieces = []
+    for c, shadowed in pairs.items():
+        for r in shadowed:
+            lo = np.maximum.reduce([box[c][0, :2], box[r][0, :2], view[0, :2]])
+            hi = np.minimum.reduce([box[c][1, :2], box[r][1, :2], view[1, :2]])
+            if np.all(lo <= hi):
+                pieces.append((lo, hi))
+    if not pieces:
         return None, np.eye(4), params, 0.0
+    lo = np.min([p[0] for p in pieces], axis=0)
+    hi = np.max([p[1] for p in pieces], axis=0)
     resolution, guard = light_map.resolution, light_map.guard
-    half_inner = max(float((hi - lo).max()) / 2.0, 1e-9 * (1.0 + float(np.abs(box).max())))
+    extent = max(float(np.abs(b).max()) for b in box.values())
+    half_inner = max(float((hi - lo).max()) / 2.0, 1e-9 * (1.0 + extent))
     texel = 2.0 * half_inner / (resolution - 2 * guard)
     centre = np.round((lo + hi) / 2.0 / texel) * texel       # snapped: steady as the camera moves
     half = resolution * texel / 2.0
-    region_lo, region_hi = centre - half, centre + half
-    depth = -box[:, 2]
-    near_depth, far_depth = float(depth.min()), float(depth.max())
-    drawn = []
-    for i, p in zip(casters, cast):
-        if np.any(p[:, :2].max(axis=0) < region_lo) or np.any(p[:, :2].min(axis=0) > region_hi):
-            continue
-        d = -p[:, 2]
-        if d.min() > far_depth:
-            continue
-        drawn.append(i)
-        near_depth = min(near_depth, float(d.min()))
+    region = (centre - half, centre + half)
+    drawn = [c for c in pairs if _meets(box[c], region)]
+    seen = [r for r in receivers if _meets(box[r], region)]
+    if not drawn or not seen:
+        return None, np.eye(4), params, texel
+    far_depth = max(float(box[r][1, 2]) for r in seen)
+    near_depth = min(float(box[i][0, 2]) for i in (*drawn, *seen))
     margin = max(DEPTH_MARGIN * (far_depth - near_depth), 2.0 * texel)
     near_depth, far_depth = near_depth - margin, far_depth + margin
     clip = _ortho_rows(centre[0], centre[1], half, near_depth, far_depth) @ rotation
-    lookup = _map_from_clip(light_map.tiles[0], layout.side) @ clip
-    if not drawn:
-        return None, lookup, params, texel
     tile = light_map.tiles[0]
+    lookup = _map_from_clip(tile, layout.side) @ clip
     params[:] = (tile.layer, texel, light_map.shadow.kernel, tile.size / layout.side)
-    return (ShadowPass("directional", index, 0, light_map.tiles[0], clip, tuple(drawn)),
-            lookup, params, texel)
+    return ShadowPass("directional", index, 0, tile, clip, tuple(drawn)), lookup, params, texel
 
 
-# A caster's vertices within PLANAR_TOLERANCE of its extent from one plane make it planar.
-PLANAR_TOLERANCE = 1e-9
+def _box(points: np.ndarray) -> np.ndarray:
+    """(2, 3): the points' least and greatest coordinates."""
+    return np.stack([points.min(axis=0), points.max(axis=0)])
 
 
-def _plane_of(points: np.ndarray):
-    """(unit normal, a point) of the plane the points lie in, or None when they do not."""
-    if len(points) < 3:
-        return None
-    centre = points.mean(axis=0)
-    _, singular, rows = np.linalg.svd(points - centre, full_matrices=False)
-    if singular[0] == 0.0 or singular[-1] > PLANAR_TOLERANCE * singular[0]:
-        return None
-    return rows[-1], centre
-
-
-def can_shadow(scene, points, caster: int, receivers: list[int], light_position=None,
-               light_direction=None, planes: dict | None = None) -> bool:
-    """Whether object `caster` can shadow any receiver for a light at `light_position` (point)
-    or travelling along `light_direction` (directional). Conservative (True when unsure); False
-    for: a caster with no receiver but itself that cannot shadow itself (a convex analytic
-    shape, or a planar mesh), and a planar caster with every other receiver on the light's side
-    of its plane (a floor under the lit objects: it can shadow only what is below it).
-    `planes`: object index -> its plane (or None), filled as they are found, so that the
-    lights of one plan find each caster's once."""
-    obj = scene.objects[caster]
-    planes = {} if planes is None else planes
-    if caster not in planes:
-        planes[caster] = _plane_of(points[caster])
-    plane = planes[caster]
-    convex = plane is not None or obj.shape is not None
-    receives = caster in receivers
-    if len(receivers) == int(receives):              # no receiver but (maybe) itself
-        return not convex and receives
-    if plane is None:
-        return True
-    normal, origin = plane
-    scale = PLANAR_TOLERANCE * (1.0 + float(np.abs(points[caster]).max()))
-    if light_position is not None:
-        side = float(normal @ (np.asarray(light_position) - origin))
-    else:
-        side = -float(normal @ np.asarray(light_direction, dtype=np.float64))
-    if abs(side) <= scale:
-        return False                         # the light grazes the plane: no shadow of any area
-    facing = normal if side > 0 else -normal
-    return any(bool(((points[r] - origin) @ facing < -scale).any()) for r in receivers if r != caster)
+def _meets(box: np.ndarray, region: tuple[np.ndarray, np.ndarray]) -> bool:
+    """Whether a light-frame box (2, 3) meets the region (lo, hi) across the light."""
+    return bool(np.all(box[1, :2] >= region[0]) and np.all(box[0, :2] <= region[1]))
 
 
 def triangle_distance(corners: np.ndarray, position: np.ndarray) -> np.ndarray:
@@ -407,19 +389,24 @@ def point_face_projection(resolution: int, guard: int, near: float, far: float) 
     return projection, tan_half
 
 
-def _plan_point(index, light, light_map, layout, matrices, points, receivers, casters, scene,
+def _plan_point(index, light, light_map, layout, matrices, points, receivers, pairs, scene,
                 prune=True):
+    """The light's six cube faces (docs/conventions.md, "A point light's cube"): a face is
+    drawn when its frustum holds a caster and a receiver that caster can shadow (`pairs`: c ->
+    its receivers; with `prune` False, every face, with every caster in its frustum)."""
     position = matrices.relative(light.position)
     passes = []
     rects = np.zeros((6, 4))
     params = np.zeros(4)
     depth = np.zeros(4)
     seen = [points[i] for i in receivers]
+    casters = list(pairs)
     if not seen or not casters:
         return passes, rects, params, depth
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
-    lo, hi = _boxes(points, casters + receivers)
+    objects = casters + [r for r in receivers if r not in pairs]
+    lo, hi = _boxes(points, objects)
     n = len(casters)
     near = max(0.5 * _nearest_caster(scene, points, casters, lo[:n], hi[:n], position),
                NEAR_FRACTION * far)
@@ -431,11 +418,13 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, ca
         view[:3, :3] = CUBE_FACE_ROTATIONS[face]
         view[:3, 3] = -CUBE_FACE_ROTATIONS[face] @ position
         clips[face] = projection @ view
-    outside = _outside_frusta(clips, lo, hi)              # (6, the casters then the receivers)
+    outside = _outside_frusta(clips, lo, hi)              # (6, objects)
     for face in range(6):
         tile = light_map.tiles[face]
-        drawn = tuple(i for i, out in zip(casters, outside[face]) if not out)
-        needed = not prune or (bool(drawn) and not outside[face, n:].all())
+        inside = {i for i, out in zip(objects, outside[face]) if not out}
+        drawn = tuple(c for c in casters if c in inside
+                      and (not prune or any(r in inside for r in pairs[c])))
+        needed = not prune or bool(drawn)
         rects[face] = tile.rect(layout.side, needed)   # not drawn: the lookup reads it as lit
         if not needed:
             continue
@@ -451,9 +440,9 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
     """The frame's shadow passes and lookup uniforms (module docstring). `visible`: which
     objects the camera can see (renderer/core/visibility.visible_objects; all if None); only
     those count as receivers to fit a map to. `prune` False draws every caster, also those
-    that cannot shadow any receiver (`can_shadow`), into every cube face, also those that see
-    no caster or no receiver: a plane in its own map, to study the bias, and the work the
-    pruning saves (benchmarks/bench_shadow_pruning.py)."""
+    that cannot shadow any receiver (renderer/core/shadow_casting.py), into every cube face,
+    also those that see no caster or no receiver: a plane in its own map, to study the bias,
+    and the work the pruning saves (benchmarks/bench_shadow_pruning.py)."""
     n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
     uniforms = {
         "u_shadow_map_size": np.array(float(layout.side)),
@@ -470,20 +459,20 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         return plan
     visible = [True] * len(scene.objects) if visible is None else visible
     points = world_points(scene, matrices)
+    occluders = Occluders(scene, points, [np.asarray(m.model, dtype=np.float64) for m in matrices.objects])
     receivers = [i for i, o in enumerate(scene.objects)
                  if o.receives_shadows and visible[i] and o.mesh.triangle_count]
     casters = [i for i, o in enumerate(scene.objects) if o.casts_shadows and o.mesh.triangle_count]
     frustum = _camera_frustum_corners(scene.camera, matrices)
-    planes = {}                                   # caster -> its plane, for every light
     for light_map in layout.maps:
         i = light_map.index
         bias = light_map.shadow.bias_rule().as_vec4()
         if light_map.kind == "directional":
             light = scene.directional_lights[i]
-            relevant = [c for c in casters if not prune or can_shadow(
-                scene, points, c, receivers, light_direction=light.direction, planes=planes)]
+            pairs = (occluders.pairs(casters, receivers, light_direction=light.direction) if prune
+                     else {c: receivers for c in casters})
             shadow_pass, lookup, params, texel = _plan_directional(
-                i, light, light_map, layout, points, receivers, relevant, frustum)
+                i, light, light_map, layout, points, receivers, pairs, frustum)
             uniforms["u_directional_shadow_matrix"][i] = lookup
             uniforms["u_directional_shadow"][i] = params
             uniforms["u_directional_shadow_bias"][i] = bias
@@ -493,10 +482,10 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         else:
             light = scene.point_lights[i]
             position = matrices.relative(light.position)
-            relevant = [c for c in casters if not prune or can_shadow(
-                scene, points, c, receivers, light_position=position, planes=planes)]
+            pairs = (occluders.pairs(casters, receivers, light_position=position) if prune
+                     else {c: receivers for c in casters})
             passes, rects, params, depth = _plan_point(
-                i, light, light_map, layout, matrices, points, receivers, relevant, scene, prune)
+                i, light, light_map, layout, matrices, points, receivers, pairs, scene, prune)
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias

@@ -350,7 +350,7 @@ class GpuRenderer:
         the image size), the frame's shadow plan for the depth pass; its lookup uniforms, or
         None when the scene has no maps. The plan is fitted to the objects the camera sees in
         either build, so that the all-features build draws the same shadows."""
-        layout = shadow_layout(self.scene, self.width, self.height)
+        layout = shadow_layout(self.scene, self.width, self.height, prune=self.prune_shadows)
         if layout != self._shadow_layout and layout.any:
             if self._shadow_maps is None:
                 self._shadow_maps = ShadowMaps(self.ctx, layout)

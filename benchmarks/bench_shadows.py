@@ -45,7 +45,7 @@ from renderer.gpu.context import activate, make_context
 from renderer.gpu.pipeline import CULL_FLAGS, make_float_depth
 from renderer.gpu.shaders import shader_source
 from renderer.gpu.shadow_maps import ShadowMaps
-from renderer.gpu.uniforms import SHADOW_MAPS_UNIT, frame_uniform_values, object_uniform_values
+from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values, set_shadow_sampler_units
 
 from common import alternating_ms, machine, parser       # benchmarks/common.py
 
@@ -92,7 +92,7 @@ class BareShadows:
             draws = [(self._vao(self.depth_program, i, "3f 3x4", "in_position"),
                       to_glsl(shadow_pass.clip_from_world @ matrices.objects[i].model))
                      for i in shadow_pass.casters]
-            self.passes.append((self.storage.framebuffers[shadow_pass.tile.layer],
+            self.passes.append((self.storage.framebuffers(shadow_pass.kind)[shadow_pass.tile.layer],
                                 shadow_pass.tile.size, draws))
         frame_values = frame_uniform_values(scene, matrices, shadows=plan.uniforms)
         programs, self.draws = {}, []                     # (vao, enable, cull, [(uniform, bytes)])
@@ -128,8 +128,10 @@ class BareShadows:
         defines = {"NUM_DIRECTIONAL_LIGHTS": len(scene.directional_lights),
                    "NUM_POINT_LIGHTS": len(scene.point_lights),
                    "TWO_SIDED": two_sided, "SPECULAR": specular}
-        return self.ctx.program(vertex_shader=self._source("bare_phong.vert"),
-                                fragment_shader=self._source("bare_phong.frag", defines))
+        program = self.ctx.program(vertex_shader=self._source("bare_phong.vert"),
+                                   fragment_shader=self._source("bare_phong.frag", defines))
+        set_shadow_sampler_units(self.ctx, program)
+        return program
 
     def _vao(self, program, index: int, layout: str, *attributes: str) -> moderngl.VertexArray:
         vbo, ibo = self.buffers[index]
@@ -149,7 +151,7 @@ class BareShadows:
                 self.clip_from_model.write(clip_from_model)
                 vao.render(moderngl.TRIANGLES)
         self.fbo.use()
-        self.storage.texture.use(SHADOW_MAPS_UNIT)
+        self.storage.bind()
         self.fbo.clear(*self.background, 0.0, depth=clear_depth)
         for vao, enable, cull, uploads in self.draws:
             ctx.enable_only(enable)
@@ -183,7 +185,8 @@ def maps_label(renderer: GpuRenderer) -> str:
     layout, plan = renderer.shadow_maps.layout, renderer.shadow_maps.plan
     sizes = " + ".join(f"{m.resolution}" + ("x6" if m.kind == "point" else "") for m in layout.maps)
     draws = sum(len(p.casters) for p in plan.passes)
-    return f"{sizes} ({layout.layers}x{layout.side}²), {len(plan.passes)} passes, {draws} draws"
+    stacks = " + ".join(f"{s.layers}x{s.side}²" for s in layout.stacks if s.layers)
+    return f"{sizes} ({stacks}), {len(plan.passes)} passes, {draws} draws"
 
 
 def measure(ctx, scene: Scene, size, rounds: int) -> dict:

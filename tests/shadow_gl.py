@@ -36,7 +36,7 @@ def depth32f_texture(ctx, width: int, height: int, data: np.ndarray | None = Non
 
 def depth32f_array_texture(ctx, maps: np.ndarray):
     """A DEPTH_COMPONENT32F GL_TEXTURE_2D_ARRAY holding maps (layers, S, S) float32 (GL rows),
-    sampled as the design's u_shadow_maps: LINEAR, COMPARE_REF_TO_TEXTURE with LEQUAL,
+    sampled as the design's u_*_shadow_maps: LINEAR, COMPARE_REF_TO_TEXTURE with LEQUAL,
     CLAMP_TO_EDGE."""
     layers, height, width = maps.shape
     texture = ctx.texture_array((width, height, layers), 1, dtype="f4")
@@ -60,7 +60,7 @@ def depth32f_array_texture(ctx, maps: np.ndarray):
 def run_lookup_shader(ctx, inputs: np.ndarray, mode: int, maps: np.ndarray | None = None,
                       layer: int = 0) -> np.ndarray:
     """out_value of tests/glsl/shadow_lookup.frag for each row of inputs (N, 4) -> (N, 4)
-    float32; `maps` (layers, S, S) float32 is sampled as u_shadow_maps (LINEAR, LEQUAL, CLAMP),
+    float32; `maps` (layers, S, S) float32 is sampled as u_point_shadow_maps (LINEAR, LEQUAL, CLAMP),
     at `layer`."""
     from renderer.gpu.context import activate
     activate(ctx)
@@ -82,8 +82,8 @@ def run_lookup_shader(ctx, inputs: np.ndarray, mode: int, maps: np.ndarray | Non
             texture = depth32f_array_texture(ctx, maps)
             things.append(texture)
             texture.use(0)
-            program["u_shadow_maps"].value = 0
-            program["u_shadow_map_size"].value = float(maps.shape[1])
+            program["u_point_shadow_maps"].value = 0
+            program["u_point_shadow_map_size"].value = float(maps.shape[1])
             program["u_layer"].value = float(layer)
         framebuffer.use()
         ctx.viewport = (0, 0, n, 1)

@@ -61,7 +61,9 @@ GPU_ONLY_UNIFORMS = {
     "u_num_point_lights": "all-features build: as u_num_directional_lights",
     "u_two_sided": "all-features build: two-sidedness at run time; the twin reads "
                    "Material.two_sided",
-    "u_shadow_maps": "the maps' texture unit; the twin reads its array of layers",
+    "u_directional_shadow_maps": "the directional maps' texture unit; the twin reads its "
+                                 "array of layers",
+    "u_point_shadow_maps": "the point lights' maps' texture unit; the twin reads its array of layers",
     "u_texture": "the material texture's unit; the twin reads the MaterialTexture",
 }
 
@@ -80,13 +82,15 @@ def every_feature_scene():
 def uploaded_uniform_names() -> set[str]:
     """Every uniform name the GPU path uploads for a scene with every feature, in the
     specialised and in the all-features build."""
-    from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
+    from renderer.gpu.uniforms import SHADOW_MAPS_UNITS, frame_uniform_values, object_uniform_values
     scene = every_feature_scene()
     matrices = scene.matrices(64, 48)
     shadows = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48)).uniforms
     names = set(frame_uniform_values(scene, matrices, shadows=shadows))
     names |= set(frame_uniform_values(scene, matrices, light_slots=ALL_FEATURES_LIGHTS))
     names |= set(SHADOW_PASS_UNIFORMS)          # renderer/gpu/shadow_maps.py, per pass and object
+    # the stacks' samplers, pointed at their units once at link (set_shadow_sampler_units)
+    names |= {f"u_{kind}_shadow_maps" for kind in SHADOW_MAPS_UNITS}
     for obj, object_matrices in zip(scene.objects, matrices.objects):
         names |= set(object_uniform_values(obj, object_matrices))
     return names

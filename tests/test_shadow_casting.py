@@ -16,7 +16,7 @@ from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, Point
 from renderer.core.scene_file import load_scene
 from renderer.core.shadow_casting import Occluders, world_geometry
 from renderer.core.shadow_settings import CONSTANT_BIAS_TEXELS, Shadow
-from renderer.core.shadows import plan_shadows, shadow_layout, shadow_lights
+from renderer.core.shadows import LayerStack, plan_shadows, shadow_layout, shadow_lights
 from renderer.gpu import GpuRenderer
 
 REPO = Path(__file__).resolve().parents[1]
@@ -174,3 +174,13 @@ def test_the_documents_give_the_automatic_constant_bias_the_code_uses():
         text = (REPO / document).read_text()
         stated = re.findall(r"constant`? = (\S+?), `?slope`? = 0", text)
         assert stated and set(stated) == {half}, (document, stated)
+
+
+def test_each_kind_of_light_has_a_stack_of_its_own_size():
+    """classic at 640x480: its directional map (2048, twice the longer side) is the one layer of
+    the directional stack; its point light's six faces (512, half the longer side) are six
+    layers of 512, not of 2048 (a quarter of the memory each: 6 MiB, not 96)."""
+    layout = shadow_layout(load_scene("classic"), 640, 480)
+    assert layout.stack("directional") == LayerStack(2048, 1)
+    assert layout.stack("point") == LayerStack(512, 6)
+    assert [tile.layer for tile in layout.get("point", 0).tiles] == [0, 1, 2, 3, 4, 5]

@@ -14,7 +14,7 @@ from renderer.core.builtin import builtin_scenes
 from renderer.core.gl_rules import STANDARD_DEPTH
 from renderer.core.scene import Mesh
 from renderer.core.scene_file import load_scene
-from renderer.core.shadows import ShadowPass, Tile, plan_shadows, shadow_layout
+from renderer.core.shadows import SHADOW_KINDS, ShadowPass, Tile, plan_shadows, shadow_layout
 from renderer.gpu.shaders import shader_source
 from shadow_gl import GLSL, depth32f_texture
 
@@ -77,13 +77,15 @@ def test_a_texel_whose_coverage_snapping_may_change_spans_both_depths():
     assert (layers.below[0, :, 2:] == 0).all() and (layers.above[0] == 0).all()
 
 
-def gpu_layers(ctx, scene, matrices, plan) -> np.ndarray:
-    """llvmpipe's maps (layers, S, S) float32, GL rows: every pass drawn as the design says
-    (viewport (0, 0, R, R), cleared to 1.0, GL_LESS, no culling) into an R x R texture of its
-    own, which rasterises as a layer does (from texel (0, 0)), read back into its layer."""
+def gpu_layers(ctx, scene, matrices, plan) -> dict[str, np.ndarray]:
+    """llvmpipe's maps per kind of light (layers, S, S) float32, GL rows: every pass drawn as
+    the design says (viewport (0, 0, R, R), cleared to 1.0, GL_LESS, no culling) into an R x R
+    texture of its own, which rasterises as a layer does (from texel (0, 0)), read back into
+    its layer of its kind's stack."""
     from renderer.gpu.context import activate
     activate(ctx)
-    out = np.ones((plan.layout.layers, plan.side, plan.side), F32)
+    out = {kind: np.ones((plan.layout.stack(kind).layers, plan.layout.stack(kind).side,
+                          plan.layout.stack(kind).side), F32) for kind in SHADOW_KINDS}
     program = ctx.program(vertex_shader=shader_source("shadow_depth.vert", directory=GLSL).text,
                           fragment_shader=shader_source("shadow_depth.frag", directory=GLSL).text)
     things = [program]
@@ -108,7 +110,7 @@ def gpu_layers(ctx, scene, matrices, plan) -> np.ndarray:
                 vao = ctx.vertex_array(program, [(vbo, "3f", "in_position")], index_buffer=ibo)
                 vao.render()
                 things += [vao, vbo, ibo]
-            out[shadow_pass.tile.layer, :R, :R] = np.frombuffer(texture.read(), F32).reshape(R, R)
+            out[shadow_pass.kind][shadow_pass.tile.layer, :R, :R] = np.frombuffer(texture.read(), F32).reshape(R, R)
         return out
     finally:
         ctx.disable(ctx.DEPTH_TEST)
@@ -134,9 +136,11 @@ def test_the_maps_of_a_scene_match_llvmpipes(gl_contexts):
     scene = load_scene(builtin_scenes()["classic"])
     matrices = scene.matrices(64, 48)
     plan = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48))
-    layers = render_layers(scene, matrices, plan)
-    assert (layers.caster >= 0).sum() > 4000
+    stacks = render_layers(scene, matrices, plan)
+    assert sum((layers.caster >= 0).sum() for layers in stacks.values()) > 4000
     for kind, ctx in gl_contexts.items():
-        differ, ulps, use = store_error(gpu_layers(ctx, scene, matrices, plan), layers)
-        assert differ == 0, (kind, differ)
-        assert use.max() <= 1.0, (kind, float(use.max()), float(ulps.max()))
+        gpu = gpu_layers(ctx, scene, matrices, plan)
+        for light_kind, layers in stacks.items():
+            differ, ulps, use = store_error(gpu[light_kind], layers)
+            assert differ == 0, (kind, light_kind, differ)
+            assert use.size == 0 or use.max() <= 1.0, (kind, light_kind, float(use.max()), float(ulps.max()))

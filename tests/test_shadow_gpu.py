@@ -62,7 +62,7 @@ def test_the_map_holds_the_planes_depth_seen_from_the_light(ctx):
     with GpuRenderer(scene, W, H, context=ctx) as gpu:
         gpu.render(depth=False)
         (shadow_pass,) = gpu.shadow_maps.plan.passes
-        layer = gpu.shadow_maps.read_layer(shadow_pass.tile.layer)
+        layer = gpu.shadow_maps.read_layer("directional", shadow_pass.tile.layer)
     matrices = scene.matrices(W, H)
     C = shadow_pass.clip_from_world
     tile = shadow_pass.tile
@@ -177,12 +177,12 @@ def test_update_keeps_the_maps_texture_programs_and_vertex_arrays(ctx):
     scene = sphere_over_plane()
     with GpuRenderer(scene, W, H, context=ctx) as gpu:
         gpu.render(depth=False)
-        made = (gpu.shadow_maps, gpu.shadow_maps.texture, gpu.shadow_maps.program,
+        made = (gpu.shadow_maps, gpu.shadow_maps.texture("directional"), gpu.shadow_maps.program,
                 dict(gpu.programs), gpu.shadow_maps.vertex_arrays)
         scene.directional_lights[0] = replace(LIGHT, direction=(-0.3, -1.0, 0.1))
         gpu.update()
         gpu.render(depth=False)
-        again = (gpu.shadow_maps, gpu.shadow_maps.texture, gpu.shadow_maps.program,
+        again = (gpu.shadow_maps, gpu.shadow_maps.texture("directional"), gpu.shadow_maps.program,
                  dict(gpu.programs), gpu.shadow_maps.vertex_arrays)
     assert all(a is b for a, b in zip(made[:3], again[:3]))
     assert made[3] == again[3] and all(made[3][v] is again[3][v] for v in made[3])
@@ -230,9 +230,12 @@ def test_update_makes_new_maps_in_the_renderers_own_context(gl_contexts):
 
 
 def test_the_light_budget_counts_the_shadow_uniforms():
-    sizes = {"float": 1, "vec4[]": 4, "mat4[]": 16}
+    # The per-light arrays; a stack's sampler and size are one each per program, among the
+    # OTHER_UNIFORM_COMPONENTS.
+    sizes = {"vec4[]": 4, "mat4[]": 16}
     per_light = {kind: sum(sizes[t] * (6 if name.endswith("_tiles") else 1)
-                           for name, t in SHADOW_UNIFORMS.items() if name.startswith(f"u_{kind}_"))
+                           for name, t in SHADOW_UNIFORMS.items()
+                           if name.startswith(f"u_{kind}_") and t.endswith("[]"))
                  for kind in ("directional", "point")}
     assert per_light == {"directional": COMPONENTS_PER_DIRECTIONAL_SHADOW,
                          "point": COMPONENTS_PER_POINT_SHADOW} == {"directional": 24, "point": 36}

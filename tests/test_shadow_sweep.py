@@ -71,8 +71,11 @@ def test_without_a_bias_the_same_measure_finds_acne(gl_contexts):
     scene = elevation_scene(30)
     [light] = scene.directional_lights
     scene = replace(scene, directional_lights=[replace(light, shadow=replace(light.shadow, bias=BiasRule()))])
-    assert truth_figures(scene, SIZE)["acne_pixels"] > 0.5 * SIZE[0] * SIZE[1] / 4
-    assert truth_figures(scene, SIZE, gpu_visibility(scene, SIZE, gl_contexts["egl"]))["acne_pixels"] > 100
+    # The ground, a convex box, cannot shadow itself: its map covers where the box and the ball
+    # can shadow it (their boxes across the light), and there, with no bias, it is acne:
+    # 211 of the 2,191 pixels the light reaches at 64x48, in the twin and on the GPU alike.
+    assert truth_figures(scene, SIZE)["acne_pixels"] > 150
+    assert truth_figures(scene, SIZE, gpu_visibility(scene, SIZE, gl_contexts["egl"]))["acne_pixels"] > 150
 
 
 @pytest.mark.slow

@@ -54,7 +54,7 @@ def test_a_directional_map_is_its_texels_stretched_to_grey(ctx):
     with GpuRenderer(scene, W, H, context=ctx) as gpu:
         before = gpu.render(depth=False).rgba8
         image, (lo, hi) = shown(ctx, gpu, (R + 20, R))          # letterboxed: 10 px each side
-        layer = gpu.shadow_maps.read_layer(0)
+        layer = gpu.shadow_maps.read_layer("directional", 0)
         after = gpu.render(depth=False).rgba8
     assert np.array_equal(before, after)                # the lighting's lookups are untouched
     stored = layer[layer < 1.0]
@@ -76,7 +76,7 @@ def test_a_point_lights_faces_are_a_3x2_grid_and_undrawn_faces_are_white(ctx):
         gpu.draw()
         image, (lo, hi) = shown(ctx, gpu, (3 * R, 2 * R))
         assert drawn_faces(gpu.drawn_shadow_plan, gpu.drawn_shadow_plan.layout.maps[0]) == [3]
-        face = gpu.shadow_maps.read_layer(3)
+        face = gpu.shadow_maps.read_layer("point", 3)
     bottom_left, others = image[:R, :R, 0], [image[R:, :R], image[R:, R:2 * R], image[R:, 2 * R:],
                                             image[:R, R:2 * R], image[:R, 2 * R:]]
     assert all((other == 255).all() for other in others)

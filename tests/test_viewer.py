@@ -468,7 +468,7 @@ def test_d_shows_the_map_the_frame_drew_and_again_the_picture(shadow_viewer):
     plan = shadow_viewer.gpu.drawn_shadow_plan
     (light_map,) = plan.layout.maps
     r = light_map.resolution
-    layer = shadow_viewer.gpu.shadow_maps.read_layer(0)[:r, :r]
+    layer = shadow_viewer.gpu.shadow_maps.read_layer(light_map.kind, 0)[:r, :r]
     lo, hi = shadow_viewer._map_view.depth_range
     square = shown[::-1][50:170].astype(int)             # GL rows, as the layer
     texel = ((np.arange(120) + 0.5) * r / 120).astype(int)

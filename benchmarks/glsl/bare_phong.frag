@@ -15,15 +15,16 @@ uniform float u_n;
 uniform vec3 u_eye;
 #endif
 uniform vec3 u_ambient;
-uniform sampler2DArrayShadow u_shadow_maps;
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
+uniform sampler2DArrayShadow u_directional_shadow_maps;
 uniform vec3 u_directional_direction[NUM_DIRECTIONAL_LIGHTS];
 uniform vec3 u_directional_intensity[NUM_DIRECTIONAL_LIGHTS];
 uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];
 uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];      // (layer, texel, kernel, R/S or 0)
 #endif
 #if NUM_POINT_LIGHTS > 0
+uniform sampler2DArrayShadow u_point_shadow_maps;
 uniform vec3 u_point_position[NUM_POINT_LIGHTS];
 uniform vec3 u_point_intensity[NUM_POINT_LIGHTS];
 uniform vec3 u_point_attenuation[NUM_POINT_LIGHTS];
@@ -76,7 +77,7 @@ void main() {
         vec4 p = u_directional_shadow[i];
         if (p.w != 0.0 && dot(N, L) > 0.0) {
             vec3 q = (u_directional_shadow_matrix[i] * vec4(P + p.y * (N + 0.25 * L), 1.0)).xyz;
-            term *= texture(u_shadow_maps, vec4(q.xy, p.x, q.z));
+            term *= texture(u_directional_shadow_maps, vec4(q.xy, p.x, q.z));
         }
         color += term;
     }
@@ -101,7 +102,7 @@ void main() {
                 float m = dot(FACE_AXIS[f], d);
                 vec2 uv = (0.5 * vec2(dot(FACE_RIGHT[f], d), dot(FACE_UP[f], d)) / (m * p.y) + 0.5) * tile.y;
                 vec4 z = u_point_shadow_depth[i];
-                term *= texture(u_shadow_maps, vec4(uv, tile.x, z.x + z.y / m));
+                term *= texture(u_point_shadow_maps, vec4(uv, tile.x, z.x + z.y / m));
             }
         }
         color += term;

@@ -6,24 +6,25 @@
 // with the depth the light's depth pass stored (glsl/shadow/depth.vert) through GL's depth-compare
 // sampler: a tap is lit where its reference depth is <= the stored one (LEQUAL), and LINEAR
 // filtering blends the four nearest texels' comparisons bilinearly (percentage-closer filtering).
-// Every map is a layer of one array texture (u_shadow_maps; layers of side u_shadow_map_size, a
-// power of two), drawn from texel (0, 0); a point light has six, one per cube face, each widened
-// so that no tap leaves its map.
+// Every map is a layer of its light kind's array texture (u_directional_shadow_maps,
+// u_point_shadow_maps; layers of side u_*_shadow_map_size, a power of two), drawn from texel
+// (0, 0); a point light has six, one per cube face, each widened so that no tap leaves its map.
 // Coordinates are camera-relative world coordinates, as lighting.glsl's, whose light counts
 // and light uniforms (directions, positions) this reads.
 
 #include "lighting.glsl"
 #define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
 
-uniform sampler2DArrayShadow u_shadow_maps;
-uniform float u_shadow_map_size;     // S, texels on a side of a layer
-
 #if NUM_DIRECTIONAL_LIGHTS > 0
+uniform sampler2DArrayShadow u_directional_shadow_maps;
+uniform float u_directional_shadow_map_size;                       // S of its layers
 uniform mat4 u_directional_shadow_matrix[NUM_DIRECTIONAL_LIGHTS];  // P -> (u, v, z_w) in its layer
 uniform vec4 u_directional_shadow[NUM_DIRECTIONAL_LIGHTS];         // (layer, texel size, kernel, R/S or 0)
 uniform vec4 u_directional_shadow_bias[NUM_DIRECTIONAL_LIGHTS];    // (normal, constant, slope) texels
 #endif
 #if NUM_POINT_LIGHTS > 0
+uniform sampler2DArrayShadow u_point_shadow_maps;
+uniform float u_point_shadow_map_size;                             // S of its layers
 uniform vec4 u_point_shadow[NUM_POINT_LIGHTS];             // (drawn, tan(half angle), kernel, R)
 uniform vec4 u_point_shadow_depth[NUM_POINT_LIGHTS];       // (A, B, near, far): z_w = A + B / m
 uniform vec4 u_point_shadow_bias[NUM_POINT_LIGHTS];        // (normal, constant, slope) texels
@@ -56,17 +57,16 @@ vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bia
 // read through the LINEAR sampler at that texel's centre (exact: S is a power of two, so the
 // centre's weight is 1); K x K PCF is the mean of (K-1)^2 bilinear comparisons on a unit grid
 // centred on the point, j (the map's y) outer.
-float shadow_filter(vec3 uvz, float layer, int kernel) {
-    float S = u_shadow_map_size;
+float shadow_filter(sampler2DArrayShadow maps, float S, vec3 uvz, float layer, int kernel) {
     if (kernel == 1) {
-        return texture(u_shadow_maps, vec4((floor(uvz.xy * S) + 0.5) / S, layer, uvz.z));
+        return texture(maps, vec4((floor(uvz.xy * S) + 0.5) / S, layer, uvz.z));
     }
     float sum = 0.0;
     float first = -0.5 * float(kernel - 2);
     for (int j = 0; j < kernel - 1; ++j) {
         for (int i = 0; i < kernel - 1; ++i) {
             vec2 offset = vec2(first + float(i), first + float(j));
-            sum += texture(u_shadow_maps, vec4(uvz.xy + offset / S, layer, uvz.z));
+            sum += texture(maps, vec4(uvz.xy + offset / S, layer, uvz.z));
         }
     }
     return sum / float((kernel - 1) * (kernel - 1));
@@ -87,7 +87,8 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
     if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(p.w)))) {
         return 1.0;                  // outside the map, which holds every caster: nothing there
     }
-    return shadow_filter(uvz, p.x, LIGHT_KERNEL(p));
+    return shadow_filter(u_directional_shadow_maps, u_directional_shadow_map_size, uvz, p.x,
+                         LIGHT_KERNEL(p));
 }
 #endif
 
@@ -139,6 +140,7 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
     float m = dot(CUBE_FACE_AXIS[f], d);
     vec2 uv = (0.5 * vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / (m * p.y) + 0.5) * rect.y;
     vec4 depth = u_point_shadow_depth[i];
-    return shadow_filter(vec3(uv, depth.x + depth.y / m), rect.x, LIGHT_KERNEL(p));
+    return shadow_filter(u_point_shadow_maps, u_point_shadow_map_size, vec3(uv, depth.x + depth.y / m),
+                         rect.x, LIGHT_KERNEL(p));
 }
 #endif

@@ -1,7 +1,7 @@
 """# Twin: glsl/shadow/depth.vert, glsl/shadow/depth.frag
 
 The shadow maps' depth pass: each `ShadowPass` of a frame's `ShadowPlan` draws its casters
-into its layer of the array texture, as GL draws them with the viewport at (0, 0), R x R on
+into its layer of its light kind's array texture, as GL draws them with the viewport at (0, 0), R x R on
 that layer: gl_Position = u_clip_from_model * vec4(in_position, 1) with u_clip_from_model =
 pass.clip_from_world @ model (camera-relative), clipping with standard depth
 (z_w = (z_ndc + 1) / 2), snapping with SUBPIXEL_BITS, no culling, the reference rasteriser's
@@ -37,6 +37,7 @@ from reference.clipping import clip_triangles
 from reference.rasterizer import WindowTriangles, coverage, depth_planes, edge_equations, setup_triangles
 from renderer.core.gl_rules import SUBPIXEL_BITS, is_inside_edge, pixel_centre
 from renderer.core.memory import REFERENCE_TILE_PIXELS
+from renderer.core.shadows import SHADOW_KINDS
 
 # llvmpipe sets up and evaluates the depth plane in float32 from the window origin (a0 at
 # (0, 0), then a0 + dz/dx x + dz/dy y: lp_state_setup.c calc_coef4, lp_bld_interp.c), so its
@@ -278,9 +279,11 @@ def draw_pass(scene, matrices, shadow_pass, layers: ShadowLayers, dtype=np.float
 
 
 def render_layers(scene, matrices, plan, dtype=np.float64,
-                  tile_pixels: int = REFERENCE_TILE_PIXELS) -> ShadowLayers:
-    """The frame's maps: `plan.layout.layers` layers of side S cleared, then every pass drawn."""
-    layers = ShadowLayers.cleared(plan.layout.layers, plan.side)
+                  tile_pixels: int = REFERENCE_TILE_PIXELS) -> dict[str, ShadowLayers]:
+    """The frame's maps, per kind of light (renderer/core/shadows.py SHADOW_KINDS): its stack's
+    layers of its side cleared, then every pass of that kind drawn into its layer."""
+    stacks = {kind: ShadowLayers.cleared(plan.layout.stack(kind).layers, plan.layout.stack(kind).side)
+              for kind in SHADOW_KINDS}
     for shadow_pass in plan.passes:
-        draw_pass(scene, matrices, shadow_pass, layers, dtype, tile_pixels)
-    return layers
+        draw_pass(scene, matrices, shadow_pass, stacks[shadow_pass.kind], dtype, tile_pixels)
+    return stacks

@@ -68,14 +68,16 @@ class ShadowLookup:
 
 @dataclass
 class ShadowMaps:
-    """What the lookup reads: the frame's layers, the plan's uniforms in the pipeline's dtype
-    (ShadowPlan.uniforms, named as the GLSL's) and the lights (their direction and position)."""
-    layers: ShadowLayers
+    """What the lookup reads: the frame's layers per kind of light ("directional", "point":
+    the GLSL's u_directional_shadow_maps and u_point_shadow_maps), the plan's uniforms in the
+    pipeline's dtype (ShadowPlan.uniforms, named as the GLSL's) and the lights (their direction
+    and position)."""
+    layers: dict[str, ShadowLayers]
     uniforms: dict[str, np.ndarray]
     lights: Lights
 
     @classmethod
-    def from_plan(cls, layers: ShadowLayers, plan, lights: Lights, dtype) -> "ShadowMaps":
+    def from_plan(cls, layers: dict[str, ShadowLayers], plan, lights: Lights, dtype) -> "ShadowMaps":
         return cls(layers, {k: np.asarray(v).astype(dtype) for k, v in plan.uniforms.items()}, lights)
 
 
@@ -198,11 +200,12 @@ def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, N: np.
     scale = np.abs(Q).astype(np.float64) + np.asarray(position_scale, np.float64)[:, None]
     A = np.abs(M.astype(np.float64))
     tie_ref = SHADOW_TIE * (scale @ A[2, :3] + A[2, 3])
-    tie_texel = SHADOW_TIE * maps.layers.side * (scale @ A[:2, :3].T + A[:2, 3])
+    layers = maps.layers["directional"]
+    tie_texel = SHADOW_TIE * layers.side * (scale @ A[:2, :3].T + A[:2, 3])
     # Outside the map, which holds every caster that can shadow, nothing is there: lit.
     inside = np.flatnonzero(((uvz[:, :2] >= 0.0) & (uvz[:, :2] <= p[3])).all(axis=1))
     result = ShadowLookup.lit(len(P), dtype)
-    result.put(inside, shadow_filter(maps.layers, uvz[inside], int(p[0]), int(p[2]),
+    result.put(inside, shadow_filter(layers, uvz[inside], int(p[0]), int(p[2]),
                                      tie_ref[inside], tie_texel[inside]))
     return result
 
@@ -252,8 +255,8 @@ def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarra
         tie_ref, tie_texel = _point_tie_bounds(
             Q.astype(np.float64), np.asarray(light, np.float64), d, m.astype(np.float64),
             right_up.astype(np.float64), scale.astype(np.float64), depth, float(p[1]),
-            rect[:, 1].astype(np.float64), maps.layers.side)
-    out.put(rows, shadow_filter(maps.layers, uvz, rect[:, 0].astype(np.int64), int(p[2]), tie_ref,
+            rect[:, 1].astype(np.float64), maps.layers["point"].side)
+    out.put(rows, shadow_filter(maps.layers["point"], uvz, rect[:, 0].astype(np.int64), int(p[2]), tie_ref,
                                 tie_texel))
     return out
 

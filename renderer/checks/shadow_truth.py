@@ -281,12 +281,13 @@ def _self_shadowed(light: LightRays, surface: SurfacePixels, rows: np.ndarray) -
     """(K,) bool: the lookup darkens surface pixels `rows` (v < 1) in a map that holds only
     their own object's texels (every other texel cleared, as where nothing was drawn)."""
     out = np.zeros(len(rows), bool)
-    layers = light.maps.layers
+    layers = light.maps.layers[light.kind]
     for index in np.unique(surface.object[rows]):
         at = np.flatnonzero(surface.object[rows] == index)
         own = replace(layers, depth=np.where(layers.caster == index, layers.depth, np.float32(1.0)))
         k = rows[at]
-        v = LOOKUPS[light.kind](replace(light.maps, layers=own), light.index, surface.P[k],
+        v = LOOKUPS[light.kind](replace(light.maps, layers={**light.maps.layers, light.kind: own}),
+                                light.index, surface.P[k],
                                 surface.N[k], surface.position_scale[k]).visibility
         out[at] = v < 1.0
     return out

@@ -8,17 +8,20 @@ This module holds what the GPU path and the reference share and neither computes
 
 - (the settings of a light's map, `Shadow`: on/off, resolution, filter, bias, are in
   renderer/core/shadow_settings.py; objects carry `casts_shadows` / `receives_shadows`);
-- the layers: every map of a scene is a layer of one DEPTH_COMPONENT32F 2D array texture,
-  drawn from texel (0, 0) (`ShadowLayout`, `Tile`); a directional light has one, a point light
-  six (the faces of a cube around it, each a 90-degree perspective view widened by a guard
-  band, so that no filter tap ever leaves its map: no seams);
+- the layers: every map of a scene is a layer of a DEPTH_COMPONENT32F 2D array texture, one
+  texture per kind of light (`ShadowLayout`, `LayerStack`, `Tile`), each map drawn from texel
+  (0, 0) of its layer; a directional light has one layer in the directional stack, a point
+  light six in the point stack (the faces of a cube around it, each a 90-degree perspective
+  view widened by a guard band, so that no filter tap ever leaves its map: no seams). A
+  stack's layers are its largest map's size, so a cube face of 512 texels is not a layer of
+  a directional map's 2048;
 - each frame's light views (`plan_shadows`): an orthographic view for a directional light
   fitted to the receivers the camera can see and the casters that can shadow them, six
   perspective views for a point light, the passes worth drawing (none for a light that
   nothing can shadow, none for a cube face that sees no caster), and the uniform values;
 
 Coordinates are camera-relative, as everything else the pipelines get (FrameMatrices). A map
-of R texels in layers of side S covers texture coordinates [0, R/S)^2 of its layer; its rows
+of R texels in layers of side S (its stack's) covers texture coordinates [0, R/S)^2 of its layer; its rows
 count up from the bottom as GL's window rows do (the depth pass draws with the viewport at
 (0, 0), R x R, on that layer).
 """
@@ -68,9 +71,13 @@ def cube_face(direction: np.ndarray) -> np.ndarray:
 
 # --- the layers ------------------------------------------------------------------------------
 
+SHADOW_KINDS = ("directional", "point")     # the stacks' order
+
+
 @dataclass(frozen=True)
 class Tile:
-    """One map: the texels [0, size)^2 of layer `layer` (GL rows: y counts up from the bottom).
+    """One map: the texels [0, size)^2 of layer `layer` of its light kind's stack (GL rows: y
+    counts up from the bottom).
     Every map starts at texel (0, 0) of its own layer, because llvmpipe evaluates a triangle's
     depth plane from the window origin in float32: a map drawn at an offset in a larger texture
     would store depths hundreds of float32 units from the plane's (the probe in
@@ -98,12 +105,27 @@ class LightMap:
 
 
 @dataclass(frozen=True)
+class LayerStack:
+    """One kind of light's array texture: `layers` layers of `side` texels on a side (its
+    largest map's; 0 and 0 where the kind has no map)."""
+    side: int = 0
+    layers: int = 0
+
+    @property
+    def texels(self) -> int:
+        return self.layers * self.side * self.side
+
+
+@dataclass(frozen=True)
 class ShadowLayout:
-    """Which lights have a map and where: fixed for a scene at an image size (the array texture
-    is made from it once). `side`: the layers' side, the largest map's; `layers`: how many."""
-    side: int
-    layers: int
-    maps: tuple[LightMap, ...]
+    """Which lights have a map and where: fixed for a scene at an image size (the array
+    textures are made from it once). `stacks`: the directional and the point lights' array
+    textures (SHADOW_KINDS order); `maps`: each light's map, its tiles in its kind's stack."""
+    stacks: tuple[LayerStack, LayerStack] = (LayerStack(), LayerStack())
+    maps: tuple[LightMap, ...] = ()                  # ShadowLayout(): no maps at all
+
+    def stack(self, kind: str) -> LayerStack:
+        return self.stacks[SHADOW_KINDS.index(kind)]
 
     def get(self, kind: str, index: int) -> LightMap | None:
         for m in self.maps:
@@ -153,28 +175,37 @@ def shadow_layout(scene, width: int, height: int, prune: bool = True) -> ShadowL
         resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
         wanted.append([kind, i, light.shadow, resolution])
     if not wanted:
-        return ShadowLayout(0, 0, ())
-    layers = sum(6 if kind == "point" else 1 for kind, *_ in wanted)
-    while layers * max(w[3] for w in wanted) ** 2 > MAX_SHADOW_TEXELS:
+        return ShadowLayout()
+    while sum(stack.texels for stack in _stacks(wanted)) > MAX_SHADOW_TEXELS:
         shrinkable = [w for w in wanted if w[2].resolution is None and w[3] > RESOLUTIONS[0]]
         if not shrinkable:
-            side = max(w[3] for w in wanted)
-            raise SceneError(f"the shadow maps need {layers} layers of {side}x{side} texels, more "
-                             f"than {MAX_SHADOW_TEXELS} texels: lower shadow_resolution or turn "
-                             f"shadows off for some lights", file=getattr(scene, "source", "") or None,
-                             key="lights")
+            sizes = " and ".join(f"{s.layers} layers of {s.side}x{s.side}" for s in _stacks(wanted) if s.layers)
+            raise SceneError(f"the shadow maps need {sizes} texels, more than {MAX_SHADOW_TEXELS} "
+                             f"texels: lower shadow_resolution or turn shadows off for some lights",
+                             file=getattr(scene, "source", "") or None, key="lights")
         largest = max(w[3] for w in shrinkable)
         for w in shrinkable:
             if w[3] == largest:
                 w[3] //= 2
-    side = max(w[3] for w in wanted)
-    maps, layer = [], 0
+    maps, next_layer = [], {kind: 0 for kind in SHADOW_KINDS}
     for kind, i, shadow, resolution in wanted:
         count = 6 if kind == "point" else 1
+        first = next_layer[kind]
         maps.append(LightMap(kind, i, shadow, resolution,
-                             tuple(Tile(layer + k, resolution) for k in range(count))))
-        layer += count
-    return ShadowLayout(side, layer, tuple(maps))
+                             tuple(Tile(first + k, resolution) for k in range(count))))
+        next_layer[kind] += count
+    return ShadowLayout(_stacks(wanted), tuple(maps))
+
+
+def _stacks(wanted) -> tuple[LayerStack, LayerStack]:
+    """The stacks the wanted maps ([kind, index, shadow, resolution]) need: per kind, its
+    layers (six for a point light) of its largest resolution."""
+    out = []
+    for kind in SHADOW_KINDS:
+        sizes = [w[3] for w in wanted if w[0] == kind]
+        out.append(LayerStack(max(sizes), len(sizes) * (6 if kind == "point" else 1)) if sizes
+                   else LayerStack())
+    return tuple(out)
 
 
 # --- each frame's light views ----------------------------------------------------------------
@@ -207,10 +238,6 @@ class ShadowPlan:
     passes: list[ShadowPass]
     uniforms: dict[str, np.ndarray]
     texel_size: dict = field(default_factory=dict)   # (kind, light) -> world size of a texel (directional)
-
-    @property
-    def side(self) -> int:
-        return self.layout.side
 
 
 def world_points(scene, matrices) -> list[np.ndarray]:
@@ -300,9 +327,9 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
     margin = max(DEPTH_MARGIN * (far_depth - near_depth), 2.0 * texel)
     near_depth, far_depth = near_depth - margin, far_depth + margin
     clip = _ortho_rows(centre[0], centre[1], half, near_depth, far_depth) @ rotation
-    tile = light_map.tiles[0]
-    lookup = _map_from_clip(tile, layout.side) @ clip
-    params[:] = (tile.layer, texel, light_map.shadow.kernel, tile.size / layout.side)
+    tile, side = light_map.tiles[0], layout.stack("directional").side
+    lookup = _map_from_clip(tile, side) @ clip
+    params[:] = (tile.layer, texel, light_map.shadow.kernel, tile.size / side)
     return ShadowPass("directional", index, 0, tile, clip, tuple(drawn)), lookup, params, texel
 
 
@@ -425,7 +452,7 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, pa
         drawn = tuple(c for c in casters if c in inside
                       and (not prune or any(r in inside for r in pairs[c])))
         needed = not prune or bool(drawn)
-        rects[face] = tile.rect(layout.side, needed)   # not drawn: the lookup reads it as lit
+        rects[face] = tile.rect(layout.stack("point").side, needed)   # not drawn: read as lit
         if not needed:
             continue
         passes.append(ShadowPass("point", index, face, tile, clips[face], drawn))
@@ -445,7 +472,8 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
     and the work the pruning saves (benchmarks/bench_shadow_pruning.py)."""
     n_dir, n_point = len(scene.directional_lights), len(scene.point_lights)
     uniforms = {
-        "u_shadow_map_size": np.array(float(layout.side)),
+        "u_directional_shadow_map_size": np.array(float(layout.stack("directional").side)),
+        "u_point_shadow_map_size": np.array(float(layout.stack("point").side)),
         "u_directional_shadow_matrix": np.tile(np.eye(4), (n_dir, 1, 1)),
         "u_directional_shadow": np.zeros((n_dir, 4)),
         "u_directional_shadow_bias": np.zeros((n_dir, 4)),

@@ -56,8 +56,10 @@ LIGHT_COUNT_UNIFORMS = {"u_num_directional_lights": "int", "u_num_point_lights":
 # the values are the frame's renderer/core/shadows.py ShadowPlan.uniforms; the arrays have a
 # row per light of their kind (ROWS_PER_LIGHT rows for the cube's faces).
 SHADOW_UNIFORMS = {
-    "u_shadow_maps": "sampler2DArrayShadow",   # the maps' texture unit (the GPU path's alone)
-    "u_shadow_map_size": "float",           # S, texels on a side of a layer
+    "u_directional_shadow_maps": "sampler2DArrayShadow",   # the directional stack's unit (GPU only)
+    "u_directional_shadow_map_size": "float",   # S, texels on a side of its layers
+    "u_point_shadow_maps": "sampler2DArrayShadow",         # the point stack's unit (GPU only)
+    "u_point_shadow_map_size": "float",     # S, texels on a side of its layers
     "u_directional_shadow_matrix": "mat4[]",   # camera-relative world -> (u, v, z_w, 1)
     "u_directional_shadow": "vec4[]",       # (layer, texel size, kernel, R/S; 0 when not drawn)
     "u_directional_shadow_bias": "vec4[]",  # (normal, constant, slope, 0) in texels

@@ -194,7 +194,7 @@ class GpuRenderer:
         self._staging: dict[int, np.ndarray] = {}       # attachment -> read-back array
         self._multisample: dict[int, moderngl.Framebuffer] = {}   # samples -> MSAA target
         self._jittered: dict[bool, tuple] = {}           # plan -> sample offset its programs hold
-        self._shadow_layout = ShadowLayout(0, 0, ())         # update() sets it (renderer/core/shadows.py)
+        self._shadow_layout = ShadowLayout()         # update() sets it (renderer/core/shadows.py)
         self._shadow_maps: ShadowMaps | None = None       # made when the layout has maps
         self._shadowed: dict[bool, bool] = {}             # plan -> whether a program looks maps up
         self._drawn_shadow_plan = None                    # what the last draw() drew into the maps

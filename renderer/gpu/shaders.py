@@ -27,6 +27,7 @@ import moderngl
 from renderer.core.resources import glsl_dir
 from renderer.core.shadow_settings import shared_kernel
 from renderer.core.textures import MODULATED
+from renderer.gpu.uniforms import set_shadow_sampler_units
 
 _INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
 _INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
@@ -317,11 +318,13 @@ class ProgramCache:
     def _compile(self, variant: ShaderVariant) -> moderngl.Program:
         sources = program_sources(variant)
         try:
-            return self.ctx.program(**{stage: s.text for stage, s in sources.items()})
+            program = self.ctx.program(**{stage: s.text for stage, s in sources.items()})
         except moderngl.Error as exc:
             legend = "; ".join(f"{stage.split('_')[0]}: " + ", ".join(
                 f"{i}={name}" for i, name in enumerate(s.files)) for stage, s in sources.items())
             raise ShaderSourceError(f"{variant} does not compile (source strings {legend}):\n{exc}")
+        set_shadow_sampler_units(self.ctx, program)
+        return program
 
     def items(self):
         return self._programs.items()

@@ -1,12 +1,12 @@
-"""The shadow maps on the GPU: their array texture and the light-view depth pass that fills it.
+"""The shadow maps on the GPU: their array textures and the light-view depth pass that fills them.
 
     maps = ShadowMaps(ctx, layout)                  # once per GpuRenderer whose layout has maps
     maps.set_plan(plan, buffers, models)            # each update(): what each pass draws
     maps.draw()                                     # each frame, before the camera pass
-    maps.bind()                                     # the maps on SHADOW_MAPS_UNIT for lighting
+    maps.bind()                                     # the maps on SHADOW_MAPS_UNITS for lighting
 
-Every map is a layer of one DEPTH_COMPONENT32F 2D array texture (`layout.layers` layers of
-`layout.side` texels on a side; renderer/core/shadows.py), drawn from texel (0, 0): llvmpipe
+Every map is a layer of its light kind's DEPTH_COMPONENT32F 2D array texture (a stack:
+`layout.stack(kind)`'s layers of its side; renderer/core/shadows.py), drawn from texel (0, 0): llvmpipe
 evaluates a triangle's depth plane from the window origin in float32, so a map drawn at an
 offset would store other depths. moderngl makes no depth array textures, so the storage is
 re-specified through glTexImage3D (as make_float_depth does for renderbuffers), and each layer
@@ -32,12 +32,12 @@ import moderngl
 import numpy as np
 
 from renderer.core.gl_rules import STANDARD_DEPTH
-from renderer.core.shadows import ShadowLayout, ShadowPlan
+from renderer.core.shadows import SHADOW_KINDS, ShadowLayout, ShadowPlan
 from renderer.core.transforms import to_glsl
 from renderer.errors import ContextError
 from renderer.gpu.context import gl_function
 from renderer.gpu.shaders import shader_source
-from renderer.gpu.uniforms import SHADOW_MAPS_UNIT
+from renderer.gpu.uniforms import SHADOW_MAPS_UNITS
 
 GL_TEXTURE_2D_ARRAY = 0x8C1A
 GL_DEPTH_COMPONENT = 0x1902
@@ -129,14 +129,15 @@ def _layer_framebuffers(ctx: moderngl.Context, gl: _GL, texture, layers: int) ->
 
 
 class ShadowMaps:
-    """The maps' array texture, a framebuffer per layer and the depth pass of one GpuRenderer."""
+    """The maps' array textures (one per kind of light with maps), a framebuffer per layer and
+    the depth pass of one GpuRenderer."""
 
     def __init__(self, ctx: moderngl.Context, layout: ShadowLayout):
         self.ctx = ctx
         self._gl = _GL(ctx)
         self.layout: ShadowLayout | None = None
-        self.texture: moderngl.TextureArray | None = None
-        self._framebuffers: list = []                    # per layer: (GL name, moderngl view)
+        # kind -> (array texture, per layer (GL name, moderngl view)) for the kinds with maps
+        self._stacks: dict[str, tuple[moderngl.TextureArray, list]] = {}
         self.program = ctx.program(vertex_shader=shader_source("shadow/depth.vert").text,
                                    fragment_shader=shader_source("shadow/depth.frag").text)
         self._clip_from_model = self.program["u_clip_from_model"]
@@ -146,11 +147,16 @@ class ShadowMaps:
         self.set_layout(layout)
 
     def set_layout(self, layout: ShadowLayout) -> None:
-        """Use `layout` from now on; the texture is made again only when its size changes."""
-        if self.texture is None or (layout.side, layout.layers) != (self.layout.side, self.layout.layers):
-            self._release_texture()
-            self.texture = make_depth_layers(self.ctx, self._gl, layout.side, layout.layers)
-            self._framebuffers = _layer_framebuffers(self.ctx, self._gl, self.texture, layout.layers)
+        """Use `layout` from now on; a stack's texture is made again only when its size changes."""
+        for kind in SHADOW_KINDS:
+            stack = layout.stack(kind)
+            before = None if self.layout is None else self.layout.stack(kind)
+            if kind in self._stacks and stack == before:
+                continue
+            self._release_stack(kind)
+            if stack.layers:
+                texture = make_depth_layers(self.ctx, self._gl, stack.side, stack.layers)
+                self._stacks[kind] = (texture, _layer_framebuffers(self.ctx, self._gl, texture, stack.layers))
         self.layout = layout
         self.plan, self._passes = None, []
 
@@ -164,7 +170,8 @@ class ShadowMaps:
             draws = [(self._vertex_array(i, *buffers[i]),
                       to_glsl(shadow_pass.clip_from_world @ np.asarray(models[i], dtype=np.float64)))
                      for i in shadow_pass.casters]
-            self._passes.append((self._framebuffers[tile.layer][1], tile.size, draws))
+            framebuffer = self._stacks[shadow_pass.kind][1][tile.layer][1]
+            self._passes.append((framebuffer, tile.size, draws))
 
     def _vertex_array(self, index: int, vbo: moderngl.Buffer, ibo: moderngl.Buffer) -> moderngl.VertexArray:
         """Object `index`'s vertex array, made again when the renderer uploaded a new mesh."""
@@ -178,11 +185,15 @@ class ShadowMaps:
         self._vertex_arrays[index] = (vbo, vao)
         return vao
 
-    @property
-    def framebuffers(self) -> list[moderngl.Framebuffer]:
-        """Per layer, its depth-only framebuffer (benchmarks/bench_shadows.py's bare program
-        draws into the same storage)."""
-        return [view for _name, view in self._framebuffers]
+    def texture(self, kind: str) -> moderngl.TextureArray | None:
+        """Kind `kind`'s array texture (None where the layout has no map of that kind)."""
+        made = self._stacks.get(kind)
+        return None if made is None else made[0]
+
+    def framebuffers(self, kind: str) -> list[moderngl.Framebuffer]:
+        """Per layer of kind `kind`'s stack, its depth-only framebuffer
+        (benchmarks/bench_shadows.py's bare program draws into the same storage)."""
+        return [view for _name, view in self._stacks.get(kind, (None, []))[1]]
 
     @property
     def vertex_arrays(self) -> dict:
@@ -204,28 +215,31 @@ class ShadowMaps:
                 vao.render(moderngl.TRIANGLES)
 
     def bind(self) -> None:
-        """The maps on SHADOW_MAPS_UNIT, where the lighting programs' u_shadow_maps reads."""
-        self.texture.use(SHADOW_MAPS_UNIT)
+        """Each stack on its SHADOW_MAPS_UNITS unit, where the lighting programs'
+        u_directional_shadow_maps and u_point_shadow_maps read."""
+        for kind, (texture, _framebuffers) in self._stacks.items():
+            texture.use(SHADOW_MAPS_UNITS[kind])
 
-    def read_layer(self, layer: int) -> np.ndarray:
-        """Layer `layer`'s depths, float32 (S, S), GL rows (row 0 at the bottom): for tests and
-        the viewer's map view (renderer/viewer/shadow_view.py)."""
-        side = self.layout.side
-        data = self._framebuffers[layer][1].read(viewport=(0, 0, side, side), attachment=-1,
-                                                 components=1, dtype="f4")
+    def read_layer(self, kind: str, layer: int) -> np.ndarray:
+        """Layer `layer` of kind `kind`'s stack: its depths, float32 (S, S), GL rows (row 0 at
+        the bottom): for tests and the viewer's map view (renderer/viewer/shadow_view.py)."""
+        side = self.layout.stack(kind).side
+        data = self._stacks[kind][1][layer][1].read(viewport=(0, 0, side, side), attachment=-1,
+                                                   components=1, dtype="f4")
         return np.frombuffer(data, dtype=np.float32).reshape(side, side).copy()
 
-    def _release_texture(self) -> None:
-        if self._framebuffers:
-            names = (ctypes.c_uint * len(self._framebuffers))(*(n for n, _ in self._framebuffers))
+    def _release_stack(self, kind: str) -> None:
+        texture, framebuffers = self._stacks.pop(kind, (None, []))
+        if framebuffers:
+            names = (ctypes.c_uint * len(framebuffers))(*(n for n, _ in framebuffers))
             self._gl.DeleteFramebuffers(len(names), names)
-        if self.texture is not None:
-            self.texture.release()
-        self._framebuffers, self.texture = [], None
+        if texture is not None:
+            texture.release()
 
     def release(self) -> None:
         for _vbo, vao in self._vertex_arrays.values():
             vao.release()
         self._vertex_arrays, self._passes = {}, []
-        self._release_texture()
+        for kind in SHADOW_KINDS:
+            self._release_stack(kind)
         self.program.release()

@@ -4,20 +4,39 @@ column-major float32 (transforms.to_glsl, so that GLSL `M * v` is `M @ v`), flag
 int32. A light array of a kind the scene lacks is left out (neither does the shader declare
 it), except in the all-features build, whose arrays have `light_slots` rows, zeros past the
 scene's lights, with the counts as uniforms. The shadow-map lookup's uniforms are the frame's
-ShadowPlan.uniforms (renderer/core/shadows.py), the maps on texture unit SHADOW_MAPS_UNIT; a
-textured material's texture is on MATERIAL_TEXTURE_UNIT.
+ShadowPlan.uniforms (renderer/core/shadows.py), the directional maps' array texture on unit
+SHADOW_MAPS_UNITS["directional"], the point lights' on SHADOW_MAPS_UNITS["point"]; a textured
+material's texture is on MATERIAL_TEXTURE_UNIT.
 """
 
 from __future__ import annotations
+
+import ctypes
 
 import numpy as np
 
 from renderer.core.scene import FrameMatrices, Scene, SceneObject
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms, object_uniforms
+from renderer.gpu.context import gl_function
 
-SHADOW_MAPS_UNIT = 0                     # the texture unit the shadow maps are bound to
 MATERIAL_TEXTURE_UNIT = 1                # the unit a textured material's texture is bound to
+# The texture units each kind of light's shadow-map stack (array texture) is bound to.
+SHADOW_MAPS_UNITS = {"directional": 0, "point": 2}
+
+
+def set_shadow_sampler_units(ctx, program) -> None:
+    """Point the program's u_directional_shadow_maps and u_point_shadow_maps (where it has
+    them) at SHADOW_MAPS_UNITS, once, when it is linked. Through glProgramUniform1i: moderngl
+    (5.x) has no setter for GL_SAMPLER_2D_ARRAY_SHADOW uniforms and ignores writes to them,
+    so they would stay at unit 0 (where, with one stack, the other stack would be read)."""
+    names = [(f"u_{kind}_shadow_maps", unit) for kind, unit in SHADOW_MAPS_UNITS.items()]
+    present = [(program[name].location, unit) for name, unit in names if program.get(name, None) is not None]
+    if not present:
+        return
+    set_int = gl_function(ctx, "glProgramUniform1i", None, ctypes.c_uint, ctypes.c_int, ctypes.c_int)
+    for location, unit in present:
+        set_int(program.glo, location, unit)
 
 
 def as_bytes(name: str, value) -> bytes:
@@ -44,8 +63,7 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices, light_slots: int
         values["u_num_directional_lights"] = np.asarray(directional)
         values["u_num_point_lights"] = np.asarray(point)
     if shadows is not None:
-        values |= shadows
-        values["u_shadow_maps"] = np.asarray(SHADOW_MAPS_UNIT)
+        values |= shadows                 # the samplers' units: set_shadow_sampler_units
     out = {}
     for name, value in values.items():
         if UNIFORM_TYPES[name].endswith("[]"):

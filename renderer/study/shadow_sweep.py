@@ -6,9 +6,10 @@ map's visibility v taken from the reference's lookup and from each GPU backend's
     rows = measure_sweep((160, 120), {"egl": ctx, "osmesa": ctx})
 
 The template (`elevation_scene`): a large low box as the ground (12 x 0.2 x 8: not planar,
-so it is drawn into its own map and its lit top can self-shadow: acne; a plane could not,
-shadows.can_shadow leaves it out), a cube and a tessellated ball standing on it (contact:
-peter-panning shows as a gap), one directional light from azimuth LIGHT_AZIMUTH.
+so it is drawn into the map, as a caster of the box's and the ball's shadows, and a wrong
+bias shows as acne on its lit top where the map covers it: where the box and the ball can
+shadow it; renderer/core/shadow_casting.py), a cube and a tessellated ball standing on it
+(contact: peter-panning shows as a gap), one directional light from azimuth LIGHT_AZIMUTH.
 
 The GPU's v, per pixel, from three renders of the one-light scene in linear float colour:
 shadows on (I_s), the light's shadows off (I_u) and the light off (I_a, the ambient term):

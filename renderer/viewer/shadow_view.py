@@ -44,7 +44,7 @@ def stored_depth_range(maps: ShadowMaps, light_map: LightMap, faces: list[int]) 
     """(nearest, farthest) depth below 1.0 in texels [0, R)^2 of the given faces' layers;
     None when they hold nothing but 1.0."""
     r = light_map.resolution
-    depths = np.concatenate([maps.read_layer(light_map.tiles[f].layer)[:r, :r].ravel()
+    depths = np.concatenate([maps.read_layer(light_map.kind, light_map.tiles[f].layer)[:r, :r].ravel()
                              for f in faces] or [np.ones(1, np.float32)])
     stored = depths[depths < 1.0]
     return (float(stored.min()), float(stored.max())) if stored.size else None
@@ -95,7 +95,7 @@ class ShadowMapView:
             self.program[name].value = value
         ctx.viewport = (x0, y0, x1 - x0, y1 - y0)
         ctx.enable_only(moderngl.NOTHING)
-        maps.texture.use(VIEW_UNIT)
+        maps.texture(light_map.kind).use(VIEW_UNIT)
         self._sampler.use(VIEW_UNIT)
         try:
             self._vao.render(moderngl.TRIANGLES, vertices=3)

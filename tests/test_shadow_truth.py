@@ -11,6 +11,7 @@ compare --shadows-vs-truth`), read as its specification:
   quotes."""
 
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -320,3 +321,22 @@ def test_builtin_shadow_scenes_reach_the_issue_targets(name):
     flagged = (result.acne | result.wrong_beyond).reshape(-1)[surface.pixel]
     assert 0 < flagged.sum() < 200
     assert second_wall_distance(world[flagged]).max() < 0.02
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("filter, acne, wrong_beyond", [("hard", 3, 3), ("pcf2x2", 90, 4),
+                                                        ("pcf3x3", 250, 21), ("pcf5x5", 645, 19)])
+def test_shadow_room_s_corners_as_the_conventions_say(filter, acne, wrong_beyond):
+    """docs/conventions.md, "Shadows", the bias rule: on shadow_room at 320x240 each filter's
+    acne and wrong-beyond-2-px pixels, all at the room's concave corners (within 0.05 units of
+    a second wall)."""
+    scene = load_scene(resolve_scene("shadow_room"))
+    scene = replace(scene, point_lights=[replace(light, shadow=replace(light.shadow, filter=filter))
+                                         for light in scene.point_lights])
+    result = shadows_vs_truth(scene, 320, 240)
+    figures = result.as_dict()
+    assert (figures["acne_pixels"], figures["wrong_beyond_2px_pixels"]) == (acne, wrong_beyond)
+    surface, _ = surface_pixels(scene, 320, 240)
+    world = surface.P + np.asarray(scene.camera.eye)
+    flagged = (result.acne | result.wrong_beyond).reshape(-1)[surface.pixel]
+    assert second_wall_distance(world[flagged]).max() < 0.05

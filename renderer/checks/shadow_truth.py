@@ -296,7 +296,7 @@ class LightTruth:
     NOT_CONSIDERED), the true shadow boundary (shadow_boundary), the pixels wrong farther than
     EDGE_PX from it, acne, peter-panning in texels (0 where not measured, MAX_REACH_TEXELS + 1
     where no lit point was found), and the map's world texel size at the median considered
-    pixel (None where none is)."""
+    pixel (None where none is, or where the light's map draws nothing: its lookup reads lit)."""
     kind: str
     index: int
     resolution: int
@@ -471,10 +471,11 @@ def measure_light(light: LightRays, light_map, surface: SurfacePixels, rows: np.
     boundary = shadow_boundary(truth_image, _image(surface.pixel, surface.object, -1, width, height))
     wrong = out((v >= LIT_FROM) != truth, False)
     texels = light.texel_axes(surface.P[rows])[0]
+    texel = float(np.median(texels)) if len(texels) else 0.0
     return LightTruth(light_map.kind, light_map.index, light_map.resolution, light_map.shadow.filter,
                       out(k, NOT_CONSIDERED).astype(np.int8), truth_image, boundary,
                       wrong & ~near(boundary, EDGE_PX), out(acne, False), out(reach, 0),
-                      float(np.median(texels)) if len(texels) else None)
+                      texel if texel > 0.0 else None)
 
 
 def shadows_vs_truth(scene, width: int, height: int, visibility: dict | None = None) -> ShadowTruth:

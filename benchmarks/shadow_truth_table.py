@@ -12,7 +12,7 @@ Columns: the pixels compared (lit receivers, any light), wrong beyond 2 px of th
 boundary (count and share of those compared: the headline), acne pixels, wrong outside the
 1-texel band (count and share of all pixels) and each light's world texel (d0: directional
 light 0, the map's t; p0: point light 0, t at its median compared pixel). The figures do not
-depend on the machine; the time does (the whole table: about ten minutes on the project's
+depend on the machine; the time does (the whole table: about five minutes on the project's
 2-core machine). Not a test.
 """
 

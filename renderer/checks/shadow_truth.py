@@ -93,6 +93,9 @@ CLASSES = (
 ACNE = PixelClass("acne", (255, 0, 255), "magenta",
                   "lit in truth, darkened by the map where its texel holds the receiver itself "
                   "(self-shadowing), farther than a texel from a true shadow edge")
+WRONG_BEYOND = PixelClass(EDGE_KEY, (255, 255, 255), "white",
+                          f"the map's decision differs from the truth farther than {EDGE_PX} px from "
+                          f"every pixel of the true shadow boundary (the headline)")
 NOT_CONSIDERED = -1
 _INDEX = {c.name: k for k, c in enumerate(CLASSES)}
 _OUTSIDE = (_INDEX["wrongly_lit"], _INDEX["wrongly_shadowed"])
@@ -386,11 +389,13 @@ class ShadowTruth:
                 f"up to {pp['max_texels']} texels (mean {pp['mean_texels']:.1f})")
 
     def image(self) -> np.ndarray:
-        """(H, W, 3) uint8: each class's colour (CLASSES), acne over it, black elsewhere."""
+        """(H, W, 3) uint8: each class's colour (CLASSES), acne over it, the pixels wrong
+        beyond EDGE_PX over both (WRONG_BEYOND), black elsewhere."""
         image = np.full((*self.classes.shape, 3), _BACKDROP, np.uint8)
         for k, c in enumerate(CLASSES):
             image[self.classes == k] = c.colour
         image[self.acne] = ACNE.colour
+        image[self.wrong_beyond] = WRONG_BEYOND.colour
         return image
 
 

@@ -19,7 +19,6 @@ import pytest
 import reference.pipeline
 from reference.pipeline import surface_pixels
 from reference.shadow.lookup import LOOKUPS
-from renderer.checks import shadow_truth
 from renderer.checks.shadow_truth import (CLASSES, NOT_CONSIDERED, LightRays, TruthScenes, near,
                                           shadow_boundary, shadows_vs_truth)
 from renderer.cli import main

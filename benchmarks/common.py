@@ -7,6 +7,7 @@ import argparse
 import os
 import platform
 import statistics
+import subprocess
 import time
 
 from renderer.cli import parse_size
@@ -31,6 +32,16 @@ def machine() -> str:
     """The host, its CPU count and load average: absolute times depend on them."""
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     return f"{platform.node()}: {os.cpu_count()} CPUs, load average {load}"
+
+
+def revision() -> str:
+    """The repository's commit (short hash), with "+ uncommitted changes" when the work tree
+    differs from it: what the figures were measured with."""
+    def git(*args) -> str:
+        return subprocess.run(["git", *args], capture_output=True, text=True,
+                              cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip()
+    commit = git("rev-parse", "--short", "HEAD") or "unknown"
+    return commit + (" + uncommitted changes" if git("status", "--porcelain", "--untracked-files=no") else "")
 
 
 def alternating_ms(calls, frames: int) -> list[float]:

@@ -26,7 +26,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from renderer.checks.shadow_truth import shadows_vs_truth
+from renderer.checks.shadow_truth import EDGE_KEY, EDGE_PX, shadows_vs_truth
 from renderer.core.primitives import cube, uv_sphere
 from renderer.core.scene import Camera, DirectionalLight, Material, Scene, SceneObject, Transform
 from renderer.gpu.pipeline import GpuRenderer
@@ -83,8 +83,8 @@ def gpu_visibility(scene: Scene, size: tuple[int, int], ctx) -> np.ndarray:
 
 
 def truth_figures(scene: Scene, size: tuple[int, int], visibility: np.ndarray | None = None) -> dict:
-    """The truth's figures for `scene` (ShadowTruth.as_dict(): acne_pixels,
-    wrong_outside_band_pixels, peter_panning, ...), the one light's visibility from the
+    """The truth's figures for `scene` (ShadowTruth.as_dict(): wrong_beyond_2px_pixels,
+    acne_pixels, wrong_outside_band_pixels, peter_panning, ...), the one light's visibility from the
     reference's lookup, or `visibility` (H, W) (gpu_visibility's image)."""
     given = None if visibility is None else {("directional", 0): visibility}
     return shadows_vs_truth(scene, *size, visibility=given).as_dict()
@@ -92,6 +92,7 @@ def truth_figures(scene: Scene, size: tuple[int, int], visibility: np.ndarray | 
 
 def _summary(figures: dict) -> dict:
     return {"acne_pixels": figures["acne_pixels"],
+            f"{EDGE_KEY}_pixels": figures[f"{EDGE_KEY}_pixels"],
             "wrong_outside_band_pixels": figures["wrong_outside_band_pixels"],
             "wrong_outside_band_fraction": figures["wrong_outside_band_fraction"],
             "peter_panning_max_texels": figures["peter_panning"]["max_texels"],
@@ -129,14 +130,17 @@ def markdown_section(rows: list[dict], size: tuple[int, int]) -> str:
              f"({size[0]}x{size[1]}, default shadow settings), held against ray-cast truth "
              f"(renderer/checks/shadow_truth.py); the map's visibility from the reference's "
              f"lookup (ref) and from each GPU backend's images (renderer/study/shadow_sweep.py). "
-             f"Acne: pixels lit in truth that the receiver's own texels darken; wrong outside "
-             f"the band: pixels the map gets wrong farther than a texel from the true shadow "
-             f"edge; peter-panning: the largest gap between a shadow and its caster, in texels.", "",
-             f"| elevation | acne ({header}) | wrong outside band ({header}) "
-             f"| peter-panning max, texels ({header}) |",
-             "| ---: | ---: | ---: | ---: |"]
+             f"Acne: pixels lit in truth that the receiver's own texels darken; wrong beyond "
+             f"{EDGE_PX} px: pixels the map gets wrong farther than {EDGE_PX} pixels from the true "
+             f"shadow boundary; wrong outside the band: farther than a texel from the true shadow "
+             f"edge along the surface; peter-panning: the largest gap between a shadow and its "
+             f"caster, in texels.", "",
+             f"| elevation | acne ({header}) | wrong beyond {EDGE_PX} px ({header}) "
+             f"| wrong outside band ({header}) | peter-panning max, texels ({header}) |",
+             "| ---: | ---: | ---: | ---: | ---: |"]
     for row in rows:
         lines.append(f"| {row['elevation']}° | {_cell(row, backends, 'acne_pixels')} "
+                     f"| {_cell(row, backends, f'{EDGE_KEY}_pixels')} "
                      f"| {_cell(row, backends, 'wrong_outside_band_pixels')} "
                      f"| {_cell(row, backends, 'peter_panning_max_texels')} |")
     return "\n".join(lines) + "\n"

@@ -291,51 +291,28 @@ def test_cli_refuses_a_scene_without_shadow_maps(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def second_wall_distance(world):
-    """(K,) the distance of points (K, 3) inside shadow_room's room (x, z in [-2, 2], y in
-    [0, 3]) to the second-nearest of its six walls: small only near a concave corner."""
-    to_walls = np.stack([2 - world[:, 0], 2 + world[:, 0], world[:, 1], 3 - world[:, 1],
-                         2 - world[:, 2], 2 + world[:, 2]], axis=1)
-    return np.sort(to_walls, axis=1)[:, 1]
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ["shadow_plane", "shadow_room", "shadow_curved"])
 def test_builtin_shadow_scenes_reach_the_issue_targets(name):
-    """The issue's target at default settings, 320x240: fewer than 0.1 % of the pixels wrong
-    outside the 1-texel band, and no pixel wrong beyond 2 px of the true shadow boundary and no
-    acne, but at shadow_room's concave corners (a K x K filter reads the other wall: no bias
-    along one plane can cover it), every one of those within 0.02 units (about a texel) of a
-    second wall. (shadow_room also had 4 acne pixels at cube-face seams while a point light's
-    lookup read the face its moved point fell on; it reads P's own face now.)"""
+    """The issue's target at default settings, 320x240: no acne, no pixel wrong beyond 2 px of
+    the true shadow boundary, fewer than 0.1 % of the pixels wrong outside the 1-texel band.
+    (shadow_room had acne and wrong pixels at its concave corners while its room, a convex box
+    around the lamp, was drawn into the lamp's maps: it cannot shadow anything in it and is in
+    no map now; renderer/core/shadow_casting.py.)"""
     scene = load_scene(resolve_scene(name))
-    result = shadows_vs_truth(scene, 320, 240)
-    figures = result.as_dict()
+    figures = shadows_vs_truth(scene, 320, 240).as_dict()
     assert figures["wrong_outside_band_fraction"] < 0.001
-    if name != "shadow_room":
-        assert figures["acne_pixels"] == 0 and figures["wrong_beyond_2px_pixels"] == 0
-        return
-    surface, _ = surface_pixels(scene, 320, 240)
-    world = surface.P + np.asarray(scene.camera.eye)
-    flagged = (result.acne | result.wrong_beyond).reshape(-1)[surface.pixel]
-    assert 0 < flagged.sum() < 200
-    assert second_wall_distance(world[flagged]).max() < 0.02
+    assert figures["acne_pixels"] == 0 and figures["wrong_beyond_2px_pixels"] == 0
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("filter, acne, wrong_beyond", [("hard", 3, 3), ("pcf2x2", 90, 4),
-                                                        ("pcf3x3", 250, 21), ("pcf5x5", 645, 19)])
-def test_shadow_room_s_corners_as_the_conventions_say(filter, acne, wrong_beyond):
-    """docs/conventions.md, "Shadows", the bias rule: on shadow_room at 320x240 each filter's
-    acne and wrong-beyond-2-px pixels, all at the room's concave corners (within 0.05 units of
-    a second wall)."""
+@pytest.mark.parametrize("filter", ["hard", "pcf2x2", "pcf3x3", "pcf5x5"])
+def test_shadow_room_s_corners_as_the_conventions_say(filter):
+    """docs/conventions.md, "Shadows", the bias rule: on shadow_room at 320x240 no filter
+    leaves acne or a pixel wrong beyond 2 px at the room's concave corners: the room is in no
+    map (with it in its own maps they numbered 3 to 645 acne pixels, 3 to 21 wrong)."""
     scene = load_scene(resolve_scene("shadow_room"))
     scene = replace(scene, point_lights=[replace(light, shadow=replace(light.shadow, filter=filter))
                                          for light in scene.point_lights])
-    result = shadows_vs_truth(scene, 320, 240)
-    figures = result.as_dict()
-    assert (figures["acne_pixels"], figures["wrong_beyond_2px_pixels"]) == (acne, wrong_beyond)
-    surface, _ = surface_pixels(scene, 320, 240)
-    world = surface.P + np.asarray(scene.camera.eye)
-    flagged = (result.acne | result.wrong_beyond).reshape(-1)[surface.pixel]
-    assert second_wall_distance(world[flagged]).max() < 0.05
+    figures = shadows_vs_truth(scene, 320, 240).as_dict()
+    assert (figures["acne_pixels"], figures["wrong_beyond_2px_pixels"]) == (0, 0)

@@ -40,6 +40,15 @@ in vec2 v_uv;                        // from vertex.glsl
 vec3 texel;                          // the material's texel at this fragment (main() looks it up)
 #endif
 
+#if defined(SHADOW_MAPS) && !defined(SHADING_FLAT)
+// The facet normals (renderer/core/facets.py: object space, float32, face f at texel
+// (f mod FACE_TEXTURE_WIDTH, f div FACE_TEXTURE_WIDTH)), for the shadow lookup's facet; flat
+// has its geometry stage's face normal.
+uniform sampler2D u_face_normals;
+uniform mat3 u_normal_matrix;
+uniform int u_shadow_facets;         // 1: a mesh, its facets are its surface; 0: an analytic shape
+#endif
+
 #if defined(SHADING_PHONG)
 in vec3 v_world_position;
 in vec3 v_world_normal;
@@ -193,6 +202,22 @@ void main() {
     if (BACK_FACE_LIT) {
         N = -N;                      // the back face is seen: light its side
         back = true;
+    }
+#endif
+#if defined(SHADOW_MAPS) && defined(SHADING_FLAT)
+    shadow_facet_normal = N;         // the face normal, flipped with N
+#elif defined(SHADOW_MAPS)
+    // The facet's normal in world space, on the side N lights (gl_PrimitiveID: the face's
+    // index in the indexed draw, whichever part of it clipping left).
+    // An analytic shape's triangles only stand in for it (u_shadow_facets 0): its surface is
+    // smooth, its normal N.
+    shadow_facet_normal = N;
+    if (u_shadow_facets != 0) {
+        ivec2 face = ivec2(gl_PrimitiveID % FACE_TEXTURE_WIDTH, gl_PrimitiveID / FACE_TEXTURE_WIDTH);
+        shadow_facet_normal = normalize_or_zero(u_normal_matrix * texelFetch(u_face_normals, face, 0).xyz);
+        if (dot(shadow_facet_normal, N) < 0.0) {
+            shadow_facet_normal = -shadow_facet_normal;
+        }
     }
 #endif
 #if defined(SHADING_PHONG)

@@ -40,12 +40,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.geometry import TriangleOutputs
-from reference.lighting import LightTerms, Lights, MaterialUniforms, light_terms, lighting, normalize_or_zero
+from reference.lighting import (LightTerms, Lights, MaterialUniforms, dot, light_terms, lighting,
+                                normalize_or_zero)
 from reference.rasterizer import perspective_weights_at
 from reference.sampler import quad_reference
 from reference.shadow.lookup import FragmentShadows, ShadowMaps
 from reference.texture import material_texel
 from reference.vertex import VertexOutputs, modulated
+from renderer.core.facets import face_normals
 
 
 @dataclass
@@ -56,6 +58,8 @@ class ObjectVaryings:
     triangles: TriangleOutputs | None  # flat shading only
     receives_shadows: bool = False
     displace_lookup: object = None     # a check's displacement of the texture lookup (reference/texture.py)
+    index: int = -1                    # the object's index in the scene (the shadow masks')
+    facet_normals: np.ndarray | None = None  # (T, 3) world facet normals (a Phong or Gouraud receiver)
 
 
 def interpolate(varying: np.ndarray, faces: np.ndarray, triangle: np.ndarray,
@@ -89,6 +93,24 @@ def lit_point(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
     if obj.material.two_sided:
         N = np.where(gl_FrontFacing[:, None], N, -N)
     return P, N
+
+
+def facet_normal(obj: ObjectVaryings, triangle: np.ndarray, N: np.ndarray) -> np.ndarray:
+    """(N, 3) the fragments' facet normals on the side N lights, as glsl/fragment.glsl sets
+    shadow_facet_normal: flat's face normal (N itself, flipped with it); Phong's and Gouraud's
+    from their face's world facet normal (obj.facet_normals: world_facet_normals), turned to
+    N's side; an analytic shape's (no facet_normals: its triangles only stand in for it) N."""
+    if obj.material.shading == "flat" or obj.facet_normals is None:
+        return N
+    facet = obj.facet_normals[triangle]
+    return np.where((dot(facet, N) < 0.0), -facet, facet)
+
+
+def world_facet_normals(mesh, u_normal_matrix: np.ndarray, dtype) -> np.ndarray:
+    """(T, 3) the faces' world unit normals as the GLSL computes them: the float32 object-space
+    face normals (renderer/core/facets.py) through the normal matrix, renormalised, in dtype."""
+    n = face_normals(mesh).astype(dtype)
+    return normalize_or_zero(n @ np.asarray(u_normal_matrix, dtype).T)
 
 
 def fragment_texel(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
@@ -150,7 +172,7 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
                                    texel)
             # the tie bands' scale: GL interpolates P from these vertices (lookup.py, SHADOW_TIE)
             scale = np.abs(vertices.v_world_position[faces[triangle]]).max(axis=(1, 2))
-            look = FragmentShadows(shadows, scale)
+            look = FragmentShadows(shadows, scale, facet_normal(obj, triangle, N), obj.index)
             color = terms.shade(P, N, look.visibility)
             tied = look.tied
             if tied is not None and tied.any():

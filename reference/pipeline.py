@@ -34,7 +34,7 @@ import numpy as np
 
 from reference.clipping import clip_triangles
 from reference.depth_buffer import DepthBuffer
-from reference.fragment import ObjectVaryings, lit_point, shade_fragments
+from reference.fragment import ObjectVaryings, facet_normal, lit_point, shade_fragments, world_facet_normals
 from reference.geometry import shade_triangles
 from reference.lighting import Lights, normalize_or_zero
 from reference.framebuffer import compose_frame
@@ -67,7 +67,8 @@ class PreparedObject:
 
 
 def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: int, height: int,
-                   subpixel_bits: int, reversed_z: bool, dtype, displace_lookup=None) -> PreparedObject:
+                   subpixel_bits: int, reversed_z: bool, dtype, displace_lookup=None,
+                   index: int = -1, shadowed: bool = False) -> PreparedObject:
     """Vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping ->
     viewport transform and snapping -> facing and culling, for one object."""
     mesh, material = obj.mesh, obj.material
@@ -83,8 +84,12 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
+    # a mesh's facets are its surface; an analytic shape's triangles only stand in for it
+    facets = (world_facet_normals(mesh, matrices.normal, dtype)
+              if shadowed and obj.receives_shadows and material.shading != "flat"
+              and obj.shape is None else None)
     return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows,
-                                         displace_lookup),
+                                         displace_lookup, index, facets),
                           window.select(keep),
                           clipped.source[keep], clipped.weights[keep])
 
@@ -167,14 +172,15 @@ def prepare_frame(scene, width: int, height: int, dtype, subpixel_bits: int = SU
 
     # Objects wholly outside the view volume are skipped, as the GPU path skips them.
     visible = visible_objects(scene, frame_matrices)
+    shadows = shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype, tile_pixels)
     prepared, first_orders, first_order = [], [], 0
-    for obj, matrices, shown in zip(scene.objects, frame_matrices.objects, visible):
+    for index, (obj, matrices, shown) in enumerate(zip(scene.objects, frame_matrices.objects, visible)):
         prepared.append(prepare_object(obj, matrices, frame_matrices, lights, eye, width, height,
-                                       subpixel_bits, reversed_z, dtype, displace_lookup)
+                                       subpixel_bits, reversed_z, dtype, displace_lookup,
+                                       index=index, shadowed=shadows is not None)
                         if shown else None)
         first_orders.append(first_order)
         first_order += len(obj.mesh.faces)
-    shadows = shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype, tile_pixels)
     return PreparedFrame(lights, eye, prepared, first_orders, shadows)
 
 
@@ -306,16 +312,18 @@ class SurfacePixels:
     N: np.ndarray                 # (K, 3) the lit unit normal (flipped on a two-sided back face)
     Ng: np.ndarray                # (K, 3) the unit normal of the triangle's plane, as wound
     position_scale: np.ndarray    # (K,) the largest |coordinate| of its triangle's vertices
+    facet: np.ndarray             # (K, 3) the shadow lookup's facet normal (lit side; receivers)
 
 
 def _surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
-    """(P, N, Ng, position_scale) of one object's fragments: where the fragment stage looks its
-    shadows up (reference/fragment.py, lit_point) and the lookup's tie scale
-    (reference/shadow/lookup.py)."""
+    """(P, N, Ng, position_scale, facet) of one object's fragments: where the fragment stage
+    looks its shadows up (reference/fragment.py, lit_point, facet_normal) and the lookup's tie
+    scale (reference/shadow/lookup.py)."""
     P, N = lit_point(varyings, triangle, weights, gl_FrontFacing)
     corners = varyings.vertices.v_world_position[varyings.faces[triangle]]
     Ng = normalize_or_zero(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
-    return P, N, Ng, np.abs(corners).max(axis=(1, 2))
+    facet = facet_normal(varyings, triangle, N)
+    return P, N, Ng, np.abs(corners).max(axis=(1, 2)), facet
 
 
 def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
@@ -344,6 +352,6 @@ def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
     if not parts:
         empty = np.zeros((0, 3), dtype)
         return SurfacePixels(np.zeros(0, np.int64), np.zeros(0, np.int64), empty, empty, empty,
-                             np.zeros(0, dtype)), prepared.shadows
+                             np.zeros(0, dtype), empty), prepared.shadows
     columns = [np.concatenate(column) for column in zip(*parts)]
     return SurfacePixels(*columns), prepared.shadows

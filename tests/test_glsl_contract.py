@@ -65,6 +65,10 @@ GPU_ONLY_UNIFORMS = {
                                  "array of layers",
     "u_point_shadow_maps": "the point lights' maps' texture unit; the twin reads its array of layers",
     "u_texture": "the material texture's unit; the twin reads the MaterialTexture",
+    "u_face_normals": "the facet normals' texture unit; the twin reads renderer.core.facets."
+                      "face_normals of the mesh",
+    "u_shadow_facets": "whether the object is a mesh (1) or an analytic shape (0); the twin "
+                       "leaves a shape's ObjectVaryings.facet_normals out",
 }
 
 
@@ -91,8 +95,9 @@ def uploaded_uniform_names() -> set[str]:
     names |= set(SHADOW_PASS_UNIFORMS)          # renderer/gpu/shadow_maps.py, per pass and object
     # the stacks' samplers, pointed at their units once at link (set_shadow_sampler_units)
     names |= {f"u_{kind}_shadow_maps" for kind in SHADOW_MAPS_UNITS}
-    for obj, object_matrices in zip(scene.objects, matrices.objects):
-        names |= set(object_uniform_values(obj, object_matrices))
+    plan = plan_shadows(scene, matrices, shadow_layout(scene, 64, 48))
+    for index, (obj, object_matrices) in enumerate(zip(scene.objects, matrices.objects)):
+        names |= set(object_uniform_values(obj, object_matrices, plan.self_masks(index)))
     return names
 
 
@@ -315,8 +320,8 @@ def uniforms_not_in_the_twin(parsed) -> list[str]:
         lighting_names, "reference.lighting.Lights or MaterialUniforms, nor a parameter of "
                         "every stage of the twin that lights")
     problems += names_missing_from(
-        of(parsed["fragment.glsl"], "uniform").values(), set(GPU_ONLY_UNIFORMS),
-        "GPU_ONLY_UNIFORMS of this test")
+        of(parsed["fragment.glsl"], "uniform").values(), set(GPU_ONLY_UNIFORMS) | vertex_parameters,
+        "GPU_ONLY_UNIFORMS of this test or the parameters of reference.vertex.shade_vertices")
     problems += names_missing_from(
         of(parsed[TEXTURE], "uniform").values(), parameters(lookup_coordinates) | set(GPU_ONLY_UNIFORMS),
         "the parameters of reference.texture.lookup_coordinates or GPU_ONLY_UNIFORMS")
@@ -324,8 +329,9 @@ def uniforms_not_in_the_twin(parsed) -> list[str]:
     plan = plan_shadows(scene, scene.matrices(64, 48), shadow_layout(scene, 64, 48))
     problems += names_missing_from(
         of(parsed["shadow/lookup.glsl"], "uniform").values(),
-        set(plan.uniforms) | set(GPU_ONLY_UNIFORMS), "renderer.core.shadows.ShadowPlan.uniforms "
-        "(what reference/shadow/lookup.py reads) or GPU_ONLY_UNIFORMS")
+        set(plan.uniforms) | set(plan.self_masks(0)) | set(GPU_ONLY_UNIFORMS),
+        "renderer.core.shadows.ShadowPlan.uniforms or self_masks (what reference/shadow/lookup.py "
+        "reads) or GPU_ONLY_UNIFORMS")
     return problems
 
 

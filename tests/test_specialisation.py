@@ -192,7 +192,7 @@ def test_both_pipelines_skip_the_same_objects_and_draw_the_same_image(gl_context
     drawn = []
     original = reference.pipeline.prepare_object
     monkeypatch.setattr(reference.pipeline, "prepare_object",
-                        lambda obj, *rest: drawn.append(obj.name) or original(obj, *rest))
+                        lambda obj, *rest, **named: drawn.append(obj.name) or original(obj, *rest, **named))
     expected = reference.render(scene, *SIZE, subpixel_bits=subpixel_bits)
     assert drawn == ["box0", "box3"]
     result = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth,

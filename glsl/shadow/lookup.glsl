@@ -11,9 +11,19 @@
 // (0, 0); a point light has six, one per cube face, each widened so that no tap leaves its map.
 // Coordinates are camera-relative world coordinates, as lighting.glsl's, whose light counts
 // and light uniforms (directions, positions) this reads.
+// The facet (docs/conventions.md, "The facet normal"; renderer/core/facets.py): a point whose
+// facet is turned from the light (its geometric normal, on the lit side, shadow_facet_normal,
+// which fragment.glsl sets before lighting) is not reached by it, as a shadow ray from there
+// is blocked by the solid behind; the bias moves the point along the facet's normal, and by
+// the normal term only where the light's map holds the object's own texels (its bit in
+// u_shadow_self_*: ShadowPlan.self_masks).
 
 #include "lighting.glsl"
 #define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
+
+vec3 shadow_facet_normal;            // the fragment's facet normal on the lit side (fragment.glsl)
+uniform int u_shadow_self_directional;   // bit i: this object is in directional light i's map
+uniform int u_shadow_self_point;         // bit i: ... in point light i's cube
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
 uniform sampler2DArrayShadow u_directional_shadow_maps;
@@ -31,8 +41,8 @@ uniform vec4 u_point_shadow_bias[NUM_POINT_LIGHTS];        // (normal, constant,
 uniform vec4 u_point_shadow_tiles[6 * NUM_POINT_LIGHTS];   // per face (layer, size / S, drawn, 0)
 #endif
 
-// The receiver point moved before it is compared (shadow_settings.BiasRule): along N by
-// normal * (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by
+// The receiver point moved before it is compared (shadow_settings.BiasRule): along the facet
+// normal N by normal * (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by
 // constant + slope * min(tan(theta), SHADOW_MAX_SLOPE) texels; t is the world size of a texel.
 vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bias) {
     float c = clamp(dot(N, L), 0.0, 1.0);
@@ -74,15 +84,20 @@ float shadow_filter(sampler2DArrayShadow maps, float S, vec3 uvz, float layer, i
 
 #if NUM_DIRECTIONAL_LIGHTS > 0
 float light_visibility_directional(int i, vec3 P, vec3 N) {
+    vec3 L = normalize(-u_directional_direction[i]);
+    if (dot(shadow_facet_normal, L) < 0.0) {
+        return 0.0;                  // the facet is turned from the light
+    }
     vec4 p = u_directional_shadow[i];
     if (p.w == 0.0) {
         return 1.0;                  // no pass this frame: nothing can shadow the receivers
     }
     mat4 M = u_directional_shadow_matrix[i];
-    vec3 L = normalize(-u_directional_direction[i]);
     vec3 X = normalize(vec3(M[0][0], M[1][0], M[2][0]));     // row 0 of M: the map's x axis
     vec3 Y = normalize(vec3(M[0][1], M[1][1], M[2][1]));     // row 1: its y axis
-    vec3 Q = shadow_bias_point(P, N, L, X, Y, p.y, u_directional_shadow_bias[i]);
+    vec4 bias = u_directional_shadow_bias[i];
+    bias.x *= float((u_shadow_self_directional >> i) & 1);  // no texel of its own: no normal offset
+    vec3 Q = shadow_bias_point(P, shadow_facet_normal, L, X, Y, p.y, bias);
     vec3 uvz = (M * vec4(Q, 1.0)).xyz;
     if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(p.w)))) {
         return 1.0;                  // outside the map, which holds every caster: nothing there
@@ -115,23 +130,27 @@ int cube_face(vec3 d) {
 }
 
 float light_visibility_point(int i, vec3 P, vec3 N) {
-    vec4 p = u_point_shadow[i];
-    if (p.x == 0.0) {
-        return 1.0;
-    }
     vec3 light = u_point_position[i];
     vec3 to_light = light - P;
     if (dot(to_light, to_light) == 0.0) {
         return 1.0;                  // a light on the surface: fully incident (lighting.glsl)
     }
     vec3 L = normalize(to_light);
+    if (dot(shadow_facet_normal, L) < 0.0) {
+        return 0.0;                  // the facet is turned from the light
+    }
+    vec4 p = u_point_shadow[i];
+    if (p.x == 0.0) {
+        return 1.0;                  // no pass this frame
+    }
     // The face is P's own, also for the moved point Q: the bias is sized with that face's axes,
     // and its guard band holds Q (at most the normal offset across the map from P). Reading the
     // face Q falls on instead would meet another face's axes at a seam: acne there.
     int f = cube_face(-to_light);
     float t = 2.0 * dot(CUBE_FACE_AXIS[f], -to_light) * p.y / p.w;    // a texel at P's distance
-    vec3 Q = shadow_bias_point(P, N, L, CUBE_FACE_RIGHT[f], CUBE_FACE_UP[f], t,
-                               u_point_shadow_bias[i]);
+    vec4 bias = u_point_shadow_bias[i];
+    bias.x *= float((u_shadow_self_point >> i) & 1);          // no texel of its own: no normal offset
+    vec3 Q = shadow_bias_point(P, shadow_facet_normal, L, CUBE_FACE_RIGHT[f], CUBE_FACE_UP[f], t, bias);
     vec3 d = Q - light;
     vec4 rect = u_point_shadow_tiles[6 * i + f];
     if (rect.z == 0.0) {

@@ -46,6 +46,10 @@ SMALLEST_NORMAL32 = 2.0 ** -126
 # `tolerance` (STORE_TIE_ROUNDINGS); the compare band is their sum, around the range of depths
 # GL may have stored where its snapping may change a caster's coverage (depth.py below, above).
 SHADOW_TIE = 16 * UNIT_ROUNDOFF32
+# The facet test (facet . L < 0: the facet is turned from the light) is decided either way
+# where |facet . L| is within FACET_TIE: GL's facet normal (a float32 mat3 product of the
+# float32 face normal, renormalised) and L differ from the reference's by a few roundings.
+FACET_TIE = 64 * UNIT_ROUNDOFF32
 
 
 @dataclass
@@ -70,22 +74,48 @@ class ShadowLookup:
 class ShadowMaps:
     """What the lookup reads: the frame's layers per kind of light ("directional", "point":
     the GLSL's u_directional_shadow_maps and u_point_shadow_maps), the plan's uniforms in the
-    pipeline's dtype (ShadowPlan.uniforms, named as the GLSL's) and the lights (their direction
-    and position)."""
+    pipeline's dtype (ShadowPlan.uniforms, named as the GLSL's), the lights (their direction
+    and position) and `self_masks(object)` (ShadowPlan.self_masks: the GLSL's u_shadow_self_*)."""
     layers: dict[str, ShadowLayers]
     uniforms: dict[str, np.ndarray]
     lights: Lights
+    self_masks: object = None
 
     @classmethod
     def from_plan(cls, layers: dict[str, ShadowLayers], plan, lights: Lights, dtype) -> "ShadowMaps":
-        return cls(layers, {k: np.asarray(v).astype(dtype) for k, v in plan.uniforms.items()}, lights)
+        return cls(layers, {k: np.asarray(v).astype(dtype) for k, v in plan.uniforms.items()}, lights,
+                   plan.self_masks)
+
+    def own_texels(self, kind: str, i: int, index: int) -> bool:
+        """Whether light i's map (of `kind`) holds object `index`'s own texels (its bit in
+        u_shadow_self_<kind>): only then does its lookup take the bias's normal term."""
+        return self.self_masks is not None and bool(self.self_masks(index)[f"u_shadow_self_{kind}"] >> i & 1)
+
+
+def facet_test(facet: np.ndarray, L: np.ndarray, lookup) -> ShadowLookup:
+    """The light's visibility where the facet (unit normal on the lit side, (N, 3)) is turned
+    from the light L ((N, 3) or (3,)): 0 where facet . L < 0, else `lookup(rows)`'s (a
+    ShadowLookup of those rows; a facet along the light, facet . L = 0, is looked up as a ray
+    grazing it is not blocked by it); within FACET_TIE of 0 the other decision is the
+    alternative."""
+    c = dot(facet, L)[:, 0]
+    rows = np.flatnonzero(c > -FACET_TIE)
+    out = ShadowLookup(np.zeros(len(c), facet.dtype), np.zeros(len(c), facet.dtype), np.zeros(len(c), bool))
+    if len(rows):
+        out.put(rows, lookup(rows))
+    facing = c >= 0.0
+    near = np.abs(c) <= FACET_TIE
+    out.alternative = np.where(near, np.where(facing, 0.0, out.visibility), out.alternative).astype(facet.dtype)
+    out.visibility = np.where(facing, out.visibility, 0.0).astype(facet.dtype)
+    out.tied = out.tied & facing | near
+    return out
 
 
 # --- the bias ---------------------------------------------------------------------------------
 
 def shadow_bias_point(P, N, L, X, Y, t, bias) -> np.ndarray:
-    """The receiver point moved before it is compared (shadow_settings.BiasRule): along N by
-    bias.x (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by bias.y +
+    """The receiver point moved before it is compared (shadow_settings.BiasRule): along the
+    facet normal N by bias.x (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by bias.y +
     bias.z min(tan(theta), MAX_SLOPE) texels; t (..., 1) or scalar is the world size of a texel."""
     dtype = np.result_type(P)
     c = np.clip(dot(N, L), 0.0, 1.0)
@@ -184,18 +214,25 @@ def shadow_filter(layers: ShadowLayers, uvz: np.ndarray, layer, kernel: int, tie
 
 # --- the lights -------------------------------------------------------------------------------
 
-def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarray,
-                                 position_scale: np.ndarray) -> ShadowLookup:
-    """Directional light i at points P (N, 3), normals N; position_scale (N,): the largest
-    |coordinate| of the vertices P was interpolated from (the tie bands)."""
+def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, facet: np.ndarray,
+                                 position_scale: np.ndarray, own: bool = True) -> ShadowLookup:
+    """Directional light i at points P (N, 3) on facets of unit normal `facet` (the lit side);
+    position_scale (N,): the largest |coordinate| of the vertices P was interpolated from (the
+    tie bands); `own`: the map holds the object's own texels (ShadowMaps.own_texels)."""
+    L = normalize(-maps.lights.u_directional_direction[i])
+    return facet_test(facet, np.broadcast_to(L, facet.shape), lambda rows: _directional(
+        maps, i, P[rows], facet[rows], np.asarray(position_scale)[rows], own, L))
+
+
+def _directional(maps: ShadowMaps, i: int, P, facet, position_scale, own: bool, L) -> ShadowLookup:
     dtype = P.dtype
     p = maps.uniforms["u_directional_shadow"][i]                 # (layer, t, kernel, extent)
     if p[3] == 0.0:
         return ShadowLookup.lit(len(P), dtype)    # no pass this frame: nothing can shadow
     M = maps.uniforms["u_directional_shadow_matrix"][i]
-    L = normalize(-maps.lights.u_directional_direction[i])
     X, Y = normalize(M[0, :3]), normalize(M[1, :3])
-    Q = shadow_bias_point(P, N, L, X, Y, p[1], maps.uniforms["u_directional_shadow_bias"][i])
+    bias = maps.uniforms["u_directional_shadow_bias"][i] * np.array([float(own), 1, 1, 1], dtype)
+    Q = shadow_bias_point(P, facet, L, X, Y, p[1], bias)
     uvz = Q @ M[:3, :3].T + M[:3, 3]
     scale = np.abs(Q).astype(np.float64) + np.asarray(position_scale, np.float64)[:, None]
     A = np.abs(M.astype(np.float64))
@@ -224,24 +261,35 @@ def _point_tie_bounds(Q, light, d, m, right_up, position_scale, depth, tan_half,
     return tie_ref, tie_texel
 
 
-def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, N: np.ndarray,
-                           position_scale: np.ndarray) -> ShadowLookup:
-    """Point light i at points P (N, 3), normals N (as light_visibility_directional)."""
+def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, facet: np.ndarray,
+                           position_scale: np.ndarray, own: bool = True) -> ShadowLookup:
+    """Point light i at points P (N, 3) on facets of unit normal `facet` (as
+    light_visibility_directional)."""
+    dtype = P.dtype
+    out = ShadowLookup.lit(len(P), dtype)
+    light = maps.lights.u_point_position[i]
+    to_light = light - P
+    rows = np.flatnonzero(dot(to_light, to_light)[:, 0] != 0.0)   # a light on the surface: lit
+    L = normalize(to_light[rows])
+    out.put(rows, facet_test(facet[rows], L, lambda k: _point(
+        maps, i, P[rows[k]], facet[rows[k]], np.asarray(position_scale)[rows[k]], own, L[k],
+        to_light[rows[k]])))
+    return out
+
+
+def _point(maps: ShadowMaps, i: int, P, facet, scale, own: bool, L, to_light) -> ShadowLookup:
     dtype = P.dtype
     out = ShadowLookup.lit(len(P), dtype)
     p = maps.uniforms["u_point_shadow"][i]
     if p[0] == 0.0:
         return out
     light = maps.lights.u_point_position[i]
-    to_light = light - P
-    rows = np.flatnonzero(dot(to_light, to_light)[:, 0] != 0.0)   # a light on the surface: lit
-    P, N, to_light, scale = P[rows], N[rows], to_light[rows], np.asarray(position_scale)[rows]
-    L = normalize(to_light)
+    rows = np.arange(len(P))
     rotations, axes = CUBE_FACE_ROTATIONS.astype(dtype), CUBE_FACE_AXES.astype(dtype)
     f = cube_face(-to_light)          # P's own face, also for Q (the GLSL says why)
     t = 2.0 * dot(axes[f], -to_light) * p[1] / p[3]           # a texel's size at P's distance
-    Q = shadow_bias_point(P, N, L, rotations[f, 0], rotations[f, 1], t,
-                          maps.uniforms["u_point_shadow_bias"][i])
+    bias = maps.uniforms["u_point_shadow_bias"][i] * np.array([float(own), 1, 1, 1], dtype)
+    Q = shadow_bias_point(P, facet, L, rotations[f, 0], rotations[f, 1], t, bias)
     d = Q - light
     rect = maps.uniforms["u_point_shadow_tiles"][6 * i + f]
     drawn = rect[:, 2] != 0.0                                   # else the face sees no caster
@@ -271,6 +319,8 @@ class FragmentShadows:
     other way, and `tied` (N,) says where some light's lookup (where its term is not 0) was."""
     maps: ShadowMaps
     position_scale: np.ndarray
+    facet: np.ndarray                  # (N, 3) the fragments' facet normals on the lit side
+    index: int                         # the object's index in the scene
     lookups: dict = field(default_factory=dict)
 
     def _lookup(self, kind, i, P, N, needed) -> ShadowLookup:
@@ -279,7 +329,9 @@ class FragmentShadows:
             out = ShadowLookup.lit(len(P), P.dtype)
             rows = np.flatnonzero(needed)          # elsewhere the light adds nothing
             if len(rows):
-                out.put(rows, LOOKUPS[kind](self.maps, i, P[rows], N[rows], self.position_scale[rows]))
+                out.put(rows, LOOKUPS[kind](self.maps, i, P[rows], self.facet[rows],
+                                            self.position_scale[rows],
+                                            self.maps.own_texels(kind, i, self.index)))
             self.lookups[key] = out
         return self.lookups[key]
 

@@ -405,8 +405,20 @@ def _visibility(light: LightRays, surface: SurfacePixels, rows, given) -> np.nda
     """(K,) v at surface pixels `rows`: the reference's lookup, or `given` (H, W)."""
     if given is not None:
         return given.reshape(-1)[surface.pixel[rows]]
-    return LOOKUPS[light.kind](light.maps, light.index, surface.P[rows], surface.N[rows],
-                               surface.position_scale[rows]).visibility
+    return _lookup(light, surface, rows, light.maps)
+
+
+def _lookup(light: LightRays, surface: SurfacePixels, rows, maps) -> np.ndarray:
+    """(K,) the reference's lookup in `maps` at surface pixels `rows`, each object's with its
+    own facet normals and whether the map holds its own texels (as its fragments look up)."""
+    v = np.ones(len(rows), surface.P.dtype)
+    for index in np.unique(surface.object[rows]):
+        at = np.flatnonzero(surface.object[rows] == index)
+        k = rows[at]
+        v[at] = LOOKUPS[light.kind](maps, light.index, surface.P[k], surface.facet[k],
+                                    surface.position_scale[k],
+                                    maps.own_texels(light.kind, light.index, int(index))).visibility
+    return v
 
 
 def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, v, truth):
@@ -446,11 +458,8 @@ def _self_shadowed(light: LightRays, surface: SurfacePixels, rows: np.ndarray) -
     for index in np.unique(surface.object[rows]):
         at = np.flatnonzero(surface.object[rows] == index)
         own = replace(layers, depth=np.where(layers.caster == index, layers.depth, np.float32(1.0)))
-        k = rows[at]
-        v = LOOKUPS[light.kind](replace(light.maps, layers={**light.maps.layers, light.kind: own}),
-                                light.index, surface.P[k],
-                                surface.N[k], surface.position_scale[k]).visibility
-        out[at] = v < 1.0
+        maps = replace(light.maps, layers={**light.maps.layers, light.kind: own})
+        out[at] = _lookup(light, surface, rows[at], maps) < 1.0
     return out
 
 

@@ -13,16 +13,16 @@ such meshes: `convex_body(mesh)` is the solid's face planes (object space) when
 
 A mesh of more than MAX_FACE_VERTEX_CHECKS face-vertex pairs is not tested (None: treated as
 not convex, which costs a pass, never a wrong shadow). Results are cached per Mesh object, so a
-frame pays for a mesh once (meshes are not changed in place: a renderer uploads a new Mesh
-object, docs/conventions.md).
+frame pays for a mesh once (renderer/core/mesh_cache.py).
 """
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 
 import numpy as np
+
+from renderer.core.mesh_cache import per_mesh
 
 CONVEX_TOLERANCE = 1e-9          # of the mesh's largest extent: a vertex this far out is "on" a plane
 WELD_TOLERANCE = 1e-9            # of the extent: vertices this close are one (seams, poles)
@@ -52,21 +52,13 @@ class ConvexBody:
         return (p @ self.normals.T + self.offsets <= self.tolerance).all(axis=1)
 
 
-_cache: dict[int, tuple[weakref.ref, ConvexBody | None]] = {}
-
-
+@per_mesh
 def convex_body(mesh) -> ConvexBody | None:
     """The mesh's convex solid (module docstring), or None when the mesh is open, not
     consistently wound, not convex, flat, or too large to test. Cached per Mesh object."""
-    key = id(mesh)
-    hit = _cache.get(key)
-    if hit is not None and hit[0]() is mesh:
-        return hit[1]
-    body = _find_body(np.asarray(mesh.positions, dtype=np.float64),
+    return _find_body(np.asarray(mesh.positions, dtype=np.float64),
                       np.asarray(mesh.normals, dtype=np.float64),
                       np.asarray(mesh.faces, dtype=np.int64))
-    _cache[key] = (weakref.ref(mesh, lambda _ref, key=key: _cache.pop(key, None)), body)
-    return body
 
 
 def _find_body(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> ConvexBody | None:

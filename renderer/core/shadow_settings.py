@@ -65,9 +65,11 @@ def auto_bias(filter_name: str) -> BiasRule:
     square of centres), where the plane is r tan(theta) nearer. No texel of the receiver itself
     then shadows the point when o / cos(theta) >= r tan(theta), i.e. o >= radius (|n_x| + |n_y|):
     finite at every angle, unlike a slope-scaled depth bias (tan(theta) is unbounded at grazing
-    light). CONSTANT_BIAS_TEXELS more towards the light covers rounding (depth stored in
-    float32, positions interpolated in float32) and a mesh's facets lying off the interpolated
-    normal N (steeper than N says on concave and grazing parts)."""
+    light). N is the facet's normal (renderer/core/facets.py), for which the planar argument
+    is exact, and the normal term is taken only where the map holds the receiver's own texels
+    (ShadowPlan.self_masks). CONSTANT_BIAS_TEXELS more towards the light covers rounding (depth
+    stored in float32, positions interpolated in float32) and the neighbouring facets of a
+    concave part rising above the facet's plane."""
     return BiasRule(normal=footprint_radius(FILTERS[filter_name]), constant=CONSTANT_BIAS_TEXELS)
 
 
@@ -129,9 +131,8 @@ def auto_resolution(width: int, height: int, point: bool) -> int:
     a side; for a point light's cube face (90 degrees of directions, about twice a usual
     camera's field of view) the power of two at or above half the longer side, about one
     texel per pixel where the camera looks at what the light lights; within RESOLUTIONS.
-    (Held against ray-cast truth, renderer compare --shadows-vs-truth: the three shadow scenes
-    at 320x240 have no acne and no pixel wrong outside the 1-texel band with these; half the
-    directional side leaves one acne pixel on shadow_curved.)"""
+    (Held against ray-cast truth: renderer compare --shadows-vs-truth and
+    benchmarks/shadow_truth_table.py give each built-in scene's figures at these sizes.)"""
     target = max(width, height) / 2 if point else max(width, height) * 2
     side = 1 << max(0, math.ceil(math.log2(max(target, 1))))
     return min(max(side, RESOLUTIONS[0]), RESOLUTIONS[-1])

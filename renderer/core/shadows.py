@@ -43,7 +43,9 @@ from renderer.errors import SceneError
 # --- cube faces ------------------------------------------------------------------------------
 
 # Face f of a point light's cube looks along CUBE_FACE_AXES[f] (+x, -x, +y, -y, +z, -z); its view
-# rotation's rows are (right, up, back) = CUBE_FACE_ROTATIONS[f], a proper rotation, so that a
+# rotation's rows are (right, up, back) = CUBE_FACE_ROTATIONS[f] (each a reflection, determinant -1, as
+# GL's cube-map faces are: a face counter-clockwise seen from outside is clockwise in its
+# window), so that a
 # direction d from the light has eye coordinates R d with -z_eye = d . axis. The face for d is
 # its major axis: the largest |d_i|, ties going to the earlier axis (x before y before z); the
 # sign picks + or - (+ for a zero component). glsl/shadow/lookup.glsl writes the same table.
@@ -238,6 +240,17 @@ class ShadowPlan:
     passes: list[ShadowPass]
     uniforms: dict[str, np.ndarray]
     texel_size: dict = field(default_factory=dict)   # (kind, light) -> world size of a texel (directional)
+
+    def self_masks(self, index: int) -> dict[str, int]:
+        """The lookup's per-object bit masks (u_shadow_self_directional, u_shadow_self_point):
+        bit i set where object `index` is drawn into a pass of light i of that kind, i.e.
+        where the map holds its own texels and its lookups need the bias's normal offset
+        (docs/conventions.md, "The bias rule"); elsewhere no texel of its own can shadow it."""
+        masks = {"u_shadow_self_directional": 0, "u_shadow_self_point": 0}
+        for shadow_pass in self.passes:
+            if index in shadow_pass.casters:
+                masks[f"u_shadow_self_{shadow_pass.kind}"] |= 1 << shadow_pass.light
+        return masks
 
 
 def world_points(scene, matrices) -> list[np.ndarray]:

@@ -69,10 +69,20 @@ SHADOW_UNIFORMS = {
     "u_point_shadow_tiles": "vec4[]",       # per cube face: (layer, size / S, drawn, 0)
 }
 ROWS_PER_LIGHT = {"u_point_shadow_tiles": 6}   # other light arrays: 1
+# Per receiving object of a frame with maps: which lights' maps hold its own texels (bit i:
+# light i of the kind; ShadowPlan.self_masks), and its faces' normals (renderer/core/facets.py)
+# on the GPU path's FACE_NORMALS_UNIT, fetched at gl_PrimitiveID (Phong and Gouraud; flat has
+# its geometry stage's face normal).
+SHADOW_OBJECT_UNIFORMS = {
+    "u_shadow_self_directional": "int",
+    "u_shadow_self_point": "int",
+    "u_shadow_facets": "int",               # 1: its facets are its surface; 0: an analytic shape's
+    "u_face_normals": "sampler2D",          # the face-normal texture's unit (the GPU path's alone)
+}
 # The depth pass (glsl/shadow/depth.vert): light clip from object coordinates, per pass and object.
 SHADOW_PASS_UNIFORMS = {"u_clip_from_model": "mat4"}
 UNIFORM_TYPES = (FRAME_UNIFORMS | OBJECT_UNIFORMS | TEXTURE_UNIFORMS | LIGHT_COUNT_UNIFORMS
-                 | SHADOW_UNIFORMS | SHADOW_PASS_UNIFORMS)
+                 | SHADOW_UNIFORMS | SHADOW_OBJECT_UNIFORMS | SHADOW_PASS_UNIFORMS)
 
 
 def _rows(values) -> np.ndarray:

@@ -73,6 +73,7 @@ import numpy as np
 
 from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
 from renderer.errors import ContextError, SystemFault
+from renderer.core.facets import face_texture
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
@@ -81,7 +82,8 @@ from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVarian
 from renderer.gpu.shadow_maps import ShadowMaps
 from renderer.gpu.textures import TextureCache
 from renderer.core.transforms import jitter, to_glsl
-from renderer.gpu.uniforms import MATERIAL_TEXTURE_UNIT, frame_uniform_values, object_uniform_values
+from renderer.gpu.uniforms import (FACE_NORMALS_UNIT, MATERIAL_TEXTURE_UNIT, frame_uniform_values,
+                                   object_uniform_values)
 from renderer.core.visibility import visible_objects
 
 GL_DITHER = 0x0BD0
@@ -152,6 +154,7 @@ class _ObjectBuffers:
     vertex_arrays: dict                    # ShaderVariant -> moderngl.VertexArray
     uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
     texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
+    face_normals: moderngl.Texture | None = None   # its facets' normals, once a shadowed program draws it
 
 
 @dataclass
@@ -162,6 +165,7 @@ class _Draw:
     cull_face: str | None
     uploads: list                          # [(moderngl Uniform, bytes)]
     texture: tuple | None = None           # (texture, sampler) bound on MATERIAL_TEXTURE_UNIT
+    face_normals: moderngl.Texture | None = None   # bound on FACE_NORMALS_UNIT (shadowed Phong, Gouraud)
 
 
 class GpuRenderer:
@@ -198,6 +202,7 @@ class GpuRenderer:
         self._shadow_maps: ShadowMaps | None = None       # made when the layout has maps
         self._shadowed: dict[bool, bool] = {}             # plan -> whether a program looks maps up
         self._drawn_shadow_plan = None                    # what the last draw() drew into the maps
+        self._shadow_plan = None                          # the frame's plan (update()); None: no maps
         try:
             activate(self.ctx)
             self._check_size()
@@ -286,10 +291,21 @@ class GpuRenderer:
     def _release_buffers(item: _ObjectBuffers) -> None:
         for vao in item.vertex_arrays.values():
             vao.release()
-        for buffer in (item.vbo, item.ibo, item.uv_vbo):
+        for buffer in (item.vbo, item.ibo, item.uv_vbo, item.face_normals):
             if buffer is not None:
                 buffer.release()
-        item.vertex_arrays, item.vbo, item.ibo, item.uv_vbo = {}, None, None, None
+        item.vertex_arrays, item.vbo, item.ibo, item.uv_vbo, item.face_normals = {}, None, None, None, None
+
+    def _face_normals(self, item: _ObjectBuffers) -> moderngl.Texture:
+        """The object's facet normals as an RGBA32F texture (renderer/core/facets.py), made the
+        first time a shadowed Phong or Gouraud program draws it; texelFetch reads it (NEAREST,
+        one level, so that it is complete)."""
+        if item.face_normals is None:
+            data = face_texture(item.mesh)
+            texture = self.ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(), dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            item.face_normals = texture
+        return item.face_normals
 
     def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
         return ShaderVariant.for_material(self.scene, obj.material, linear,
@@ -334,8 +350,10 @@ class GpuRenderer:
             shadows=shadows)
         # Objects wholly outside the view volume are left out of the frame's plan.
         self._visible = visible if self.specialise else [True] * len(self._objects)
-        for item, object_matrices in zip(self._objects, matrices.objects):
-            item.uniform_bytes = object_uniform_values(item.obj, object_matrices)
+        for index, (item, object_matrices) in enumerate(zip(self._objects, matrices.objects)):
+            item.uniform_bytes = object_uniform_values(
+                item.obj, object_matrices,
+                None if self._shadow_plan is None else self._shadow_plan.self_masks(index))
             # Uploaded the first time a texture is asked for; a material's new texture then.
             texture = item.obj.material.texture
             item.texture = None if texture is None else self._textures.get(texture)
@@ -357,9 +375,11 @@ class GpuRenderer:
             else:
                 self._shadow_maps.set_layout(layout)
         self._shadow_layout = layout
+        self._shadow_plan = None
         if not layout.any:
             return None
-        plan = plan_shadows(self.scene, matrices, layout, visible, prune=self.prune_shadows)
+        plan = self._shadow_plan = plan_shadows(self.scene, matrices, layout, visible,
+                                                prune=self.prune_shadows)
         self._shadow_maps.set_plan(plan, [(item.vbo, item.ibo) for item in self._objects],
                                    [m.model for m in matrices.objects])
         return plan.uniforms
@@ -403,7 +423,10 @@ class GpuRenderer:
                        if program.get(name, None) is not None]
             cull = CULL_FLAGS[item.obj.cull]
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
-            plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None))
+            facets = (self._face_normals(item) if variant.shadows and variant.shading != "flat"
+                      else None)
+            plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None,
+                              facets))
         self._shadowed[linear] = any(variant.shadows for variant in programs)
         for program in programs.values():          # the same for every object: set once here
             for name, data in self._frame_uniforms.items():
@@ -494,6 +517,8 @@ class GpuRenderer:
                     texture, sampler = draw.texture
                     texture.use(MATERIAL_TEXTURE_UNIT)
                     sampler.use(MATERIAL_TEXTURE_UNIT)
+                if draw.face_normals is not None:
+                    draw.face_normals.use(FACE_NORMALS_UNIT)
                 draw.vertex_array.render(moderngl.TRIANGLES)
             if target is not fbo:
                 ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)

@@ -21,6 +21,7 @@ from renderer.core.uniforms import ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms
 from renderer.gpu.context import gl_function
 
 MATERIAL_TEXTURE_UNIT = 1                # the unit a textured material's texture is bound to
+FACE_NORMALS_UNIT = 3                    # a shadowed Phong or Gouraud object's facet normals
 # The texture units each kind of light's shadow-map stack (array texture) is bound to.
 SHADOW_MAPS_UNITS = {"directional": 0, "point": 2}
 
@@ -75,12 +76,18 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices, light_slots: int
     return out
 
 
-def object_uniform_values(obj: SceneObject, matrices) -> dict[str, bytes]:
+def object_uniform_values(obj: SceneObject, matrices, shadow_masks: dict | None = None) -> dict[str, bytes]:
     """One object's uniforms: its model and normal matrices and its material (a textured
-    one's UV transform and texture unit too)."""
+    one's UV transform and texture unit too); with `shadow_masks` (the frame's
+    ShadowPlan.self_masks of the object, when the scene has maps) the shadow lookup's per-object
+    masks and its facet normals' unit."""
     values = object_uniforms(obj, matrices)
     if obj.material.texture is not None:
         values["u_texture"] = np.asarray(MATERIAL_TEXTURE_UNIT)
+    if shadow_masks is not None:
+        values |= {name: np.asarray(mask) for name, mask in shadow_masks.items()}
+        values["u_shadow_facets"] = np.asarray(int(obj.shape is None))
+        values["u_face_normals"] = np.asarray(FACE_NORMALS_UNIT)
     return {name: as_bytes(name, value) for name, value in values.items()}
 
 

@@ -40,10 +40,10 @@ in vec2 v_uv;                        // from vertex.glsl
 vec3 texel;                          // the material's texel at this fragment (main() looks it up)
 #endif
 
-#if defined(SHADOW_MAPS) && !defined(SHADING_FLAT)
-// The facet normals (renderer/core/facets.py: object space, float32, face f at texel
-// (f mod FACE_TEXTURE_WIDTH, f div FACE_TEXTURE_WIDTH)), for the shadow lookup's facet; flat
-// has its geometry stage's face normal.
+#ifdef SHADOW_MAPS
+// The faces (renderer/core/facets.py face_texture: two texels a face, FACES_PER_ROW a row;
+// (object-space normal as wound, crease on its side), (crease on the other side, 0, 0, 0)),
+// for the shadow lookup's facet normal and crease.
 uniform sampler2D u_face_normals;
 uniform mat3 u_normal_matrix;
 uniform int u_shadow_facets;         // 1: a mesh, its facets are its surface; 0: an analytic shape
@@ -204,20 +204,23 @@ void main() {
         back = true;
     }
 #endif
-#if defined(SHADOW_MAPS) && defined(SHADING_FLAT)
-    shadow_facet_normal = N;         // the face normal, flipped with N
-#elif defined(SHADOW_MAPS)
-    // The facet's normal in world space, on the side N lights (gl_PrimitiveID: the face's
-    // index in the indexed draw, whichever part of it clipping left).
-    // An analytic shape's triangles only stand in for it (u_shadow_facets 0): its surface is
-    // smooth, its normal N.
+#ifdef SHADOW_MAPS
+    // The facet under the fragment (gl_PrimitiveID: the face's index in the indexed draw,
+    // whichever part of it clipping left; flat's geometry stage passes it on): its normal in
+    // world space on the side N lights (flat: its face normal, N itself), and how steeply its
+    // neighbours rise on that side. An analytic shape's triangles only stand in for its smooth
+    // surface (u_shadow_facets 0): its normal is N, its crease 0.
     shadow_facet_normal = N;
+    shadow_crease = 0.0;
     if (u_shadow_facets != 0) {
-        ivec2 face = ivec2(gl_PrimitiveID % FACE_TEXTURE_WIDTH, gl_PrimitiveID / FACE_TEXTURE_WIDTH);
-        shadow_facet_normal = normalize_or_zero(u_normal_matrix * texelFetch(u_face_normals, face, 0).xyz);
-        if (dot(shadow_facet_normal, N) < 0.0) {
-            shadow_facet_normal = -shadow_facet_normal;
-        }
+        ivec2 at = ivec2(2 * (gl_PrimitiveID % FACES_PER_ROW), gl_PrimitiveID / FACES_PER_ROW);
+        vec4 face = texelFetch(u_face_normals, at, 0);
+        vec3 wound = normalize_or_zero(u_normal_matrix * face.xyz);
+        bool lit_side = dot(wound, N) >= 0.0;
+#ifndef SHADING_FLAT
+        shadow_facet_normal = lit_side ? wound : -wound;
+#endif
+        shadow_crease = lit_side ? face.w : texelFetch(u_face_normals, at + ivec2(1, 0), 0).x;
     }
 #endif
 #if defined(SHADING_PHONG)

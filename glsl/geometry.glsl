@@ -85,6 +85,7 @@ void main() {
         f_uv = v_uv[i];
 #endif
 #ifdef SHADOW_MAPS
+        gl_PrimitiveID = gl_PrimitiveIDIn;      // the face, for fragment.glsl's face texture
         f_world_position = v_world_position[i];
         f_face_normal = face_normal;
         f_ambient = kept_ambient[OTHER_PART];

@@ -59,7 +59,8 @@ class ObjectVaryings:
     receives_shadows: bool = False
     displace_lookup: object = None     # a check's displacement of the texture lookup (reference/texture.py)
     index: int = -1                    # the object's index in the scene (the shadow masks')
-    facet_normals: np.ndarray | None = None  # (T, 3) world facet normals (a Phong or Gouraud receiver)
+    facet_normals: np.ndarray | None = None  # (T, 3) world facet normals as wound (a mesh receiver)
+    creases: np.ndarray | None = None  # (T, 2) its faces' creases (renderer/core/facets.py)
 
 
 def interpolate(varying: np.ndarray, faces: np.ndarray, triangle: np.ndarray,
@@ -95,15 +96,19 @@ def lit_point(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarray,
     return P, N
 
 
-def facet_normal(obj: ObjectVaryings, triangle: np.ndarray, N: np.ndarray) -> np.ndarray:
-    """(N, 3) the fragments' facet normals on the side N lights, as glsl/fragment.glsl sets
-    shadow_facet_normal: flat's face normal (N itself, flipped with it); Phong's and Gouraud's
-    from their face's world facet normal (obj.facet_normals: world_facet_normals), turned to
-    N's side; an analytic shape's (no facet_normals: its triangles only stand in for it) N."""
-    if obj.material.shading == "flat" or obj.facet_normals is None:
-        return N
-    facet = obj.facet_normals[triangle]
-    return np.where((dot(facet, N) < 0.0), -facet, facet)
+def facet_normal(obj: ObjectVaryings, triangle: np.ndarray, N: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """((N, 3), (N,)): the fragments' facet normals on the side N lights and their facets'
+    creases on that side, as glsl/fragment.glsl sets shadow_facet_normal and shadow_crease:
+    the face's world normal as wound (obj.facet_normals: world_facet_normals), turned to N's
+    side (flat: its geometry stage's face normal, N itself), and the crease of that side; an
+    analytic shape's (no facet_normals: its triangles only stand in for it) N and 0."""
+    if obj.facet_normals is None:
+        return N, np.zeros(len(N), N.dtype)
+    wound = obj.facet_normals[triangle]
+    lit_side = dot(wound, N)[:, 0] >= 0.0
+    crease = np.where(lit_side, obj.creases[triangle, 0], obj.creases[triangle, 1]).astype(N.dtype)
+    facet = N if obj.material.shading == "flat" else np.where(lit_side[:, None], wound, -wound)
+    return facet, crease
 
 
 def world_facet_normals(mesh, u_normal_matrix: np.ndarray, dtype) -> np.ndarray:
@@ -172,7 +177,8 @@ def shade_fragments(obj: ObjectVaryings, triangle: np.ndarray, weights: np.ndarr
                                    texel)
             # the tie bands' scale: GL interpolates P from these vertices (lookup.py, SHADOW_TIE)
             scale = np.abs(vertices.v_world_position[faces[triangle]]).max(axis=(1, 2))
-            look = FragmentShadows(shadows, scale, facet_normal(obj, triangle, N), obj.index)
+            facet, crease = facet_normal(obj, triangle, N)
+            look = FragmentShadows(shadows, scale, facet, obj.index, crease)
             color = terms.shade(P, N, look.visibility)
             tied = look.tied
             if tied is not None and tied.any():

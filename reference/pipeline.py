@@ -42,6 +42,7 @@ from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_tri
 from reference.shadow.depth import render_layers
 from reference.shadow.lookup import ShadowMaps
 from reference.vertex import shade_vertices
+from renderer.core.facets import face_creases
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import SUBPIXEL_BITS, check_light_count
 from renderer.core.memory import REFERENCE_TILE_PIXELS
@@ -85,11 +86,11 @@ def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: in
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
     # a mesh's facets are its surface; an analytic shape's triangles only stand in for it
-    facets = (world_facet_normals(mesh, matrices.normal, dtype)
-              if shadowed and obj.receives_shadows and material.shading != "flat"
-              and obj.shape is None else None)
+    mesh_receiver = shadowed and obj.receives_shadows and obj.shape is None
+    facets = world_facet_normals(mesh, matrices.normal, dtype) if mesh_receiver else None
+    creases = face_creases(mesh) if mesh_receiver else None
     return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows,
-                                         displace_lookup, index, facets),
+                                         displace_lookup, index, facets, creases),
                           window.select(keep),
                           clipped.source[keep], clipped.weights[keep])
 
@@ -313,6 +314,7 @@ class SurfacePixels:
     Ng: np.ndarray                # (K, 3) the unit normal of the triangle's plane, as wound
     position_scale: np.ndarray    # (K,) the largest |coordinate| of its triangle's vertices
     facet: np.ndarray             # (K, 3) the shadow lookup's facet normal (lit side; receivers)
+    crease: np.ndarray            # (K,) its facet's crease on that side (renderer/core/facets.py)
 
 
 def _surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
@@ -322,8 +324,8 @@ def _surface(varyings: ObjectVaryings, triangle, weights, gl_FrontFacing):
     P, N = lit_point(varyings, triangle, weights, gl_FrontFacing)
     corners = varyings.vertices.v_world_position[varyings.faces[triangle]]
     Ng = normalize_or_zero(np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0]))
-    facet = facet_normal(varyings, triangle, N)
-    return P, N, Ng, np.abs(corners).max(axis=(1, 2)), facet
+    facet, crease = facet_normal(varyings, triangle, N)
+    return P, N, Ng, np.abs(corners).max(axis=(1, 2)), facet, crease
 
 
 def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
@@ -352,6 +354,6 @@ def surface_pixels(scene, width: int, height: int, *, dtype=np.float64,
     if not parts:
         empty = np.zeros((0, 3), dtype)
         return SurfacePixels(np.zeros(0, np.int64), np.zeros(0, np.int64), empty, empty, empty,
-                             np.zeros(0, dtype), empty), prepared.shadows
+                             np.zeros(0, dtype), empty, np.zeros(0, dtype)), prepared.shadows
     columns = [np.concatenate(column) for column in zip(*parts)]
     return SurfacePixels(*columns), prepared.shadows

@@ -227,7 +227,8 @@ def test_a_filter_reading_the_other_wall_is_acne(filter, kernel):
     scene = corner_scene(filter)
     result = shadows_vs_truth(scene, 64, 48)
     surface, maps = surface_pixels(scene, 64, 48)
-    v = LOOKUPS["directional"](maps, 0, surface.P, surface.N, surface.position_scale).visibility
+    v = LOOKUPS["directional"](maps, 0, surface.P, surface.facet, surface.position_scale,
+                               maps.own_texels("directional", 0, 0), surface.crease).visibility
     darkened = np.zeros(64 * 48, bool)
     darkened[surface.pixel] = v < 1.0
     assert (result.lights[0].truth != 0).all()

@@ -20,8 +20,10 @@
 
 #include "lighting.glsl"
 #define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
+#define SHADOW_SQRT2 1.41421356      // shadow_settings.SQRT2: the normal offset's move across the map
 
 vec3 shadow_facet_normal;            // the fragment's facet normal on the lit side (fragment.glsl)
+float shadow_crease;                 // how steeply its neighbours rise on that side (facets.py)
 uniform int u_shadow_self_directional;   // bit i: this object is in directional light i's map
 uniform int u_shadow_self_point;         // bit i: ... in point light i's cube
 
@@ -35,20 +37,29 @@ uniform vec4 u_directional_shadow_bias[NUM_DIRECTIONAL_LIGHTS];    // (normal, c
 #if NUM_POINT_LIGHTS > 0
 uniform sampler2DArrayShadow u_point_shadow_maps;
 uniform float u_point_shadow_map_size;                             // S of its layers
-uniform vec4 u_point_shadow[NUM_POINT_LIGHTS];             // (drawn, tan(half angle), kernel, R)
+uniform vec4 u_point_shadow[NUM_POINT_LIGHTS];             // (drawn, R / S, kernel, R)
 uniform vec4 u_point_shadow_depth[NUM_POINT_LIGHTS];       // (A, B, near, far): z_w = A + B / m
 uniform vec4 u_point_shadow_bias[NUM_POINT_LIGHTS];        // (normal, constant, slope) texels
-uniform vec4 u_point_shadow_tiles[6 * NUM_POINT_LIGHTS];   // per face (layer, size / S, drawn, 0)
+uniform vec4 u_point_shadow_tiles[6 * NUM_POINT_LIGHTS];   // per face (centre x, y, half, layer or -1)
 #endif
 
 // The receiver point moved before it is compared (shadow_settings.BiasRule): along the facet
-// normal N by normal * (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by
-// constant + slope * min(tan(theta), SHADOW_MAX_SLOPE) texels; t is the world size of a texel.
-vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bias) {
+// normal N by normal * (|N.X| + |N.Y|) + lift texels (X, Y the map's axes) and towards the
+// light L by constant + slope * min(tan(theta), SHADOW_MAX_SLOPE) texels; t is the world size
+// of a texel.
+//
+// The crease lift (shadow_settings.crease_lift): where the map holds the receiver's own texels
+// (`own`), its point is lifted as high as a neighbouring facet rising at the crease's slope can
+// stand within the texels the lookup reads (the filter's reach plus the normal offset's move).
+float crease_lift(float own, int kernel, float normal) {
+    float reach = kernel == 1 ? 0.5 : 0.5 * float(kernel);
+    return own * shadow_crease * (reach + normal * SHADOW_SQRT2);
+}
+vec3 shadow_bias_point(vec3 P, vec3 N, vec3 L, vec3 X, vec3 Y, float t, vec4 bias, float lift) {
     float c = clamp(dot(N, L), 0.0, 1.0);
     float s = sqrt(1.0 - c * c);
     float tan_theta = c > 0.0 ? min(s / c, SHADOW_MAX_SLOPE) : SHADOW_MAX_SLOPE;
-    float normal = bias.x * (abs(dot(N, X)) + abs(dot(N, Y)));
+    float normal = bias.x * (abs(dot(N, X)) + abs(dot(N, Y))) + lift;
     float toward = bias.y + bias.z * tan_theta;
     return P + t * (normal * N + toward * L);
 }
@@ -95,9 +106,11 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
     mat4 M = u_directional_shadow_matrix[i];
     vec3 X = normalize(vec3(M[0][0], M[1][0], M[2][0]));     // row 0 of M: the map's x axis
     vec3 Y = normalize(vec3(M[0][1], M[1][1], M[2][1]));     // row 1: its y axis
+    float own = float((u_shadow_self_directional >> i) & 1);  // no texel of its own: no normal offset
     vec4 bias = u_directional_shadow_bias[i];
-    bias.x *= float((u_shadow_self_directional >> i) & 1);  // no texel of its own: no normal offset
-    vec3 Q = shadow_bias_point(P, shadow_facet_normal, L, X, Y, p.y, bias);
+    bias.x *= own;
+    vec3 Q = shadow_bias_point(P, shadow_facet_normal, L, X, Y, p.y, bias,
+                               crease_lift(own, LIGHT_KERNEL(p), bias.x));
     vec3 uvz = (M * vec4(Q, 1.0)).xyz;
     if (any(lessThan(uvz.xy, vec2(0.0))) || any(greaterThan(uvz.xy, vec2(p.w)))) {
         return 1.0;                  // outside the map, which holds every caster: nothing there
@@ -139,7 +152,7 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
     if (dot(shadow_facet_normal, L) < 0.0) {
         return 0.0;                  // the facet is turned from the light
     }
-    vec4 p = u_point_shadow[i];
+    vec4 p = u_point_shadow[i];      // (drawn, R / S, kernel, R)
     if (p.x == 0.0) {
         return 1.0;                  // no pass this frame
     }
@@ -147,19 +160,26 @@ float light_visibility_point(int i, vec3 P, vec3 N) {
     // and its guard band holds Q (at most the normal offset across the map from P). Reading the
     // face Q falls on instead would meet another face's axes at a seam: acne there.
     int f = cube_face(-to_light);
-    float t = 2.0 * dot(CUBE_FACE_AXIS[f], -to_light) * p.y / p.w;    // a texel at P's distance
-    vec4 bias = u_point_shadow_bias[i];
-    bias.x *= float((u_shadow_self_point >> i) & 1);          // no texel of its own: no normal offset
-    vec3 Q = shadow_bias_point(P, shadow_facet_normal, L, CUBE_FACE_RIGHT[f], CUBE_FACE_UP[f], t, bias);
-    vec3 d = Q - light;
-    vec4 rect = u_point_shadow_tiles[6 * i + f];
-    if (rect.z == 0.0) {
-        return 1.0;                  // the face sees no caster: it was not drawn
+    vec4 face = u_point_shadow_tiles[6 * i + f];   // (centre x, y, half, layer; -1: not drawn)
+    if (face.w < 0.0) {
+        return 1.0;                  // the face holds no caster-receiver pair: not drawn
     }
+    float t = 2.0 * dot(CUBE_FACE_AXIS[f], -to_light) * face.z / p.w;    // a texel at P's distance
+    float own = float((u_shadow_self_point >> i) & 1);        // no texel of its own: no normal offset
+    vec4 bias = u_point_shadow_bias[i];
+    bias.x *= own;
+    vec3 Q = shadow_bias_point(P, shadow_facet_normal, L, CUBE_FACE_RIGHT[f], CUBE_FACE_UP[f], t,
+                               bias, crease_lift(own, LIGHT_KERNEL(p), bias.x));
+    vec3 d = Q - light;
     float m = dot(CUBE_FACE_AXIS[f], d);
-    vec2 uv = (0.5 * vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / (m * p.y) + 0.5) * rect.y;
+    // The face's map covers the square of tangent coordinates within half of its centre.
+    vec2 tangent = vec2(dot(CUBE_FACE_RIGHT[f], d), dot(CUBE_FACE_UP[f], d)) / m;
+    vec2 uv = (0.5 * (tangent - face.xy) / face.z + 0.5) * p.y;
+    if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(p.y)))) {
+        return 1.0;                  // outside the fitted square, which holds every pair's shadow
+    }
     vec4 depth = u_point_shadow_depth[i];
     return shadow_filter(u_point_shadow_maps, u_point_shadow_map_size, vec3(uv, depth.x + depth.y / m),
-                         rect.x, LIGHT_KERNEL(p));
+                         face.w, LIGHT_KERNEL(p));
 }
 #endif

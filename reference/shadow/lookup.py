@@ -27,7 +27,7 @@ import numpy as np
 
 from reference.lighting import Lights, dot, normalize
 from reference.shadow.depth import ShadowLayers
-from renderer.core.shadow_settings import MAX_SLOPE, tap_offsets
+from renderer.core.shadow_settings import MAX_SLOPE, SQRT2, tap_offsets
 from renderer.core.shadows import CUBE_FACE_AXES, CUBE_FACE_ROTATIONS, cube_face
 
 UNIT_ROUNDOFF32 = 2.0 ** -24
@@ -113,7 +113,16 @@ def facet_test(facet: np.ndarray, L: np.ndarray, lookup) -> ShadowLookup:
 
 # --- the bias ---------------------------------------------------------------------------------
 
-def shadow_bias_point(P, N, L, X, Y, t, bias) -> np.ndarray:
+def crease_lift(own: bool, kernel: int, normal, crease) -> np.ndarray:
+    """How far (texels) the point is lifted along the facet normal for its crease (glsl's
+    crease_lift): where the map holds the receiver's own texels, the crease's slope times the
+    texels the lookup reads (the filter's reach plus the normal offset's move, normal sqrt 2)."""
+    dtype = np.result_type(crease)
+    reach = dtype.type(0.5) if kernel == 1 else dtype.type(0.5) * dtype.type(kernel)
+    return dtype.type(float(own)) * crease * (reach + dtype.type(normal) * dtype.type(SQRT2))
+
+
+def shadow_bias_point(P, N, L, X, Y, t, bias, lift=0.0) -> np.ndarray:
     """The receiver point moved before it is compared (shadow_settings.BiasRule): along the
     facet normal N by bias.x (|N.X| + |N.Y|) texels (X, Y the map's axes) and towards the light L by bias.y +
     bias.z min(tan(theta), MAX_SLOPE) texels; t (..., 1) or scalar is the world size of a texel."""
@@ -122,7 +131,7 @@ def shadow_bias_point(P, N, L, X, Y, t, bias) -> np.ndarray:
     s = np.sqrt(1.0 - c * c)
     with np.errstate(divide="ignore", invalid="ignore"):
         tan_theta = np.where(c > 0.0, np.minimum(s / c, dtype.type(MAX_SLOPE)), dtype.type(MAX_SLOPE))
-    normal = bias[0] * (np.abs(dot(N, X)) + np.abs(dot(N, Y)))
+    normal = bias[0] * (np.abs(dot(N, X)) + np.abs(dot(N, Y))) + np.reshape(lift, (-1, 1))
     toward = bias[1] + bias[2] * tan_theta
     return P + t * (normal * N + toward * L)
 
@@ -215,16 +224,19 @@ def shadow_filter(layers: ShadowLayers, uvz: np.ndarray, layer, kernel: int, tie
 # --- the lights -------------------------------------------------------------------------------
 
 def light_visibility_directional(maps: ShadowMaps, i: int, P: np.ndarray, facet: np.ndarray,
-                                 position_scale: np.ndarray, own: bool = True) -> ShadowLookup:
+                                 position_scale: np.ndarray, own: bool = True,
+                                 crease=None) -> ShadowLookup:
     """Directional light i at points P (N, 3) on facets of unit normal `facet` (the lit side);
     position_scale (N,): the largest |coordinate| of the vertices P was interpolated from (the
-    tie bands); `own`: the map holds the object's own texels (ShadowMaps.own_texels)."""
+    tie bands); `own`: the map holds the object's own texels (ShadowMaps.own_texels); `crease`
+    (N,): each facet's crease on its lit side (renderer/core/facets.py; None: 0)."""
     L = normalize(-maps.lights.u_directional_direction[i])
+    crease = np.zeros(len(P), P.dtype) if crease is None else np.asarray(crease, P.dtype)
     return facet_test(facet, np.broadcast_to(L, facet.shape), lambda rows: _directional(
-        maps, i, P[rows], facet[rows], np.asarray(position_scale)[rows], own, L))
+        maps, i, P[rows], facet[rows], np.asarray(position_scale)[rows], own, L, crease[rows]))
 
 
-def _directional(maps: ShadowMaps, i: int, P, facet, position_scale, own: bool, L) -> ShadowLookup:
+def _directional(maps: ShadowMaps, i: int, P, facet, position_scale, own: bool, L, crease) -> ShadowLookup:
     dtype = P.dtype
     p = maps.uniforms["u_directional_shadow"][i]                 # (layer, t, kernel, extent)
     if p[3] == 0.0:
@@ -232,7 +244,7 @@ def _directional(maps: ShadowMaps, i: int, P, facet, position_scale, own: bool, 
     M = maps.uniforms["u_directional_shadow_matrix"][i]
     X, Y = normalize(M[0, :3]), normalize(M[1, :3])
     bias = maps.uniforms["u_directional_shadow_bias"][i] * np.array([float(own), 1, 1, 1], dtype)
-    Q = shadow_bias_point(P, facet, L, X, Y, p[1], bias)
+    Q = shadow_bias_point(P, facet, L, X, Y, p[1], bias, crease_lift(own, int(p[2]), bias[0], crease))
     uvz = Q @ M[:3, :3].T + M[:3, 3]
     scale = np.abs(Q).astype(np.float64) + np.asarray(position_scale, np.float64)[:, None]
     A = np.abs(M.astype(np.float64))
@@ -247,65 +259,70 @@ def _directional(maps: ShadowMaps, i: int, P, facet, position_scale, own: bool, 
     return result
 
 
-def _point_tie_bounds(Q, light, d, m, right_up, position_scale, depth, tan_half, rect_size, S):
+def _point_tie_bounds(Q, light, d, m, right_up, position_scale, depth, half, rect_size, S):
     """(tie_ref, tie_texel) of a cube lookup: d = Q - light is off by e (the roundings of
     |Q|, P's vertices and |light|); m = axis.d by e too; z_w = A + B / m by |B| e / m^2 and
-    the roundings of A and B / m; u S by S size (0.5 / tan) (e / |m| + |r.d| e / m^2)."""
+    the roundings of A and B / m; u S by S size (0.5 / half) (e / |m| + |r.d| e / m^2)."""
     e = SHADOW_TIE * (np.abs(Q).max(axis=1) + position_scale + np.abs(light).max())
     m = np.abs(m)
     A, B = abs(float(depth[0])), abs(float(depth[1]))
     tie_ref = B * e / (m * m) + SHADOW_TIE * (A + B / m)
-    per_texel = S * rect_size * 0.5 / tan_half
+    per_texel = S * rect_size * 0.5 / half
     tie_texel = per_texel[:, None] * ((e / m)[:, None] + np.abs(right_up) * (e / (m * m))[:, None])
     tie_texel += SHADOW_TIE * S
     return tie_ref, tie_texel
 
 
 def light_visibility_point(maps: ShadowMaps, i: int, P: np.ndarray, facet: np.ndarray,
-                           position_scale: np.ndarray, own: bool = True) -> ShadowLookup:
+                           position_scale: np.ndarray, own: bool = True, crease=None) -> ShadowLookup:
     """Point light i at points P (N, 3) on facets of unit normal `facet` (as
     light_visibility_directional)."""
     dtype = P.dtype
     out = ShadowLookup.lit(len(P), dtype)
+    crease = np.zeros(len(P), dtype) if crease is None else np.asarray(crease, dtype)
     light = maps.lights.u_point_position[i]
     to_light = light - P
     rows = np.flatnonzero(dot(to_light, to_light)[:, 0] != 0.0)   # a light on the surface: lit
     L = normalize(to_light[rows])
     out.put(rows, facet_test(facet[rows], L, lambda k: _point(
         maps, i, P[rows[k]], facet[rows[k]], np.asarray(position_scale)[rows[k]], own, L[k],
-        to_light[rows[k]])))
+        to_light[rows[k]], crease[rows[k]])))
     return out
 
 
-def _point(maps: ShadowMaps, i: int, P, facet, scale, own: bool, L, to_light) -> ShadowLookup:
+def _point(maps: ShadowMaps, i: int, P, facet, scale, own: bool, L, to_light, crease) -> ShadowLookup:
     dtype = P.dtype
     out = ShadowLookup.lit(len(P), dtype)
-    p = maps.uniforms["u_point_shadow"][i]
+    p = maps.uniforms["u_point_shadow"][i]                      # (drawn, R / S, kernel, R)
     if p[0] == 0.0:
         return out
     light = maps.lights.u_point_position[i]
-    rows = np.arange(len(P))
     rotations, axes = CUBE_FACE_ROTATIONS.astype(dtype), CUBE_FACE_AXES.astype(dtype)
     f = cube_face(-to_light)          # P's own face, also for Q (the GLSL says why)
-    t = 2.0 * dot(axes[f], -to_light) * p[1] / p[3]           # a texel's size at P's distance
+    face = maps.uniforms["u_point_shadow_tiles"][6 * i + f]   # (centre x, y, half, layer or -1)
+    rows = np.flatnonzero(face[:, 3] >= 0.0)                 # else the face is not drawn: lit
+    P, facet, scale, L, to_light, crease, f, face = (a[rows] for a in (P, facet, scale, L, to_light,
+                                                                       crease, f, face))
+    t = 2.0 * dot(axes[f], -to_light) * face[:, 2:3] / p[3]   # a texel's size at P's distance
     bias = maps.uniforms["u_point_shadow_bias"][i] * np.array([float(own), 1, 1, 1], dtype)
-    Q = shadow_bias_point(P, facet, L, rotations[f, 0], rotations[f, 1], t, bias)
+    Q = shadow_bias_point(P, facet, L, rotations[f, 0], rotations[f, 1], t, bias,
+                          crease_lift(own, int(p[2]), bias[0], crease))
     d = Q - light
-    rect = maps.uniforms["u_point_shadow_tiles"][6 * i + f]
-    drawn = rect[:, 2] != 0.0                                   # else the face sees no caster
-    d, f, rect, Q, scale, rows = d[drawn], f[drawn], rect[drawn], Q[drawn], scale[drawn], rows[drawn]
     m = dot(axes[f], d)[:, 0]
     right_up = np.stack([dot(rotations[f, 0], d)[:, 0], dot(rotations[f, 1], d)[:, 0]], axis=1)
     with np.errstate(divide="ignore", invalid="ignore"):
-        uv = (0.5 * right_up / (m * p[1])[:, None] + 0.5) * rect[:, 1:2]
+        tangent = right_up / m[:, None]
+        uv = (dtype.type(0.5) * (tangent - face[:, :2]) / face[:, 2:3] + dtype.type(0.5)) * p[1]
         depth = maps.uniforms["u_point_shadow_depth"][i]
         uvz = np.concatenate([uv, (depth[0] + depth[1] / m)[:, None]], axis=1)
         tie_ref, tie_texel = _point_tie_bounds(
             Q.astype(np.float64), np.asarray(light, np.float64), d, m.astype(np.float64),
-            right_up.astype(np.float64), scale.astype(np.float64), depth, float(p[1]),
-            rect[:, 1].astype(np.float64), maps.layers["point"].side)
-    out.put(rows, shadow_filter(maps.layers["point"], uvz, rect[:, 0].astype(np.int64), int(p[2]), tie_ref,
-                                tie_texel))
+            right_up.astype(np.float64), scale.astype(np.float64), depth,
+            face[:, 2].astype(np.float64), float(p[1]), maps.layers["point"].side)
+    # outside the fitted square, which holds every caster-receiver pair's shadow: lit
+    inside = np.flatnonzero(((uv >= 0.0) & (uv <= p[1])).all(axis=1))
+    out.put(rows[inside], shadow_filter(maps.layers["point"], uvz[inside], face[inside, 3].astype(np.int64),
+                                        int(p[2]), tie_ref[inside], tie_texel[inside]))
     return out
 
 
@@ -321,6 +338,7 @@ class FragmentShadows:
     position_scale: np.ndarray
     facet: np.ndarray                  # (N, 3) the fragments' facet normals on the lit side
     index: int                         # the object's index in the scene
+    crease: np.ndarray | None = None   # (N,) their facets' creases on the lit side
     lookups: dict = field(default_factory=dict)
 
     def _lookup(self, kind, i, P, N, needed) -> ShadowLookup:
@@ -331,7 +349,8 @@ class FragmentShadows:
             if len(rows):
                 out.put(rows, LOOKUPS[kind](self.maps, i, P[rows], self.facet[rows],
                                             self.position_scale[rows],
-                                            self.maps.own_texels(kind, i, self.index)))
+                                            self.maps.own_texels(kind, i, self.index),
+                                            None if self.crease is None else self.crease[rows]))
             self.lookups[key] = out
         return self.lookups[key]
 

@@ -58,6 +58,7 @@ from reference.raytrace.trace import HIT_TIE, occluded, ray_origin, shadow_visib
 from reference.shadow.lookup import LOOKUPS, ShadowMaps
 from renderer.core.raytrace_scene import RayScene, ray_scene
 from renderer.core.scene import Mesh
+from renderer.core.shadow_settings import footprint_radius
 from renderer.core.shadows import CUBE_FACE_AXES, CUBE_FACE_ROTATIONS, cube_face, shadow_layout
 
 LIT_FROM = 0.5                 # the map's decision: lit where its visibility v >= LIT_FROM
@@ -215,11 +216,12 @@ class LightRays:
             M = u["u_directional_shadow_matrix"][self.index]
             t = np.full(len(P), u["u_directional_shadow"][self.index][1])
             return t, *(np.broadcast_to(normalize(M[k, :3]), P.shape) for k in (0, 1))
-        _, tan_half, _, resolution = u["u_point_shadow"][self.index]
+        resolution = u["u_point_shadow"][self.index][3]
         from_light = P - self.maps.lights.u_point_position[self.index]
         face = cube_face(from_light)
         m = _dot(CUBE_FACE_AXES[face], from_light)
-        t = 2.0 * m * tan_half / resolution if resolution else np.zeros(len(P))
+        half = u["u_point_shadow_tiles"][6 * self.index + face][:, 2]     # each face's fitted half
+        t = 2.0 * m * half / resolution if resolution else np.zeros(len(P))
         return t, CUBE_FACE_ROTATIONS[face, 0], CUBE_FACE_ROTATIONS[face, 1]
 
     def steps(self, P, Ng, texels: float) -> np.ndarray:
@@ -417,19 +419,33 @@ def _lookup(light: LightRays, surface: SurfacePixels, rows, maps) -> np.ndarray:
         k = rows[at]
         v[at] = LOOKUPS[light.kind](maps, light.index, surface.P[k], surface.facet[k],
                                     surface.position_scale[k],
-                                    maps.own_texels(light.kind, light.index, int(index))).visibility
+                                    maps.own_texels(light.kind, light.index, int(index)),
+                                    surface.crease[k]).visibility
     return v
 
 
-def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, v, truth):
-    """(class, acne, peter-panning) of surface pixels `rows` (K,) against the truth (K,)."""
+def band_texels(shadow) -> float:
+    """The band's width for a light's map (its Shadow), in texels: how far from P its lookup
+    reads, so that a true shadow edge that far away may darken P by the filter's doing, not
+    the receiver's: the filter's footprint radius (shadow_settings.footprint_radius: 1/2 hard,
+    K/2 for K x K) plus the bias's normal offset across the map (normal (|F.X| + |F.Y|) <=
+    normal sqrt 2); at least one texel."""
+    rule = shadow.bias_rule()
+    return max(1.0, footprint_radius(shadow.kernel) + rule.normal * math.sqrt(2.0))
+
+
+def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, v, truth, width: float = 1.0):
+    """(class, acne, peter-panning) of surface pixels `rows` (K,) against the truth (K,);
+    `width`: the band's, in texels (band_texels)."""
     P, Ng, N, obj = surface.P[rows], surface.Ng[rows], surface.N[rows], surface.object[rows]
     said_lit = v >= LIT_FROM
     wrong = said_lit != truth
     darkened = truth & (v < 1.0)
     band = np.zeros(len(rows), bool)
     ask = np.flatnonzero(wrong | darkened)
-    band[ask] = light.changes_within(P[ask], Ng[ask], N[ask], obj[ask], truth[ask], 1.0)
+    for radius in _band_radii(width):       # a ring at each whole texel out to the width
+        left = ask[~band[ask]]
+        band[left] = light.changes_within(P[left], Ng[left], N[left], obj[left], truth[left], radius)
     k = np.where(truth, np.where(said_lit, _INDEX["lit"], _INDEX["wrongly_shadowed"]),
                  np.where(said_lit, _INDEX["wrongly_lit"], _INDEX["shadowed"]))
     k = np.where(wrong & band, np.where(truth, _INDEX["wrongly_shadowed_band"], _INDEX["wrongly_lit_band"]), k)
@@ -448,6 +464,11 @@ def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, v, tru
         reach[left[found]] = r
         left = left[~found]
     return k, acne, reach
+
+
+def _band_radii(width: float) -> list[float]:
+    """The rings the band is looked for on: 1, 2, ... texels, and `width` itself."""
+    return sorted({*(float(r) for r in range(1, int(math.floor(width)) + 1)), float(width)})
 
 
 def _self_shadowed(light: LightRays, surface: SurfacePixels, rows: np.ndarray) -> np.ndarray:
@@ -480,7 +501,7 @@ def measure_light(light: LightRays, light_map, surface: SurfacePixels, rows: np.
         rows = rows[np.isfinite(given.reshape(-1)[surface.pixel[rows]])]
     v = _visibility(light, surface, rows, given)
     truth = light.lit(surface.P[rows], surface.Ng[rows], surface.object[rows])
-    k, acne, reach = _classify(light, surface, rows, v, truth)
+    k, acne, reach = _classify(light, surface, rows, v, truth, band_texels(light_map.shadow))
     out = lambda values, fill: _image(surface.pixel[rows], values, fill, width, height)   # noqa: E731
     truth_image = out(truth.astype(np.int8), np.int8(NOT_CONSIDERED))
     boundary = shadow_boundary(truth_image, _image(surface.pixel, surface.object, -1, width, height))

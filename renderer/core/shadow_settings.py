@@ -39,6 +39,9 @@ class BiasRule:
 
 
 MAX_SLOPE = 16.0                       # tan(theta) is capped here in the slope term (86.4 deg)
+# sqrt 2 as the lookup's GLSL writes it (SHADOW_SQRT2): the normal offset moves the point at most
+# normal * sqrt 2 texels across the map (|N.X| + |N.Y| <= sqrt 2).
+SQRT2 = 1.41421356
 CONSTANT_BIAS_TEXELS = 0.5             # towards the light: rounding; facets off the smooth normal
 # The most a bias term may be (scene files refuse more): far beyond any useful bias (the
 # automatic one is at most 2.5 texels), and the guard band it asks for (guard_texels: at most
@@ -125,15 +128,18 @@ def shared_kernel(scene) -> int:
     return kernels.pop() if len(kernels) == 1 else 0
 
 
-def auto_resolution(width: int, height: int, point: bool) -> int:
+def auto_resolution(width: int, height: int, point: bool, kernel: int = FILTERS[DEFAULT_FILTER]) -> int:
     """The default map side: for a directional light the power of two at or above twice the
     image's longer side, so that a map spread over the view has about two texels per pixel on
     a side; for a point light's cube face (90 degrees of directions, about twice a usual
     camera's field of view) the power of two at or above half the longer side, about one
-    texel per pixel where the camera looks at what the light lights; within RESOLUTIONS.
+    texel per pixel where the camera looks at what the light lights; times the filter's reach
+    in texels (footprint_radius: 1 for the default pcf2x2, 2.5 for pcf5x5; not less than 1),
+    so that a wider filter reads as far in pixels, and a shadow thinner than its footprint,
+    which it washes out, is as thin on the screen; within RESOLUTIONS.
     (Held against ray-cast truth: renderer compare --shadows-vs-truth and
     benchmarks/shadow_truth_table.py give each built-in scene's figures at these sizes.)"""
-    target = max(width, height) / 2 if point else max(width, height) * 2
+    target = (max(width, height) / 2 if point else max(width, height) * 2) * max(1.0, footprint_radius(kernel))
     side = 1 << max(0, math.ceil(math.log2(max(target, 1))))
     return min(max(side, RESOLUTIONS[0]), RESOLUTIONS[-1])
 

@@ -87,10 +87,6 @@ class Tile:
     layer: int
     size: int
 
-    def rect(self, side: int, drawn: bool) -> np.ndarray:
-        """(layer, size / side, drawn 0 or 1, 0): what the lookup reads for a cube face."""
-        return np.array([float(self.layer), self.size / side, 1.0 if drawn else 0.0, 0.0])
-
 
 @dataclass(frozen=True)
 class LightMap:
@@ -174,7 +170,8 @@ def shadow_layout(scene, width: int, height: int, prune: bool = True) -> ShadowL
     wanted = []
     for kind, i in shadow_lights(scene, prune):
         light = (scene.directional_lights if kind == "directional" else scene.point_lights)[i]
-        resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point")
+        resolution = light.shadow.resolution or auto_resolution(width, height, kind == "point",
+                                                                light.shadow.kernel)
         wanted.append([kind, i, light.shadow, resolution])
     if not wanted:
         return ShadowLayout()
@@ -216,6 +213,8 @@ def _stacks(wanted) -> tuple[LayerStack, LayerStack]:
 # least NEAR_FRACTION of the far distance (geometry nearer than that to the light casts no
 # shadow; depth precision near the far plane stays ~1e-7 * far^2 / near = ~1e-4 far).
 NEAR_FRACTION = 2.0 ** -10
+FACE_PLANE_SLACK = 1e-9                # a point this near a cube face's plane (of its distance) is on it
+FACE_STEPS_PER_OCTAVE = 4              # a fitted cube face's size: the whole face's / 2^(k / 4)
 DEPTH_MARGIN = 2.0 ** -8               # of the depth span, added at both ends of a light view
 
 
@@ -429,20 +428,72 @@ def point_face_projection(resolution: int, guard: int, near: float, far: float) 
     return projection, tan_half
 
 
+def fitted_face_projection(projection: np.ndarray, centre, half: float) -> np.ndarray:
+    """`projection` (a face's, point_face_projection) made to cover the square of tangent
+    coordinates (x, y) = (right.d, up.d) / (axis.d) within `half` of `centre`: clip x =
+    (x_view + cx z_view) / half, so that x_ndc = (x - cx) / half (y likewise); depth as before."""
+    fitted = projection.copy()
+    fitted[0, :] = (1.0 / half, 0.0, centre[0] / half, 0.0)
+    fitted[1, :] = (0.0, 1.0 / half, centre[1] / half, 0.0)
+    return fitted
+
+
+def _face_box(points: np.ndarray, face: int, position: np.ndarray) -> np.ndarray:
+    """(2, 2): the rectangle of tangent coordinates (x, y) = (right.d, up.d) / (axis.d), d from
+    the light, that `points` project to on cube face `face`, within the face's own square
+    [-1, 1]^2; the whole square where a point lies on or behind the face's plane (its
+    projection is unbounded there)."""
+    d = points - position
+    m = d @ CUBE_FACE_AXES[face]
+    whole = np.array([[-1.0, -1.0], [1.0, 1.0]])
+    if not len(d) or np.any(m <= FACE_PLANE_SLACK * np.linalg.norm(d, axis=1)):
+        return whole
+    xy = np.stack([d @ CUBE_FACE_ROTATIONS[face, 0], d @ CUBE_FACE_ROTATIONS[face, 1]], axis=1) / m[:, None]
+    return np.clip(np.stack([xy.min(axis=0), xy.max(axis=0)]), -1.0, 1.0)
+
+
+def _fit_face(boxes: dict, pairs_in_face: list, resolution: int, guard: int):
+    """(centre (2,), half) of the square a face's map covers in tangent coordinates: the union
+    over the caster-receiver pairs in the face of the caster's box and the receiver's, meeting
+    (a point light's shadow falls within its caster's projection), squared, its inner R - 2g - 2
+    texels spanning it (a guard band, and a texel each side for the snapped centre); the half
+    size rounded up to the whole face's over a power of 2^(1/4), the centre to whole texels, so
+    that the map does not crawl as the camera moves. None where no pair's boxes meet."""
+    pieces = []
+    for c, r in pairs_in_face:
+        lo, hi = np.maximum(boxes[c][0], boxes[r][0]), np.minimum(boxes[c][1], boxes[r][1])
+        if np.all(lo <= hi):
+            pieces.append((lo, hi))
+    if not pieces:
+        return None
+    lo = np.min([p[0] for p in pieces], axis=0)
+    hi = np.max([p[1] for p in pieces], axis=0)
+    whole = resolution / (resolution - 2.0 * guard)
+    needed = max(float((hi - lo).max()) / 2.0, 1e-9) * resolution / (resolution - 2.0 * guard - 2.0)
+    steps = max(0, math.floor(FACE_STEPS_PER_OCTAVE * math.log2(whole / min(needed, whole))))
+    half = whole / 2.0 ** (steps / FACE_STEPS_PER_OCTAVE)
+    texel = 2.0 * half / resolution
+    centre = np.round((lo + hi) / 2.0 / texel) * texel
+    if half >= whole:
+        centre = np.zeros(2)                  # the whole face
+    return centre, half
+
+
 def _plan_point(index, light, light_map, layout, matrices, points, receivers, pairs, scene,
                 prune=True):
     """The light's six cube faces (docs/conventions.md, "A point light's cube"): a face is
     drawn when its frustum holds a caster and a receiver that caster can shadow (`pairs`: c ->
-    its receivers; with `prune` False, every face, with every caster in its frustum)."""
+    its receivers), fitted to where those pairs' boxes meet on it (_fit_face); with `prune`
+    False, every face whole, with every caster in its frustum."""
     position = matrices.relative(light.position)
     passes = []
-    rects = np.zeros((6, 4))
+    faces = np.tile([0.0, 0.0, 1.0, -1.0], (6, 1))      # (cx, cy, half, layer or -1)
     params = np.zeros(4)
     depth = np.zeros(4)
     seen = [points[i] for i in receivers]
     casters = list(pairs)
     if not seen or not casters:
-        return passes, rects, params, depth
+        return passes, faces, params, depth
     far = float(np.sqrt(((np.vstack(seen) - position) ** 2).sum(axis=1)).max()) * (1.0 + DEPTH_MARGIN)
     far = max(far, 1e-30)
     objects = casters + [r for r in receivers if r not in pairs]
@@ -451,28 +502,34 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, pa
     near = max(0.5 * _nearest_caster(scene, points, casters, lo[:n], hi[:n], position),
                NEAR_FRACTION * far)
     near = min(near, 0.5 * far)
-    projection, tan_half = point_face_projection(light_map.resolution, light_map.guard, near, far)
-    clips = np.empty((6, 4, 4))
+    resolution, guard = light_map.resolution, light_map.guard
+    projection, tan_half = point_face_projection(resolution, guard, near, far)
+    views = np.empty((6, 4, 4))
     for face in range(6):
-        view = np.eye(4)
-        view[:3, :3] = CUBE_FACE_ROTATIONS[face]
-        view[:3, 3] = -CUBE_FACE_ROTATIONS[face] @ position
-        clips[face] = projection @ view
-    outside = _outside_frusta(clips, lo, hi)              # (6, objects)
+        views[face] = np.eye(4)
+        views[face][:3, :3] = CUBE_FACE_ROTATIONS[face]
+        views[face][:3, 3] = -CUBE_FACE_ROTATIONS[face] @ position
+    outside = _outside_frusta(projection @ views, lo, hi)    # (6, objects)
     for face in range(6):
         tile = light_map.tiles[face]
         inside = {i for i, out in zip(objects, outside[face]) if not out}
-        drawn = tuple(c for c in casters if c in inside
-                      and (not prune or any(r in inside for r in pairs[c])))
-        needed = not prune or bool(drawn)
-        rects[face] = tile.rect(layout.stack("point").side, needed)   # not drawn: read as lit
-        if not needed:
-            continue
-        passes.append(ShadowPass("point", index, face, tile, clips[face], drawn))
+        if prune:
+            pairs_in_face = [(c, r) for c in casters if c in inside for r in pairs[c] if r in inside]
+            boxes = {i: _face_box(points[i], face, position) for pair in pairs_in_face for i in pair}
+            fit = _fit_face(boxes, pairs_in_face, resolution, guard)
+            if fit is None:
+                continue                        # not drawn: its lookups read as lit
+            drawn = tuple(dict.fromkeys(c for c, _ in pairs_in_face))
+        else:
+            fit, drawn = (np.zeros(2), tan_half), tuple(c for c in casters if c in inside)
+        centre, half = fit
+        faces[face] = (centre[0], centre[1], half, float(tile.layer))
+        clip = fitted_face_projection(projection, centre, half) @ views[face]
+        passes.append(ShadowPass("point", index, face, tile, clip, drawn))
     if passes:
-        params[:] = (1.0, tan_half, light_map.shadow.kernel, light_map.resolution)
+        params[:] = (1.0, resolution / layout.stack("point").side, light_map.shadow.kernel, resolution)
         depth[:] = (0.5 - 0.5 * projection[2, 2], 0.5 * projection[2, 3], near, far)
-    return passes, rects, params, depth
+    return passes, faces, params, depth
 
 
 def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | None = None,
@@ -493,7 +550,7 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
         "u_point_shadow": np.zeros((n_point, 4)),
         "u_point_shadow_depth": np.zeros((n_point, 4)),
         "u_point_shadow_bias": np.zeros((n_point, 4)),
-        "u_point_shadow_tiles": np.zeros((6 * n_point, 4)),
+        "u_point_shadow_tiles": np.tile([0.0, 0.0, 1.0, -1.0], (6 * n_point, 1)),
     }
     plan = ShadowPlan(layout, [], uniforms)
     if not layout.any:
@@ -525,11 +582,11 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
             position = matrices.relative(light.position)
             pairs = (occluders.pairs(casters, receivers, light_position=position) if prune
                      else {c: receivers for c in casters})
-            passes, rects, params, depth = _plan_point(
+            passes, faces, params, depth = _plan_point(
                 i, light, light_map, layout, matrices, points, receivers, pairs, scene, prune)
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias
-            uniforms["u_point_shadow_tiles"][6 * i:6 * i + 6] = rects
+            uniforms["u_point_shadow_tiles"][6 * i:6 * i + 6] = faces
             plan.passes.extend(passes)
     return plan

@@ -63,10 +63,10 @@ SHADOW_UNIFORMS = {
     "u_directional_shadow_matrix": "mat4[]",   # camera-relative world -> (u, v, z_w, 1)
     "u_directional_shadow": "vec4[]",       # (layer, texel size, kernel, R/S; 0 when not drawn)
     "u_directional_shadow_bias": "vec4[]",  # (normal, constant, slope, 0) in texels
-    "u_point_shadow": "vec4[]",             # (drawn, tan(half angle), kernel, tile side)
+    "u_point_shadow": "vec4[]",             # (drawn, R / S, kernel, R: the faces' side)
     "u_point_shadow_depth": "vec4[]",       # (A, B, near, far): z_w = A + B / m
     "u_point_shadow_bias": "vec4[]",
-    "u_point_shadow_tiles": "vec4[]",       # per cube face: (layer, size / S, drawn, 0)
+    "u_point_shadow_tiles": "vec4[]",       # per cube face: (centre x, y, half, layer or -1: not drawn)
 }
 ROWS_PER_LIGHT = {"u_point_shadow_tiles": 6}   # other light arrays: 1
 # Per receiving object of a frame with maps: which lights' maps hold its own texels (bit i:

@@ -154,7 +154,7 @@ class _ObjectBuffers:
     vertex_arrays: dict                    # ShaderVariant -> moderngl.VertexArray
     uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
     texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
-    face_normals: moderngl.Texture | None = None   # its facets' normals, once a shadowed program draws it
+    face_normals: moderngl.Texture | None = None   # its faces (facets.face_texture), once a shadowed program draws it
 
 
 @dataclass
@@ -165,7 +165,7 @@ class _Draw:
     cull_face: str | None
     uploads: list                          # [(moderngl Uniform, bytes)]
     texture: tuple | None = None           # (texture, sampler) bound on MATERIAL_TEXTURE_UNIT
-    face_normals: moderngl.Texture | None = None   # bound on FACE_NORMALS_UNIT (shadowed Phong, Gouraud)
+    face_normals: moderngl.Texture | None = None   # bound on FACE_NORMALS_UNIT (a shadowed program's)
 
 
 class GpuRenderer:
@@ -297,9 +297,9 @@ class GpuRenderer:
         item.vertex_arrays, item.vbo, item.ibo, item.uv_vbo, item.face_normals = {}, None, None, None, None
 
     def _face_normals(self, item: _ObjectBuffers) -> moderngl.Texture:
-        """The object's facet normals as an RGBA32F texture (renderer/core/facets.py), made the
-        first time a shadowed Phong or Gouraud program draws it; texelFetch reads it (NEAREST,
-        one level, so that it is complete)."""
+        """The object's faces (normals and creases) as an RGBA32F texture (renderer/core/facets.py
+        face_texture), made the first time a shadowed program draws it; texelFetch reads it
+        (NEAREST, one level, so that it is complete)."""
         if item.face_normals is None:
             data = face_texture(item.mesh)
             texture = self.ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(), dtype="f4")
@@ -423,8 +423,7 @@ class GpuRenderer:
                        if program.get(name, None) is not None]
             cull = CULL_FLAGS[item.obj.cull]
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
-            facets = (self._face_normals(item) if variant.shadows and variant.shading != "flat"
-                      else None)
+            facets = self._face_normals(item) if variant.shadows else None
             plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None,
                               facets))
         self._shadowed[linear] = any(variant.shadows for variant in programs)

@@ -24,7 +24,7 @@ from typing import Mapping
 
 import moderngl
 
-from renderer.core.facets import FACE_TEXTURE_WIDTH
+from renderer.core.facets import FACES_PER_ROW
 from renderer.core.resources import glsl_dir
 from renderer.core.shadow_settings import shared_kernel
 from renderer.core.textures import MODULATED
@@ -212,8 +212,8 @@ class ShaderVariant:
                  "NUM_POINT_TERMS": parts * self.num_point_lights} if self.light_terms else {}
         terms |= {"TEXTURED": bool(self.texture)} | {
             f"TEXTURE_{k.upper()}": k in self.texture for k in MODULATED}
-        if self.shadows:                           # glsl/fragment.glsl's face-normal fetch
-            terms["FACE_TEXTURE_WIDTH"] = FACE_TEXTURE_WIDTH
+        if self.shadows:                           # glsl/fragment.glsl's face texture
+            terms["FACES_PER_ROW"] = FACES_PER_ROW
         if self.all_features:
             return {
                 f"SHADING_{self.shading.upper()}": True,

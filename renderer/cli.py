@@ -780,6 +780,7 @@ def cmd_compare(args) -> int:
 def cmd_shaders(args) -> int:
     """One set of files per shader variant the scene draws with, named after the variant,
     and a line per variant naming the objects that use it."""
+    from renderer.core.drawn import triangle_bound
     from renderer.core.imageio import check_folder, outputs
     from renderer.core.paths import output_stem
     from renderer.core.shadows import has_shadow_maps
@@ -791,7 +792,7 @@ def cmd_shaders(args) -> int:
     users: dict[ShaderVariant, list[str]] = {}
     maps = has_shadow_maps(scene)
     for obj in scene.objects:
-        if obj.mesh.triangle_count:
+        if triangle_bound(obj):            # what the camera pass may draw (renderer/core/drawn.py)
             variant = ShaderVariant.for_material(scene, obj.material,
                                                  shadows=maps and obj.receives_shadows)
             users.setdefault(variant, []).append(obj.name)

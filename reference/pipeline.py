@@ -5,7 +5,9 @@ scene order, vertex processing -> primitive assembly -> (flat: geometry stage) -
 -> viewport transform and snapping -> facing and culling -> rasterisation -> depth test;
 then fragment shading for the one surviving fragment per pixel, and output conversion. A
 large frame runs the stages from rasterisation on band by band (TILE_PIXELS), so that its
-memory stays bounded. Objects wholly outside the view volume are skipped (renderer/core/visibility.py, as the GPU path).
+memory stays bounded. Each object draws what the camera pass draws of it (renderer/core/drawn.py:
+its mesh, or an analytic plane's polygon in the view volume, as the GPU path); objects wholly
+outside the view volume are skipped (renderer/core/visibility.py, as the GPU path).
 Where a pixel's runner-up is within depth precision of its winner (a depth tie, see
 docs/conventions.md) the runner-up is shaded too, into Frame.rgba8_tie.
 When the scene has shadow maps (renderer/core/shadows.py: shadow_layout(...).any), the
@@ -42,6 +44,7 @@ from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_tri
 from reference.shadow.depth import render_layers
 from reference.shadow.lookup import ShadowMaps
 from reference.vertex import shade_vertices
+from renderer.core.drawn import DrawnMesh, drawn_meshes
 from renderer.core.facets import face_creases
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import SUBPIXEL_BITS, check_light_count
@@ -67,17 +70,18 @@ class PreparedObject:
     clip_weights: np.ndarray      # (T, 3, 3) its vertices as weights of the source's
 
 
-def prepare_object(obj, matrices, frame_matrices, lights: Lights, eye, width: int, height: int,
-                   subpixel_bits: int, reversed_z: bool, dtype, displace_lookup=None,
-                   index: int = -1, shadowed: bool = False) -> PreparedObject:
+def prepare_object(obj, drawn: DrawnMesh, frame_matrices, lights: Lights, eye, width: int,
+                   height: int, subpixel_bits: int, reversed_z: bool, dtype,
+                   displace_lookup=None, index: int = -1, shadowed: bool = False) -> PreparedObject:
     """Vertex processing -> primitive assembly -> (flat: geometry stage) -> clipping ->
-    viewport transform and snapping -> facing and culling, for one object."""
-    mesh, material = obj.mesh, obj.material
+    viewport transform and snapping -> facing and culling, for one object: `drawn`, what the
+    camera pass draws of it (renderer/core/drawn.py: its mesh, or a plane's polygon)."""
+    mesh, matrices, material = drawn.mesh, drawn.matrices, obj.material
     vertices = shade_vertices(mesh.positions, mesh.normals, u_model=matrices.model,
                               u_normal_matrix=matrices.normal, u_view=frame_matrices.view,
                               u_projection=frame_matrices.projection, u_eye=eye,
                               material=material, lights=lights, dtype=dtype,
-                              in_uv=obj.texture_coordinates())
+                              in_uv=obj.texture_coordinates(mesh))
     faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
     triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye,
                                  v_uv=None if vertices.v_uv is None else vertices.v_uv[faces])
@@ -171,17 +175,19 @@ def prepare_frame(scene, width: int, height: int, dtype, subpixel_bits: int = SU
     eye = frame_matrices.relative(scene.camera.eye).astype(dtype)
     reversed_z = scene.camera.reversed_z
 
-    # Objects wholly outside the view volume are skipped, as the GPU path skips them.
-    visible = visible_objects(scene, frame_matrices)
+    # What the camera pass draws (an analytic plane: its polygon in the view volume, the same
+    # at every sample offset), and, as the GPU path, not the objects wholly outside the view.
+    drawn = drawn_meshes(scene, frame_matrices)
+    visible = visible_objects(scene, frame_matrices, drawn)
     shadows = shadow_maps(scene, frame_matrices, width, height, visible, lights, dtype, tile_pixels)
     prepared, first_orders, first_order = [], [], 0
-    for index, (obj, matrices, shown) in enumerate(zip(scene.objects, frame_matrices.objects, visible)):
-        prepared.append(prepare_object(obj, matrices, frame_matrices, lights, eye, width, height,
+    for index, (obj, item, shown) in enumerate(zip(scene.objects, drawn, visible)):
+        prepared.append(prepare_object(obj, item, frame_matrices, lights, eye, width, height,
                                        subpixel_bits, reversed_z, dtype, displace_lookup,
                                        index=index, shadowed=shadows is not None)
                         if shown else None)
         first_orders.append(first_order)
-        first_order += len(obj.mesh.faces)
+        first_order += len(item.mesh.faces)
     return PreparedFrame(lights, eye, prepared, first_orders, shadows)
 
 

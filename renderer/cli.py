@@ -187,7 +187,8 @@ def build_parser() -> argparse.ArgumentParser:
                     f"({PIPELINE_TOLERANCE.describe()}; docs/conventions.md), 1 when they do not "
                     "(what fails is said on stderr), 2 for bad input. With --methods: the "
                     "rasteriser against the ray tracer instead, status 0; with --shadows-vs-truth: "
-                    "the rasteriser's shadow maps against ray-cast shadows, status 0.")
+                    "the rasteriser's shadow maps against ray-cast shadows, status 0; with "
+                    "--depth-vs-truth: the GPU's depth against ray-cast depth, status 0.")
     common(compare)
     raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
@@ -203,6 +204,12 @@ def build_parser() -> argparse.ArgumentParser:
                               "1-texel band around the true edge, acne, peter-panning); writes "
                               "shadow_truth.png and shadow_truth.json (default folder: "
                               "compare-shadows-SCENE_NAME)")
+    compare.add_argument("--depth-vs-truth", action="store_true",
+                         help="the GPU's depth against a float64 ray cast through each pixel "
+                              "centre at the surfaces the rasteriser draws: the relative error's "
+                              "99.9th percentile and maximum, in all and per object; writes "
+                              "depth_truth.png and depth_truth.json (default folder: "
+                              "compare-depth-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
                          metavar="LEVELS",
                          help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
@@ -703,9 +710,6 @@ def cmd_compare_shadows(args) -> int:
     readable line on stdout, the classification image and the figures in --out; status 0
     (a measurement, not a check)."""
     from renderer.checks.shadow_truth import shadows_vs_truth
-    from renderer.core.imageio import check_folder, check_outputs, outputs
-    from renderer.core.jsonio import json_text, to_json
-    from renderer.core.paths import output_stem
     from renderer.core.shadows import has_shadow_maps
     if args.methods:
         args.parser.error("--shadows-vs-truth and --methods are two different comparisons; give one")
@@ -719,17 +723,51 @@ def cmd_compare_shadows(args) -> int:
                         "with shadows on, nothing that casts or nothing that receives)",
                         file=scene.source or scene.name)
     check_render(scene, args.size, ["reference"])
-    out = check_folder(args.out or Path(f"compare-shadows-{output_stem(scene)}"))
-    names = [out / "shadow_truth.png", out / "shadow_truth.json"]
+    names = _measurement_files(args, scene, "shadows", "shadow_truth")
+    return _write_measurement(names, shadows_vs_truth(scene, *args.size))
+
+
+def _measurement_files(args, scene, folder: str, stem: str) -> list[Path]:
+    """A measurement's image and figures, STEM.png and STEM.json, in --out (default
+    compare-FOLDER-SCENE), checked before anything is rendered."""
+    from renderer.core.imageio import check_folder, check_outputs
+    from renderer.core.paths import output_stem
+    out = check_folder(args.out or Path(f"compare-{folder}-{output_stem(scene)}"))
+    names = [out / f"{stem}.png", out / f"{stem}.json"]
     check_outputs(*names)
-    result = shadows_vs_truth(scene, *args.size)
+    return names
+
+
+def _write_measurement(names: list[Path], result) -> int:
+    """Write a measurement's image and figures (both or neither) and print the figures as one
+    JSON line and one readable line; status 0 (a measurement, not a check)."""
+    from renderer.core.imageio import outputs
+    from renderer.core.jsonio import json_text, to_json
     figures = result.as_dict()
-    with outputs(*names) as written:             # both or neither
+    with outputs(*names) as written:
         written.png(names[0], result.image())
         written.text(names[1], json_text(figures))
     print(to_json(figures))
     print(result.line())
     return 0
+
+
+def cmd_compare_depth(args) -> int:
+    """`compare --depth-vs-truth` (from cmd_compare): the figures as one JSON line and one
+    readable line on stdout, the error image and the figures in --out; status 0 (a
+    measurement, not a check)."""
+    from renderer.checks.depth_truth import depth_vs_truth
+    if args.methods or args.shadows_vs_truth:
+        other = "--methods" if args.methods else "--shadows-vs-truth"
+        args.parser.error(f"--depth-vs-truth and {other} are two different comparisons; give one")
+    if args.method is not None:
+        args.parser.error(f"--depth-vs-truth measures the rasteriser's depth; leave out "
+                          f"--method {args.method}")
+    check_raytrace_options(args)
+    scene = _load(args.scene)
+    check_render(scene, args.size, ["gpu"])
+    names = _measurement_files(args, scene, "depth", "depth_truth")
+    return _write_measurement(names, depth_vs_truth(scene, *args.size, context=args.context))
 
 
 def cmd_compare(args) -> int:
@@ -739,6 +777,8 @@ def cmd_compare(args) -> int:
     from renderer.core.jsonio import to_json
     if args.out is not None:
         check_folder(args.out)
+    if args.depth_vs_truth:
+        return cmd_compare_depth(args)
     if args.shadows_vs_truth:
         return cmd_compare_shadows(args)
     check_raytrace_options(args)
@@ -780,6 +820,7 @@ def cmd_compare(args) -> int:
 def cmd_shaders(args) -> int:
     """One set of files per shader variant the scene draws with, named after the variant,
     and a line per variant naming the objects that use it."""
+    from renderer.core.drawn import triangle_bound
     from renderer.core.imageio import check_folder, outputs
     from renderer.core.paths import output_stem
     from renderer.core.shadows import has_shadow_maps
@@ -791,7 +832,7 @@ def cmd_shaders(args) -> int:
     users: dict[ShaderVariant, list[str]] = {}
     maps = has_shadow_maps(scene)
     for obj in scene.objects:
-        if obj.mesh.triangle_count:
+        if triangle_bound(obj):            # what the camera pass may draw (renderer/core/drawn.py)
             variant = ShaderVariant.for_material(scene, obj.material,
                                                  shadows=maps and obj.receives_shadows)
             users.setdefault(variant, []).append(obj.name)

@@ -48,6 +48,10 @@ CASES = [
                '[[objects]]\nname = "floor"\nmesh = { primitive = "plane" }\ncull = "back"\n',
      'floor is in the view volume, yet no triangle covers a pixel centre or all that do are '
      'culled (cull = "back")'),
+    # an analytic plane is drawn where it meets the view volume: looking up, the floor does not
+    ("plane misses", "[camera]\neye = [0, 1, 5]\nlook = [0, 9, 4]\n"
+                     '[[objects]]\nname = "floor"\nshape = { type = "plane" }\n',
+     "floor is outside the view volume (an infinite plane that misses it)"),
     ("empty", CAMERA, "the scene has no objects"),
 ]
 

@@ -93,6 +93,15 @@ def clip_from_model(shadow_pass, model) -> np.ndarray:
     return np.asarray(shadow_pass.clip_from_world, np.float64) @ np.asarray(model, np.float64)
 
 
+def caster_mesh(scene, matrices, shadow_pass, index: int):
+    """(mesh, u_clip_from_model) a pass draws of caster `index`: an analytic plane's polygon in
+    the pass's volume (pass.polygons; camera-relative world, so the identity model), else the
+    object's mesh through its model matrix."""
+    if index in shadow_pass.polygons:
+        return shadow_pass.polygons[index], np.asarray(shadow_pass.clip_from_world, np.float64)
+    return scene.objects[index].mesh, clip_from_model(shadow_pass, matrices.objects[index].model)
+
+
 def _caster_triangles(mesh, clip_from_model_matrix, dtype):
     """(T, 3, 4) clip coordinates of a mesh's triangles in `dtype`, and (T, 4) the magnitude
     of the products that made each coordinate (largest over the triangle's vertices, float64):
@@ -144,8 +153,7 @@ def _pass_triangles(scene, matrices, shadow_pass, dtype) -> _PassTriangles:
     so the draw order is the casters', each in its mesh's order): clipped, set up at the
     tile's size, zero-area ones dropped (no culling)."""
     size = shadow_pass.tile.size
-    parts = [_caster_triangles(scene.objects[index].mesh,
-                               clip_from_model(shadow_pass, matrices.objects[index].model), dtype)
+    parts = [_caster_triangles(*caster_mesh(scene, matrices, shadow_pass, index), dtype)
              for index in shadow_pass.casters]
     triangles = np.concatenate([p[0] for p in parts])
     magnitude = np.concatenate([p[1] for p in parts])

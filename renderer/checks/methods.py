@@ -63,8 +63,8 @@ CAUSES = (
           "either side; neither is wrong, and the pipeline tolerance's ±1 px allowance forgives it"),
     Cause("tessellation", (255, 120, 0), "orange",
           "the surface seen, or its shading, differs beyond ±1 px: the rasteriser draws an "
-          "analytic sphere as an icosphere and a plane as a finite square (and skips the faces "
-          "an object's cull names); the ray tracer's exact shapes are right"),
+          "analytic sphere as an icosphere (and skips the faces an object's cull names; a plane "
+          "it draws as itself to the view's edge); the ray tracer's exact shapes are right"),
     Cause("sampling", (0, 220, 220), "cyan",
           "several samples per pixel: the ray tracer averages its samples (anti-aliased edges), "
           "the rasteriser takes one at the pixel centre; the average is nearer the pixel's "

@@ -161,6 +161,9 @@ def check(needed: int, what: str, *, file: str | None = None) -> None:
 def check_render(scene, size, backends) -> None:
     """One line, before any rendering, when rasterising `scene` at `size` on each of
     `backends` ("gpu", "reference") would need more than the limit."""
+    # Every object's mesh is held, an analytic plane's square too (the shadow passes draw it);
+    # the polygon the camera pass draws for a plane instead (renderer/core/drawn.py) adds at
+    # most 4 triangles, a few kilobytes, below these figures' rounding.
     triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
     estimate = {"gpu": gpu_bytes, "reference": reference_bytes}
     needed = sum(estimate[backend](*size, triangles) for backend in backends)

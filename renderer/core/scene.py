@@ -2,7 +2,9 @@
 
 A scene is plain data: camera, objects (mesh + transform + material), lights, background.
 An object may also carry an analytic shape (`Sphere`, `Plane`) for the ray tracer; its `mesh`
-is then the shape's tessellation, which the rasteriser draws (renderer/core/shapes.py).
+is then the shape's tessellation (renderer/core/shapes.py). The rasteriser's camera pass draws
+a sphere's tessellation, and for a plane, each frame, the polygon where the plane meets the
+view volume (renderer/core/drawn.py).
 Both pipelines read it, and both take their matrices from `Scene.matrices()` so that the
 only thing they do differently is the pipeline itself. Units and conventions:
 docs/conventions.md; the file format: docs/scene-format.md.
@@ -249,7 +251,10 @@ def world_shape(shape: Shape, model: np.ndarray, origin=(0.0, 0.0, 0.0)) -> Worl
 @dataclass
 class SceneObject:
     name: str
-    mesh: Mesh                   # what the rasteriser draws; for a shape, its tessellation
+    # What the rasteriser draws: a mesh's triangles, a sphere's tessellation; for a plane, the
+    # square of renderer/core/shapes.py, which only the shadow passes draw (the camera pass
+    # draws the plane's polygon in its view volume: renderer/core/drawn.py).
+    mesh: Mesh
     material: Material = field(default_factory=Material)
     transform: Transform = field(default_factory=Transform)
     parent: str | None = None    # name of another object; its world matrix applies after ours
@@ -263,16 +268,19 @@ class SceneObject:
     velocity: tuple | None = None
     angular_velocity: tuple | None = None
 
-    def texture_coordinates(self) -> np.ndarray | None:
-        """The mesh's UVs (V, 2) where the material is textured (what its lookup reads), None
-        where it is not; a ValueError naming the object for a textured material on a mesh
-        without UVs (a scene file is refused so as it loads, renderer/core/scene_file.py)."""
+    def texture_coordinates(self, mesh: Mesh | None = None) -> np.ndarray | None:
+        """The UVs (V, 2) of `mesh` (default: the object's own; the camera pass passes what it
+        draws, renderer/core/drawn.py) where the material is textured (what its lookup
+        reads), None where it is not; a ValueError naming the object for a textured material
+        on a mesh without UVs (a scene file is refused so as it loads,
+        renderer/core/scene_file.py)."""
+        mesh = self.mesh if mesh is None else mesh
         if self.material.texture is None:
             return None
-        if self.mesh.uvs is None:
+        if mesh.uvs is None:
             raise ValueError(f"object {self.name!r}: its material has a texture but its mesh "
-                             f"({self.mesh.source or 'made in code'}) has no texture coordinates")
-        return self.mesh.uvs
+                             f"({mesh.source or 'made in code'}) has no texture coordinates")
+        return mesh.uvs
 
 
 @dataclass
@@ -338,6 +346,15 @@ class FrameMatrices:
     projection: np.ndarray
     objects: list[ObjectMatrices]
     origin: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    size: tuple[int, int] = (1, 1)           # (width, height) of the image they are for
+    # The projection before a sample offset's jitter (None: `projection` has none). What the
+    # camera pass draws is made for it, the same at every sample offset (renderer/core/drawn.py).
+    unjittered_projection: np.ndarray | None = None
+
+    @property
+    def camera_projection(self) -> np.ndarray:
+        """The projection without the sample offset's jitter."""
+        return self.projection if self.unjittered_projection is None else self.unjittered_projection
 
     def relative(self, points) -> np.ndarray:
         """World points (..., 3) relative to the origin, in float64."""
@@ -388,7 +405,7 @@ class Scene:
         origin = np.asarray(self.camera.eye, dtype=np.float64)
         to_origin = transforms.translate(*(-origin))
         cam = self.camera
-        projection = cam.projection_matrix(width / height)
+        unjittered = projection = cam.projection_matrix(width / height)
         if tuple(sample_offset) != (0.0, 0.0):
             projection = transforms.jitter(*sample_offset, width, height) @ projection
         return FrameMatrices(
@@ -397,6 +414,8 @@ class Scene:
             objects=[ObjectMatrices(to_origin @ m, transforms.normal_matrix(m))
                      for m in self.world_matrices()],
             origin=origin,
+            size=(int(width), int(height)),
+            unjittered_projection=None if projection is unjittered else unjittered,
         )
 
     def world_shapes(self) -> list[WorldSphere | WorldPlane | None]:

@@ -29,13 +29,17 @@ count up from the bottom as GL's window rows do (the depth pass draws with the v
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from renderer.core import transforms
 from renderer.core.shadow_settings import (MAX_SHADOW_TEXELS, RESOLUTIONS, Shadow, auto_resolution,
                                            guard_texels, scene_has_shadows)
+from renderer.core.drawn import drawn_meshes, is_plane
+from renderer.core.gl_rules import STANDARD_DEPTH
+from renderer.core.plane_clip import plane_polygon
+from renderer.core.scene import world_shape
 from renderer.core.shadow_casting import Occluders, light_can_shadow, world_geometry
 from renderer.core.visibility import all_outside, corners
 from renderer.errors import SceneError
@@ -229,6 +233,10 @@ class ShadowPass:
     tile: Tile
     clip_from_world: np.ndarray
     casters: tuple[int, ...]
+    # An analytic plane among the casters is drawn as the polygon where it meets this pass's
+    # view volume (renderer/core/plane_clip.py; camera-relative world, the identity model):
+    # caster index -> that Mesh. The other casters draw their meshes.
+    polygons: dict = field(default_factory=dict)
 
 
 @dataclass
@@ -253,12 +261,39 @@ class ShadowPlan:
 
 
 def world_points(scene, matrices) -> list[np.ndarray]:
-    """Each object's vertices in camera-relative world coordinates (float64, (V, 3))."""
+    """Each object's vertices in camera-relative world coordinates (float64, (V, 3)); for an
+    analytic plane, those of the polygon the camera pass draws (renderer/core/drawn.py: what of
+    it can receive a visible shadow), or of its square where it misses the view."""
     out = []
-    for obj, m in zip(scene.objects, matrices.objects):
+    for obj, m, what in zip(scene.objects, matrices.objects, drawn_meshes(scene, matrices)):
+        if is_plane(obj) and what.mesh.triangle_count:
+            out.append(np.asarray(what.mesh.positions, dtype=np.float64))
+            continue
         model = np.asarray(m.model, dtype=np.float64)
         out.append(np.asarray(obj.mesh.positions, dtype=np.float64) @ model[:3, :3].T + model[:3, 3])
     return out
+
+
+def plane_polygons(scene, matrices, casters, clip_from_world: np.ndarray) -> dict:
+    """{caster: the polygon where its analytic plane meets the view volume of
+    `clip_from_world`} for the analytic planes among `casters` (renderer/core/plane_clip.py),
+    None where it misses the volume."""
+    return {i: plane_polygon(world_shape(scene.objects[i].shape, matrices.objects[i].model),
+                             clip_from_world, STANDARD_DEPTH)
+            for i in casters if is_plane(scene.objects[i])}
+
+
+def _with_polygons(shadow_pass: ShadowPass, scene, matrices) -> ShadowPass | None:
+    """`shadow_pass` with its analytic planes' polygons (plane_polygons); a plane that misses
+    the pass's volume is left out of its casters (None: no caster is left)."""
+    polygons = plane_polygons(scene, matrices, shadow_pass.casters, shadow_pass.clip_from_world)
+    if not polygons:
+        return shadow_pass
+    casters = tuple(c for c in shadow_pass.casters if polygons.get(c, True) is not None)
+    if not casters:
+        return None
+    return replace(shadow_pass, casters=casters,
+                   polygons={c: mesh for c, mesh in polygons.items() if mesh is not None})
 
 
 def _camera_frustum_corners(camera, matrices) -> np.ndarray:
@@ -296,8 +331,18 @@ def _light_frame(points: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     return (points @ rotation[:3, :3].T) * np.array([1.0, 1.0, -1.0])
 
 
+def _plane_depths(plane, rotation: np.ndarray, region) -> tuple[float, float]:
+    """The least and greatest depth along a directional light (its frame: `rotation`) of an
+    infinite plane over the square `region` (lo, hi) across the light: at the square's corners,
+    the plane's depth being linear across it."""
+    n = rotation[:3, :3] @ np.asarray(plane.normal, np.float64)     # light frame: x, y, -depth
+    corners = np.array([(x, y) for x in (region[0][0], region[1][0]) for y in (region[0][1], region[1][1])])
+    depth = (corners @ n[:2] + float(plane.offset)) / n[2]           # -z: the plane's depth
+    return float(depth.min()), float(depth.max())
+
+
 def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
-                      frustum) -> tuple[ShadowPass | None, np.ndarray, np.ndarray, float]:
+                      frustum, planes=None) -> tuple[ShadowPass | None, np.ndarray, np.ndarray, float]:
     """The light's orthographic view, fitted to where a visible shadow can fall: across the
     light, the union over the pairs (caster c, receiver r) that can interact (`pairs`: c -> its
     receivers) of c's box, r's box and the camera's view volume's box, intersected (a parallel
@@ -305,12 +350,18 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
     a receiver point outside the map reads as lit. Square texels; the centre snapped to whole
     texels so that the map does not shimmer as the camera moves. In depth, from the nearest
     caster drawn to the deepest visible receiver whose box meets the region (a receiver point
-    past the far plane would compare as shadowed)."""
+    past the far plane would compare as shadowed). `planes`: caster -> its analytic plane
+    (camera-relative world): unbounded across the light, its depth over the region its own."""
     rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light.direction, (0.0, 1.0, 0.0))
     params = np.zeros(4)
+    planes = planes or {}
     if not pairs:
         return None, np.eye(4), params, 0.0
     box = {i: _box(_light_frame(points[i], rotation)) for i in {*receivers, *pairs}}
+    for i in planes:
+        if i in box and i not in receivers:
+            box[i] = box[i].copy()
+            box[i][:, :2] = ((-np.inf, -np.inf), (np.inf, np.inf))
     view = _box(_light_frame(frustum, rotation))
     pieces = []
     for c, shadowed in pairs.items():
@@ -324,7 +375,7 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
     lo = np.min([p[0] for p in pieces], axis=0)
     hi = np.max([p[1] for p in pieces], axis=0)
     resolution, guard = light_map.resolution, light_map.guard
-    extent = max(float(np.abs(b).max()) for b in box.values())
+    extent = max(float(np.abs(b[np.isfinite(b)]).max(initial=0.0)) for b in box.values())
     half_inner = max(float((hi - lo).max()) / 2.0, 1e-9 * (1.0 + extent))
     texel = 2.0 * half_inner / (resolution - 2 * guard)
     centre = np.round((lo + hi) / 2.0 / texel) * texel       # snapped: steady as the camera moves
@@ -335,6 +386,9 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
     if not drawn or not seen:
         return None, np.eye(4), params, texel
     far_depth = max(float(box[r][1, 2]) for r in seen)
+    for i in drawn:
+        if i in planes:                       # the plane over the region, not beyond the deepest receiver
+            box[i][:, 2] = np.clip(_plane_depths(planes[i], rotation, region), -np.inf, far_depth)
     near_depth = min(float(box[i][0, 2]) for i in (*drawn, *seen))
     margin = max(DEPTH_MARGIN * (far_depth - near_depth), 2.0 * texel)
     near_depth, far_depth = near_depth - margin, far_depth + margin
@@ -562,6 +616,8 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
                  if o.receives_shadows and visible[i] and o.mesh.triangle_count]
     casters = [i for i, o in enumerate(scene.objects) if o.casts_shadows and o.mesh.triangle_count]
     frustum = _camera_frustum_corners(scene.camera, matrices)
+    planes = {i: world_shape(scene.objects[i].shape, matrices.objects[i].model)
+              for i in casters if is_plane(scene.objects[i])}
     for light_map in layout.maps:
         i = light_map.index
         bias = light_map.shadow.bias_rule().as_vec4()
@@ -570,7 +626,11 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
             pairs = (occluders.pairs(casters, receivers, light_direction=light.direction) if prune
                      else {c: receivers for c in casters})
             shadow_pass, lookup, params, texel = _plan_directional(
-                i, light, light_map, layout, points, receivers, pairs, frustum)
+                i, light, light_map, layout, points, receivers, pairs, frustum, planes)
+            if shadow_pass is not None:
+                shadow_pass = _with_polygons(shadow_pass, scene, matrices)
+                if shadow_pass is None:
+                    params = np.zeros(4)           # only a plane that misses it: no pass
             uniforms["u_directional_shadow_matrix"][i] = lookup
             uniforms["u_directional_shadow"][i] = params
             uniforms["u_directional_shadow_bias"][i] = bias
@@ -584,6 +644,10 @@ def plan_shadows(scene, matrices, layout: ShadowLayout, visible: list[bool] | No
                      else {c: receivers for c in casters})
             passes, faces, params, depth = _plan_point(
                 i, light, light_map, layout, matrices, points, receivers, pairs, scene, prune)
+            kept = [_with_polygons(p, scene, matrices) for p in passes]
+            for dropped in (p for p, k in zip(passes, kept) if k is None):
+                faces[dropped.face, 3] = -1.0          # only a plane that misses it: not drawn
+            passes = [p for p in kept if p is not None]
             uniforms["u_point_shadow"][i] = params
             uniforms["u_point_shadow_depth"][i] = depth
             uniforms["u_point_shadow_bias"][i] = bias

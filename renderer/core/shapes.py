@@ -1,21 +1,22 @@
-"""The meshes the rasteriser draws for analytic shapes (renderer.core.scene.Sphere, Plane).
+"""The meshes of the analytic shapes (renderer.core.scene.Sphere, Plane), as a SceneObject's `mesh`.
 
-The ray tracer intersects the shape itself; the rasteriser draws these triangles instead, so
-that every scene renders both ways. Both are deterministic and counted before they are built
-(TRIANGLES, as primitives.TRIANGLES; renderer/core/memory.py):
+The ray tracer intersects the shape itself. The rasteriser draws:
 
-- a sphere is an icosphere (primitives.icosphere: 20 · 4^subdivisions triangles, default
-  SPHERE_SUBDIVISIONS) of the sphere's radius moved to its centre, with exact normals;
-- a plane is a square of side `size` (default PLANE_SIZE, object units) split into
-  segments × segments cells, centred on the point of the plane nearest the object's origin
-  (-d N / |N|²), counter-clockwise seen from the side N points to; the frustum clips what
-  lies outside the view. A ray-traced plane is infinite: where the square ends inside the
-  view (a far plane beyond size / 2, or a horizon), the two renderings differ; make `size`
-  larger than twice the distance to the far plane to avoid it.
+- for a sphere, this icosphere (primitives.icosphere: 20 · 4^subdivisions triangles, default
+  SPHERE_SUBDIVISIONS) of the sphere's radius moved to its centre, with exact normals, in
+  every pass;
+- for a plane, in the camera pass, not a mesh made here but each frame's polygon where the
+  infinite plane meets the view volume (renderer/core/plane_clip.py, renderer/core/drawn.py),
+  so that it sees the surface the ray tracer intersects to the view's edge. The square made
+  here (side `size`, default PLANE_SIZE object units, segments × segments cells, centred on
+  the point of the plane nearest the object's origin, -d N / |N|², counter-clockwise seen from
+  the side N points to) is what the shadow passes draw (renderer/core/shadows.py), until
+  they too clip the plane to each light's view.
 
-Their UVs are the shapes' own (renderer/core/uv_rules.py), which the ray tracer computes at
-its hits: the sphere's from the direction from its centre, the plane's from the object-space
-point, so both renderings texture a shape alike.
+Both are deterministic and counted before they are built (TRIANGLES, as primitives.TRIANGLES;
+renderer/core/memory.py). Their UVs are the shapes' own (renderer/core/uv_rules.py), which the
+ray tracer computes at its hits: the sphere's from the direction from its centre, the plane's
+from the object-space point (the polygon's too), so every rendering textures a shape alike.
 """
 
 from __future__ import annotations

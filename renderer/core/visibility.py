@@ -2,8 +2,9 @@
 
 Both pipelines ask this before drawing (renderer/gpu/pipeline.py when it plans a frame, and
 reference/pipeline.py), so an object wholly outside the view volume costs neither of them
-its vertex work. The test is exact for the object's bounding box and never drops anything
-visible: the box's 8 corners are taken to clip space (p_clip = P V M p, float64) and the
+its vertex work. It tests what the camera pass draws of each object (renderer/core/drawn.py:
+its mesh, or an analytic plane's polygon in the view volume, empty where the plane misses it).
+The test is exact for that mesh's bounding box and never drops anything visible: the box's 8 corners are taken to clip space (p_clip = P V M p, float64) and the
 object is dropped only when all 8 lie outside one and the same clip plane (GL keeps
 -w <= x, y, z <= w, docs/conventions.md). Each plane's inequality is linear in clip
 coordinates, so when the corners fail it so does every point of the box, whatever w is
@@ -24,6 +25,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from renderer.core.drawn import DrawnMesh, drawn_meshes, is_plane
 from renderer.core.gl_rules import depth_mapping
 from renderer.core.scene import FrameMatrices, Mesh, Scene
 from renderer.errors import show_number
@@ -68,12 +70,18 @@ def outside_view_volume(clip_from_object: np.ndarray, mesh: Mesh) -> bool:
     return bool(all_outside(clip_corners(clip_from_object, mesh)))
 
 
-def visible_objects(scene: Scene, matrices: FrameMatrices) -> list[bool]:
-    """For each object of the scene, whether any of it may fall inside the view volume."""
+def visible_objects(scene: Scene, matrices: FrameMatrices,
+                    drawn: list[DrawnMesh] | None = None) -> list[bool]:
+    """For each object of the scene, whether any of what the camera pass draws of it
+    (`drawn`, renderer/core/drawn.py; made from `matrices` when not given) may fall inside the
+    view volume. A plane's polygon lies in it, or is empty where the plane misses it."""
+    drawn = drawn_meshes(scene, matrices) if drawn is None else drawn
     clip_from_world = matrices.projection @ matrices.view
-    return [not outside_view_volume(clip_from_world @ m.model, obj.mesh)
-            for obj, m in zip(scene.objects, matrices.objects)]
+    return [not outside_view_volume(clip_from_world @ d.matrices.model, d.mesh) for d in drawn]
 
+
+# Why an analytic plane draws nothing: no point of it is in the view volume.
+PLANE_MISSES = "outside the view volume (an infinite plane that misses it)"
 
 # Side planes as (axis, sign, where the box is): outside when sign * coordinate > w.
 SIDES = ((0, -1.0, "to the left of the view"), (0, 1.0, "to the right of the view"),
@@ -82,20 +90,23 @@ SIDES = ((0, -1.0, "to the left of the view"), (0, 1.0, "to the right of the vie
 
 def not_in_view(scene: Scene, matrices: FrameMatrices) -> list[str | None]:
     """For each object, why none of it can show, as a user would say it ("behind the
-    camera", "beyond the far plane (100)", ...), from its bounding box's corners in clip
-    space; None when the box reaches into the view volume. In order: no triangles, behind the
-    camera or else nearer than the near plane, beyond the far plane, beside the view."""
+    camera", "beyond the far plane (100)", ...), from the bounding box's corners in clip space
+    of what the camera pass draws of it (renderer/core/drawn.py); None when the box reaches
+    into the view volume. In order: no triangles (for an analytic plane: it misses the view
+    volume), behind the camera or else nearer than the near plane, beyond the far plane,
+    beside the view."""
     camera = scene.camera
     mapping = depth_mapping(camera.reversed_z)
     inward = np.sign(mapping.ndc_far - mapping.ndc_near)     # +1, or -1 under reversed-Z
     clip_from_world = matrices.projection @ matrices.view
     reasons = []
-    for obj, m in zip(scene.objects, matrices.objects):
-        if obj.mesh.triangle_count == 0:
-            reasons.append("has no triangles")
+    for obj, drawn in zip(scene.objects, drawn_meshes(scene, matrices)):
+        mesh, model = drawn.mesh, drawn.matrices.model
+        if mesh.triangle_count == 0:
+            reasons.append(PLANE_MISSES if is_plane(obj) else "has no triangles")
             continue
-        x, y, z, w = clip_corners(clip_from_world @ m.model, obj.mesh).T
-        depth = -clip_corners(matrices.view @ m.model, obj.mesh)[:, 2]    # -z_eye; w in perspective
+        x, y, z, w = clip_corners(clip_from_world @ model, mesh).T
+        depth = -clip_corners(matrices.view @ model, mesh)[:, 2]    # -z_eye; w in perspective
         if np.all(inward * (z - mapping.ndc_near * w) < 0.0):
             reasons.append("behind the camera" if np.all(depth <= 0.0) else
                            f"nearer than the near plane ({show_number(camera.near)})")

@@ -16,7 +16,10 @@ first time either way).
 Everything GL is made once per renderer: one program per shader variant the scene's materials
 use, one vertex buffer (positions and normals, float32, interleaved), index buffer and vertex
 array per object (and for an object with a textured material, a buffer of its vertices' UVs,
-float32, the program's in_uv: no other object has one), each texture the materials use, with
+float32, the program's in_uv: no other object has one), for an analytic plane a second such
+set for the polygon its camera pass draws (renderer/core/drawn.py: made once at their largest,
+MAX_POLYGON_VERTICES and MAX_POLYGON_TRIANGLES, written by each update(); the shadow passes
+draw the object's mesh), each texture the materials use, with
 its sampler object (renderer/gpu/textures.py, TextureCache: one upload per texture however
 many materials share it), and a single-sample framebuffer with an RGBA8 colour buffer and a 32-bit
 float depth buffer (DEPTH_COMPONENT32F, so the stored depth is the rasteriser's float z_w with
@@ -53,7 +56,8 @@ object there, and the frame unbinds the sampler object after its last draw, so t
 shared with other drawing (a viewer) is left with no sampler state of ours.
 
 Uniform values are computed once per update(), as bytes (renderer/gpu/uniforms.py, from the
-layout the reference reads too: renderer/core/uniforms.py), from `Scene.matrices()`
+layout the reference reads too: renderer/core/uniforms.py), and each plane's polygon with
+them, from `Scene.matrices()`
 (camera-relative) and the scene's lights and materials, and `render()` only hands them to GL;
 a pass at a sample offset (`render(sample_offset=(dx, dy))`, docs/conventions.md) uploads
 u_projection alone again. After changing the scene (camera, lights, materials, transforms, or
@@ -73,9 +77,11 @@ import numpy as np
 
 from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
 from renderer.errors import ContextError, SystemFault
+from renderer.core.drawn import drawn_meshes, is_plane
 from renderer.core.facets import face_texture
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
+from renderer.core.plane_clip import MAX_POLYGON_TRIANGLES, MAX_POLYGON_VERTICES
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
@@ -144,8 +150,33 @@ def multisample_counts(ctx: moderngl.Context) -> list[int]:
 
 
 @dataclass
+class _PolygonBuffers:
+    """An analytic plane's polygon for the camera pass (renderer/core/drawn.py): buffers made
+    once at their largest (MAX_POLYGON_VERTICES vertices, MAX_POLYGON_TRIANGLES triangles),
+    written again by each update() with that frame's polygon, of which `count` indices are
+    drawn (0: the plane misses the view)."""
+    vbo: moderngl.Buffer                   # in_position, in_normal: float32, interleaved
+    ibo: moderngl.Buffer                   # faces, uint32
+    uv_vbo: moderngl.Buffer                # in_uv, float32
+    count: int = 0
+
+    def write(self, mesh: Mesh) -> None:
+        if mesh.triangle_count:
+            self.vbo.write(_vertex_bytes(mesh))
+            self.ibo.write(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
+            self.uv_vbo.write(np.ascontiguousarray(mesh.uvs, dtype=np.float32).tobytes())
+        self.count = 3 * mesh.triangle_count
+
+    def release(self) -> None:
+        for buffer in (self.vbo, self.ibo, self.uv_vbo):
+            buffer.release()
+
+
+@dataclass
 class _ObjectBuffers:
-    """GL objects of one scene object: its mesh on the GPU and its vertex arrays per variant."""
+    """GL objects of one scene object: its mesh on the GPU and its vertex arrays per variant.
+    The camera pass draws the mesh, or an analytic plane's polygon (`polygon`); the shadow
+    passes draw the mesh (renderer/gpu/shadow_maps.py)."""
     obj: SceneObject
     mesh: Mesh                             # the mesh uploaded (update() re-uploads a new one)
     vbo: moderngl.Buffer | None            # in_position, in_normal: float32, interleaved
@@ -155,6 +186,19 @@ class _ObjectBuffers:
     uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
     texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
     face_normals: moderngl.Texture | None = None   # its faces (facets.face_texture), once a shadowed program draws it
+    polygon: _PolygonBuffers | None = None  # an analytic plane's, which the camera pass draws
+
+    @property
+    def drawn_buffers(self) -> tuple:
+        """(vbo, ibo, uv_vbo) the camera pass draws from."""
+        if self.polygon is not None:
+            return self.polygon.vbo, self.polygon.ibo, self.polygon.uv_vbo
+        return self.vbo, self.ibo, self.uv_vbo
+
+    @property
+    def count(self) -> int:
+        """Indices the camera pass draws: -1 for all of the mesh's, a polygon's own count."""
+        return -1 if self.polygon is None else self.polygon.count
 
 
 @dataclass
@@ -166,6 +210,7 @@ class _Draw:
     uploads: list                          # [(moderngl Uniform, bytes)]
     texture: tuple | None = None           # (texture, sampler) bound on MATERIAL_TEXTURE_UNIT
     face_normals: moderngl.Texture | None = None   # bound on FACE_NORMALS_UNIT (a shadowed program's)
+    count: int = -1                        # indices drawn (-1: all)
 
 
 class GpuRenderer:
@@ -269,26 +314,34 @@ class GpuRenderer:
                 raise ValueError(f"object {obj.name!r}: cull must be one of "
                                  f"{', '.join(CULL_FLAGS)}, got {obj.cull!r}")
             item = _ObjectBuffers(obj, obj.mesh, None, None, None, {}, {})
+            if is_plane(obj):        # its polygon's buffers, at their largest, written per update()
+                item.polygon = _PolygonBuffers(
+                    self.ctx.buffer(reserve=MAX_POLYGON_VERTICES * 6 * 4),
+                    self.ctx.buffer(reserve=MAX_POLYGON_TRIANGLES * 3 * 4),
+                    self.ctx.buffer(reserve=MAX_POLYGON_VERTICES * 2 * 4))
             self._objects.append(item)
             self._upload(item)
 
     def _upload(self, item: _ObjectBuffers) -> None:
         mesh = item.mesh = item.obj.mesh
         if mesh.triangle_count:
-            vertices = np.hstack([mesh.positions, mesh.normals]).astype(np.float32)
-            item.vbo = self.ctx.buffer(np.ascontiguousarray(vertices).tobytes())
+            item.vbo = self.ctx.buffer(_vertex_bytes(mesh))
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
         self._upload_uvs(item)
 
     def _upload_uvs(self, item: _ObjectBuffers) -> None:
         """The mesh's UVs (in_uv, float32) once the object's material is textured: when it is
-        made, or at the update() after a material gains a texture."""
+        made, or at the update() after a material gains a texture. (A plane's polygon has
+        its own, written with it.)"""
+        if item.polygon is not None:
+            return
         uvs = item.obj.texture_coordinates()
         if uvs is not None and item.uv_vbo is None and item.vbo is not None:
             item.uv_vbo = self.ctx.buffer(np.ascontiguousarray(uvs, dtype=np.float32).tobytes())
 
     @staticmethod
     def _release_buffers(item: _ObjectBuffers) -> None:
+        """The mesh's buffers and the vertex arrays (a polygon's buffers stay: release())."""
         for vao in item.vertex_arrays.values():
             vao.release()
         for buffer in (item.vbo, item.ibo, item.uv_vbo, item.face_normals):
@@ -317,20 +370,23 @@ class GpuRenderer:
         vao = item.vertex_arrays.get(variant)
         if vao is None:
             program = self._programs.get(variant)
+            vbo, ibo, uv_vbo = item.drawn_buffers
             if program.get("in_normal", None) is not None:
-                content = [(item.vbo, "3f 3f", "in_position", "in_normal")]
+                content = [(vbo, "3f 3f", "in_position", "in_normal")]
             else:                                    # flat: the normal is the face's, not read
-                content = [(item.vbo, "3f 3x4", "in_position")]
+                content = [(vbo, "3f 3x4", "in_position")]
             if program.get("in_uv", None) is not None:   # textured, and the texel is used
-                content.append((item.uv_vbo, "2f", "in_uv"))
-            vao = self.ctx.vertex_array(program, content, index_buffer=item.ibo,
+                content.append((uv_vbo, "2f", "in_uv"))
+            vao = self.ctx.vertex_array(program, content, index_buffer=ibo,
                                         index_element_size=4)
             item.vertex_arrays[variant] = vao
         return vao
 
     # -- uniforms ----------------------------------------------------------------------------
     def update(self) -> None:
-        """Recompute every uniform from the scene (camera, lights, materials, transforms)."""
+        """Recompute every uniform from the scene (camera, lights, materials, transforms), and
+        what the camera pass draws of each analytic plane (its polygon in the view volume,
+        written into the buffers made for it)."""
         scene = self.scene
         if len(scene.objects) != len(self._objects) or any(
                 a is not b.obj for a, b in zip(scene.objects, self._objects)):
@@ -343,16 +399,20 @@ class GpuRenderer:
                 self._upload(item)
             self._upload_uvs(item)
         matrices = scene.matrices(self.width, self.height)
-        visible = visible_objects(scene, matrices)
+        drawn = drawn_meshes(scene, matrices)
+        for item, what in zip(self._objects, drawn):
+            if item.polygon is not None:
+                item.polygon.write(what.mesh)
+        visible = visible_objects(scene, matrices, drawn)
         shadows = self._update_shadows(matrices, visible)
         self._frame_uniforms = frame_uniform_values(
             scene, matrices, light_slots=None if self.specialise else ALL_FEATURES_LIGHTS,
             shadows=shadows)
         # Objects wholly outside the view volume are left out of the frame's plan.
         self._visible = visible if self.specialise else [True] * len(self._objects)
-        for index, (item, object_matrices) in enumerate(zip(self._objects, matrices.objects)):
+        for index, (item, what) in enumerate(zip(self._objects, drawn)):
             item.uniform_bytes = object_uniform_values(
-                item.obj, object_matrices,
+                item.obj, what.matrices,
                 None if self._shadow_plan is None else self._shadow_plan.self_masks(index))
             # Uploaded the first time a texture is asked for; a material's new texture then.
             texture = item.obj.material.texture
@@ -414,7 +474,7 @@ class GpuRenderer:
             return plan
         plan, programs = [], {}
         for item, visible in zip(self._objects, self._visible):
-            if item.vbo is None or not visible:
+            if item.vbo is None or not visible or item.count == 0:
                 continue
             variant = self._variant(item.obj, linear)
             vao = self._vertex_array(item, variant)
@@ -425,7 +485,7 @@ class GpuRenderer:
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
             facets = self._face_normals(item) if variant.shadows else None
             plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None,
-                              facets))
+                              facets, item.count))
         self._shadowed[linear] = any(variant.shadows for variant in programs)
         for program in programs.values():          # the same for every object: set once here
             for name, data in self._frame_uniforms.items():
@@ -518,7 +578,7 @@ class GpuRenderer:
                     sampler.use(MATERIAL_TEXTURE_UNIT)
                 if draw.face_normals is not None:
                     draw.face_normals.use(FACE_NORMALS_UNIT)
-                draw.vertex_array.render(moderngl.TRIANGLES)
+                draw.vertex_array.render(moderngl.TRIANGLES, vertices=draw.count)
             if target is not fbo:
                 ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
         finally:
@@ -626,7 +686,7 @@ class GpuRenderer:
         """Names of the objects the current frame plan draws, in order: those with triangles
         and, when specialising, not wholly outside the view volume."""
         return [item.obj.name for item, visible in zip(self._objects, self._visible)
-                if item.vbo is not None and visible]
+                if item.vbo is not None and visible and item.count != 0]
 
     @property
     def vertex_arrays(self) -> list:
@@ -647,6 +707,8 @@ class GpuRenderer:
                 self._shadow_maps = None
             for item in self._objects:
                 self._release_buffers(item)
+                if item.polygon is not None:
+                    item.polygon.release()
             self._release_targets()
             self._programs.release()
             self._textures.release()
@@ -665,6 +727,11 @@ class GpuRenderer:
     def __repr__(self) -> str:
         state = "released" if self._released else context_kind(self.ctx)
         return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
+
+
+def _vertex_bytes(mesh: Mesh) -> bytes:
+    """in_position, in_normal of each vertex: float32, interleaved."""
+    return np.ascontiguousarray(np.hstack([mesh.positions, mesh.normals]), dtype=np.float32).tobytes()
 
 
 def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:

@@ -32,6 +32,7 @@ import moderngl
 import numpy as np
 
 from renderer.core.gl_rules import STANDARD_DEPTH
+from renderer.core.plane_clip import MAX_POLYGON_TRIANGLES, MAX_POLYGON_VERTICES
 from renderer.core.shadows import SHADOW_KINDS, ShadowLayout, ShadowPlan
 from renderer.core.transforms import to_glsl
 from renderer.errors import ContextError
@@ -142,6 +143,7 @@ class ShadowMaps:
                                    fragment_shader=shader_source("shadow/depth.frag").text)
         self._clip_from_model = self.program["u_clip_from_model"]
         self._vertex_arrays: dict[int, tuple[moderngl.Buffer, moderngl.VertexArray]] = {}
+        self._polygon_slots: dict[tuple, tuple] = {}     # (pass, plane) -> (vbo, ibo, vao)
         self._passes: list = []                          # (framebuffer, R, [(vao, bytes)])
         self.plan: ShadowPlan | None = None
         self.set_layout(layout)
@@ -165,13 +167,37 @@ class ShadowMaps:
         (vertex buffer, index buffer) (positions then normals, float32; faces uint32) and
         `models[i]` its camera-relative model matrix (float64)."""
         self.plan, self._passes = plan, []
-        for shadow_pass in plan.passes:
+        for k, shadow_pass in enumerate(plan.passes):
             tile = shadow_pass.tile
-            draws = [(self._vertex_array(i, *buffers[i]),
-                      to_glsl(shadow_pass.clip_from_world @ np.asarray(models[i], dtype=np.float64)))
-                     for i in shadow_pass.casters]
+            draws = []
+            for i in shadow_pass.casters:
+                if i in shadow_pass.polygons:       # an analytic plane: its polygon in this pass
+                    vao = self._polygon_array((k, i), shadow_pass.polygons[i])
+                    draws.append((vao, to_glsl(np.asarray(shadow_pass.clip_from_world, np.float64)),
+                                  3 * shadow_pass.polygons[i].triangle_count))
+                else:
+                    draws.append((self._vertex_array(i, *buffers[i]),
+                                  to_glsl(shadow_pass.clip_from_world @ np.asarray(models[i], dtype=np.float64)),
+                                  -1))
             framebuffer = self._stacks[shadow_pass.kind][1][tile.layer][1]
             self._passes.append((framebuffer, tile.size, draws))
+
+    def _polygon_array(self, slot: tuple, polygon) -> moderngl.VertexArray:
+        """The vertex array of a plane's polygon in a pass (`slot`: the pass's place in the
+        plan and the plane's object index): buffers made the first time the slot is used, at
+        the largest polygon's size (MAX_POLYGON_VERTICES), written with this plan's polygon."""
+        made = self._polygon_slots.get(slot)
+        if made is None:
+            vbo = self.ctx.buffer(reserve=MAX_POLYGON_VERTICES * 6 * 4)
+            ibo = self.ctx.buffer(reserve=MAX_POLYGON_TRIANGLES * 3 * 4)
+            vao = self.ctx.vertex_array(self.program, [(vbo, "3f 3x4", "in_position")],
+                                        index_buffer=ibo, index_element_size=4)
+            made = self._polygon_slots[slot] = (vbo, ibo, vao)
+        vbo, ibo, vao = made
+        vertices = np.hstack([polygon.positions, polygon.normals]).astype(np.float32)
+        vbo.write(np.ascontiguousarray(vertices).tobytes())
+        ibo.write(np.ascontiguousarray(polygon.faces, dtype=np.uint32).tobytes())
+        return vao
 
     def _vertex_array(self, index: int, vbo: moderngl.Buffer, ibo: moderngl.Buffer) -> moderngl.VertexArray:
         """Object `index`'s vertex array, made again when the renderer uploaded a new mesh."""
@@ -210,9 +236,9 @@ class ShadowMaps:
             ctx.enable_only(moderngl.DEPTH_TEST)            # no culling: both sides cast
             ctx.depth_func = STANDARD_DEPTH.depth_func      # GL_LESS
             ctx.wireframe = False                           # a viewer's wireframe is the camera's
-            for vao, clip_from_model in draws:
+            for vao, clip_from_model, count in draws:
                 self._clip_from_model.write(clip_from_model)
-                vao.render(moderngl.TRIANGLES)
+                vao.render(moderngl.TRIANGLES, vertices=count)
 
     def bind(self) -> None:
         """Each stack on its SHADOW_MAPS_UNITS unit, where the lighting programs'
@@ -239,7 +265,10 @@ class ShadowMaps:
     def release(self) -> None:
         for _vbo, vao in self._vertex_arrays.values():
             vao.release()
-        self._vertex_arrays, self._passes = {}, []
+        for gl_objects in self._polygon_slots.values():
+            for gl_object in reversed(gl_objects):
+                gl_object.release()
+        self._vertex_arrays, self._passes, self._polygon_slots = {}, [], {}
         for kind in SHADOW_KINDS:
             self._release_stack(kind)
         self.program.release()

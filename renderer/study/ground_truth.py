@@ -42,7 +42,8 @@ from renderer.study.tessellation import FINEST, scene_at_level
 from renderer.study.texture_report import truth_textures
 
 TRUTH_GRID = 16                        # samples per pixel along x and along y
-TRUTH_VERSION = 1                      # bump when the truth's recipe changes: old entries miss
+TRUTH_VERSION = 2                      # bump when the truth's recipe changes: old entries miss
+                                       # (2: an analytic plane drawn as its view-volume polygon)
 MAX_TRUTH_PIXELS = 5120 * 3840         # the 16x image of 320x240; rendered in one piece
 RAY_TRUTH_SAMPLES = 64                 # jittered samples per pixel in one frame (8 x 8 strata)
 RAY_TRUTH_PASSES = 16                  # frames averaged: 1024 samples per pixel

@@ -47,6 +47,7 @@ from pathlib import Path
 import numpy as np
 
 from renderer.core import sampling
+from renderer.core.drawn import triangle_bound
 from renderer.core.shadow_settings import BIAS_RULES, FILTERS
 from renderer.study.report_output import csv_text, plot_png, report_markdown
 from renderer.study.ground_truth import (MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir,
@@ -269,9 +270,10 @@ class RasterStudy:
         return any(s.variant[0] not in ("shadow", output_report.KNOB) for s in plan)
 
     def describe(self, scene) -> tuple:
-        """The Scenes table's cells: triangles as authored, at the finest tessellation; the
+        """The Scenes table's cells: triangles as authored, at the finest tessellation (the most
+        the camera pass draws: an analytic plane's polygon at most MAX_POLYGON_TRIANGLES); the
         textures as authored."""
-        return (*(sum(obj.mesh.triangle_count for obj in drawn.objects)
+        return (*(sum(triangle_bound(obj) for obj in drawn.objects)
                   for drawn in (scene, truth_scene(scene))), texture_line(scene))
 
     def scene_run(self, scene, width: int, height: int, ctx) -> SceneRun:

@@ -209,18 +209,22 @@ void main() {
     // whichever part of it clipping left; flat's geometry stage passes it on): its normal in
     // world space on the side N lights (flat: its face normal, N itself), and how steeply its
     // neighbours rise on that side. An analytic shape's triangles only stand in for its smooth
-    // surface (u_shadow_facets 0): its normal is N, its crease 0.
+    // surface (u_shadow_facets 0): its normal is N, its crease how steeply the facet tilts off N.
+    ivec2 at = ivec2(2 * (gl_PrimitiveID % FACES_PER_ROW), gl_PrimitiveID / FACES_PER_ROW);
+    vec4 face = texelFetch(u_face_normals, at, 0);
+    vec3 wound = normalize_or_zero(u_normal_matrix * face.xyz);
+    bool lit_side = dot(wound, N) >= 0.0;
     shadow_facet_normal = N;
-    shadow_crease = 0.0;
     if (u_shadow_facets != 0) {
-        ivec2 at = ivec2(2 * (gl_PrimitiveID % FACES_PER_ROW), gl_PrimitiveID / FACES_PER_ROW);
-        vec4 face = texelFetch(u_face_normals, at, 0);
-        vec3 wound = normalize_or_zero(u_normal_matrix * face.xyz);
-        bool lit_side = dot(wound, N) >= 0.0;
 #ifndef SHADING_FLAT
         shadow_facet_normal = lit_side ? wound : -wound;
 #endif
         shadow_crease = lit_side ? face.w : texelFetch(u_face_normals, at + ivec2(1, 0), 0).x;
+    } else {
+        // The facet tilts off N by the angle whose cosine is |N.F|: it rises above N's plane
+        // at that slope (tan), as a crease's neighbour does (shadow_settings.CREASE_CAP).
+        float c = abs(dot(wound, N));
+        shadow_crease = c > 0.0 ? min(sqrt(max(1.0 - c * c, 0.0)) / c, SHADOW_CREASE_CAP) : SHADOW_CREASE_CAP;
     }
 #endif
 #if defined(SHADING_PHONG)

@@ -47,7 +47,7 @@ from reference.sampler import quad_reference
 from reference.shadow.lookup import FragmentShadows, ShadowMaps
 from reference.texture import material_texel
 from reference.vertex import VertexOutputs, modulated
-from renderer.core.facets import face_normals
+from renderer.core.facets import CREASE_CAP, face_normals
 
 
 @dataclass
@@ -59,8 +59,8 @@ class ObjectVaryings:
     receives_shadows: bool = False
     displace_lookup: object = None     # a check's displacement of the texture lookup (reference/texture.py)
     index: int = -1                    # the object's index in the scene (the shadow masks')
-    facet_normals: np.ndarray | None = None  # (T, 3) world facet normals as wound (a mesh receiver)
-    creases: np.ndarray | None = None  # (T, 2) its faces' creases (renderer/core/facets.py)
+    facet_normals: np.ndarray | None = None  # (T, 3) world facet normals as wound (a receiver)
+    creases: np.ndarray | None = None  # (T, 2) its faces' creases (facets.py; None: an analytic shape)
 
 
 def interpolate(varying: np.ndarray, faces: np.ndarray, triangle: np.ndarray,
@@ -101,11 +101,18 @@ def facet_normal(obj: ObjectVaryings, triangle: np.ndarray, N: np.ndarray) -> tu
     creases on that side, as glsl/fragment.glsl sets shadow_facet_normal and shadow_crease:
     the face's world normal as wound (obj.facet_normals: world_facet_normals), turned to N's
     side (flat: its geometry stage's face normal, N itself), and the crease of that side; an
-    analytic shape's (no facet_normals: its triangles only stand in for it) N and 0."""
+    analytic shape's (no creases: its triangles only stand in for it) N, and for crease how
+    steeply its facet tilts off N (tan of the angle, up to CREASE_CAP)."""
     if obj.facet_normals is None:
         return N, np.zeros(len(N), N.dtype)
     wound = obj.facet_normals[triangle]
     lit_side = dot(wound, N)[:, 0] >= 0.0
+    if obj.creases is None:                   # an analytic shape: N, its facet's tilt off N
+        c = np.abs(dot(wound, N)[:, 0])
+        cap = N.dtype.type(CREASE_CAP)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tilt = np.where(c > 0.0, np.minimum(np.sqrt(np.maximum(1 - c * c, 0)) / c, cap), cap)
+        return N, tilt.astype(N.dtype)
     crease = np.where(lit_side, obj.creases[triangle, 0], obj.creases[triangle, 1]).astype(N.dtype)
     facet = N if obj.material.shading == "flat" else np.where(lit_side[:, None], wound, -wound)
     return facet, crease

@@ -90,9 +90,9 @@ def prepare_object(obj, drawn: DrawnMesh, frame_matrices, lights: Lights, eye, w
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
     # a mesh's facets are its surface; an analytic shape's triangles only stand in for it
-    mesh_receiver = shadowed and obj.receives_shadows and obj.shape is None
-    facets = world_facet_normals(mesh, matrices.normal, dtype) if mesh_receiver else None
-    creases = face_creases(mesh) if mesh_receiver else None
+    receiver = shadowed and obj.receives_shadows
+    facets = world_facet_normals(mesh, matrices.normal, dtype) if receiver else None
+    creases = face_creases(mesh) if receiver and obj.shape is None else None
     return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows,
                                          displace_lookup, index, facets, creases),
                           window.select(keep),

@@ -27,11 +27,14 @@ BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_p
                  "mesh_file", "open_mesh_inside", "orthographic", "near_plane", "flat_shading",
                  "hierarchy", "classic", "cornell_box", "mesh_shadow", "tir_bubble",
                  "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "soft_shadows",
-                 "glossy", "motion_blur", "textured_mesh", "checker_horizon", "globe"}
+                 "glossy", "motion_blur", "textured_mesh", "checker_horizon", "globe",
+                 "shadow_boxes", "shadow_thin_contact", "shadow_big_floor", "shadow_lowpoly_sphere",
+                 "shadow_knot_floor"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera, a ground under it), or a backdrop (tir_bubble's checkerboard) filling
 # the view.
-PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room", "checker_horizon"}
+PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room", "checker_horizon", "shadow_boxes",
+                  "shadow_big_floor"}
 IMAGE_SIZES = [(640, 480), (320, 240)]
 
 OBJ_TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"

@@ -34,7 +34,8 @@ vec3 area_light_point(int i, vec2 u) {
 
 // Light i's term at P: the mean over its LIGHT_SAMPLES points q_m (the numbers of dimension
 // LIGHT + i at this ray's slot, m of LIGHT_SAMPLES) of point_term_at(q_m), each times the
-// visibility of q_m (SHADOWS; no shadow ray where the term is 0), summed in m order.
+// visibility of q_m (SHADOWS; no shadow ray where the term is 0, and 0 where the facet is
+// turned from q_m: trace.glsl's facet_turned_from), summed in m order.
 vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
     vec3 sum = vec3(0.0);
     for (int m = 0; m < LIGHT_SAMPLES; ++m) {
@@ -43,7 +44,8 @@ vec3 area_light_term(int i, vec3 P, vec3 N, vec3 V) {
         vec3 Q = area_light_point(i, u);
         vec3 term = point_term_at(i, Q, P, N, V);
 #ifdef SHADOWS
-        term = term != vec3(0.0) ? light_visibility_at(Q, P) * term : vec3(0.0);
+        term = term != vec3(0.0) && !facet_turned_from(N, Q - P) ? light_visibility_at(Q, P) * term
+                                                                 : vec3(0.0);
 #endif
         sum += term;
     }

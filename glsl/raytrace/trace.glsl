@@ -283,9 +283,22 @@ vec3 ray_origin(vec3 P, vec3 n, int shape) {
     return shape >= 0 ? P : offset_ray_origin(P, n);
 }
 
+// The facet rule (docs/conventions.md, "The facet normal"): a point whose facet, on the side
+// its lit normal N faces, is turned from the light (towards L) is not reached by it, with no
+// shadow ray cast: on a closed mesh the ray would be blocked by the solid behind anyway; on an
+// open one (a bowl's rim, a sheet) it would pass behind the facet and light its other side. A
+// sphere's or plane's geometric normal is its lit normal: never turned where it is lit.
+bool facet_turned_from(vec3 N, vec3 L) {
+    vec3 facet = dot(g_geometric_normal, N) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
+    return dot(facet, L) < 0.0;
+}
+
 #if NUM_DIRECTIONAL_LIGHTS > 0
 float light_visibility_directional(int i, vec3 P, vec3 N) {
     vec3 L = normalize(-u_directional_direction[i]);
+    if (facet_turned_from(N, L)) {
+        return 0.0;
+    }
     vec3 n = dot(g_geometric_normal, L) >= 0.0 ? g_geometric_normal : -g_geometric_normal;
     return occluded(ray_origin(P, n, g_shape), L, TRACE_INF, g_shape) ? 0.0 : 1.0;
 }
@@ -303,6 +316,9 @@ float light_visibility_at(vec3 Q, vec3 P) {
 }
 
 float light_visibility_point(int i, vec3 P, vec3 N) {
+    if (facet_turned_from(N, u_point_position[i] - P)) {
+        return 0.0;
+    }
     return light_visibility_at(u_point_position[i], P);
 }
 #endif

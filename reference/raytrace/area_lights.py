@@ -41,7 +41,7 @@ def area_light_terms(lights: Lights, areas, draw, shadow=None):
     """The area_light callable of lighting.py (the GLSL's has_area and area_light_term): for
     point light i with an area (row 3i's w not NO_AREA), the mean of point_term_at(q_m) over
     its M points q_m = area_light_point(u_m), u_m = draw(i, m), each times the visibility of
-    q_m (shadow(i, m, q_m, P, needed) -> blocked per hit, asked only where the term is not 0;
+    q_m (shadow(i, m, q_m, P, needed, N) -> blocked per hit, asked only where the term is not 0;
     None: no shadow rays), summed in m order; None for a light without an area."""
     M = draw.light_samples
 
@@ -55,7 +55,7 @@ def area_light_terms(lights: Lights, areas, draw, shadow=None):
             term = point_term_at(P, N, V, Q, lights.u_point_intensity[i], lights.u_point_attenuation[i],
                                  material)
             if shadow is not None:
-                blocked = shadow(i, m, Q, P, (term != 0).any(-1))
+                blocked = shadow(i, m, Q, P, (term != 0).any(-1), N)
                 term = np.where(blocked, t(0), t(1))[:, None] * term
             total += term
         return total / t(M)

@@ -270,21 +270,27 @@ def blocked_towards(rs, Q, P, Ng, shape, time=None):
 def shadow_visibility(rs, lights: Lights, Ng, shape, record=None, time=None):
     """The visibility callable of lighting.py for hits with outward geometric normals Ng on
     analytic shapes `shape` (shape_id): one shadow ray per point and light (the GLSL's
-    light_visibility_directional / _point), at the hits' `time`. `record(needed, event)`, if
-    given, hears each shadow ray's outcome (ray_tree_event)."""
+    light_visibility_directional / _point), at the hits' `time`; 0 without one where the facet,
+    on the side of the lit normal N, is turned from the light (the facet rule, the GLSL's
+    facet_turned_from; a blocked ray for the hash). `record(needed, event)`, if given, hears
+    each shadow ray's outcome (ray_tree_event)."""
     t = Ng.dtype.type
 
     def visibility(kind, i, P, N, needed):
         blocked = np.zeros(len(P), bool)
         P, n, on = P[needed], Ng[needed], shape[needed]
+        facet = np.where((_dot(n, N[needed]) >= 0)[:, None], n, -n)   # on the lit side
         if kind == "directional":
             L = normalize(-lights.u_directional_direction[i])
+            turned = _dot(facet, np.broadcast_to(L, facet.shape)) < 0
             n = np.where((_dot(n, L) >= 0)[:, None], n, -n)
             O = ray_origin(P, n, on)
-            blocked[needed] = occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf), on,
-                                       _at(time, needed))
+            blocked[needed] = turned | occluded(rs, O, np.broadcast_to(L, O.shape).astype(t), t(np.inf),
+                                                on, _at(time, needed))
         else:
-            blocked[needed] = blocked_towards(rs, lights.u_point_position[i], P, n, on, _at(time, needed))
+            turned = _dot(facet, lights.u_point_position[i] - P) < 0
+            blocked[needed] = turned | blocked_towards(rs, lights.u_point_position[i], P, n, on,
+                                                       _at(time, needed))
         if record is not None:
             light = i if kind == "directional" else len(lights.u_directional_direction) + i
             record(blocked, ray_tree_event(SHADOW, light))
@@ -294,16 +300,19 @@ def shadow_visibility(rs, lights: Lights, Ng, shape, record=None, time=None):
 
 def area_light_shadow(rs, lights: Lights, Ng, shape, record=None, time=None):
     """The `shadow` of area_lights.area_light_terms for hits with outward geometric normals
-    Ng on analytic shapes `shape`, at the hits' `time`: shadow(i, m, Q, P, needed) -> whether
-    the shadow ray from each hit (where `needed`) to point Q of light i's area is blocked
-    (blocked_towards); `record` hears each (the event of light l's m-th point: SHADOW,
+    Ng on analytic shapes `shape`, at the hits' `time`: shadow(i, m, Q, P, needed, N) ->
+    whether the shadow ray from each hit (where `needed`) to point Q of light i's area is
+    blocked (blocked_towards), or the facet on the lit normal N's side turned from Q (the facet
+    rule); `record` hears each (the event of light l's m-th point: SHADOW,
     l + m * (number of lights))."""
     n_lights = len(lights.u_directional_direction) + len(lights.u_point_position)
 
-    def shadow(i, m, Q, P, needed):
+    def shadow(i, m, Q, P, needed, N):
         blocked = np.zeros(len(P), bool)
-        blocked[needed] = blocked_towards(rs, Q[needed], P[needed], Ng[needed], shape[needed],
-                                          _at(time, needed))
+        n = Ng[needed]
+        facet = np.where((_dot(n, N[needed]) >= 0)[:, None], n, -n)      # the facet rule
+        blocked[needed] = (_dot(facet, Q[needed] - P[needed]) < 0) | blocked_towards(
+            rs, Q[needed], P[needed], n, shape[needed], _at(time, needed))
         if record is not None:
             light = len(lights.u_directional_direction) + i
             record(blocked, ray_tree_event(SHADOW, light + m * n_lights))

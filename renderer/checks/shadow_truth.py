@@ -54,10 +54,12 @@ import numpy as np
 
 from reference.lighting import Lights, normalize
 from reference.pipeline import SurfacePixels, surface_pixels
-from reference.raytrace.trace import HIT_TIE, occluded, ray_origin, shadow_visibility
+from reference.raytrace.trace import (HIT_TIE, MISS, occluded, ray_origin, scene_hit, shadow_visibility,
+                                     surface)
 from reference.shadow.lookup import LOOKUPS, ShadowMaps
 from renderer.core.raytrace_scene import RayScene, ray_scene
 from renderer.core.scene import Mesh
+from renderer.core.facets import CREASE_CAP
 from renderer.core.shadow_settings import footprint_radius
 from renderer.core.shadows import CUBE_FACE_AXES, CUBE_FACE_ROTATIONS, cube_face, shadow_layout
 
@@ -179,26 +181,29 @@ class LightRays:
             return np.broadcast_to(normalize(-lights.u_directional_direction[self.index]), P.shape)
         return normalize(lights.u_point_position[self.index] - P)
 
-    def lit(self, P, Ng, obj) -> np.ndarray:
+    def lit(self, P, Ng, obj, N=None) -> np.ndarray:
         """(K,) bool: the ray tracer's shadow ray from P (on object `obj` (K,), its triangle's
-        plane normal Ng) through the casting objects is free."""
+        plane normal Ng, the lit normal N: Ng where None) through the casting objects is free,
+        and the facet, on N's side, is not turned from the light (the ray tracer's rule)."""
         s = self.scenes
         see = shadow_visibility(s.casting, s.lights, Ng, s.casting_shape[obj])
-        return see(self.kind, self.index, P, None, np.ones(len(P), bool))[:, 0] > 0
+        return see(self.kind, self.index, P, Ng if N is None else N, np.ones(len(P), bool))[:, 0] > 0
 
-    def reachable(self, P, Ng, N, obj, S) -> np.ndarray:
-        """(K,) bool: step point S (K, 3), on the plane of P's triangle, lies on P's own
-        surface: the segment from P (on an analytic shape), else from P lifted off the surface
-        by the ray tracer's offset along Ng on the side of the lit normal N (the side the
-        camera sees and lights: on a facet that turns from the light while N still faces it,
-        the light's side would be inside the solid), to S lifted alike (so that it runs
-        parallel to the surface and its end does not meet the surface's own triangles through
-        rounding) meets no surface of `scenes.every`, the receiver's own analytic shape left
-        out (a plane or a sphere has no concave corner with itself)."""
+    def reachable(self, P, Ng, N, obj, S, S_Ng=None) -> np.ndarray:
+        """(K,) bool: step point S (K, 3), on P's own surface (onto_surface; its plane normal
+        S_Ng, Ng where None), is reached from P along that surface: the segment between the two
+        points, each lifted off the surface along its plane normal on the side of the lit
+        normal N (the side the camera sees and lights) by half their distance, meets no surface
+        of `scenes.every`, the receiver's own analytic shape left out (a plane or a sphere has
+        no concave corner with itself). Half the distance clears a convex or gently concave
+        surface between them (its sagitta is a small part of the chord), not a wall standing
+        between them at a concave corner."""
         n = np.where((_dot(Ng, N) >= 0)[:, None], Ng, -Ng)
+        m = n if S_Ng is None else np.where((_dot(S_Ng, N) >= 0)[:, None], S_Ng, -S_Ng)
         own = self.scenes.every_shape[obj]
-        O = ray_origin(P, n, own)
-        D = S - P
+        lift = 0.5 * np.sqrt(_dot(S - P, S - P))[:, None]
+        O = ray_origin(P, n, own) + lift * n
+        D = (S + lift * m) - O
         d = np.sqrt(_dot(D, D))
         with np.errstate(divide="ignore", invalid="ignore"):
             D = D / d[:, None]
@@ -244,14 +249,42 @@ class LightRays:
             out.append(P + lifted)
         return np.stack(out)
 
+    def onto_surface(self, P, Ng, N, obj, S):
+        """(S', Ng', N', on) for step points S (K, 3) on the plane of P's triangle: the point of
+        P's own object under S along the plane's normal (n: Ng on the side of the lit normal N),
+        found by a ray from S + h n along -n (h the step's length) through every surface, and
+        that surface's plane normal and lit normal (its shading normal on the side N faces);
+        `on` (K,) bool: the first surface it meets within 2 h is
+        P's object (a step off the object's edge, or onto another object, is not on P's
+        surface). On a curved receiver the plane leaves the surface within a few texels, and
+        the truth above it (in the air beside a convex part, inside a concave one) is not the
+        surface's."""
+        n = np.where((_dot(Ng, N) >= 0)[:, None], Ng, -Ng)
+        h = np.sqrt(_dot(S - P, S - P))
+        O, D = S + h[:, None] * n, -n
+        kind, index, s, uv = scene_hit(self.scenes.every, O, D, 0.0, 2.0 * h)
+        hit = np.flatnonzero(kind != MISS)
+        surface_P, surface_Ng, surface_N = S.copy(), Ng.copy(), N.copy()
+        on = np.zeros(len(S), bool)
+        if len(hit):
+            Q, Nq, Ns, owner = surface(self.scenes.every, O[hit], D[hit], kind[hit], index[hit], s[hit], uv[hit])
+            mine = hit[owner == obj[hit]]
+            k = owner == obj[hit]
+            surface_P[mine], surface_Ng[mine] = Q[k], Nq[k]
+            # its lit normal: the shading normal on the side P's lit normal faces
+            surface_N[mine] = np.where((_dot(Ns[k], N[mine]) >= 0)[:, None], Ns[k], -Ns[k])
+            on[mine] = True
+        return surface_P, surface_Ng, surface_N, on
+
     def changes_within(self, P, Ng, N, obj, truth, texels: float) -> np.ndarray:
-        """(K,) bool: the truth at one of the reachable steps `texels` texels away differs
-        from `truth` (K,)."""
+        """(K,) bool: the truth at one of the steps `texels` texels away, carried onto P's own
+        surface (onto_surface) and reachable from P along it, differs from `truth` (K,)."""
         points = self.steps(P, Ng, texels).reshape(-1, 3)
         P8, Ng8, N8, obj8 = (np.tile(a, (DIRECTIONS,) + (1,) * (a.ndim - 1)) for a in (P, Ng, N, obj))
-        differs = self.lit(points, Ng8, obj8) != np.tile(truth, DIRECTIONS)
+        points, normals, lit_normals, on = self.onto_surface(P8, Ng8, N8, obj8, points)
+        differs = on & (self.lit(points, normals, obj8, lit_normals) != np.tile(truth, DIRECTIONS))
         ask = np.flatnonzero(differs)
-        differs[ask] = self.reachable(P8[ask], Ng8[ask], N8[ask], obj8[ask], points[ask])
+        differs[ask] = self.reachable(P8[ask], Ng8[ask], N8[ask], obj8[ask], points[ask], normals[ask])
         return differs.reshape(DIRECTIONS, len(P)).any(axis=0)
 
 
@@ -428,10 +461,12 @@ def band_texels(shadow) -> float:
     """The band's width for a light's map (its Shadow), in texels: how far from P its lookup
     reads, so that a true shadow edge that far away may darken P by the filter's doing, not
     the receiver's: the filter's footprint radius (shadow_settings.footprint_radius: 1/2 hard,
-    K/2 for K x K) plus the bias's normal offset across the map (normal (|F.X| + |F.Y|) <=
-    normal sqrt 2); at least one texel."""
+    K/2 for K x K) plus the bias's moves of the point across the map, its normal offset
+    (normal (|F.X| + |F.Y|) <= normal sqrt 2) and its crease lift (up to CREASE_CAP times the
+    first two: reference/shadow/lookup.py crease_lift); at least one texel."""
     rule = shadow.bias_rule()
-    return max(1.0, footprint_radius(shadow.kernel) + rule.normal * math.sqrt(2.0))
+    reads = footprint_radius(shadow.kernel) + rule.normal * math.sqrt(2.0)
+    return max(1.0, reads * (1.0 + CREASE_CAP))
 
 
 def _classify(light: LightRays, surface: SurfacePixels, rows: np.ndarray, v, truth, width: float = 1.0):
@@ -500,7 +535,7 @@ def measure_light(light: LightRays, light_map, surface: SurfacePixels, rows: np.
     if given is not None:
         rows = rows[np.isfinite(given.reshape(-1)[surface.pixel[rows]])]
     v = _visibility(light, surface, rows, given)
-    truth = light.lit(surface.P[rows], surface.Ng[rows], surface.object[rows])
+    truth = light.lit(surface.P[rows], surface.Ng[rows], surface.object[rows], surface.N[rows])
     k, acne, reach = _classify(light, surface, rows, v, truth, band_texels(light_map.shadow))
     out = lambda values, fill: _image(surface.pixel[rows], values, fill, width, height)   # noqa: E731
     truth_image = out(truth.astype(np.int8), np.int8(NOT_CONSIDERED))

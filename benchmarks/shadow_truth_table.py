@@ -21,6 +21,7 @@ from __future__ import annotations
 import argparse
 import json
 import time
+from pathlib import Path
 
 from renderer.checks.shadow_truth import EDGE_KEY, shadows_vs_truth
 from renderer.cli import parse_size
@@ -72,29 +73,58 @@ def main() -> None:
     options.add_argument("--filters", default=FILTERS)
     options.add_argument("--scenes", default="", help="comma-separated built-in scenes (default: all with shadow maps)")
     options.add_argument("--json", help="also write the rows to this JSON file")
+    options.add_argument("--out", help="also write table.md (this output) and rows.json to this folder "
+                                       "(docs/report/shadow-truth: the README's table comes from it)")
     args = options.parse_args()
     sizes = [parse_size(s) for s in args.sizes.split(",")]
     names = [n for n in args.scenes.split(",") if n]
     start = time.perf_counter()
-    print(f"Shadow maps against ray-cast truth; {machine()}; {time.strftime('%Y-%m-%d %H:%M')}; "
-          f"commit {revision()}")
-    print()
-    print("| scene | size | filter | compared px | wrong beyond 2 px | acne px | wrong outside the band "
-          "| world texel |")
-    print("| --- | --- | --- | ---: | ---: | ---: | ---: | --- |")
+    lines = []
+
+    def say(text: str = "") -> None:
+        lines.append(text)
+        print(text, flush=True)
+
+    say(f"Shadow maps against ray-cast truth; {machine()}; {time.strftime('%Y-%m-%d %H:%M')}; "
+        f"commit {revision()}")
+    say()
+    say("| scene | size | filter | compared px | wrong beyond 2 px | acne px | wrong outside the band "
+        "| world texel |")
+    say("| --- | --- | --- | ---: | ---: | ---: | ---: | --- |")
     rows = []
     for size in sizes:
         for name in shadowed_scenes(names, size):
             for filter in args.filters.split(","):
                 rows.append(row(name, size, filter))
-                print(line(rows[-1]), flush=True)
-    print()
-    print(f"{len(rows)} rows in {time.perf_counter() - start:.0f} s. Reproduce: .venv/bin/python "
-          f"benchmarks/shadow_truth_table.py --sizes {args.sizes} --filters {args.filters}"
-          + (f" --scenes {args.scenes}" if names else ""))
+                say(line(rows[-1]))
+    say()
+    say("Per scene, the worst of the four filters (acne px / wrong beyond 2 px, share of compared):")
+    say()
+    sizes_seen = list(dict.fromkeys(r["size"] for r in rows))
+    say("| scene | " + " | ".join(sizes_seen) + " |")
+    say("| --- |" + " ---: |" * len(sizes_seen))
+    for name in dict.fromkeys(r["scene"] for r in rows):
+        cells = []
+        for size in sizes_seen:
+            mine = [r for r in rows if r["scene"] == name and r["size"] == size]
+            cells.append(f"{max(r['acne'] for r in mine)} / {max(r['beyond_fraction'] for r in mine):.3%}"
+                         if mine else "-")
+        say(f"| {name} | " + " | ".join(cells) + " |")
+    say()
+    worst = max(rows, key=lambda r: r["beyond_fraction"])
+    say(f"Acne: {sum(r['acne'] for r in rows)} pixels in all. Wrong beyond 2 px: at most "
+        f"{worst['beyond_fraction']:.3%} ({worst['scene']} {worst['size']} {worst['filter']}).")
+    say(f"{len(rows)} rows in {time.perf_counter() - start:.0f} s. Reproduce: .venv/bin/python "
+        f"benchmarks/shadow_truth_table.py --sizes {args.sizes} --filters {args.filters}"
+        + (f" --scenes {args.scenes}" if names else ""))
     if args.json:
         with open(args.json, "w") as out:
             json.dump(rows, out, indent=1)
+    if args.out:
+        folder = Path(args.out)
+        folder.mkdir(parents=True, exist_ok=True)
+        (folder / "table.md").write_text("\n".join(lines) + "\n")
+        (folder / "rows.json").write_text(json.dumps(rows, indent=1) + "\n")
 
 
 if __name__ == "__main__":

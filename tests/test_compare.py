@@ -69,6 +69,19 @@ def test_depth_relative_error_allows_a_silhouette_to_move_one_pixel():
     assert math.isclose(depth_max_rel(a, b), 0.1, rel_tol=1e-5)
 
 
+def test_depth_at_an_edge_on_silhouette_is_held_against_the_surface_continued_one_pixel():
+    """A surface seen edge-on changes depth by 1 % a pixel: where one image covers one more
+    pixel of it than the other, that pixel's depth is the other's surface continued, not its
+    neighbour's; a depth off that line still fails."""
+    a = np.full((3, 5), 20.0)                        # the floor behind ...
+    a[1, :4] = [10.0, 10.1, 10.2, 10.3]              # ... a surface rising 0.1 a pixel
+    b = a.copy()
+    b[1, 3] = 20.0                                   # b's silhouette one pixel to the left
+    assert math.isclose(depth_max_rel(a, b), 0.0, abs_tol=1e-12)     # 10.2 + 0.1 = 10.3
+    a[1, 3] = 10.4                                   # not on the surface's line
+    assert math.isclose(depth_max_rel(a, b), 0.1 / 10.3, rel_tol=1e-6)
+
+
 def test_heat_map_marks_failing_pixels_magenta():
     a, b = blank(), blank()
     a[4, 4] = 255

@@ -82,10 +82,11 @@ def test_every_knob_runs_on_its_backends():
         {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
 
 
-@pytest.mark.slow                       # the quick sweep, through the command line
+@pytest.mark.slow                       # the quick sweep, through the command line, on a scene
+                                        # whose lights get shadow maps (point_light_plane has none)
 def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     out = tmp_path / "report"
-    result = cli("report", "point_light_plane", "--quick", "--size", "16x12", "--out", str(out),
+    result = cli("report", "shadow_plane", "--quick", "--size", "16x12", "--out", str(out),
                  "--cache", str(tmp_path / "cache"), "--context", "osmesa")
     assert result.returncode == 0, result.stderr
     with open(out / "results.csv", newline="") as handle:
@@ -93,7 +94,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
         assert tuple(reader.fieldnames) == CSV_COLUMNS
         rows = list(reader)
     assert len(rows) == len([s for s in settings(QUICK, [1, 4]) if s.variant[0] != "texture"])
-    assert {row["scene"] for row in rows} == {"point_light_plane"}
+    assert {row["scene"] for row in rows} == {"shadow_plane"}
     assert all(int(row["runs"]) >= 5 and float(row["median_ms"]) > 0 for row in rows)
     image_rows = [row for row in rows if not row["knob"].startswith(("shadows-", "output"))]
     assert all(0 <= float(row["rmse"]) <= float(row["max_abs"]) <= 1 for row in image_rows)
@@ -102,7 +103,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     for backend in ("gpu", "reference"):
         assert error[("jittered 16", backend)] < error[("jittered 1", backend)]
     plots = sorted(path.name for path in (out / "plots").iterdir())
-    assert plots == [f"point_light_plane-{knob}.png"
+    assert plots == [f"shadow_plane-{knob}.png"
                      for knob in ("antialiasing", "output", "precision", "shading", "shadows-bias",
                                   "shadows-filter", "shadows-resolution", "tessellation")]
     assert all((out / "plots" / name).read_bytes().startswith(b"\x89PNG") for name in plots)
@@ -114,7 +115,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
     for name in plots:
         assert f"](plots/{name})" in report
     assert "| jittered | reference |" in report and "N^-0.75 at edges" in report
-    assert "| point_light_plane |" in report
+    assert "| shadow_plane |" in report
     assert "wrote" in result.stdout and "%" in result.stderr          # the progress bar
 
 

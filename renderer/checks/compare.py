@@ -129,13 +129,24 @@ def raw_mismatch(result: np.ndarray, reference, threshold: int = DEFAULT_THRESHO
 
 
 def _depth_rel_nearby(a: np.ndarray, b: np.ndarray, deviation: int) -> np.ndarray:
-    """Per pixel of `a`: smallest relative difference to a finite depth of `b` within ±deviation."""
+    """Per pixel of `a`: smallest relative difference to a depth of `b` within ±deviation, or
+    to `b`'s surface there continued by one pixel towards `a`'s (b(p+d) - (b(p+2d) - b(p+d)),
+    where both are finite): at a silhouette seen edge-on, the surface's depth changes by more
+    than the limit from one pixel to the next, so the pixel one image covers and the other
+    does not is held against the other's surface extrapolated to it, not its neighbour."""
+    b = b.astype(np.float64)
     best = np.full(a.shape, np.inf)
     for dy, dx in _offsets(deviation):
-        nearby = _shifted(b.astype(np.float64), dy, dx, fill=np.inf)
-        with np.errstate(invalid="ignore"):
-            rel = np.abs(a - nearby) / np.abs(nearby)
-        best = np.fmin(best, np.where(np.isfinite(nearby), rel, np.inf))
+        nearby = _shifted(b, dy, dx, fill=np.inf)
+        candidates = [nearby]
+        if (dy, dx) != (0, 0):
+            beyond = _shifted(b, 2 * dy, 2 * dx, fill=np.inf)
+            with np.errstate(invalid="ignore"):
+                candidates.append(np.where(np.isfinite(beyond), 2 * nearby - beyond, np.inf))
+        for depth in candidates:
+            with np.errstate(invalid="ignore", divide="ignore"):
+                rel = np.abs(a - depth) / np.abs(depth)
+            best = np.fmin(best, np.where(np.isfinite(depth), rel, np.inf))
     return best
 
 

@@ -8,7 +8,8 @@ The rule is dEQP's threshold compare with position deviation (renderer/checks/co
 - at most `raw_mismatch_limit` of the pixels (0.1 %) may differ by more than `threshold` in
   place (edges that moved by a pixel, which the first rule forgives, must stay rare);
 - where both drew, depth agrees within `depth_rel_limit` relative (1e-3), with the same
-  ±`deviation` allowance.
+  ±`deviation` allowance (a neighbour's depth, or the neighbour's surface continued by one
+  pixel: an edge-on silhouette's depth changes faster than the limit per pixel).
 """
 
 from __future__ import annotations

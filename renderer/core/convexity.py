@@ -13,11 +13,13 @@ such meshes: `convex_body(mesh)` is the solid's face planes (object space) when
 
 A mesh of more than MAX_FACE_VERTEX_CHECKS face-vertex pairs is not tested (None: treated as
 not convex, which costs a pass, never a wrong shadow). Results are cached per Mesh object, so a
-frame pays for a mesh once (renderer/core/mesh_cache.py).
+frame pays for a mesh once (renderer/core/mesh_cache.py), and by content, so that a scene of
+thousands of objects made from one primitive pays for it once too.
 """
 
 from __future__ import annotations
 
+import hashlib
 from dataclasses import dataclass
 
 import numpy as np
@@ -27,6 +29,7 @@ from renderer.core.mesh_cache import per_mesh
 CONVEX_TOLERANCE = 1e-9          # of the mesh's largest extent: a vertex this far out is "on" a plane
 WELD_TOLERANCE = 1e-9            # of the extent: vertices this close are one (seams, poles)
 MAX_FACE_VERTEX_CHECKS = 50_000_000
+MAX_CACHED_CONTENTS = 1024       # mesh contents whose bodies are kept
 CHUNK_VALUES = 1 << 22            # heights computed at once (32 MiB of float64)
 
 
@@ -56,9 +59,18 @@ class ConvexBody:
 def convex_body(mesh) -> ConvexBody | None:
     """The mesh's convex solid (module docstring), or None when the mesh is open, not
     consistently wound, not convex, flat, or too large to test. Cached per Mesh object."""
-    return _find_body(np.asarray(mesh.positions, dtype=np.float64),
-                      np.asarray(mesh.normals, dtype=np.float64),
-                      np.asarray(mesh.faces, dtype=np.int64))
+    arrays = (np.ascontiguousarray(mesh.positions, dtype=np.float64),
+              np.ascontiguousarray(mesh.normals, dtype=np.float64),
+              np.ascontiguousarray(mesh.faces, dtype=np.int64))
+    digest = hashlib.blake2b(b"".join(a.tobytes() + repr(a.shape).encode() for a in arrays)).digest()
+    if digest not in _BY_CONTENT:
+        if len(_BY_CONTENT) >= MAX_CACHED_CONTENTS:
+            _BY_CONTENT.pop(next(iter(_BY_CONTENT)))          # the oldest
+        _BY_CONTENT[digest] = _find_body(*arrays)
+    return _BY_CONTENT[digest]
+
+
+_BY_CONTENT: dict[bytes, ConvexBody | None] = {}     # content digest -> body (bounded)
 
 
 def _find_body(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> ConvexBody | None:

@@ -55,6 +55,7 @@ class Occluders:
         self.scene, self.points, self.models = scene, points, models
         self._planes: dict[int, object] = {}
         self._bodies: dict[int, ConvexBody | None] = {}
+        self._scale_array: np.ndarray | None = None
 
     def plane(self, i: int):
         if i not in self._planes:
@@ -67,72 +68,108 @@ class Occluders:
         return self._bodies[i]
 
     def _scale(self, i: int) -> float:
-        return PLANAR_TOLERANCE * (1.0 + float(np.abs(self.points[i]).max()))
+        return float(self._scales()[i])
+
+    def _scales(self) -> np.ndarray:
+        """(objects,) each object's planar tolerance, PLANAR_TOLERANCE (1 + its largest |coordinate|)."""
+        if self._scale_array is None:
+            self._scale_array = np.array([PLANAR_TOLERANCE * (1.0 + (float(np.abs(p).max()) if len(p) else 0.0))
+                                          for p in self.points])
+        return self._scale_array
+
+    def _stacked(self, objects: np.ndarray):
+        """(points (V, 3), owner (V,) position in `objects`, starts (n,)) of the objects' points
+        in one array, for reductions per object (np.minimum.reduceat)."""
+        counts = np.array([len(self.points[i]) for i in objects], np.int64)
+        points = np.concatenate([self.points[i] for i in objects]) if len(objects) else np.zeros((0, 3))
+        return points, np.repeat(np.arange(len(objects)), counts), np.concatenate([[0], np.cumsum(counts)[:-1]])
 
     def pairs(self, casters: list[int], receivers: list[int], light_position=None,
-              light_direction=None) -> dict[int, list[int]]:
+              light_direction=None, first: bool = False) -> dict[int, list[int]]:
         """caster -> the receivers (in `receivers`' order) it can shadow, for a point light at
         `light_position` or a directional one travelling along `light_direction`; casters that
-        can shadow none are left out."""
+        can shadow none are left out. Each caster's receivers are decided at once (arrays over
+        the receivers), so that a scene of thousands of objects stays quick. `first`: stop at
+        the first caster that can shadow something (whether any can)."""
+        rec = np.asarray(list(receivers), np.int64)
+        rec = rec[np.array([len(self.points[r]) > 0 for r in rec], bool)] if len(rec) else rec
         boxes = None if light_direction is None else self._light_boxes(
-            sorted({*casters, *receivers}), light_direction)
+            sorted({*casters, *rec.tolist()}), light_direction)
+        stacked = None
         out = {}
         for c in casters:
-            shadowed = [r for r in receivers if self.can_shadow(c, r, light_position, light_direction, boxes)]
-            if shadowed:
-                out[c] = shadowed
+            plane = self.plane(c)
+            if plane is not None or (self.body(c) is not None and light_position is not None):
+                stacked = stacked if stacked is not None else self._stacked(rec)
+            ok = self._shadowable(c, rec, light_position, light_direction, boxes, stacked)
+            if ok.any():
+                out[c] = rec[ok].tolist()
+                if first:
+                    break
         return out
 
-    def can_shadow(self, c: int, r: int, light_position=None, light_direction=None, boxes=None) -> bool:
-        """Whether caster c can shadow receiver r (the module docstring's rule). `boxes`:
-        _light_boxes of both, for a directional light (found here when None)."""
+    def can_shadow(self, c: int, r: int, light_position=None, light_direction=None) -> bool:
+        """Whether caster c can shadow receiver r (the module docstring's rule)."""
+        return bool(self.pairs([c], [r], light_position, light_direction))
+
+    def _shadowable(self, c: int, rec: np.ndarray, light_position, light_direction, boxes,
+                    stacked) -> np.ndarray:
+        """(R,) bool: caster c can shadow each of the receivers `rec` (the module's rule)."""
+        ok = np.ones(len(rec), bool)
         plane = self.plane(c)
         if plane is not None:
-            return r != c and self._below_plane(c, plane, r, light_position, light_direction)
+            return (rec != c) & self._below_plane(c, plane, light_position, light_direction, stacked)
         body = self.body(c)
         if body is not None:
             inside = light_position is not None and bool(
                 body.contains(np.asarray(light_position)[None], self.models[c])[0])
-            if r == c:
-                outside_lit = body.normals_outward is True and not self.scene.objects[c].material.two_sided
-                return not (inside or outside_lit)
-            if inside and body.contains(self.points[r], self.models[c]).all():
-                return False
-        if light_direction is not None and r != c:
-            boxes = boxes if boxes is not None else self._light_boxes([c, r], light_direction)
-            return self._across_light_meet(boxes[c], boxes[r], self._scale(c) + self._scale(r))
-        return True
+            outside_lit = body.normals_outward is True and not self.scene.objects[c].material.two_sided
+            if inside or outside_lit:
+                ok &= rec != c
+            if inside:                     # only what reaches outside the solid around the light
+                points, owner, starts = stacked
+                out = ~body.contains(points, self.models[c]) if len(points) else np.zeros(0, bool)
+                ok &= np.logical_or.reduceat(out, starts) if len(points) else False
+        if light_direction is not None:
+            ok &= (rec == c) | self._across_light_meet(c, rec, boxes)
+        return ok
 
-    def _light_boxes(self, objects, light_direction) -> dict[int, np.ndarray]:
-        """object -> (2, 3): its vertices' least and greatest (x, y, depth) in the directional
-        light's frame (x, y across the light, depth along it)."""
+    def _light_boxes(self, objects, light_direction) -> np.ndarray:
+        """(objects in the scene, 2, 3): each of `objects`' vertices' least and greatest
+        (x, y, depth) in the directional light's frame (x, y across the light, depth along
+        it); NaN for the others."""
         rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light_direction, (0.0, 1.0, 0.0))[:3, :3]
         flip = np.array([1.0, 1.0, -1.0])                     # the view's -z is the depth
-        out = {}
+        out = np.full((len(self.points), 2, 3), np.nan)
         for i in objects:
             p = (self.points[i] @ rotation.T) * flip
-            out[i] = np.stack([p.min(axis=0), p.max(axis=0)])
+            if len(p):
+                out[i] = (p.min(axis=0), p.max(axis=0))
         return out
 
-    def _below_plane(self, c, plane, r, light_position, light_direction) -> bool:
+    def _below_plane(self, c, plane, light_position, light_direction, stacked) -> np.ndarray:
+        """(R,) bool: some point of each receiver lies beyond planar caster c's plane from the
+        light (all False where the light grazes the plane: no shadow of any area)."""
+        points, owner, starts = stacked
         normal, origin = plane
         scale = self._scale(c)
         if light_position is not None:
             side = float(normal @ (np.asarray(light_position) - origin))
         else:
             side = -float(normal @ np.asarray(light_direction, dtype=np.float64))
-        if abs(side) <= scale:
-            return False                     # the light grazes the plane: no shadow of any area
+        if abs(side) <= scale or not len(points):
+            return np.zeros(len(starts), bool)
         facing = normal if side > 0 else -normal
-        return bool(((self.points[r] - origin) @ facing < -scale).any())
+        return np.logical_or.reduceat((points - origin) @ facing < -scale, starts)
 
-    @staticmethod
-    def _across_light_meet(caster: np.ndarray, receiver: np.ndarray, slack: float) -> bool:
-        """Directional light, boxes from _light_boxes: the receiver's box across the light
-        meets the caster's, and some of the receiver lies deeper than the caster's nearest."""
-        if np.any(caster[1, :2] < receiver[0, :2] - slack) or np.any(receiver[1, :2] < caster[0, :2] - slack):
-            return False
-        return bool(receiver[1, 2] > caster[0, 2] - slack)
+    def _across_light_meet(self, c: int, rec: np.ndarray, boxes: dict) -> np.ndarray:
+        """(R,) bool, directional light (boxes from _light_boxes): each receiver's box across
+        the light meets caster c's, and some of the receiver lies deeper than c's nearest."""
+        caster, theirs = boxes[c], boxes[rec]
+        slack = self._scale(c) + self._scales()[rec]
+        apart = (np.any(caster[1, :2] < theirs[:, 0, :2] - slack[:, None], axis=1)
+                 | np.any(theirs[:, 1, :2] < caster[0, :2] - slack[:, None], axis=1))
+        return ~apart & (theirs[:, 1, 2] > caster[0, 2] - slack)
 
 
 def world_geometry(scene) -> tuple[list[np.ndarray], list[np.ndarray]]:
@@ -150,6 +187,6 @@ def light_can_shadow(scene, occluders: Occluders, kind: str, index: int) -> bool
     receivers = [i for i, o in enumerate(scene.objects) if o.receives_shadows and o.mesh.triangle_count]
     if kind == "directional":
         light = scene.directional_lights[index]
-        return bool(occluders.pairs(casters, receivers, light_direction=light.direction))
+        return bool(occluders.pairs(casters, receivers, light_direction=light.direction, first=True))
     light = scene.point_lights[index]
-    return bool(occluders.pairs(casters, receivers, light_position=light.position))
+    return bool(occluders.pairs(casters, receivers, light_position=light.position, first=True))

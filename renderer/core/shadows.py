@@ -11,19 +11,23 @@ This module holds what the GPU path and the reference share and neither computes
 - the layers: every map of a scene is a layer of a DEPTH_COMPONENT32F 2D array texture, one
   texture per kind of light (`ShadowLayout`, `LayerStack`, `Tile`), each map drawn from texel
   (0, 0) of its layer; a directional light has one layer in the directional stack, a point
-  light six in the point stack (the faces of a cube around it, each a 90-degree perspective
-  view widened by a guard band, so that no filter tap ever leaves its map: no seams). A
-  stack's layers are its largest map's size, so a cube face of 512 texels is not a layer of
-  a directional map's 2048;
-- each frame's light views (`plan_shadows`): an orthographic view for a directional light
-  fitted to the receivers the camera can see and the casters that can shadow them, six
-  perspective views for a point light, the passes worth drawing (none for a light that
-  nothing can shadow, none for a cube face that sees no caster), and the uniform values;
+  light six in the point stack (the faces of a cube around it, each a perspective view of
+  the face, or of the part of it where a shadow can fall, widened by a guard band, so that no
+  filter tap ever leaves its map: no seams). A stack's layers are its largest map's size, so
+  a cube face of 512 texels is not a layer of a directional map's 2048;
+- each frame's light views (`plan_shadows`), by the pair rule of
+  renderer/core/shadow_casting.py (which caster can shadow which receiver): an orthographic
+  view for a directional light fitted to where a pair's caster and receiver meet across the
+  light within the camera's view volume, a fitted perspective view per cube face of a point
+  light, the passes worth drawing (none for a light or a face without a pair), each caster in
+  the passes where it has a pair (an analytic plane as its polygon in the pass's volume:
+  renderer/core/plane_clip.py), and the uniform values (ShadowPlan.uniforms, and per object
+  ShadowPlan.self_masks).
 
 Coordinates are camera-relative, as everything else the pipelines get (FrameMatrices). A map
-of R texels in layers of side S (its stack's) covers texture coordinates [0, R/S)^2 of its layer; its rows
-count up from the bottom as GL's window rows do (the depth pass draws with the viewport at
-(0, 0), R x R, on that layer).
+of R texels in layers of side S (its stack's) covers texture coordinates [0, R/S)^2 of its
+layer; its rows count up from the bottom as GL's window rows do (the depth pass draws with
+the viewport at (0, 0), R x R, on that layer).
 """
 
 from __future__ import annotations
@@ -363,17 +367,17 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
             box[i] = box[i].copy()
             box[i][:, :2] = ((-np.inf, -np.inf), (np.inf, np.inf))
     view = _box(_light_frame(frustum, rotation))
-    pieces = []
-    for c, shadowed in pairs.items():
-        for r in shadowed:
-            lo = np.maximum.reduce([box[c][0, :2], box[r][0, :2], view[0, :2]])
-            hi = np.minimum.reduce([box[c][1, :2], box[r][1, :2], view[1, :2]])
-            if np.all(lo <= hi):
-                pieces.append((lo, hi))
-    if not pieces:
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    for c, shadowed in pairs.items():           # each caster's receivers at once
+        theirs = np.array([box[r] for r in shadowed])                   # (n, 2, 3)
+        piece_lo = np.maximum(np.maximum(box[c][0, :2], theirs[:, 0, :2]), view[0, :2])
+        piece_hi = np.minimum(np.minimum(box[c][1, :2], theirs[:, 1, :2]), view[1, :2])
+        meet = np.all(piece_lo <= piece_hi, axis=1)
+        if meet.any():
+            lo = np.minimum(lo, piece_lo[meet].min(axis=0))
+            hi = np.maximum(hi, piece_hi[meet].max(axis=0))
+    if not np.all(lo <= hi):
         return None, np.eye(4), params, 0.0
-    lo = np.min([p[0] for p in pieces], axis=0)
-    hi = np.max([p[1] for p in pieces], axis=0)
     resolution, guard = light_map.resolution, light_map.guard
     extent = max(float(np.abs(b[np.isfinite(b)]).max(initial=0.0)) for b in box.values())
     half_inner = max(float((hi - lo).max()) / 2.0, 1e-9 * (1.0 + extent))
@@ -506,22 +510,24 @@ def _face_box(points: np.ndarray, face: int, position: np.ndarray) -> np.ndarray
     return np.clip(np.stack([xy.min(axis=0), xy.max(axis=0)]), -1.0, 1.0)
 
 
-def _fit_face(boxes: dict, pairs_in_face: list, resolution: int, guard: int):
+def _fit_face(boxes: dict, pairs_in_face: dict, resolution: int, guard: int):
     """(centre (2,), half) of the square a face's map covers in tangent coordinates: the union
-    over the caster-receiver pairs in the face of the caster's box and the receiver's, meeting
+    over the caster-receiver pairs in the face (`pairs_in_face`: caster -> its receivers there)
+    of the caster's box and the receiver's, meeting
     (a point light's shadow falls within its caster's projection), squared, its inner R - 2g - 2
     texels spanning it (a guard band, and a texel each side for the snapped centre); the half
     size rounded up to the whole face's over a power of 2^(1/4), the centre to whole texels, so
     that the map does not crawl as the camera moves. None where no pair's boxes meet."""
-    pieces = []
-    for c, r in pairs_in_face:
-        lo, hi = np.maximum(boxes[c][0], boxes[r][0]), np.minimum(boxes[c][1], boxes[r][1])
-        if np.all(lo <= hi):
-            pieces.append((lo, hi))
-    if not pieces:
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    for c, shadowed in pairs_in_face.items():   # each caster's receivers at once
+        theirs = np.array([boxes[r] for r in shadowed])                 # (n, 2, 2)
+        piece_lo, piece_hi = np.maximum(boxes[c][0], theirs[:, 0]), np.minimum(boxes[c][1], theirs[:, 1])
+        meet = np.all(piece_lo <= piece_hi, axis=1)
+        if meet.any():
+            lo = np.minimum(lo, piece_lo[meet].min(axis=0))
+            hi = np.maximum(hi, piece_hi[meet].max(axis=0))
+    if not np.all(lo <= hi):
         return None
-    lo = np.min([p[0] for p in pieces], axis=0)
-    hi = np.max([p[1] for p in pieces], axis=0)
     whole = resolution / (resolution - 2.0 * guard)
     needed = max(float((hi - lo).max()) / 2.0, 1e-9) * resolution / (resolution - 2.0 * guard - 2.0)
     steps = max(0, math.floor(FACE_STEPS_PER_OCTAVE * math.log2(whole / min(needed, whole))))
@@ -568,12 +574,21 @@ def _plan_point(index, light, light_map, layout, matrices, points, receivers, pa
         tile = light_map.tiles[face]
         inside = {i for i, out in zip(objects, outside[face]) if not out}
         if prune:
-            pairs_in_face = [(c, r) for c in casters if c in inside for r in pairs[c] if r in inside]
-            boxes = {i: _face_box(points[i], face, position) for pair in pairs_in_face for i in pair}
+            in_face = np.zeros(len(scene.objects), bool)
+            in_face[list(inside)] = True
+            pairs_in_face = {}
+            for c in casters:
+                if in_face[c]:
+                    shadowed = np.asarray(pairs[c], np.int64)
+                    shadowed = shadowed[in_face[shadowed]]
+                    if len(shadowed):
+                        pairs_in_face[c] = shadowed
+            boxes = {i: _face_box(points[i], face, position)
+                     for i in {*pairs_in_face, *(r for rs in pairs_in_face.values() for r in rs.tolist())}}
             fit = _fit_face(boxes, pairs_in_face, resolution, guard)
             if fit is None:
                 continue                        # not drawn: its lookups read as lit
-            drawn = tuple(dict.fromkeys(c for c, _ in pairs_in_face))
+            drawn = tuple(pairs_in_face)
         else:
             fit, drawn = (np.zeros(2), tan_half), tuple(c for c in casters if c in inside)
         centre, half = fit

@@ -16,7 +16,9 @@ RGBA8 colour and the float depth (glReadPixels into arrays made once):
   texture, a framebuffer per layer, each map cleared and drawn R x R from texel (0, 0)), then
   the camera pass with minimal GLSL (benchmarks/glsl/bare_*.vert/.frag): Phong with one
   LINEAR depth-compare lookup per light (pcf2x2's one bilinear comparison), a fixed normal
-  offset in place of the bias rule. It is the lower bound for the same GL work.
+  offset in place of the bias rule, the facet rule (a facet turned from the light is
+  shadowed) with the facet's normal from screen derivatives. It is the lower bound for the
+  same GL work.
 with/bare is the issue's figure (target <= 1.2). update() (uniforms and the frame's shadow
 plan: run when the camera, lights or objects move, not per frame) is timed the same way,
 with and without. The renderer also turns GL's bottom-up rows into row-0-on-top arrays and

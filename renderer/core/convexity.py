@@ -79,7 +79,7 @@ def _find_body(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) ->
     extent = float(np.ptp(positions, axis=0).max()) if len(positions) else 0.0
     if not extent > 0.0 or not np.isfinite(extent):
         return None
-    welded = _weld(positions, WELD_TOLERANCE * extent)[faces]
+    welded = weld(positions, WELD_TOLERANCE * extent)[faces]
     keep = (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 0] != welded[:, 2])
     corners = positions[faces[keep]]
     face_normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
@@ -114,9 +114,10 @@ def _height_range(positions: np.ndarray, n: np.ndarray, d: np.ndarray) -> tuple[
     return lowest, highest
 
 
-def _weld(positions: np.ndarray, tolerance: float) -> np.ndarray:
+def weld(positions: np.ndarray, tolerance: float) -> np.ndarray:
     """(V,) index of each vertex's position among the distinct positions, positions within
-    about `tolerance` of each other (on a grid of that step) counting as one."""
+    about `tolerance` of each other (on a grid of that step) counting as one (also
+    renderer/core/facets.py's, to find a face's neighbours)."""
     grid = np.round(positions / tolerance).astype(np.int64)
     _, index = np.unique(grid, axis=0, return_inverse=True)
     return index.reshape(-1)

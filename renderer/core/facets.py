@@ -19,12 +19,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from renderer.core.convexity import WELD_TOLERANCE, weld
 from renderer.core.mesh_cache import per_mesh
 
 FACE_TEXTURE_WIDTH = 1024      # texels on a row of the face texture (GL allows 16384)
 FACES_PER_ROW = FACE_TEXTURE_WIDTH // 2    # two texels a face
 CREASE_CAP = 1.0               # a crease's rise is taken up to 45 degrees (tan 1): steeper is a corner
-WELD_TOLERANCE = 1e-9          # of the extent: vertices this close are one (seams, poles)
 
 
 @per_mesh
@@ -56,9 +56,7 @@ def face_creases(mesh) -> np.ndarray:
     if len(faces) == 0:
         return out
     extent = float(np.ptp(positions, axis=0).max()) or 1.0
-    grid = np.round(positions / (WELD_TOLERANCE * extent)).astype(np.int64)
-    _, weld = np.unique(grid, axis=0, return_inverse=True)
-    welded = weld.reshape(-1)[faces]
+    welded = weld(positions, WELD_TOLERANCE * extent)[faces]
     # each face's directed edges (a -> b) with its far vertex c; its neighbour runs b -> a
     corners = [(0, 1, 2), (1, 2, 0), (2, 0, 1)]
     a = np.concatenate([faces[:, i] for i, _, _ in corners])

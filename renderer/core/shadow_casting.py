@@ -78,11 +78,11 @@ class Occluders:
         return self._scale_array
 
     def _stacked(self, objects: np.ndarray):
-        """(points (V, 3), owner (V,) position in `objects`, starts (n,)) of the objects' points
-        in one array, for reductions per object (np.minimum.reduceat)."""
+        """(points (V, 3), starts (n,)) of the objects' points in one array, for reductions
+        per object (np.logical_or.reduceat)."""
         counts = np.array([len(self.points[i]) for i in objects], np.int64)
         points = np.concatenate([self.points[i] for i in objects]) if len(objects) else np.zeros((0, 3))
-        return points, np.repeat(np.arange(len(objects)), counts), np.concatenate([[0], np.cumsum(counts)[:-1]])
+        return points, np.concatenate([[0], np.cumsum(counts)[:-1]])
 
     def pairs(self, casters: list[int], receivers: list[int], light_position=None,
               light_direction=None, first: bool = False) -> dict[int, list[int]]:
@@ -127,7 +127,7 @@ class Occluders:
             if inside or outside_lit:
                 ok &= rec != c
             if inside:                     # only what reaches outside the solid around the light
-                points, owner, starts = stacked
+                points, starts = stacked
                 out = ~body.contains(points, self.models[c]) if len(points) else np.zeros(0, bool)
                 ok &= np.logical_or.reduceat(out, starts) if len(points) else False
         if light_direction is not None:
@@ -136,21 +136,18 @@ class Occluders:
 
     def _light_boxes(self, objects, light_direction) -> np.ndarray:
         """(objects in the scene, 2, 3): each of `objects`' vertices' least and greatest
-        (x, y, depth) in the directional light's frame (x, y across the light, depth along
-        it); NaN for the others."""
-        rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light_direction, (0.0, 1.0, 0.0))[:3, :3]
-        flip = np.array([1.0, 1.0, -1.0])                     # the view's -z is the depth
+        (x, y, depth) in the directional light's frame (light_frame); NaN for the others."""
+        rotation = light_rotation(light_direction)
         out = np.full((len(self.points), 2, 3), np.nan)
         for i in objects:
-            p = (self.points[i] @ rotation.T) * flip
-            if len(p):
-                out[i] = (p.min(axis=0), p.max(axis=0))
+            if len(self.points[i]):
+                out[i] = bounds(light_frame(self.points[i], rotation))
         return out
 
     def _below_plane(self, c, plane, light_position, light_direction, stacked) -> np.ndarray:
         """(R,) bool: some point of each receiver lies beyond planar caster c's plane from the
         light (all False where the light grazes the plane: no shadow of any area)."""
-        points, owner, starts = stacked
+        points, starts = stacked
         normal, origin = plane
         scale = self._scale(c)
         if light_position is not None:
@@ -162,7 +159,7 @@ class Occluders:
         facing = normal if side > 0 else -normal
         return np.logical_or.reduceat((points - origin) @ facing < -scale, starts)
 
-    def _across_light_meet(self, c: int, rec: np.ndarray, boxes: dict) -> np.ndarray:
+    def _across_light_meet(self, c: int, rec: np.ndarray, boxes: np.ndarray) -> np.ndarray:
         """(R,) bool, directional light (boxes from _light_boxes): each receiver's box across
         the light meets caster c's, and some of the receiver lies deeper than c's nearest."""
         caster, theirs = boxes[c], boxes[rec]
@@ -170,6 +167,22 @@ class Occluders:
         apart = (np.any(caster[1, :2] < theirs[:, 0, :2] - slack[:, None], axis=1)
                  | np.any(theirs[:, 1, :2] < caster[0, :2] - slack[:, None], axis=1))
         return ~apart & (theirs[:, 1, 2] > caster[0, 2] - slack)
+
+
+def light_rotation(light_direction) -> np.ndarray:
+    """(4, 4) the view rotation of a directional light travelling along `light_direction`."""
+    return transforms.look_at_rotation((0.0, 0.0, 0.0), light_direction, (0.0, 1.0, 0.0))
+
+
+def light_frame(points: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """(V, 3) points in a directional light's frame (`rotation`: light_rotation): x, y across
+    the light, depth along it (the view's -z)."""
+    return (points @ rotation[:3, :3].T) * np.array([1.0, 1.0, -1.0])
+
+
+def bounds(points: np.ndarray) -> np.ndarray:
+    """(2, 3): the points' least and greatest coordinates."""
+    return np.stack([points.min(axis=0), points.max(axis=0)])
 
 
 def world_geometry(scene) -> tuple[list[np.ndarray], list[np.ndarray]]:

@@ -44,7 +44,8 @@ from renderer.core.drawn import drawn_meshes, is_plane
 from renderer.core.gl_rules import STANDARD_DEPTH
 from renderer.core.plane_clip import plane_polygon
 from renderer.core.scene import world_shape
-from renderer.core.shadow_casting import Occluders, light_can_shadow, world_geometry
+from renderer.core.shadow_casting import (Occluders, bounds, light_can_shadow, light_frame, light_rotation,
+                                          world_geometry)
 from renderer.core.visibility import all_outside, corners
 from renderer.errors import SceneError
 
@@ -330,11 +331,6 @@ def _map_from_clip(tile: Tile, side: int) -> np.ndarray:
     return m
 
 
-def _light_frame(points: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """(V, 3) points in a directional light's frame: x, y across the light, depth along it."""
-    return (points @ rotation[:3, :3].T) * np.array([1.0, 1.0, -1.0])
-
-
 def _plane_depths(plane, rotation: np.ndarray, region) -> tuple[float, float]:
     """The least and greatest depth along a directional light (its frame: `rotation`) of an
     infinite plane over the square `region` (lo, hi) across the light: at the square's corners,
@@ -356,26 +352,18 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
     caster drawn to the deepest visible receiver whose box meets the region (a receiver point
     past the far plane would compare as shadowed). `planes`: caster -> its analytic plane
     (camera-relative world): unbounded across the light, its depth over the region its own."""
-    rotation = transforms.look_at_rotation((0.0, 0.0, 0.0), light.direction, (0.0, 1.0, 0.0))
+    rotation = light_rotation(light.direction)
     params = np.zeros(4)
     planes = planes or {}
     if not pairs:
         return None, np.eye(4), params, 0.0
-    box = {i: _box(_light_frame(points[i], rotation)) for i in {*receivers, *pairs}}
+    box = {i: bounds(light_frame(points[i], rotation)) for i in {*receivers, *pairs}}
     for i in planes:
         if i in box and i not in receivers:
             box[i] = box[i].copy()
             box[i][:, :2] = ((-np.inf, -np.inf), (np.inf, np.inf))
-    view = _box(_light_frame(frustum, rotation))
-    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
-    for c, shadowed in pairs.items():           # each caster's receivers at once
-        theirs = np.array([box[r] for r in shadowed])                   # (n, 2, 3)
-        piece_lo = np.maximum(np.maximum(box[c][0, :2], theirs[:, 0, :2]), view[0, :2])
-        piece_hi = np.minimum(np.minimum(box[c][1, :2], theirs[:, 1, :2]), view[1, :2])
-        meet = np.all(piece_lo <= piece_hi, axis=1)
-        if meet.any():
-            lo = np.minimum(lo, piece_lo[meet].min(axis=0))
-            hi = np.maximum(hi, piece_hi[meet].max(axis=0))
+    view = bounds(light_frame(frustum, rotation))
+    lo, hi = _pairs_region(box, pairs, within=(view[0, :2], view[1, :2]))
     if not np.all(lo <= hi):
         return None, np.eye(4), params, 0.0
     resolution, guard = light_map.resolution, light_map.guard
@@ -403,9 +391,23 @@ def _plan_directional(index, light, light_map, layout, points, receivers, pairs,
     return ShadowPass("directional", index, 0, tile, clip, tuple(drawn)), lookup, params, texel
 
 
-def _box(points: np.ndarray) -> np.ndarray:
-    """(2, 3): the points' least and greatest coordinates."""
-    return np.stack([points.min(axis=0), points.max(axis=0)])
+def _pairs_region(boxes: dict, pairs: dict, within=None) -> tuple[np.ndarray, np.ndarray]:
+    """(lo, hi) across the light: the union over the pairs (`pairs`: caster c -> its
+    receivers) of c's box met with each receiver's (`boxes`: object -> (2, k), the first two
+    columns across the light) and with `within` (lo, hi) if given, where they meet; lo > hi
+    where no pair's do."""
+    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
+    for c, shadowed in pairs.items():           # each caster's receivers at once
+        theirs = np.array([boxes[r][:, :2] for r in shadowed])          # (n, 2, 2)
+        piece_lo = np.maximum(boxes[c][0, :2], theirs[:, 0])
+        piece_hi = np.minimum(boxes[c][1, :2], theirs[:, 1])
+        if within is not None:
+            piece_lo, piece_hi = np.maximum(piece_lo, within[0]), np.minimum(piece_hi, within[1])
+        meet = np.all(piece_lo <= piece_hi, axis=1)
+        if meet.any():
+            lo = np.minimum(lo, piece_lo[meet].min(axis=0))
+            hi = np.maximum(hi, piece_hi[meet].max(axis=0))
+    return lo, hi
 
 
 def _meets(box: np.ndarray, region: tuple[np.ndarray, np.ndarray]) -> bool:
@@ -518,14 +520,7 @@ def _fit_face(boxes: dict, pairs_in_face: dict, resolution: int, guard: int):
     texels spanning it (a guard band, and a texel each side for the snapped centre); the half
     size rounded up to the whole face's over a power of 2^(1/4), the centre to whole texels, so
     that the map does not crawl as the camera moves. None where no pair's boxes meet."""
-    lo, hi = np.full(2, np.inf), np.full(2, -np.inf)
-    for c, shadowed in pairs_in_face.items():   # each caster's receivers at once
-        theirs = np.array([boxes[r] for r in shadowed])                 # (n, 2, 2)
-        piece_lo, piece_hi = np.maximum(boxes[c][0], theirs[:, 0]), np.minimum(boxes[c][1], theirs[:, 1])
-        meet = np.all(piece_lo <= piece_hi, axis=1)
-        if meet.any():
-            lo = np.minimum(lo, piece_lo[meet].min(axis=0))
-            hi = np.maximum(hi, piece_hi[meet].max(axis=0))
+    lo, hi = _pairs_region(boxes, pairs_in_face)
     if not np.all(lo <= hi):
         return None
     whole = resolution / (resolution - 2.0 * guard)

@@ -81,10 +81,10 @@ from renderer.core.drawn import drawn_meshes, is_plane
 from renderer.core.facets import face_texture
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
-from renderer.core.plane_clip import MAX_POLYGON_TRIANGLES, MAX_POLYGON_VERTICES
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
+from renderer.gpu.polygon_buffers import PolygonBuffers, vertex_bytes
 from renderer.gpu.shadow_maps import ShadowMaps
 from renderer.gpu.textures import TextureCache
 from renderer.core.transforms import jitter, to_glsl
@@ -150,29 +150,6 @@ def multisample_counts(ctx: moderngl.Context) -> list[int]:
 
 
 @dataclass
-class _PolygonBuffers:
-    """An analytic plane's polygon for the camera pass (renderer/core/drawn.py): buffers made
-    once at their largest (MAX_POLYGON_VERTICES vertices, MAX_POLYGON_TRIANGLES triangles),
-    written again by each update() with that frame's polygon, of which `count` indices are
-    drawn (0: the plane misses the view)."""
-    vbo: moderngl.Buffer                   # in_position, in_normal: float32, interleaved
-    ibo: moderngl.Buffer                   # faces, uint32
-    uv_vbo: moderngl.Buffer                # in_uv, float32
-    count: int = 0
-
-    def write(self, mesh: Mesh) -> None:
-        if mesh.triangle_count:
-            self.vbo.write(_vertex_bytes(mesh))
-            self.ibo.write(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
-            self.uv_vbo.write(np.ascontiguousarray(mesh.uvs, dtype=np.float32).tobytes())
-        self.count = 3 * mesh.triangle_count
-
-    def release(self) -> None:
-        for buffer in (self.vbo, self.ibo, self.uv_vbo):
-            buffer.release()
-
-
-@dataclass
 class _ObjectBuffers:
     """GL objects of one scene object: its mesh on the GPU and its vertex arrays per variant.
     The camera pass draws the mesh, or an analytic plane's polygon (`polygon`); the shadow
@@ -186,7 +163,7 @@ class _ObjectBuffers:
     uniform_bytes: dict                    # uniform name -> bytes (object's model and material)
     texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
     face_normals: moderngl.Texture | None = None   # its faces (facets.face_texture), once a shadowed program draws it
-    polygon: _PolygonBuffers | None = None  # an analytic plane's, which the camera pass draws
+    polygon: PolygonBuffers | None = None  # an analytic plane's, which the camera pass draws
 
     @property
     def drawn_buffers(self) -> tuple:
@@ -315,17 +292,14 @@ class GpuRenderer:
                                  f"{', '.join(CULL_FLAGS)}, got {obj.cull!r}")
             item = _ObjectBuffers(obj, obj.mesh, None, None, None, {}, {})
             if is_plane(obj):        # its polygon's buffers, at their largest, written per update()
-                item.polygon = _PolygonBuffers(
-                    self.ctx.buffer(reserve=MAX_POLYGON_VERTICES * 6 * 4),
-                    self.ctx.buffer(reserve=MAX_POLYGON_TRIANGLES * 3 * 4),
-                    self.ctx.buffer(reserve=MAX_POLYGON_VERTICES * 2 * 4))
+                item.polygon = PolygonBuffers.make(self.ctx, uvs=True)
             self._objects.append(item)
             self._upload(item)
 
     def _upload(self, item: _ObjectBuffers) -> None:
         mesh = item.mesh = item.obj.mesh
         if mesh.triangle_count:
-            item.vbo = self.ctx.buffer(_vertex_bytes(mesh))
+            item.vbo = self.ctx.buffer(vertex_bytes(mesh))
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
         self._upload_uvs(item)
 
@@ -727,11 +701,6 @@ class GpuRenderer:
     def __repr__(self) -> str:
         state = "released" if self._released else context_kind(self.ctx)
         return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
-
-
-def _vertex_bytes(mesh: Mesh) -> bytes:
-    """in_position, in_normal of each vertex: float32, interleaved."""
-    return np.ascontiguousarray(np.hstack([mesh.positions, mesh.normals]), dtype=np.float32).tobytes()
 
 
 def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:

@@ -32,11 +32,11 @@ import moderngl
 import numpy as np
 
 from renderer.core.gl_rules import STANDARD_DEPTH
-from renderer.core.plane_clip import MAX_POLYGON_TRIANGLES, MAX_POLYGON_VERTICES
 from renderer.core.shadows import SHADOW_KINDS, ShadowLayout, ShadowPlan
 from renderer.core.transforms import to_glsl
 from renderer.errors import ContextError
 from renderer.gpu.context import gl_function
+from renderer.gpu.polygon_buffers import PolygonBuffers
 from renderer.gpu.shaders import shader_source
 from renderer.gpu.uniforms import SHADOW_MAPS_UNITS
 
@@ -143,7 +143,7 @@ class ShadowMaps:
                                    fragment_shader=shader_source("shadow/depth.frag").text)
         self._clip_from_model = self.program["u_clip_from_model"]
         self._vertex_arrays: dict[int, tuple[moderngl.Buffer, moderngl.VertexArray]] = {}
-        self._polygon_slots: dict[tuple, tuple] = {}     # (pass, plane) -> (vbo, ibo, vao)
+        self._polygon_slots: dict[tuple, tuple] = {}     # (pass, plane) -> (PolygonBuffers, vao)
         self._passes: list = []                          # (framebuffer, R, [(vao, bytes)])
         self.plan: ShadowPlan | None = None
         self.set_layout(layout)
@@ -185,18 +185,16 @@ class ShadowMaps:
     def _polygon_array(self, slot: tuple, polygon) -> moderngl.VertexArray:
         """The vertex array of a plane's polygon in a pass (`slot`: the pass's place in the
         plan and the plane's object index): buffers made the first time the slot is used, at
-        the largest polygon's size (MAX_POLYGON_VERTICES), written with this plan's polygon."""
+        the largest polygon's size (renderer/gpu/polygon_buffers.py), written with this plan's
+        polygon."""
         made = self._polygon_slots.get(slot)
         if made is None:
-            vbo = self.ctx.buffer(reserve=MAX_POLYGON_VERTICES * 6 * 4)
-            ibo = self.ctx.buffer(reserve=MAX_POLYGON_TRIANGLES * 3 * 4)
-            vao = self.ctx.vertex_array(self.program, [(vbo, "3f 3x4", "in_position")],
-                                        index_buffer=ibo, index_element_size=4)
-            made = self._polygon_slots[slot] = (vbo, ibo, vao)
-        vbo, ibo, vao = made
-        vertices = np.hstack([polygon.positions, polygon.normals]).astype(np.float32)
-        vbo.write(np.ascontiguousarray(vertices).tobytes())
-        ibo.write(np.ascontiguousarray(polygon.faces, dtype=np.uint32).tobytes())
+            buffers = PolygonBuffers.make(self.ctx, uvs=False)
+            vao = self.ctx.vertex_array(self.program, [(buffers.vbo, "3f 3x4", "in_position")],
+                                        index_buffer=buffers.ibo, index_element_size=4)
+            made = self._polygon_slots[slot] = (buffers, vao)
+        buffers, vao = made
+        buffers.write(polygon)
         return vao
 
     def _vertex_array(self, index: int, vbo: moderngl.Buffer, ibo: moderngl.Buffer) -> moderngl.VertexArray:
@@ -265,9 +263,9 @@ class ShadowMaps:
     def release(self) -> None:
         for _vbo, vao in self._vertex_arrays.values():
             vao.release()
-        for gl_objects in self._polygon_slots.values():
-            for gl_object in reversed(gl_objects):
-                gl_object.release()
+        for buffers, vao in self._polygon_slots.values():
+            vao.release()
+            buffers.release()
         self._vertex_arrays, self._passes, self._polygon_slots = {}, [], {}
         for kind in SHADOW_KINDS:
             self._release_stack(kind)

@@ -63,19 +63,38 @@ def export(revision: str, into: Path) -> Path:
     return into
 
 
+def open_tracer(args, scene, ctx):
+    """The exported tree's renderer of --method on `ctx`: through its open_renderer
+    (renderer/methods), or, in a revision from before that factory (issue 29), by the
+    classes it wraps, with the same arguments. (The tree is asked, not the import system: an
+    editable install of the working tree would supply the working tree's renderer/methods.)"""
+    import renderer
+    if not (Path(renderer.__file__).parent / "methods").is_dir():
+        return open_before_factory(args, scene, ctx)
+    from renderer.methods import open_renderer
+    if args.method == "raster":
+        return open_renderer(scene, args.size, context=ctx)
+    from renderer.core.ray_options import RayOptions
+    return open_renderer(scene, args.size, method="raytrace", context=ctx,
+                         options=RayOptions(samples=args.spp, max_depth=args.max_depth))
+
+
+def open_before_factory(args, scene, ctx):
+    """open_tracer in a revision without renderer/methods: its own constructors."""
+    if args.method == "raster":
+        from renderer.gpu import GpuRenderer
+        return GpuRenderer(scene, *args.size, context=ctx)
+    from renderer.gpu.raytracer import RayTracer
+    return RayTracer(scene, *args.size, context=ctx, samples=args.spp, max_depth=args.max_depth)
+
+
 def worker(args) -> None:
     """Runs in the exported tree: traces on request, one frame per line on stdin."""
     from renderer.core.scene_file import load_scene
     from renderer.gpu.context import make_context
 
     ctx = make_context(args.context)
-    if args.method == "raster":
-        from renderer.gpu import GpuRenderer
-        tracer = GpuRenderer(load_scene(args.scene), *args.size, context=ctx)
-    else:
-        from renderer.gpu.raytracer import RayTracer
-        tracer = RayTracer(load_scene(args.scene), *args.size, context=ctx, samples=args.spp,
-                           max_depth=args.max_depth)
+    tracer = open_tracer(args, load_scene(args.scene), ctx)
     frame = tracer.render()                                   # compiles; not timed
     print(json.dumps({"rgba8": hashlib.sha256(frame.rgba8.tobytes()).hexdigest(),
                       "renderer": ctx.info["GL_RENDERER"]}), flush=True)

@@ -24,12 +24,12 @@ import time
 
 import numpy as np
 
-from reference.raytrace.pipeline import render as reference_render
-from renderer.cli import parse_size
+from renderer.cli.options import parse_size
+from renderer.core.ray_options import RayOptions
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
-from renderer.gpu.raytracer import RayTracer
+from renderer.methods import open_renderer
 
 from common import machine                       # benchmarks/common.py
 
@@ -59,18 +59,20 @@ def main() -> None:
           f"warm-up ({args.context}); reference: 1 frame; error against {TRUTH_SPP} spp jittered, "
           f"in 8-bit steps")
     scenes = {"classic": load_scene("classic"), "sphere (3,968 tri)": load_scene("sphere")}
-    runs = {"jittered 4": dict(samples=4, pattern="jittered"),
-            f"jittered {N}": dict(samples=N, pattern="jittered"),
-            **{f"adaptive {N} T={t:g}/255": dict(samples=N, pattern="adaptive", adaptive_threshold=t / 255)
-               for t in steps}}
+    runs = {"jittered 4": RayOptions(samples=4, pattern="jittered"),
+            f"jittered {N}": RayOptions(samples=N, pattern="jittered"),
+            **{f"adaptive {N} T={t:g}/255": RayOptions(samples=N, pattern="adaptive",
+                                                       adaptive_threshold=t / 255) for t in steps}}
     header = (f"{'scene':20} {'pattern':22} {'spp':>6} {'refined':>8} {'GPU ms':>8} {'ref ms':>8} "
               f"{'RMS err':>8} {'max err':>8}")
     print(header)
     print("-" * len(header))
     for name, scene in scenes.items():
-        with RayTracer(scene, W, H, context=ctx, samples=TRUTH_SPP, pattern="jittered", seed=TRUTH_SEED) as tracer:
+        truth_options = RayOptions(samples=TRUTH_SPP, pattern="jittered", seed=TRUTH_SEED)
+        with open_renderer(scene, (W, H), method="raytrace", context=ctx, options=truth_options) as tracer:
             truth = tracer.render()
-        tracers = {label: RayTracer(scene, W, H, context=ctx, **options) for label, options in runs.items()}
+        tracers = {label: open_renderer(scene, (W, H), method="raytrace", context=ctx, options=options)
+                   for label, options in runs.items()}
         try:
             frames = {label: tracer.render() for label, tracer in tracers.items()}     # warm-up
             times = {label: [] for label in tracers}
@@ -87,8 +89,10 @@ def main() -> None:
             frame = frames[label]
             ref = "-"
             if not args.quick:
+                twin = open_renderer(scene, (W, H), method="raytrace", backend="reference", options=options)
+                twin.ray_scene = rs                              # made before, not timed
                 start = time.perf_counter()
-                reference_render(scene, W, H, rs=rs, **options)
+                twin.render()
                 ref = f"{(time.perf_counter() - start) * 1000.0:.0f}"
             rms, worst = error_steps(frame, truth)
             print(f"{name:20} {label:22} {frame.samples.mean():6.2f} {np.mean(frame.samples > 4):8.1%} "

@@ -25,13 +25,13 @@ from __future__ import annotations
 import time
 from dataclasses import replace
 
-from reference.raytrace.pipeline import render as reference_render
-from renderer.cli import parse_size
+from renderer.cli.options import parse_size
 from renderer.core.builtin import builtin_scenes
+from renderer.core.ray_options import RayOptions
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
-from renderer.gpu.raytracer import RayTracer
+from renderer.methods import open_renderer
 
 from common import alternating_ms, machine, parser       # benchmarks/common.py
 
@@ -71,17 +71,18 @@ def main() -> None:
         scene = load_scene(builtin_scenes()[name])
         plain = without_effect(scene)
         m = args.light_samples if name == "soft_shadows" else 1
-        options = {"samples": args.spp, "pattern": "jittered", "light_samples": m}
-        with RayTracer(scene, width, height, context=ctx, **options) as tracer, \
-                RayTracer(plain, width, height, context=ctx, **options) as bare:
+        options = RayOptions(samples=args.spp, pattern="jittered", light_samples=m)
+        with open_renderer(scene, args.size, method="raytrace", context=ctx, options=options) as tracer, \
+                open_renderer(plain, args.size, method="raytrace", context=ctx, options=options) as bare:
             tracer.render()
             bare.render()
             ms, bare_ms = alternating_ms([tracer.render, bare.render], args.frames)
         seconds = []
         for drawn in (scene, plain):
-            rs = ray_scene(drawn)
+            twin = open_renderer(drawn, (rw, rh), method="raytrace", backend="reference", options=options)
+            twin.ray_scene = ray_scene(drawn)                     # made before, not timed
             start = time.perf_counter()
-            reference_render(drawn, rw, rh, rs=rs, **options)
+            twin.render()
             seconds.append(time.perf_counter() - start)
         samples = width * height * args.spp
         light = f"{samples * m / ms / 1e3:.2f}" if name == "soft_shadows" else ""

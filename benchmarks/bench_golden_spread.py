@@ -47,13 +47,13 @@ class GoldenWorker:
 
     def run(self, batch: list[tuple[str, str]]) -> list[str]:
         from renderer.gpu.context import make_context
-        from renderer.gpu.pipeline import GpuRenderer
+        from renderer.methods import open_renderer
         self.ctx = self.ctx or make_context(self.context_kind)
         digests = []
         for name, mode in batch:
             scene = load_scene(builtin_scenes()[name])
             scene = scene if mode == "as-authored" else scene.with_shading(mode)
-            with GpuRenderer(scene, *SIZE, context=self.ctx) as gpu:
+            with open_renderer(scene, SIZE, context=self.ctx) as gpu:
                 digests.append(pixels_sha256(gpu.render(depth=False).rgba8))
         return digests
 

@@ -22,10 +22,10 @@ CHILD = r"""
 import json, resource, sys, warnings
 warnings.simplefilter("ignore")
 backend, width, height, segments = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
-import reference
+import reference.pipeline, renderer.gpu.pipeline     # open_renderer's backends, loaded before the baseline
 from renderer.core import memory
 from renderer.core.scene_file import scene_from_dict
-from renderer.gpu import GpuRenderer
+from renderer.methods import open_renderer
 scene = scene_from_dict({
     "camera": {"eye": [0, 0, 4], "look": [0, 0, 0]},
     "lights": [{"type": "directional", "direction": [0, -0.5, -1]}],
@@ -34,11 +34,11 @@ scene = scene_from_dict({
 triangles = sum(o.mesh.triangle_count for o in scene.objects)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 if backend == "gpu":
-    with GpuRenderer(scene, width, height, context_kind="egl") as gpu:
+    with open_renderer(scene, (width, height), context_kind="egl") as gpu:
         frame = gpu.render(depth=True)
     estimate = memory.gpu_bytes(width, height, triangles)
 else:
-    frame = reference.render(scene, width, height)
+    frame = open_renderer(scene, (width, height), backend="reference").render()
     estimate = memory.reference_bytes(width, height, triangles)
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 print(json.dumps({"triangles": triangles, "measured": peak - before, "estimate": estimate}))

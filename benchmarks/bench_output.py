@@ -26,9 +26,9 @@ from renderer.core.blue_noise import blue_noise_ranks
 from renderer.core.error_kernels import KERNELS, wavefronts
 from renderer.core.output_settings import ERROR_DIFFUSION, Halftone, OutputSettings, Transfer
 from renderer.core.scene_file import load_scene
-from renderer.gpu import GpuRenderer
 from renderer.gpu.context import make_context
 from renderer.gpu.output import WAVEFRONT_GROUP, OutputPass
+from renderer.methods import open_renderer
 
 from common import alternating_ms, machine, parser         # benchmarks/common.py
 
@@ -75,7 +75,7 @@ def main() -> None:
     args = args.parse_args()
     width, height = args.size
     ctx = make_context(args.context)
-    with GpuRenderer(load_scene(args.scene), width, height, context=ctx) as gpu:
+    with open_renderer(load_scene(args.scene), (width, height), context=ctx) as gpu:
         linear = gpu.render(linear=True, depth=False).linear
     stage = OutputPass(ctx)
     print(machine())

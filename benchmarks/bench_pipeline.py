@@ -14,17 +14,16 @@ import time
 
 import numpy as np
 
-import reference
 from renderer.core.builtin import builtin_scenes
 from renderer.core.drawn import triangle_bound
 from renderer.gpu.context import activate, make_context
-from renderer.gpu import GpuRenderer
 from renderer.gpu.pipeline import make_float_depth
 from renderer.gpu.uniforms import uniform_values
 from renderer.core.primitives import icosphere
 from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject
 from renderer.core.scene_file import load_scene
 from renderer.gpu.shaders import program_source
+from renderer.methods import open_renderer
 
 from common import arguments          # benchmarks/common.py
 
@@ -93,17 +92,18 @@ def bench_scenes(ctx, size, frames):
     for name, path in builtin_scenes().items():
         scene = load_scene(path)
         triangles = sum(triangle_bound(obj) for obj in scene.objects)   # a plane's polygon: at most 4
-        with GpuRenderer(scene, *size, context=ctx) as gpu:
+        with open_renderer(scene, size, context=ctx) as gpu:
             gpu.render()
             gpu_ms = statistics.median(timed(gpu.render) for _ in range(frames))
-        ref_ms = statistics.median(timed(lambda: reference.render(scene, *size)) for _ in range(3))
+        twin = open_renderer(scene, size, backend="reference")
+        ref_ms = statistics.median(timed(twin.render) for _ in range(3))
         print(f"{name:<20} {triangles:>9} {gpu_ms:>8.2f} {ref_ms:>13.1f} {ref_ms / gpu_ms:>6.1f}x")
 
 
 def bench_overhead(ctx, size, frames):
     scene = sphere_scene()
     bare = BareProgram(ctx, scene, *size)
-    with GpuRenderer(scene, *size, context=ctx) as gpu:
+    with open_renderer(scene, size, context=ctx) as gpu:
         previous = gpu.render()
         bare.frame()                                    # warm up both
         fresh, reused, theirs = [], [], []
@@ -112,7 +112,8 @@ def bench_overhead(ctx, size, frames):
             reused.append(timed(lambda: gpu.render(out=previous)))
             theirs.append(timed(bare.frame))
     fresh_ms, ours_ms, bare_ms = (statistics.median(t) for t in (fresh, reused, theirs))
-    ref_ms = statistics.median(timed(lambda: reference.render(scene, *size)) for _ in range(3))
+    twin = open_renderer(scene, size, backend="reference")
+    ref_ms = statistics.median(timed(twin.render) for _ in range(3))
     print(f"\n20,480-triangle sphere at {size[0]}x{size[1]}, colour + depth read back")
     print(f"  renderer, reusing the frame's arrays  {ours_ms:8.2f} ms/frame (median of {frames})")
     print(f"  renderer, new arrays every frame      {fresh_ms:8.2f} ms/frame")

@@ -33,13 +33,12 @@ import time
 import numpy as np
 
 import reference.raytrace.trace as trace_module
-from reference.raytrace.pipeline import render as reference_render
-from renderer.cli import parse_size
+from renderer.cli.options import parse_size
+from renderer.core.ray_options import RayOptions
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.gpu.context import make_context
-from renderer.gpu.pipeline import GpuRenderer
-from renderer.gpu.raytracer import RayTracer
+from renderer.methods import open_renderer
 
 from common import alternating_ms, machine       # benchmarks/common.py
 
@@ -120,14 +119,17 @@ def main() -> None:
     for name, scene in scenes.items():
         rs = ray_scene(scene)
         for spp in args.spp:
-            with RayTracer(scene, W, H, context=ctx, samples=spp) as tracer:
+            options = RayOptions(samples=spp)
+            with open_renderer(scene, (W, H), method="raytrace", context=ctx, options=options) as tracer:
                 g = gpu_ms(tracer, args.frames)
             if spp > 1 and args.quick and name in counts:
                 rays, r, mark = spp * counts[name], None, "~"
             else:
+                twin = open_renderer(scene, (W, H), method="raytrace", backend="reference", options=options)
+                twin.ray_scene = rs                              # made before, not timed
                 with RayCount() as count:
                     start = time.perf_counter()
-                    reference_render(scene, W, H, samples=spp, rs=rs)
+                    twin.render()
                     r = (time.perf_counter() - start) * 1000.0
                 rays, mark = count.total, " "
                 if spp == 1:
@@ -138,8 +140,9 @@ def main() -> None:
                   flush=True)
     print(f"\nspecialisation, GPU, 1 spp (frames alternate; median of {args.frames}):")
     for name, scene in scenes.items():
-        with RayTracer(scene, W, H, context=ctx) as fast, \
-                RayTracer(scene, W, H, context=ctx, specialise=False) as every:
+        with open_renderer(scene, (W, H), method="raytrace", context=ctx) as fast, \
+                open_renderer(scene, (W, H), method="raytrace", context=ctx,
+                              options=RayOptions(specialise=False)) as every:
             a, b = fast.render(), every.render()
             same = np.array_equal(a.rgba8, b.rgba8) and np.array_equal(a.linear, b.linear)
             f, e = alternating_ms((fast.render, every.render), args.frames)
@@ -149,7 +152,8 @@ def main() -> None:
     print(f"\nthe rasteriser against the ray tracer, GPU, 1 spp (frames alternate after a warm-up; "
           f"median of {args.frames}; colour and depth read back):")
     for name, scene in scenes.items():
-        with GpuRenderer(scene, W, H, context=ctx) as raster, RayTracer(scene, W, H, context=ctx) as tracer:
+        with open_renderer(scene, (W, H), context=ctx) as raster, \
+                open_renderer(scene, (W, H), method="raytrace", context=ctx) as tracer:
             raster.render()                                       # warm-up
             tracer.render()
             r, t = alternating_ms((raster.render, tracer.render), args.frames)

@@ -18,12 +18,12 @@ import statistics
 import time
 from dataclasses import replace
 
-from bench_raytrace import CLASSIC, icosphere_scene      # benchmarks/bench_raytrace.py
+from bench_raytrace import icosphere_scene              # benchmarks/bench_raytrace.py
 from common import arguments                             # benchmarks/common.py
 from renderer.core.builtin import resolve_scene
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
-from renderer.gpu.raytracer import RayTracer
+from renderer.methods import open_renderer
 from renderer.viewer.controls import working_copy
 from renderer.viewer.orbit import OrbitCamera
 
@@ -37,7 +37,7 @@ def timed(function):
 def main() -> None:
     args = arguments(__doc__, "steps", 5)
     ctx = make_context(args.context)
-    scenes = {"classic": load_scene(CLASSIC), "sphere": load_scene(resolve_scene("sphere")),
+    scenes = {"classic": load_scene(resolve_scene("classic")), "sphere": load_scene(resolve_scene("sphere")),
               "icosphere 20480": icosphere_scene()}
     print(f"{args.size[0]}x{args.size[1]}, {args.context}, load average "
           f"{os.getloadavg()[0]:.1f}; medians of {args.steps} one-degree orbit steps (ms)")
@@ -46,14 +46,14 @@ def main() -> None:
     for name, scene in scenes.items():
         shown = working_copy(scene)
         orbit = OrbitCamera(scene.camera)
-        tracer = RayTracer(shown, *args.size, context=ctx)
+        tracer = open_renderer(shown, args.size, method="raytrace", context=ctx)
         fresh_ms, update_ms, frame_ms = [], [], []
         try:
             for _ in range(args.steps):
                 orbit.orbit(1.0, 0.0)
                 shown.camera = orbit.camera
-                ms, new = timed(lambda: RayTracer(replace(shown, objects=list(shown.objects)),
-                                                  *args.size, context=ctx))
+                ms, new = timed(lambda: open_renderer(replace(shown, objects=list(shown.objects)),
+                                                      args.size, method="raytrace", context=ctx))
                 with new:
                     expected = new.render()
                 fresh_ms.append(ms)

@@ -24,7 +24,9 @@ from __future__ import annotations
 from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context, release_context
+from renderer.core.raster_options import RasterOptions
 from renderer.gpu.pipeline import GpuRenderer
+from renderer.methods import open_renderer
 
 from common import alternating_ms, machine, parser       # benchmarks/common.py
 
@@ -55,8 +57,9 @@ def main() -> None:
     try:
         for name in args.scenes.split(","):
             scene = load_scene(name)
-            with GpuRenderer(scene, width, height, context=ctx) as pruned, \
-                    GpuRenderer(scene, width, height, context=ctx, prune_shadows=False) as full:
+            with open_renderer(scene, (width, height), context=ctx) as pruned, \
+                    open_renderer(scene, (width, height), context=ctx,
+                                  options=RasterOptions(prune_shadows=False)) as full:
                 frames = [pruned.render(), full.render()]
                 calls = [lambda: pruned.render(out=frames[0]), lambda: full.render(out=frames[1])]
                 ms_pruned, ms_full = alternating_ms(calls, args.rounds)

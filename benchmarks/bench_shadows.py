@@ -48,6 +48,7 @@ from renderer.gpu.pipeline import CULL_FLAGS, make_float_depth
 from renderer.gpu.shaders import shader_source
 from renderer.gpu.shadow_maps import ShadowMaps
 from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values, set_shadow_sampler_units
+from renderer.methods import open_renderer
 
 from common import alternating_ms, machine, parser       # benchmarks/common.py
 
@@ -195,8 +196,8 @@ def measure(ctx, scene: Scene, size, rounds: int) -> dict:
     plain_scene = without_shadows(scene)
     # A scene without maps has no shadow passes for a bare program to draw: with = without.
     bare = BareShadows(ctx, scene, *size) if shadow_layout(scene, *size).any else None
-    with GpuRenderer(scene, *size, context=ctx) as shadowed, \
-            GpuRenderer(plain_scene, *size, context=ctx) as plain:
+    with open_renderer(scene, size, context=ctx) as shadowed, \
+            open_renderer(plain_scene, size, context=ctx) as plain:
         frames = shadowed.render(), plain.render()      # compiles; not timed
         same = bool((frames[0].rgba8 == frames[1].rgba8).all())
         calls = [lambda: plain.render(out=frames[1]), lambda: shadowed.render(out=frames[0])]

@@ -23,7 +23,8 @@ import numpy as np
 
 from renderer.core.builtin import builtin_scenes
 from renderer.gpu.context import make_context
-from renderer.gpu import GpuRenderer
+from renderer.core.raster_options import RasterOptions
+from renderer.methods import open_renderer
 from renderer.core.primitives import icosphere
 from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
 from renderer.core.scene_file import load_scene
@@ -51,8 +52,8 @@ def scenes() -> list[Scene]:
 
 
 def measure(ctx, scene: Scene, size, rounds: int) -> dict:
-    with GpuRenderer(scene, *size, context=ctx) as specialised, \
-            GpuRenderer(scene, *size, context=ctx, specialise=False) as general:
+    with open_renderer(scene, size, context=ctx) as specialised, \
+            open_renderer(scene, size, context=ctx, options=RasterOptions(specialise=False)) as general:
         first = specialised.render(), general.render()          # compiles; not timed
         times = {"specialised": [], "all-features": []}
         for _ in range(rounds):

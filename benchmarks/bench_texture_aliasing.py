@@ -28,8 +28,9 @@ import numpy as np
 
 from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
+from renderer.core.ray_options import RayOptions
 from renderer.gpu.context import make_context
-from renderer.gpu.raytracer import RayTracer
+from renderer.methods import open_renderer
 
 from common import machine, parser       # benchmarks/common.py
 
@@ -48,13 +49,15 @@ def rmse(a, b, where=None) -> float:
 
 def aliasing(scene, width: int, height: int, truth_samples: int, ctx) -> dict:
     """{(spp, pattern): (rmse all, rmse far half)} against `truth_samples` jittered samples."""
-    with RayTracer(scene, width, height, context=ctx, samples=truth_samples, pattern="jittered") as rt:
+    with open_renderer(scene, (width, height), method="raytrace", context=ctx,
+                       options=RayOptions(samples=truth_samples, pattern="jittered")) as rt:
         truth = rt.render()
     depth = truth.depth[np.isfinite(truth.depth)]
     far = np.isfinite(truth.depth) & (truth.depth > np.median(depth))
     out = {}
     for samples, pattern in SETTINGS:
-        with RayTracer(scene, width, height, context=ctx, samples=samples, pattern=pattern) as rt:
+        with open_renderer(scene, (width, height), method="raytrace", context=ctx,
+                           options=RayOptions(samples=samples, pattern=pattern)) as rt:
             frame = rt.render()
         out[(samples, pattern)] = (rmse(frame.rgba8, truth.rgba8), rmse(frame.rgba8, truth.rgba8, far))
     return out

@@ -36,11 +36,10 @@ from pathlib import Path
 
 import numpy as np
 
-import reference
 from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
-from renderer.gpu import GpuRenderer
 from renderer.gpu.context import make_context
+from renderer.methods import open_renderer
 from renderer.study.texture_report import filter_name, with_texture_setting, with_textures
 
 import ab_raytrace                                        # benchmarks/ab_raytrace.py
@@ -58,7 +57,8 @@ def untextured(scene):
 
 def reference_ms(scenes, width: int, height: int, frames: int) -> list[float]:
     """The median ms of reference.render() of each scene, frames alternating."""
-    return alternating_ms([lambda s=s: reference.render(s, width, height) for s in scenes], frames)
+    renderers = [open_renderer(s, (width, height), backend="reference") for s in scenes]
+    return alternating_ms([r.render for r in renderers], frames)
 
 
 def textured_against_untextured(args, ctx) -> None:
@@ -75,8 +75,8 @@ def textured_against_untextured(args, ctx) -> None:
         authored = scene.objects[0].material.texture.sampler
         for setting in FILTERS:
             drawn = with_texture_setting(scene, "filter", setting)
-            with GpuRenderer(drawn, width, height, context=ctx) as gpu, \
-                    GpuRenderer(plain, width, height, context=ctx) as bare:
+            with open_renderer(drawn, (width, height), context=ctx) as gpu, \
+                    open_renderer(plain, (width, height), context=ctx) as bare:
                 gpu.render()
                 bare.render()                                          # compiled, uploaded
                 ms, bare_ms = alternating_ms([gpu.render, bare.render], args.frames)

@@ -31,8 +31,9 @@ from dataclasses import replace
 from pathlib import Path
 
 from renderer.core.builtin import resolve_scene
-from renderer.cli import parse_size
+from renderer.cli.options import parse_size
 from renderer.gpu import GpuRenderer
+from renderer.methods import open_renderer
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene_file import load_scene
 from renderer.viewer.virtual_display import virtual_display
@@ -94,7 +95,8 @@ def main() -> None:
         renderers = {}
         for name in SCENES:
             authored = load_scene(resolve_scene(name))
-            renderers[name] = (GpuRenderer(replace(authored), width, height, context_kind="egl"), authored)
+            renderers[name] = (open_renderer(replace(authored), (width, height), context_kind="egl"),
+                               authored)
         for round_ in range(args.rounds):
             for name in SCENES:
                 for buffering in ("double", "triple"):

@@ -10,7 +10,7 @@ import statistics
 import subprocess
 import time
 
-from renderer.cli import parse_size
+from renderer.cli.options import parse_size
 
 
 def parser(doc: str, count: str, default_count: int) -> argparse.ArgumentParser:

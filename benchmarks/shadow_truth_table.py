@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from renderer.checks.shadow_truth import EDGE_KEY, shadows_vs_truth
-from renderer.cli import parse_size
+from renderer.cli.options import parse_size
 from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
 from renderer.core.shadows import shadow_layout

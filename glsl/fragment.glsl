@@ -31,8 +31,7 @@
 #ifdef TEXTURED
 #include "texture.glsl"
 #ifdef SHADING_FLAT
-in vec2 f_uv;                        // from geometry.glsl
-#define UV f_uv
+#define UV f_uv                      // from geometry.glsl (flat_varyings.glsl)
 #else
 in vec2 v_uv;                        // from vertex.glsl
 #define UV v_uv
@@ -49,34 +48,12 @@ uniform mat3 u_normal_matrix;
 uniform int u_shadow_facets;         // 1: a mesh, its facets are its surface; 0: an analytic shape
 #endif
 
-#if defined(SHADING_PHONG)
+#if defined(SHADING_FLAT)
+#define FLAT_VARYING in                  // from geometry.glsl, one per triangle
+#include "flat_varyings.glsl"
+#elif defined(SHADING_PHONG)
 in vec3 v_world_position;
 in vec3 v_world_normal;
-#elif defined(SHADOW_MAPS) && defined(SHADING_FLAT)
-in vec3 f_world_position;            // from geometry.glsl
-flat in vec3 f_face_normal;          // the terms: one per triangle
-flat in vec3 f_ambient;
-#ifdef TEXTURED
-flat in vec3 f_modulated_ambient;
-#endif
-#if NUM_DIRECTIONAL_TERMS > 0
-flat in vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
-#ifdef TWO_SIDED
-flat in vec3 f_directional_terms_back[NUM_DIRECTIONAL_TERMS];
-#endif
-#endif
-#if NUM_POINT_TERMS > 0
-flat in vec3 f_point_terms_front[NUM_POINT_TERMS];
-#ifdef TWO_SIDED
-flat in vec3 f_point_terms_back[NUM_POINT_TERMS];
-#endif
-#endif
-#define AMBIENT f_ambient
-#define MODULATED_AMBIENT f_modulated_ambient
-#define DIRECTIONAL_TERMS_FRONT f_directional_terms_front
-#define DIRECTIONAL_TERMS_BACK f_directional_terms_back
-#define POINT_TERMS_FRONT f_point_terms_front
-#define POINT_TERMS_BACK f_point_terms_back
 #elif defined(SHADOW_MAPS)
 in vec3 v_world_position;            // from vertex.glsl, interpolated
 in vec3 v_world_normal;
@@ -94,23 +71,6 @@ in vec3 v_directional_terms_back[NUM_DIRECTIONAL_TERMS];
 in vec3 v_point_terms_front[NUM_POINT_TERMS];
 #ifdef TWO_SIDED
 in vec3 v_point_terms_back[NUM_POINT_TERMS];
-#endif
-#endif
-#define AMBIENT v_ambient
-#define MODULATED_AMBIENT v_modulated_ambient
-#define DIRECTIONAL_TERMS_FRONT v_directional_terms_front
-#define DIRECTIONAL_TERMS_BACK v_directional_terms_back
-#define POINT_TERMS_FRONT v_point_terms_front
-#define POINT_TERMS_BACK v_point_terms_back
-#elif defined(SHADING_FLAT)
-flat in vec3 f_color_front;          // from geometry.glsl, one per triangle
-#ifdef TWO_SIDED
-flat in vec3 f_color_back;
-#endif
-#ifdef TEXTURED
-flat in vec3 f_modulated_front;
-#ifdef TWO_SIDED
-flat in vec3 f_modulated_back;
 #endif
 #endif
 #else
@@ -149,7 +109,8 @@ layout(location = 1) out vec4 out_linear_color;
 #endif
 
 // The terms of the side seen (`back`: a two-sided back face), each light's weighed by its
-// visibility at P with the lit normal N, added to the ambient term in lighting()'s order.
+// visibility at P with the lit normal N, added to the ambient term in lighting()'s order. The
+// varyings' names (AMBIENT, ...: flat's or Gouraud's) are lighting.glsl's.
 vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
 #ifdef TEXTURED
     vec3 color = AMBIENT + MODULATED_AMBIENT * texel;

@@ -14,48 +14,18 @@
 // f_modulated_* beside f_color_*, or with SHADOW_MAPS each light's term in TERM_PARTS rows
 // and f_modulated_ambient beside f_ambient.
 
-#include "lighting.glsl"
-
 layout(triangles) in;
 layout(triangle_strip, max_vertices = 3) out;
 
 in vec3 v_world_position[];
 #ifdef TEXTURED
 in vec2 v_uv[];
-out vec2 f_uv;
 #endif
+#define FLAT_VARYING out
+#include "flat_varyings.glsl"
 
-#ifdef SHADOW_MAPS
-out vec3 f_world_position;           // where fragment.glsl looks the maps up
-flat out vec3 f_face_normal;
-flat out vec3 f_ambient;             // I_a k_a
-#ifdef TEXTURED
-flat out vec3 f_modulated_ambient;   // I_a k_a where the texel modulates k_a, else 0
-#endif
-#if NUM_DIRECTIONAL_TERMS > 0
-flat out vec3 f_directional_terms_front[NUM_DIRECTIONAL_TERMS];
-#ifdef TWO_SIDED
-flat out vec3 f_directional_terms_back[NUM_DIRECTIONAL_TERMS];
-#endif
-#endif
-#if NUM_POINT_TERMS > 0
-flat out vec3 f_point_terms_front[NUM_POINT_TERMS];
-#ifdef TWO_SIDED
-flat out vec3 f_point_terms_back[NUM_POINT_TERMS];
-#endif
-#endif
-#else
-flat out vec3 f_color_front;         // lit with N (TEXTURED: the unmodulated coefficients')
-#ifdef TWO_SIDED
-flat out vec3 f_color_back;          // lit with -N
-#endif
-#ifdef TEXTURED
-flat out vec3 f_modulated_front;     // the modulated coefficients' terms, lit with N
-#ifdef TWO_SIDED
-flat out vec3 f_modulated_back;
-#endif
-#endif
-#endif
+#define LIGHT_TERMS_OUT                  // lighting.glsl's hand_on_light_terms writes the f_ terms
+#include "lighting.glsl"
 
 void main() {
     vec3 p0 = v_world_position[0];
@@ -88,22 +58,7 @@ void main() {
         gl_PrimitiveID = gl_PrimitiveIDIn;      // the face, for fragment.glsl's face texture
         f_world_position = v_world_position[i];
         f_face_normal = face_normal;
-        f_ambient = kept_ambient[OTHER_PART];
-#ifdef TEXTURED
-        f_modulated_ambient = kept_ambient[MODULATED_PART];
-#endif
-#if NUM_DIRECTIONAL_TERMS > 0
-        f_directional_terms_front = kept_directional_front;
-#ifdef TWO_SIDED
-        f_directional_terms_back = kept_directional_back;
-#endif
-#endif
-#if NUM_POINT_TERMS > 0
-        f_point_terms_front = kept_point_front;
-#ifdef TWO_SIDED
-        f_point_terms_back = kept_point_back;
-#endif
-#endif
+        hand_on_light_terms();
 #else
         f_color_front = front_color;
 #ifdef TWO_SIDED

@@ -29,7 +29,8 @@
 //     light's term on in TERM_PARTS rows of its array (NUM_DIRECTIONAL_TERMS = TERM_PARTS x
 //     the lights, renderer/gpu/shaders.py): OTHER_PART's rows first, then MODULATED_PART's.
 // Each light's term is a function of its own (directional_term, point_term), which flat and
-// Gouraud receivers of shadows also call to keep the terms apart (keep_light_terms).
+// Gouraud receivers of shadows also call to keep the terms apart (keep_light_terms) and hand
+// them on (hand_on_light_terms, in the stage that defines LIGHT_TERMS_OUT).
 
 #ifndef NUM_DIRECTIONAL_LIGHTS
 #define NUM_DIRECTIONAL_LIGHTS 0
@@ -251,6 +252,48 @@ void keep_light_terms(vec3 P, vec3 N, vec3 V) {
 #endif
     keep_part(P, N, V, OTHER_PART);
 }
+
+// The varyings that carry the kept terms to fragment.glsl (its shadowed_terms reads them by
+// these names): geometry.glsl's, one per triangle (flat; glsl/flat_varyings.glsl), or
+// vertex.glsl's, interpolated (Gouraud).
+#ifdef SHADING_FLAT
+#define AMBIENT f_ambient
+#define MODULATED_AMBIENT f_modulated_ambient
+#define DIRECTIONAL_TERMS_FRONT f_directional_terms_front
+#define DIRECTIONAL_TERMS_BACK f_directional_terms_back
+#define POINT_TERMS_FRONT f_point_terms_front
+#define POINT_TERMS_BACK f_point_terms_back
+#else
+#define AMBIENT v_ambient
+#define MODULATED_AMBIENT v_modulated_ambient
+#define DIRECTIONAL_TERMS_FRONT v_directional_terms_front
+#define DIRECTIONAL_TERMS_BACK v_directional_terms_back
+#define POINT_TERMS_FRONT v_point_terms_front
+#define POINT_TERMS_BACK v_point_terms_back
+#endif
+
+#ifdef LIGHT_TERMS_OUT
+// The stage that keeps the terms hands them on (vertex.glsl; geometry.glsl for each vertex it
+// emits): it defines LIGHT_TERMS_OUT and declares those outs before including this file.
+void hand_on_light_terms() {
+    AMBIENT = kept_ambient[OTHER_PART];
+#ifdef TEXTURED
+    MODULATED_AMBIENT = kept_ambient[MODULATED_PART];
+#endif
+#if NUM_DIRECTIONAL_TERMS > 0
+    DIRECTIONAL_TERMS_FRONT = kept_directional_front;
+#ifdef TWO_SIDED
+    DIRECTIONAL_TERMS_BACK = kept_directional_back;
+#endif
+#endif
+#if NUM_POINT_TERMS > 0
+    POINT_TERMS_FRONT = kept_point_front;
+#ifdef TWO_SIDED
+    POINT_TERMS_BACK = kept_point_back;
+#endif
+#endif
+}
+#endif
 #endif
 
 #ifdef SHADOWS

@@ -17,8 +17,6 @@
 // the modulated ones') and v_modulated_ambient beside v_ambient. fragment.glsl adds them
 // up as other + modulated * texel.
 
-#include "lighting.glsl"
-
 uniform mat4 u_model;                // M_world
 uniform mat3 u_normal_matrix;        // sign(det A) cof(A), A = M_world[:3, :3], scaled
 uniform mat4 u_view;                 // V
@@ -34,6 +32,7 @@ out vec2 v_uv;
 #if defined(SHADING_FLAT)
 out vec3 v_world_position;
 #elif defined(SHADING_GOURAUD) && defined(SHADOW_MAPS)
+#define LIGHT_TERMS_OUT              // lighting.glsl's hand_on_light_terms writes the v_ terms
 out vec3 v_world_position;           // where fragment.glsl looks the maps up
 out vec3 v_world_normal;
 out vec3 v_ambient;                  // I_a k_a
@@ -70,6 +69,8 @@ out vec3 v_world_normal;
 #error "define one of SHADING_FLAT, SHADING_GOURAUD, SHADING_PHONG"
 #endif
 
+#include "lighting.glsl"
+
 void main() {
     vec4 world_position = u_model * vec4(in_position, 1.0);
     gl_Position = u_projection * (u_view * world_position);        // p_clip = P V M p
@@ -84,22 +85,7 @@ void main() {
     v_world_position = world_position.xyz;
     v_world_normal = world_normal;
     keep_light_terms(world_position.xyz, world_normal, view_vector(world_position.xyz));
-    v_ambient = kept_ambient[OTHER_PART];
-#ifdef TEXTURED
-    v_modulated_ambient = kept_ambient[MODULATED_PART];
-#endif
-#if NUM_DIRECTIONAL_TERMS > 0
-    v_directional_terms_front = kept_directional_front;
-#ifdef TWO_SIDED
-    v_directional_terms_back = kept_directional_back;
-#endif
-#endif
-#if NUM_POINT_TERMS > 0
-    v_point_terms_front = kept_point_front;
-#ifdef TWO_SIDED
-    v_point_terms_back = kept_point_back;
-#endif
-#endif
+    hand_on_light_terms();
 #elif defined(SHADING_GOURAUD)
 #ifdef TEXTURED
     material_part(MODULATED_PART);

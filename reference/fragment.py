@@ -40,13 +40,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from reference.geometry import TriangleOutputs
-from reference.lighting import (LightTerms, Lights, MaterialUniforms, dot, light_terms, lighting,
+from reference.lighting import (LightTerms, Lights, MaterialUniforms, dot, light_terms, lighting, modulated,
                                 normalize_or_zero)
 from reference.rasterizer import perspective_weights_at
 from reference.sampler import quad_reference
 from reference.shadow.lookup import FragmentShadows, ShadowMaps
 from reference.texture import material_texel
-from reference.vertex import VertexOutputs, modulated
+from reference.vertex import VertexOutputs
 from renderer.core.facets import CREASE_CAP, face_normals
 
 

@@ -34,33 +34,26 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import (MODULATED_PART, OTHER_PART, LightTerms, Lights, MaterialUniforms, lit_parts,
-                                normalize_or_zero, side_colors, stacked_parts)
-from reference.vertex import modulated
+from reference.lighting import HandsOnLighting, Lights, hand_on_lighting, normalize_or_zero
 
 
 @dataclass
-class TriangleOutputs:
+class TriangleOutputs(HandsOnLighting):
+    PREFIX = "f_"
     f_face_normal: np.ndarray
     f_centroid: np.ndarray
-    f_color_front: np.ndarray
-    f_color_back: np.ndarray
     f_world_position: np.ndarray
-    f_ambient: np.ndarray
-    f_directional_terms_front: np.ndarray
-    f_directional_terms_back: np.ndarray
-    f_point_terms_front: np.ndarray
-    f_point_terms_back: np.ndarray
+    f_color_front: np.ndarray | None = None         # the lighting: shade_triangles hands it on
+    f_color_back: np.ndarray | None = None
+    f_ambient: np.ndarray | None = None
+    f_directional_terms_front: np.ndarray | None = None
+    f_directional_terms_back: np.ndarray | None = None
+    f_point_terms_front: np.ndarray | None = None
+    f_point_terms_back: np.ndarray | None = None
     f_uv: np.ndarray | None = None
     f_modulated_ambient: np.ndarray | None = None
     f_modulated_front: np.ndarray | None = None
     f_modulated_back: np.ndarray | None = None
-
-    def light_terms(self, back: bool) -> LightTerms:
-        """The terms of the front (or back) side, per triangle."""
-        if back:
-            return LightTerms(self.f_ambient, self.f_directional_terms_back, self.f_point_terms_back)
-        return LightTerms(self.f_ambient, self.f_directional_terms_front, self.f_point_terms_front)
 
 
 def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
@@ -72,27 +65,10 @@ def face_normal(p0: np.ndarray, p1: np.ndarray, p2: np.ndarray) -> np.ndarray:
 def shade_triangles(v_world_position: np.ndarray, material, lights: Lights,
                     u_eye: np.ndarray, v_uv: np.ndarray | None = None) -> TriangleOutputs:
     """The geometry stage for a flat-shaded object."""
-    dtype = v_world_position.dtype
     p0, p1, p2 = v_world_position[:, 0], v_world_position[:, 1], v_world_position[:, 2]
     f_face_normal = face_normal(p0, p1, p2)
     f_centroid = (p0 + p1 + p2) / 3.0
-    uniforms = MaterialUniforms.from_material(material, dtype)
-    eye = np.asarray(u_eye, dtype=dtype)
-    modulate = modulated(material)
+    out = TriangleOutputs(f_face_normal, f_centroid, v_world_position, f_uv=v_uv)
     with np.errstate(invalid="ignore"):
-        front = lit_parts(f_centroid, f_face_normal, eye, uniforms, lights, modulate)
-        back = (lit_parts(f_centroid, -f_face_normal, eye, uniforms, lights, modulate)
-                if material.two_sided else front)
-        colors = [side_colors(front, back, f_centroid, f_face_normal, material.two_sided, part)
-                  for part in range(len(front))]
-    out = TriangleOutputs(f_face_normal, f_centroid, *colors[OTHER_PART], v_world_position,
-                          *_terms(stacked_parts(front), stacked_parts(back)), f_uv=v_uv)
-    if modulate:
-        out.f_modulated_ambient = front[MODULATED_PART].ambient
-        out.f_modulated_front, out.f_modulated_back = colors[MODULATED_PART]
+        out.hand_on(hand_on_lighting(f_centroid, f_face_normal, u_eye, material, lights))
     return out
-
-
-def _terms(front: LightTerms, back: LightTerms) -> tuple:
-    """TriangleOutputs' f_ambient and term fields, in its order."""
-    return front.ambient, front.directional, back.directional, front.point, back.point

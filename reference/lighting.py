@@ -19,6 +19,8 @@ A textured material (the GLSL's TEXTURED) lights its coefficients times factors
 it modulates (Phong), or each part alone (`MaterialUniforms.part`, material_part: OTHER_PART
 the other coefficients, MODULATED_PART the modulated ones), which flat and Gouraud light and
 hand on apart (`lit_parts`, `stacked_parts`; LightTerms.modulated adds them up again).
+`hand_on_lighting` is what those two stages hand on, and `HandsOnLighting` their outputs that
+carry it (v_* and f_*: glsl/lighting.glsl's hand_on_light_terms).
 
 The sides rule (one-sided / two-sided) is not applied here: callers pass the normal that
 is to be lit (the vertex, geometry and fragment stages flip it for back faces).
@@ -27,6 +29,7 @@ is to be lit (the vertex, geometry and fragment stages flip it for back faces).
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import numpy as np
 
@@ -273,6 +276,55 @@ def stacked_parts(parts: list[LightTerms]) -> LightTerms:
     return LightTerms(parts[OTHER_PART].ambient,
                       np.concatenate([p.directional for p in parts], axis=-2),
                       np.concatenate([p.point for p in parts], axis=-2))
+
+
+def modulated(material) -> tuple:
+    """The coefficients `material`'s texel modulates; empty without a texture."""
+    return () if material.texture is None else tuple(material.texture.modulate)
+
+
+def hand_on_lighting(P: np.ndarray, N: np.ndarray, u_eye: np.ndarray, material,
+                     lights: Lights) -> dict[str, np.ndarray]:
+    """What flat and Gouraud hand on of the lighting at points P (..., 3) with unit normals N
+    (..., 3) for `material` (a renderer.core.scene.Material), in P's dtype (the GLSL's
+    keep_light_terms and hand_on_light_terms; without shadow maps the colours, the terms'
+    sums), by the stage outputs' names without their prefix (v_ in reference/vertex.py, f_ in
+    reference/geometry.py): the ambient term and the terms stacked by part (`stacked_parts`),
+    and the colours, each lit with N and, two-sided, with -N (else the back's are the
+    front's); with a texture, MODULATED_PART's ambient term and colours (modulated_*)."""
+    uniforms = MaterialUniforms.from_material(material, P.dtype)
+    eye = np.asarray(u_eye, dtype=P.dtype)
+    modulate = modulated(material)
+    front = lit_parts(P, N, eye, uniforms, lights, modulate)
+    back = lit_parts(P, -N, eye, uniforms, lights, modulate) if material.two_sided else front
+    colors = [side_colors(front, back, P, N, material.two_sided, part) for part in range(len(front))]
+    stacked = {"front": stacked_parts(front), "back": stacked_parts(back)}
+    lit = {"ambient": stacked["front"].ambient}
+    for side, terms in stacked.items():
+        lit[f"directional_terms_{side}"], lit[f"point_terms_{side}"] = terms.directional, terms.point
+    lit["color_front"], lit["color_back"] = colors[OTHER_PART]
+    if modulate:
+        lit["modulated_ambient"] = front[MODULATED_PART].ambient
+        lit["modulated_front"], lit["modulated_back"] = colors[MODULATED_PART]
+    return lit
+
+
+class HandsOnLighting:
+    """A stage's outputs that carry hand_on_lighting's, each as PREFIX + its name
+    (VertexOutputs' v_*, TriangleOutputs' f_*)."""
+    PREFIX: ClassVar[str] = ""
+
+    def hand_on(self, lit: dict[str, np.ndarray]) -> None:
+        """Each of `lit` into the output of its name (the GLSL's hand_on_light_terms, and the
+        colours' outs)."""
+        for name, value in lit.items():
+            setattr(self, self.PREFIX + name, value)
+
+    def light_terms(self, back: bool) -> LightTerms:
+        """The terms handed on for the front (or back) side."""
+        side = "back" if back else "front"
+        return LightTerms(*(getattr(self, self.PREFIX + name) for name in
+                            ("ambient", f"directional_terms_{side}", f"point_terms_{side}")))
 
 
 def lighting(P: np.ndarray, N: np.ndarray, E: np.ndarray, material: MaterialUniforms,

@@ -39,12 +39,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.lighting import (MODULATED_PART, OTHER_PART, LightTerms, Lights, MaterialUniforms, lit_parts,
-                                normalize_or_zero, side_colors, stacked_parts)
+from reference.lighting import HandsOnLighting, Lights, hand_on_lighting, normalize_or_zero
 
 
 @dataclass
-class VertexOutputs:
+class VertexOutputs(HandsOnLighting):
+    PREFIX = "v_"
     gl_Position: np.ndarray
     v_world_position: np.ndarray
     v_world_normal: np.ndarray
@@ -61,21 +61,10 @@ class VertexOutputs:
     v_modulated_front: np.ndarray | None = None
     v_modulated_back: np.ndarray | None = None
 
-    def light_terms(self, back: bool) -> LightTerms:
-        """The terms of the front (or back) side, per vertex."""
-        if back:
-            return LightTerms(self.v_ambient, self.v_directional_terms_back, self.v_point_terms_back)
-        return LightTerms(self.v_ambient, self.v_directional_terms_front, self.v_point_terms_front)
-
 
 def transform_points(matrix: np.ndarray, points: np.ndarray) -> np.ndarray:
     """M p for (V, 3) points taken as (x, y, z, 1); returns (V, 4) homogeneous coordinates."""
     return points @ matrix[:, :3].T + matrix[:, 3]
-
-
-def modulated(material) -> tuple:
-    """The coefficients `material`'s texel modulates; empty without a texture."""
-    return () if material.texture is None else tuple(material.texture.modulate)
 
 
 def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, in_uv: np.ndarray | None = None,
@@ -99,20 +88,5 @@ def shade_vertices(in_position: np.ndarray, in_normal: np.ndarray, in_uv: np.nda
     if in_uv is not None:
         out.v_uv = np.asarray(in_uv, dtype=dtype)
     if material.shading == "gouraud":
-        uniforms = MaterialUniforms.from_material(material, dtype)
-        eye = np.asarray(u_eye, dtype=dtype)
-        modulate = modulated(material)
-        front = lit_parts(v_world_position, v_world_normal, eye, uniforms, lights, modulate)
-        back = (lit_parts(v_world_position, -v_world_normal, eye, uniforms, lights, modulate)
-                if material.two_sided else front)
-        stacked_front, stacked_back = stacked_parts(front), stacked_parts(back)
-        out.v_ambient = stacked_front.ambient
-        out.v_directional_terms_front, out.v_point_terms_front = stacked_front.directional, stacked_front.point
-        out.v_directional_terms_back, out.v_point_terms_back = stacked_back.directional, stacked_back.point
-        colors = [side_colors(front, back, v_world_position, v_world_normal, material.two_sided, part)
-                  for part in range(len(front))]
-        out.v_color_front, out.v_color_back = colors[OTHER_PART]
-        if modulate:
-            out.v_modulated_ambient = front[MODULATED_PART].ambient
-            out.v_modulated_front, out.v_modulated_back = colors[MODULATED_PART]
+        out.hand_on(hand_on_lighting(v_world_position, v_world_normal, u_eye, material, lights))
     return out

@@ -6,8 +6,4 @@ those below it: core (scene model, matrices, GL rules), gpu (GpuRenderer), check
 tolerance, goldens), study (report, extremes), viewer (the window); README.md, "Layout".
 """
 
-from renderer import _moved
-
 __version__ = "0.1.0"
-
-_moved.install()

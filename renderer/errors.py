@@ -66,6 +66,19 @@ class SystemFault(UserError):
     status = 1
 
 
+class OptionError(ValueError):
+    """An option out of its range, or two that do not go together: `fields` names the options
+    concerned by their field names (RayOptions', OutputSettings'), `reason` says why in words
+    that name no front end's spelling. The rule is written once, where the options object is
+    made; the command line and the job file each spell the fields their own way (`--spp 2
+    --pattern adaptive`, `settings[0].samples`) in front of the same reason."""
+
+    def __init__(self, fields: str | tuple[str, ...], reason: str):
+        self.fields = (fields,) if isinstance(fields, str) else tuple(fields)
+        self.reason = reason
+        super().__init__(f"{', '.join(self.fields)}: {reason}")
+
+
 class SceneError(UserError):
     """A scene file (or a mesh it names) that cannot be rendered."""
 

@@ -193,17 +193,17 @@ def cli():
 @pytest.fixture
 def gpu_stand_in(monkeypatch):
     """gpu_stand_in(frame): from now on, in this test, the command line's GPU render
-    (renderer.cli._render_gpu, which `compare` calls) hands back
+    (renderer.cli.compare._render_gpu, which `compare` calls) hands back
     `frame` instead of drawing, so that `renderer.cli.main([...])` can be run in-process on a
     frame made to order (e.g. a reference frame with some pixels changed)."""
-    from renderer import cli
+    from renderer.cli import compare
     from renderer.core.gl_rules import SUBPIXEL_BITS
 
     def stand_in(frame):
-        def render(scene, size, context_kind, frames=1):
-            assert frame.size == tuple(size), "the stand-in frame has another size"
+        def render(scene, args, frames=1):
+            assert frame.size == tuple(args.size), "the stand-in frame has another size"
             return frame, 1.0, {"GL_RENDERER": "llvmpipe (stand-in)", "context": "stand-in"}, SUBPIXEL_BITS
-        monkeypatch.setattr(cli, "_render_gpu", render)
+        monkeypatch.setattr(compare, "_render_gpu", render)
     return stand_in
 
 

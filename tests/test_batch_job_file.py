@@ -53,17 +53,18 @@ MISTAKES = {
                               "folder: use letters, digits, '.', '_' and '-' (at most 100, starting "
                               "with a letter or digit)"),
     "ray option for raster": (SPHERE + '[[settings]]\nsamples = 4\n',
-                              'settings[0].samples: is for method = "raytrace"'),
+                              'settings[0].samples: is for method raytrace, not raster'),
     "adaptive samples": (SPHERE + '[[settings]]\nmethod = "raytrace"\npattern = "adaptive"\nsamples = 2\n',
                          "settings[0].samples: adaptive sampling needs at least 4 samples per pixel "
                          "(its first set), got 2"),
     "method": (SPHERE + '[[settings]]\nmethod = "raytrce"\n', "settings[0].method: unknown method "
                "'raytrce'; did you mean 'raytrace'? expected one of: raster, raytrace"),
     "bits": (SPHERE + '[[settings]]\noutputs = [{ format = "png8", bits = 12 }]\n',
-             "settings[0].outputs[0]: bits 12: png8 holds at most 8 bits per channel; use png16"),
+             "settings[0].outputs[0].bits: png8 holds at most 8 bits per channel; use png16"),
     "exr transparent": (SPHERE + '[[settings]]\nbackground = "transparent"\noutputs = [{ format = "exr" }]\n',
-                        'settings[0].outputs[0].format: exr with background = "transparent": '
-                        'OpenEXR\'s alpha is premultiplied; write format = "npy" (straight RGBA)'),
+                        "settings[0].outputs[0].format: OpenEXR's alpha is premultiplied, and the "
+                        "frame's colour where nothing is drawn is the background's under alpha 0; "
+                        "write format npy (straight RGBA)"),
     "output suffix": (SPHERE + '[[settings]]\noutputs = [{ format = "exr", name = "colour.png" }]\n',
                       "settings[0].outputs[0].name: 'colour.png' is written as .exr; name it colour.exr"),
     "output names": (SPHERE + '[[settings]]\noutputs = [{ format = "png8" }, { format = "png16" }]\n',

@@ -11,7 +11,7 @@ through `renderer.cli.main(argv)`. What must hold for every case (`check_outcome
   taken from the scene's `name`;
 - exit 1 or 2: exactly one line on stderr starting "renderer: " (or "renderer CMD: "); a
   command line argparse refuses may add its usage line (the documented contract of
-  renderer/cli.py); nothing written, changed or left (no hidden `.*.tmp` either);
+  renderer/cli/); nothing written, changed or left (no hidden `.*.tmp` either);
 - never: an exception out of main() (printed with the seed and the input to reproduce it),
   a Python warning (in a real process it is two lines on stderr), "Traceback" anywhere, more
   than RUNAWAY_SECONDS or RUNAWAY_BYTES of address space over what the process had.

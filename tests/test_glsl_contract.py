@@ -2,31 +2,38 @@
 
 The GLSL in glsl/ and the twin in reference/ use the same names on purpose (v_world_position,
 u_ka, u_point_position, ...). Nothing else makes them agree: a renamed varying or uniform
-still compiles, GL drops a uniform that no program has, and moderngl skips uploading a
-name a program lacks. So the `in`, `out` and `uniform` declarations of each GLSL file
-(every one in the file, whatever the #defines select) are held against:
+still compiles, and GL drops a uniform that no program has. So the `in`, `out` and `uniform`
+declarations of each GLSL file (every one in the file, whatever the #defines select; read by
+renderer/gpu/declarations.py) are held against:
 
 - the stage before: each `in` of geometry.glsl and fragment.glsl is an `out` of the stage
   before it (vertex -> geometry -> fragment), of the same type and interpolation, and each
-  `out` of the vertex and geometry stages is read by a later stage;
+  `out` of the vertex and geometry stages is read by a later stage (flat_varyings.glsl
+  declares flat shading's for both ends, read with each includer's FLAT_VARYING);
 - the twin: the vertex stage's `out`s are fields of reference.vertex.VertexOutputs, the
   geometry stage's of reference.geometry.TriangleOutputs, the fragment stage's `in`s are
   fields of either; the vertex attributes and matrices are the parameters of
   reference.vertex.shade_vertices; the material and light uniforms are the fields of
   reference.lighting.MaterialUniforms and Lights (a light array in GLSL is an array of one
   row per light in the twin); the material lookup's (texture.glsl) are the parameters of
-  reference.texture.lookup_coordinates;
-- the GPU path: every declared uniform is uploaded by renderer/gpu/pipeline.py and every
-  uploaded name is declared; the vertex attributes are the ones GpuRenderer binds.
+  reference.texture.lookup_coordinates; the ray tracer's (glsl/raytrace/) and the output
+  stage's (glsl/output/) are names the twin reads: a uniform of renderer/core's that the twin
+  takes by that name, or the data it reads in its own names (RAYTRACE_TWIN_NAMES,
+  OUTPUT_TWIN_NAMES);
+- the GPU path: every declared uniform is uploaded by renderer/gpu/pipeline.py (the ray
+  tracer's by renderer/gpu/raytracer.py, the output stage's by renderer/gpu/output.py and
+  colour.py) and every uploaded name is declared; the vertex attributes are the ones
+  GpuRenderer binds.
 
-Each failure names the GLSL file, the line and the name that drifted.
+Every GLSL file with a twin is read here (test_every_twinned_glsl_file_is_held_here). Each
+failure names the GLSL file, the line and the name that drifted.
 """
-
 from __future__ import annotations
 
 import inspect
 import re
-from dataclasses import dataclass, fields, replace
+from pathlib import Path
+from dataclasses import fields, replace
 
 import moderngl
 import numpy as np
@@ -35,22 +42,28 @@ import pytest
 from reference.fragment import shade_fragments
 from reference.geometry import TriangleOutputs, shade_triangles
 from reference.lighting import Lights, MaterialUniforms
+from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
+from renderer.core.light_areas import area_light_uniforms
+from renderer.core.output_settings import Halftone, OutputSettings, Transfer
 from reference.texture import lookup_coordinates
 from reference.vertex import VertexOutputs, shade_vertices
 from renderer.core.builtin import builtin_scenes
 from renderer.core.resources import glsl_dir
 from renderer.core.scene import SHADING_MODES
-from renderer.core.scene_file import load_scene
+from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.core.shadows import plan_shadows, shadow_layout
 from renderer.core.textures import MaterialTexture, checkerboard
 from renderer.core.uniforms import SHADOW_PASS_UNIFORMS, UNIFORM_TYPES
 from renderer.gpu import GpuRenderer
-from renderer.gpu.shaders import ALL_FEATURES_LIGHTS
+from renderer.gpu.declarations import (Declaration, declarations, program_uniforms, selected,
+                                       selected_uniforms, uniforms_to_write)
+from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ShaderSourceError
 
 STAGES = ("vertex.glsl", "geometry.glsl", "fragment.glsl")      # in pipeline order
 LIGHTING = "lighting.glsl"
 TEXTURE = "texture.glsl"                 # the material lookup (TEXTURED)
-SHADOW_FILES = ("shadow/lookup.glsl", "shadow/depth.vert")   # the lookup and the depth pass
+FLAT_VARYINGS = "flat_varyings.glsl"     # geometry.glsl's outs and fragment.glsl's ins
+SHADOW_FILES = ("shadow/lookup.glsl", "shadow/depth.vert", "shadow/depth.frag")   # lookup, depth pass
 # A scene with both kinds of light, specular materials and all three shading modes (the GPU
 # path's checks give one of its materials a texture: every_feature_scene).
 EVERY_FEATURE_SCENE = "hierarchy"
@@ -121,93 +134,36 @@ def bound_attribute_names(ctx) -> set[str]:
     return bound
 
 
-# -- reading the declarations ---------------------------------------------------------------------
+# -- reading the declarations (renderer/gpu/declarations.py) -------------------------------------
 
-@dataclass(frozen=True)
-class Declaration:
-    file: str
-    line: int
-    storage: str                 # "in", "out" or "uniform"
-    type: str                    # "vec3", "mat4", ...
-    name: str
-    array: str | None            # None: not an array; "" for name[]; else the size as written
-    interpolation: str = "smooth"     # of an in or out: GLSL's default, "flat" or "noperspective"
-    layout: str = ""             # the layout( ) qualifier's contents, if any
-
-    @property
-    def where(self) -> str:
-        return f"glsl/{self.file}:{self.line}"
+# An include that declares a stage interface for both ends, and the macro each includer defines
+# as its direction (in or out) before including it.
+INTERFACES = {FLAT_VARYINGS: "FLAT_VARYING"}
 
 
-STORAGE = {"in", "out", "uniform"}
-INTERPOLATION = {"smooth", "flat", "noperspective"}
-OTHER_QUALIFIERS = {"centroid", "sample", "invariant", "highp", "mediump", "lowp"}
-_LAYOUT = re.compile(r"^layout\s*\(([^)]*)\)\s*")
-_DECLARATOR = re.compile(r"^(\w+)\s*(?:\[\s*([\w\s*]*?)\s*\])?$")     # [6 * N] too
+def read_glsl(names=(*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES)) -> dict[str, str]:
+    return {name: (glsl_dir() / name).read_text(encoding="utf-8") for name in names}
 
 
-def without_comments_and_directives(text: str) -> str:
-    """The text with comments and preprocessor lines blanked out, newlines kept (so line
-    numbers hold): every declaration counts, whichever #if branch it is in."""
-    text = re.sub(r"/\*.*?\*/", lambda m: re.sub(r"[^\n]", " ", m.group()), text, flags=re.S)
-    text = re.sub(r"//[^\n]*", "", text)
-    return re.sub(r"(?m)^[ \t]*#[^\n]*", "", text)
-
-
-def top_level_statements(text: str):
-    """(line, statement) for each `;`-terminated statement outside any braces."""
-    depth, start = 0, 0
-    for index, char in enumerate(text):
-        if char in "{}":
-            depth += 1 if char == "{" else -1
-            start = index + 1
-        elif char == ";" and depth == 0:
-            statement = text[start:index]
-            if statement.strip():
-                leading = len(statement) - len(statement.lstrip())
-                yield text.count("\n", 0, start + leading) + 1, " ".join(statement.split())
-            start = index + 1
-
-
-def declarations(file: str, text: str) -> list[Declaration]:
-    """The `in`, `out` and `uniform` variables declared in one GLSL file."""
+def interface_declarations(file: str, sources: dict[str, str]) -> list[Declaration]:
+    """The declarations of the INTERFACES `file` includes, read with its direction: each is
+    the includer's as much as its own (its `where` names the include)."""
     found = []
-    for line, statement in top_level_statements(without_comments_and_directives(text)):
-        layout = ""
-        match = _LAYOUT.match(statement)
-        if match:
-            layout, statement = " ".join(match.group(1).split()), statement[match.end():]
-        words = statement.split(" ", 1)
-        qualifiers = []
-        while words[0] in STORAGE | INTERPOLATION | OTHER_QUALIFIERS and len(words) > 1:
-            qualifiers.append(words[0])
-            words = words[1].split(" ", 1)
-        storage = [q for q in qualifiers if q in STORAGE]
-        if not storage:                      # layout(triangles) in; a constant; a prototype
+    for include, macro in INTERFACES.items():
+        if f'#include "{include}"' not in sources[file]:
             continue
-        if len(words) < 2:
-            raise ValueError(f"glsl/{file}:{line}: cannot read the declaration {statement!r}")
-        type_, declarators = words
-        interpolation = ("" if storage[0] == "uniform"
-                         else next((q for q in qualifiers if q in INTERPOLATION), "smooth"))
-        for declarator in declarators.split(","):
-            parsed = _DECLARATOR.match(declarator.strip())
-            if not parsed:
-                raise ValueError(f"glsl/{file}:{line}: cannot read the declaration {statement!r}")
-            name, size = parsed.groups()
-            array = None if "[" not in declarator else (size or "")
-            found.append(Declaration(file, line, storage[0], type_, name, array, interpolation,
-                                     layout))
+        direction = re.search(rf"#define {macro} (in|out)\b", sources[file])
+        if direction is None:
+            raise ValueError(f"glsl/{file} includes {include} without #define {macro} in or out")
+        found += declarations(include, sources[include].replace(macro, direction.group(1)))
     return found
 
 
-def read_glsl() -> dict[str, str]:
-    return {name: (glsl_dir() / name).read_text(encoding="utf-8")
-            for name in (*STAGES, LIGHTING, TEXTURE, *SHADOW_FILES)}
-
-
 def parse(sources: dict[str, str]) -> dict[str, list[Declaration]]:
-    return {name: declarations(name, text) for name, text in sources.items()}
+    """name -> its declarations and those of the interfaces it includes (an interface alone:
+    none, its storage is its includer's)."""
+    return {name: declarations(name, text) + interface_declarations(name, sources)
+            for name, text in sources.items()}
 
 
 def of(decls: list[Declaration], storage: str) -> dict[str, Declaration]:
@@ -217,7 +173,9 @@ def of(decls: list[Declaration], storage: str) -> dict[str, Declaration]:
 
 
 def all_uniforms(parsed) -> dict[str, Declaration]:
-    return {d.name: d for decls in parsed.values() for d in decls if d.storage == "uniform"}
+    """The uniforms set by name: all but those a layout(binding = ...) binds (images)."""
+    return {d.name: d for decls in parsed.values() for d in decls
+            if d.storage == "uniform" and "binding" not in d.layout}
 
 
 # -- the checks, each a list of what drifted ------------------------------------------------------
@@ -361,15 +319,18 @@ def twin_fields_not_declared(parsed) -> list[str]:
     return problems
 
 
-def uniforms_not_uploaded(parsed, uploaded: set[str]) -> list[str]:
-    return [f"{decl.where}: uniform {name} is not uploaded by the GPU path "
-            f"(renderer/gpu: {', '.join(sorted(uploaded))})"
+def uniforms_not_uploaded(parsed, uploaded: set[str], uploader: str = "the GPU path",
+                          where: str = "renderer/gpu") -> list[str]:
+    """Each uniform of `parsed` (but one bound by its layout's binding) is in `uploaded`."""
+    return [f"{decl.where}: uniform {name} is not uploaded by {uploader} "
+            f"({where}: {', '.join(sorted(uploaded))})"
             for name, decl in all_uniforms(parsed).items() if name not in uploaded]
 
 
-def uploads_not_declared(parsed, uploaded: set[str]) -> list[str]:
+def uploads_not_declared(parsed, uploaded: set[str], uploader: str = "renderer/gpu",
+                         files: str = "glsl/") -> list[str]:
     declared = all_uniforms(parsed)
-    return [f"renderer/gpu uploads {name}, which no file of glsl/ declares "
+    return [f"{uploader} uploads {name}, which no file of {files} declares "
             f"({', '.join(sorted(declared))})" for name in sorted(uploaded - set(declared))]
 
 
@@ -418,6 +379,70 @@ void main() {
         (15, "in", "vec2", "v_f", None, "noperspective", ""),
         (16, "out", "vec4", "out_g", None, "smooth", "location = 1"),
     ]
+
+
+def test_selected_keeps_the_branches_the_defines_choose():
+    """renderer/gpu/declarations.py's preprocessor: defined(), values, macros of macros,
+    #elif, #else, #ifndef, #undef; every line keeps its number."""
+    text = """#version 330 core
+#define A 2
+#define B
+#if A > 1 && defined(B)
+uniform float u_one;
+#elif A
+uniform float u_two;
+#else
+uniform float u_three;
+#endif
+#ifndef C
+uniform float u_four;           // #if 0
+#endif
+#if !defined(B) || A == 0
+uniform float u_five;
+#endif
+#define D (A * 3)
+#if D >= 6
+uniform float u_six;
+#endif
+#undef B
+#ifdef B
+uniform float u_seven;
+#endif
+"""
+    assert selected_uniforms(text) == {"u_one", "u_four", "u_six"}
+    assert selected(text).count("\n") == text.count("\n")
+
+
+def test_uniforms_to_write_leaves_out_what_the_defines_and_the_compiler_leave_out():
+    text = "#version 330 core\n#define LENS\nuniform float u_a;\n#ifdef LENS\nuniform float u_b;\n" \
+           "#else\nuniform float u_c;\n#endif\n"
+    assert uniforms_to_write(text, {"u_a", "u_b"}, {"u_a", "u_b", "u_c"}) == {"u_a", "u_b"}
+    assert uniforms_to_write(text, {"u_b"}, {"u_a", "u_b"}) == {"u_b"}     # u_a: unused, dropped
+    with pytest.raises(ShaderSourceError, match="values for u_d, which the GLSL declares nowhere"):
+        uniforms_to_write(text, {"u_a", "u_b"}, {"u_a", "u_b", "u_d"})
+    with pytest.raises(ShaderSourceError, match="no value for u_b, which the GLSL declares"):
+        uniforms_to_write(text, {"u_a", "u_b"}, {"u_a"})
+    with pytest.raises(ShaderSourceError, match="u_c kept by the compiler though the #defines"):
+        uniforms_to_write(text, {"u_a", "u_b", "u_c"}, {"u_a", "u_b"})
+
+
+def test_selected_agrees_with_the_compiler(gl_contexts):
+    """What a linked rasteriser program kept is among the uniforms selected of its stages'
+    prepared sources, in both builds, with shadow maps and textures."""
+    from renderer.gpu.context import activate
+    from renderer.gpu.shaders import ProgramCache, ShaderVariant, program_sources
+    activate(gl_contexts["egl"])
+    cache = ProgramCache(gl_contexts["egl"])
+    try:
+        for shading in SHADING_MODES:
+            for shadows, texture, every in ((False, (), False), (True, ("kd",), False), (True, (), True)):
+                variant = ShaderVariant(shading, True, 1, 2, specular=True, shadows=shadows,
+                                        texture=texture, all_features=every)
+                chosen = set().union(*(selected_uniforms(s.text)
+                                       for s in program_sources(variant).values()))
+                assert program_uniforms(cache.get(variant)) <= chosen, variant.name
+    finally:
+        cache.release()
 
 
 def test_the_shaders_declare_what_the_pipeline_is_made_of(parsed):
@@ -556,12 +581,26 @@ def test_a_varying_changed_in_one_branch_only_is_caught():
 
 
 def test_a_changed_interpolation_is_caught():
-    """flat dropped from one of the fragment stage's inputs."""
+    """flat added to one of the fragment stage's inputs from vertex.glsl (flat shading's are
+    declared once for both ends: glsl/flat_varyings.glsl)."""
     sources = read_glsl()
     drifted = parse(sources | {"fragment.glsl": sources["fragment.glsl"].replace(
-        "flat in vec3 f_color_front;", "in vec3 f_color_front;")})
-    assert "in smooth vec3 f_color_front differs from the out of glsl/geometry.glsl" in \
+        "in vec3 v_color_front;", "flat in vec3 v_color_front;")})
+    assert "in flat vec3 v_color_front differs from the out of glsl/vertex.glsl" in \
         report(inputs_not_from_the_stage_before(drifted))
+
+
+def test_the_flat_interface_is_read_with_each_includers_direction(parsed):
+    """glsl/flat_varyings.glsl declares geometry.glsl's outs and fragment.glsl's ins; a
+    renamed one in it is caught as any other (here: the twin has no field of the name)."""
+    geometry_out, fragment_in = of(parsed["geometry.glsl"], "out"), of(parsed["fragment.glsl"], "in")
+    assert {"f_color_front", "f_ambient", "f_point_terms_back", "f_uv"} <= set(geometry_out) & set(fragment_in)
+    assert geometry_out["f_face_normal"].where.startswith(f"glsl/{FLAT_VARYINGS}:")
+    assert geometry_out["f_face_normal"].interpolation == "flat" and not parsed[FLAT_VARYINGS]
+    drifted = renamed(read_glsl(), FLAT_VARYINGS, "f_color_back", "f_colour_back")
+    assert "flat_varyings.glsl" in report(varyings_not_in_the_twin(drifted))
+    assert "out f_colour_back is not in reference.geometry.TriangleOutputs" in \
+        report(varyings_not_in_the_twin(drifted))
 
 
 def test_a_renamed_uniform_is_caught_against_the_twin_and_the_gpu_path():
@@ -575,3 +614,290 @@ def test_a_renamed_uniform_is_caught_against_the_twin_and_the_gpu_path():
     twin = report(uniforms_not_in_the_twin(drifted) + twin_fields_not_declared(drifted))
     assert f"glsl/lighting.glsl:{line}: uniform u_point_colour is not in reference.lighting" in twin
     assert "reference.lighting.Lights.u_point_intensity is no uniform of glsl/lighting.glsl" in twin
+
+
+# -- the ray tracer: glsl/raytrace/ against renderer/gpu/raytracer.py and reference/raytrace/ ----
+
+RAYTRACE_FILES = tuple(sorted(path.relative_to(glsl_dir()).as_posix()
+                              for path in (glsl_dir() / "raytrace").iterdir()))
+REFERENCE = Path(__file__).resolve().parents[1] / "reference"
+# lighting.glsl's uniforms that the ray tracer's program has not, and why.
+NOT_IN_THE_TRACER = {
+    "u_ka": "MATERIAL_VARIABLES: the hit's material, a variable the tracer sets per hit",
+    "u_kd": "MATERIAL_VARIABLES, as u_ka", "u_ks": "MATERIAL_VARIABLES, as u_ka",
+    "u_n": "MATERIAL_VARIABLES, as u_ka", "u_eye": "MATERIAL_VARIABLES: the ray's origin",
+    "u_num_directional_lights": "ALL_FEATURES: the rasteriser's build that does not specialise",
+    "u_num_point_lights": "ALL_FEATURES, as u_num_directional_lights",
+}
+# The ray tracer's uniforms that the twin does not take by the uniform's name, and the names it
+# reads instead (each must occur in reference/raytrace/ or reference/lighting.py): the GPU path
+# packs them (renderer/gpu/raytracer.py). The others are keys of the uniforms renderer/core
+# builds, which the twin takes by name (twin_uniform_names).
+RAYTRACE_TWIN_NAMES = {
+    "u_near": ("near",), "u_far": ("far",), "u_background": ("background",),
+    "u_seed": ("seed",), "u_sample_offsets": ("table",), "u_first_sample": ("first_sample",),
+    "u_adaptive_threshold": ("threshold",),
+    "u_spheres": ("sphere_centre", "sphere_radius"), "u_sphere_object": ("sphere_object",),
+    "u_planes": ("plane_normal", "plane_offset"), "u_plane_object": ("plane_object",),
+    "u_nodes": ("nodes",), "u_triangles": ("triangles",),
+    "u_triangle_data": ("triangles", "triangle_normals", "triangle_object"),
+    "u_materials": ("ka", "kd", "ks", "kr", "kt", "n", "two_sided", "ior", "gloss"),
+    "u_shutter": ("shutter",), "u_sphere_motion": ("sphere_object", "rows"),
+    "u_plane_motion": ("plane_object", "rows"), "u_mesh_motion": ("mesh_object", "rows"),
+    "u_mesh_root": ("mesh_roots",), "u_mesh_object": ("mesh_object",),
+    "u_textures": ("textures",), "u_texture_materials": ("slot", "modulate", "uv_transform"),
+    "u_triangle_uvs": ("triangle_uvs",), "u_sphere_rotation": ("sphere_rotation",),
+    "u_plane_uv": ("plane_map",),
+}
+# The tracer is made for every_ray_feature_scene with each of these: between them every #define
+# that adds a uniform (test_the_configurations_compile_every_ray_tracer_uniform_in).
+RAY_CONFIGURATIONS = ({"specialise": False, "pattern": "adaptive", "samples": 16},
+                      {"pattern": "poisson", "samples": 4})
+
+
+def every_ray_feature_scene():
+    """A sphere, a plane and a mesh that move, a mesh that does not, all textured; a glossy
+    mirror; a directional light and a point light with an area; a thin lens; a shutter."""
+    scene = scene_from_dict({
+        "camera": {"eye": [0, 1, 6], "look": [0, 0, 0], "aperture": 0.1, "shutter": [0, 1]},
+        "materials": {"glossy": {"kd": [0.5, 0.5, 0.5], "ks": [0.3, 0.3, 0.3],
+                                 "kr": [0.4, 0.4, 0.4], "gloss": 50}},
+        "lights": [{"type": "directional", "direction": [-1, -1, -1]},
+                   {"type": "point", "position": [2, 3, 2], "area": "disc", "radius": 0.5}],
+        "objects": [{"name": "ball", "shape": {"type": "sphere", "radius": 1.0},
+                     "material": "glossy", "velocity": [1, 0, 0]},
+                    {"name": "floor", "shape": {"type": "plane", "normal": [0, 1, 0], "offset": 1.0},
+                     "velocity": [0, 0, 1]},
+                    {"name": "box", "mesh": {"primitive": "cube"}, "translate": [2, 0, 0],
+                     "angular_velocity": [0, 30, 0]},
+                    {"name": "still", "mesh": {"primitive": "cube"}, "translate": [-2, 0, 0]}]})
+    texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2))
+    return replace(scene, objects=[replace(obj, material=replace(obj.material, texture=texture))
+                                   for obj in scene.objects])
+
+
+def raytracer_uploads(ctx) -> tuple[set[str], list[str]]:
+    """(every uniform name RayTracer has a value for, the prepared fragment sources) over
+    RAY_CONFIGURATIONS: what it hands renderer/gpu/declarations.py's uniforms_to_write. A
+    tracer that refuses its uniforms (a drift) is recorded as far as it got."""
+    import renderer.gpu.raytracer as raytracer
+    names, texts = set(), []
+    original = raytracer.uniforms_to_write
+
+    def recording(text, kept, values):
+        names.update(values)
+        texts.append(text)
+        return original(text, kept, values)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(raytracer, "uniforms_to_write", recording)
+        for options in RAY_CONFIGURATIONS:
+            try:
+                with raytracer.RayTracer(every_ray_feature_scene(), 8, 6, context=ctx, **options):
+                    pass
+            except ShaderSourceError:
+                pass                # test_the_ray_tracer_sets_the_uniforms_its_defines_declare
+    return names, texts
+
+
+def raytrace_uniforms(parsed) -> dict[str, list[Declaration]]:
+    """The ray tracer's files' declarations, lighting.glsl's without NOT_IN_THE_TRACER."""
+    return {file: [d for d in decls if not (file == LIGHTING and d.name in NOT_IN_THE_TRACER)]
+            for file, decls in parsed.items()}
+
+
+def twin_uniform_names() -> set[str]:
+    """The uniforms the ray tracer's twin takes by name: renderer/core builds them (the
+    camera rays and the lens: reference/raytrace/camera.py; the area lights: pipeline.py,
+    area_light_uniforms[AREA_UNIFORM]; the lights: reference.lighting.Lights)."""
+    scene = every_ray_feature_scene()
+    matrices = scene.matrices(8, 6)
+    return (set(camera_ray_uniforms(matrices.view, matrices.projection, 8, 6))
+            | set(lens_uniforms(matrices.view, 0.1, 1.0)) | set(area_light_uniforms(scene))
+            | field_names(Lights))
+
+
+def twin_text(*folders: str, files=()) -> str:
+    return "\n".join(path.read_text(encoding="utf-8") for folder in folders
+                     for path in sorted((REFERENCE / folder).glob("*.py"))) + \
+        "\n".join((REFERENCE / f).read_text(encoding="utf-8") for f in files)
+
+
+def uniforms_the_twin_does_not_read(parsed, by_name: set[str], twin_names: dict, text: str,
+                                    twin: str) -> list[str]:
+    """Each uniform is one the twin takes by name (`by_name`) or one of `twin_names` whose
+    names occur in `text`, the twin's source (described by `twin`)."""
+    problems = []
+    for name, decl in sorted(all_uniforms(parsed).items()):
+        if name in by_name:
+            continue
+        if name not in twin_names:
+            problems.append(f"{decl.where}: uniform {name} is no name {twin} reads (a uniform "
+                            "of renderer/core it takes by name, or one of this test's *_TWIN_NAMES)")
+            continue
+        problems += [f"{decl.where}: uniform {name}: {twin} reads no {word!r} "
+                     f"(this test's *_TWIN_NAMES)" for word in twin_names[name]
+                     if not re.search(rf"\b{word}\b", text)]
+    problems += [f"*_TWIN_NAMES names {name}, which no file declares"
+                 for name in sorted(set(twin_names) - set(all_uniforms(parsed)))]
+    return problems
+
+
+@pytest.fixture(scope="module")
+def raytrace_parsed():
+    return raytrace_uniforms(parse(read_glsl((*RAYTRACE_FILES, LIGHTING))))
+
+
+@pytest.fixture(scope="module")
+def ray_uploads(gl_contexts):
+    return raytracer_uploads(gl_contexts["egl"])
+
+
+def test_the_ray_tracer_sets_the_uniforms_its_defines_declare(gl_contexts):
+    """RayTracer refuses a value for a uniform its GLSL declares nowhere and a uniform its
+    #defines declare that gets no value (renderer/gpu/declarations.py, uniforms_to_write)."""
+    from renderer.gpu.raytracer import RayTracer
+    for options in RAY_CONFIGURATIONS:
+        with RayTracer(every_ray_feature_scene(), 8, 6, context=gl_contexts["egl"], **options) as rt:
+            assert {"u_spheres", "u_nodes", "u_mesh_root", "u_point_area"} <= rt._uniforms_written
+
+
+def test_every_ray_tracer_uniform_is_uploaded(raytrace_parsed, ray_uploads):
+    problems = uniforms_not_uploaded(raytrace_parsed, ray_uploads[0], "renderer/gpu/raytracer.py",
+                                     "RayTracer")
+    assert not problems, report(problems)
+
+
+def test_every_uniform_the_ray_tracer_uploads_is_declared(raytrace_parsed, ray_uploads):
+    problems = uploads_not_declared(raytrace_parsed, ray_uploads[0], "renderer/gpu/raytracer.py",
+                                    "glsl/raytrace/ (and lighting.glsl)")
+    assert not problems, report(problems)
+
+
+def test_the_ray_tracer_uniforms_are_names_its_twin_reads(raytrace_parsed):
+    problems = uniforms_the_twin_does_not_read(
+        raytrace_parsed, twin_uniform_names(), RAYTRACE_TWIN_NAMES,
+        twin_text("raytrace", files=("lighting.py",)), "reference/raytrace/")
+    assert not problems, report(problems)
+
+
+def test_the_configurations_compile_every_ray_tracer_uniform_in(raytrace_parsed, ray_uploads):
+    """Each uniform of glsl/raytrace/ is in some configuration's program (so the uploads above
+    are all of them), and NOT_IN_THE_TRACER's are in none."""
+    chosen = set().union(*(selected_uniforms(text) for text in ray_uploads[1]))
+    assert set(all_uniforms(raytrace_parsed)) <= chosen
+    assert not chosen & set(NOT_IN_THE_TRACER)
+    assert set(NOT_IN_THE_TRACER) <= set(all_uniforms(parse(read_glsl((LIGHTING,)))))
+
+
+def test_a_renamed_ray_tracer_uniform_is_caught(ray_uploads):
+    """u_background renamed in trace.glsl alone: not uploaded, the upload goes nowhere, and
+    the twin reads no such name."""
+    drifted = raytrace_uniforms(renamed(read_glsl((*RAYTRACE_FILES, LIGHTING)),
+                                        "raytrace/trace.glsl", "u_background", "u_backdrop"))
+    line = next(d.line for d in drifted["raytrace/trace.glsl"] if d.name == "u_backdrop")
+    assert report(uniforms_not_uploaded(drifted, ray_uploads[0], "renderer/gpu/raytracer.py",
+                                        "RayTracer")).startswith(
+        f"glsl/raytrace/trace.glsl:{line}: uniform u_backdrop is not uploaded by "
+        "renderer/gpu/raytracer.py")
+    assert report(uploads_not_declared(drifted, ray_uploads[0], "renderer/gpu/raytracer.py",
+                                       "glsl/raytrace/")).startswith(
+        "renderer/gpu/raytracer.py uploads u_background, which no file of glsl/raytrace/ declares")
+    twin = report(uniforms_the_twin_does_not_read(drifted, twin_uniform_names(),
+                                                  RAYTRACE_TWIN_NAMES, "", "reference/raytrace/"))
+    assert f"glsl/raytrace/trace.glsl:{line}: uniform u_backdrop is no name reference/raytrace/ reads" in twin
+
+
+# -- the output stage: glsl/output/ against renderer/gpu/output.py, colour.py, reference/output/ --
+
+OUTPUT_FILES = tuple(sorted(path.relative_to(glsl_dir()).as_posix()
+                            for path in (glsl_dir() / "output").iterdir()))
+# What the twin (reference/output/) reads for each uniform: a name of renderer/core's that it
+# calls or reads (each must occur in reference/output/), where the GPU path uploads it packed.
+OUTPUT_TWIN_NAMES = {
+    "u_exponent": ("encode",), "u_srgb": ("encode",),
+    "u_tables": ("decision_points", "code_values"), "u_table_row_bits": ("decision_points",),
+    "u_bits": ("code_bits",), "u_decision_points": ("decision_points",),
+    "u_alpha_points": ("decision_points", "LINEAR"), "u_code_values": ("code_values",),
+    "u_blue_noise_size": ("blue_noise_ranks",),
+    "u_screen": ("screen_basis",), "u_grid_cell": ("grid_screens",),
+    "u_grid_thresholds": ("grid_screens",),
+    "u_tap_offset": ("pull_taps",), "u_taps": ("pull_taps",), "u_shares": ("sender_weights",),
+    "u_skew": ("skew",), "u_reach": ("reach",), "u_wavefront": ("wavefronts",),
+    "rgb_to_xyz_matrix": ("RGB_TO_XYZ",), "white_chromaticity": ("D65_CHROMATICITY",),
+}
+# The settings the output pass runs with: between them every program and method of glsl/output/.
+OUTPUT_CONFIGURATIONS = (
+    OutputSettings(format="exr"), OutputSettings(Transfer("gamma", 2.2), format="npy"),
+    OutputSettings(Transfer("srgb")), OutputSettings(dither="bayer4"),
+    OutputSettings(dither="blue-noise", format="png16"), OutputSettings(dither="floyd-steinberg"),
+    OutputSettings(halftone=Halftone(4, 0)))
+
+
+def output_uploads(ctx) -> set[str]:
+    """Every uniform name the output pass and the colour pass set on their programs."""
+    from renderer.gpu.colour import ColourPass
+    from renderer.gpu.output import OutputPass
+    names = set()
+    getitem, get = moderngl.ComputeShader.__getitem__, moderngl.ComputeShader.get
+
+    def recording_getitem(self, key):
+        names.add(key)
+        return getitem(self, key)
+
+    def recording_get(self, key, default):
+        names.add(key)
+        return get(self, key, default)
+
+    linear = np.random.default_rng(1).uniform(0, 1, (6, 8, 4)).astype(np.float32)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(moderngl.ComputeShader, "__getitem__", recording_getitem)
+        patch.setattr(moderngl.ComputeShader, "get", recording_get)
+        stage = OutputPass(ctx)
+        try:
+            for settings in OUTPUT_CONFIGURATIONS:
+                stage.apply(linear, settings)
+        finally:
+            stage.release()
+        with ColourPass(ctx) as colour:
+            colour.apply(linear)
+    return names
+
+
+@pytest.fixture(scope="module")
+def output_parsed():
+    return parse(read_glsl(OUTPUT_FILES))
+
+
+def test_every_output_stage_uniform_is_uploaded_and_every_upload_declared(output_parsed, gl_contexts):
+    uploaded = output_uploads(gl_contexts["egl"])
+    problems = uniforms_not_uploaded(output_parsed, uploaded, "renderer/gpu/output.py or colour.py",
+                                     "they set")
+    problems += uploads_not_declared(output_parsed, uploaded, "renderer/gpu/output.py or colour.py",
+                                     "glsl/output/")
+    assert not problems, report(problems)
+
+
+def test_the_output_stage_uniforms_are_names_its_twin_reads(output_parsed):
+    problems = uniforms_the_twin_does_not_read(output_parsed, set(), OUTPUT_TWIN_NAMES,
+                                               twin_text("output"), "reference/output/")
+    assert not problems, report(problems)
+
+
+def test_a_renamed_output_uniform_is_caught():
+    drifted = renamed(read_glsl(OUTPUT_FILES), "output/quantise.glsl", "u_bits", "u_code_bits")
+    assert "glsl/output/quantise.glsl:" in report(uniforms_the_twin_does_not_read(
+        drifted, set(), OUTPUT_TWIN_NAMES, twin_text("output"), "reference/output/"))
+    assert "uniform u_code_bits is no name reference/output/ reads" in report(
+        uniforms_the_twin_does_not_read(drifted, set(), OUTPUT_TWIN_NAMES, twin_text("output"),
+                                        "reference/output/"))
+
+
+# -- coverage ------------------------------------------------------------------------------------
+
+def test_every_twinned_glsl_file_is_held_here():
+    """Each file of glsl/ whose first line names its twin is one this test reads."""
+    read = {*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *RAYTRACE_FILES, *OUTPUT_FILES}
+    twinned = {path.relative_to(glsl_dir()).as_posix() for path in glsl_dir().rglob("*")
+               if path.is_file() and path.read_text(encoding="utf-8").startswith("// Twin:")}
+    assert twinned <= read, f"not read by tests/test_glsl_contract.py: {sorted(twinned - read)}"

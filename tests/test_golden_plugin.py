@@ -902,7 +902,7 @@ def test_check_scene_ray_traces_with_the_tracer_options(spec):
     assert outcomes(result) == {"test_traced": "passed", "test_raster_with_samples": "failed",
                                 "test_unknown_method": "failed"}
     assert json.loads((spec.goldens / "test_traced.json").read_text())["scene"] == "classic"
-    assert failure(result, "test_raster_with_samples").strip() == 'samples: options of method="raytrace"'
+    assert failure(result, "test_raster_with_samples").strip() == "samples: is for method raytrace, not raster"
     assert failure(result, "test_unknown_method").strip() == \
-        "method must be one of raster, raytrace, got 'pathtrace'"
+        "method: unknown method 'pathtrace'; one of raster, raytrace"
     assert outcomes(spec.run("-k", "traced")) == {"test_traced": "passed"}

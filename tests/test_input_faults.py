@@ -360,12 +360,15 @@ def test_a_bad_ray_traced_scene_is_one_line_naming_file_key_and_reason(capsys, w
 
 @pytest.mark.parametrize("command", ["render", "compare"])
 @pytest.mark.parametrize("option, reason", [
-    (["--spp", "0"], "argument --spp: expected a whole number of at least 1, got '0'"),
-    (["--max-depth", "-1"], "--max-depth must be between 0 and 64, got -1"),
-    (["--max-depth", "65"], "--max-depth must be between 0 and 64, got 65"),
-    (["--pattern", "hexagonal"], "argument --pattern: invalid choice: 'hexagonal' (choose from"),
-    (["--light-samples", "0"], "--light-samples must be between 1 and 64, got 0"),
-    (["--light-samples", "65"], "--light-samples must be between 1 and 64, got 65"),
+    (["--spp", "0"], "--spp 0: samples per pixel must be between 1 and 256, got 0"),
+    (["--max-depth", "-1"], "--max-depth -1: must be between 0 and 64, got -1"),
+    (["--max-depth", "65"], "--max-depth 65: must be between 0 and 64, got 65"),
+    (["--pattern", "hexagonal"], "--pattern hexagonal: sample pattern must be one of regular, random, "
+                                 "jittered, poisson, adaptive, got 'hexagonal'"),
+    (["--light-samples", "0"], "--light-samples 0: light samples per hit must be a whole number "
+                               "from 1 to 64, got 0"),
+    (["--light-samples", "65"], "--light-samples 65: light samples per hit must be a whole number "
+                                "from 1 to 64, got 65"),
     (["--light-samples", "two"], "argument --light-samples: invalid int value: 'two'"),
 ], ids=["spp 0", "max depth -1", "max depth 65", "unknown pattern", "light samples 0",
         "light samples 65", "light samples not a number"])
@@ -388,6 +391,6 @@ def test_light_samples_are_for_the_ray_tracer(capsys, work, command):
     before = sorted(p.name for p in work.iterdir())
     assert main([command, "sphere", "--size", "16x12", "--light-samples", "4"]) == 2
     first, usage = capsys.readouterr().err.splitlines()
-    assert first.startswith(f"renderer {command}: --light-samples is for --method raytrace")
+    assert first.startswith(f"renderer {command}: --light-samples 4: is for method raytrace, not raster")
     assert usage.startswith(f"usage: renderer {command}")
     assert sorted(p.name for p in work.iterdir()) == before

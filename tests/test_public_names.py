@@ -1,14 +1,6 @@
-"""Names users have: the public ones stay, and the old flat module names still import for one
-release (renderer/_moved.py), as the very modules at their new homes, with a warning."""
+"""Names users have: the public ones stay."""
 
-import importlib
 import importlib.metadata
-import importlib.util
-import sys
-
-import pytest
-
-from renderer._moved import MOVED
 
 
 def test_public_names():
@@ -16,6 +8,8 @@ def test_public_names():
     from reference.pipeline import render
     from renderer.gpu import GpuRenderer
     from renderer.gpu.pipeline import GpuRenderer as same
+    from renderer.methods import open_renderer
+    assert callable(open_renderer)
     from renderer.viewer import Viewer
     from renderer.viewer.viewer import Viewer as same_viewer
     assert GpuRenderer is same and Viewer is same_viewer and reference.render is render
@@ -24,19 +18,9 @@ def test_public_names():
     assert plugins == ["renderer.checks.pytest_plugin"]
 
 
-@pytest.mark.parametrize("old", sorted(MOVED))
-def test_an_old_name_is_the_moved_module_with_a_warning(old):
-    sys.modules.pop(f"renderer.{old}", None)          # an earlier test may have imported it
-    with pytest.warns(DeprecationWarning) as caught:
-        module = importlib.import_module(f"renderer.{old}")
-    assert module is importlib.import_module(MOVED[old])
-    assert [str(w.message) for w in caught] == [
-        f"renderer.{old} moved to {MOVED[old]}; the old name will be removed in release 0.2"]
 
-
-def test_every_module_that_moved_has_its_old_name():
-    """The 33 flat modules of renderer/ that went into core, gpu, checks, study and viewer
-    (gpu.py is renderer/gpu/pipeline.py behind the package renderer.gpu)."""
-    assert len(MOVED) == 33
-    for new in MOVED.values():
-        assert importlib.util.find_spec(new) is not None, new
+def test_the_old_flat_module_names_are_gone():
+    """renderer.scene and the like (before the subpackages) import no more: no alias hook."""
+    import importlib.util
+    assert importlib.util.find_spec("renderer.scene") is None
+    assert importlib.util.find_spec("renderer.core.scene") is not None

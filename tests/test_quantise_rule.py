@@ -8,6 +8,7 @@ from renderer.core.gl_rules import to_unorm8
 from renderer.core.output_settings import (OutputSettings, Halftone, Transfer, parse_bits,
                                            parse_halftone, parse_transfer)
 from renderer.core.quantise import code_of, code_values, decision_points, decode, encode
+from renderer.gpu.defines import output_defines
 
 LINEAR, SRGB, GAMMA = Transfer("linear"), Transfer("srgb"), Transfer("gamma", 2.2)
 
@@ -104,5 +105,5 @@ def test_code_bits_and_defines():
     assert OutputSettings(format="png16").code_bits == 16
     assert OutputSettings(bits=3).code_bits == 3
     assert OutputSettings(halftone=Halftone(4.0)).code_bits == 1
-    assert OutputSettings(dither="bayer8").defines() == {"TRANSFER_LINEAR": "1", "DITHER_ORDERED": "8"}
-    assert "FLOAT_OUTPUT" in OutputSettings(transfer=SRGB, format="exr").defines()
+    assert output_defines(OutputSettings(dither="bayer8")) == {"TRANSFER_LINEAR": "1", "DITHER_ORDERED": "8"}
+    assert "FLOAT_OUTPUT" in output_defines(OutputSettings(transfer=SRGB, format="exr"))

@@ -25,11 +25,12 @@ from reference.raytrace.warp import orthonormal_basis as warp_basis
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.light_areas import (AREA_SHAPE_CODES, AREA_UNIFORM, NO_AREA, area_axes,
-                                       area_light_defines, area_light_uniforms, orthonormal_basis)
+                                       area_light_uniforms, orthonormal_basis)
 from renderer.core.ray_sampling import ray_sampling
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.scene import LightArea
 from renderer.core.scene_file import load_scene, scene_from_dict
+from renderer.gpu.defines import area_light_defines
 
 F32 = np.float32
 

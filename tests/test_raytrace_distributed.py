@@ -18,6 +18,7 @@ from reference.raytrace.sampling import distributed_1d, distributed_2d, permute
 import renderer.core.ray_sampling as ray_sampling_module
 from renderer.core.ray_sampling import (FIRST_SET, LENS_DIMENSION, MAX_LIGHT_SAMPLES, MAX_SAMPLES,
                                         MAX_STRATA_SIDE, TIME_DIMENSION, ray_sampling)
+from renderer.gpu.defines import sampling_defines
 
 
 def test_permute_is_a_bijection_of_every_length():
@@ -134,7 +135,7 @@ def test_glsl_distributed_points_are_the_twin_bit_for_bit(gl_contexts):
              (ray_sampling("poisson", 5, light_samples=2), [1, 4], 9)]
     for kind, ctx in gl_contexts.items():
         for sampling, ks, first in cases:
-            with ShaderProbe(ctx, "raytrace_distributed.frag", sampling.defines(), (width, height), 4) as shader:
+            with ShaderProbe(ctx, "raytrace_distributed.frag", sampling_defines(sampling), (width, height), 4) as shader:
                 shader.write(sampling.uniforms())
                 for k in ks:
                     for slot, dimension, m, per_sample in [(0, 1, 0, 1), (9, 2, 1, sampling.light_samples),

@@ -222,8 +222,9 @@ def test_aperture_0_is_the_pinhole_camera_bit_for_bit(gl_contexts):
 def test_command_line_aperture_and_focus_distance(tmp_path, cli_here):
     """`--aperture` and `--focus-distance` set the scene's lens for the ray tracer (the image
     changes, and equals the scene file's with those keys); a value the scene file would refuse
-    is refused naming the option, one line, status 2, nothing written; with the rasteriser
-    they are refused (the line and the usage)."""
+    is refused naming the option, status 2, nothing written: the line and the usage as any
+    option's range (RayOptions), the line alone where the scene's camera refuses it (a lens
+    on a parallel camera); with the rasteriser they are refused (the line and the usage)."""
     from PIL import Image
     small = ["--size", "24x18", "--backend", "reference", "--spp", "4", "--pattern", "jittered", "-q"]
     out = {name: tmp_path / f"{name}.png" for name in ("pinhole", "option", "file")}
@@ -240,22 +241,23 @@ def test_command_line_aperture_and_focus_distance(tmp_path, cli_here):
     assert np.array_equal(image["option"], image["file"])
     assert not np.array_equal(image["option"], image["pinhole"])
     for args, line in (
-            (["sphere", "--method", "raytrace", "--aperture", "-1"], "renderer: --aperture -1: must be >= 0, got -1"),
+            (["sphere", "--method", "raytrace", "--aperture", "-1"],
+             "renderer render: --aperture -1: must be >= 0, got -1"),
             (["sphere", "--method", "raytrace", "--aperture", "nan"],
-             "renderer: --aperture nan: expected a finite number, got nan"),
+             "renderer render: --aperture nan: expected a finite number, got nan"),
             (["sphere", "--method", "raytrace", "--focus-distance", "0"],
-             "renderer: --focus-distance 0: must be > 0, got 0"),
+             "renderer render: --focus-distance 0: must be > 0, got 0"),
             (["orthographic", "--method", "raytrace", "--aperture", "0.1"],
              "renderer: --aperture 0.1: must be 0 with a parallel camera, got 0.1: a lens focuses "
              "rays from one eye, and a parallel camera has none"),
-            (["sphere", "--aperture", "0.3"], "renderer render: --aperture is for --method raytrace")):
+            (["sphere", "--aperture", "0.3"], "renderer render: --aperture 0.3: is for method raytrace, not raster")):
         result = cli_here("render", *args, "--size", "8x6", "-o", tmp_path / "no.png")
         assert result.returncode == 2 and result.stderr.splitlines()[0] == line, result.stderr
         assert "Traceback" not in result.stderr and not (tmp_path / "no.png").exists()
         assert len(result.stderr.splitlines()) == (2 if "usage" in result.stderr else 1)
     result = cli_here("compare", "sphere", "--focus-distance", "2", "--out", tmp_path / "cmp")
     assert result.returncode == 2 and result.stderr.startswith(
-        "renderer compare: --focus-distance is for --method raytrace or --methods")
+        "renderer compare: --focus-distance 2: is for method raytrace, not raster")
 
 
 # --------------------------------------------------------------------------- GPU against twin

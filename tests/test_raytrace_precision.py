@@ -166,7 +166,7 @@ def test_max_depth_64_on_the_gpu_matches_the_twin(gl_contexts):
     expected = reference_raytrace(scene, 32, 24, max_depth=MAX_DEPTH_LIMIT)
     figures = compare_frames(frame.rgba8, expected.rgba8, frame.depth, expected.depth)
     assert PIPELINE_TOLERANCE.passes(figures), PIPELINE_TOLERANCE.failures(figures)
-    with pytest.raises(ValueError, match="max_depth must be between 0 and 64, got 65"):
+    with pytest.raises(ValueError, match="max_depth: must be between 0 and 64, got 65"):
         RayTracer(scene, 8, 8, max_depth=MAX_DEPTH_LIMIT + 1)
 
 
@@ -175,11 +175,12 @@ def test_max_depth_64_on_the_gpu_matches_the_twin(gl_contexts):
 @pytest.fixture
 def raytrace_stand_in(monkeypatch):
     """raytrace_stand_in(frame): `compare --method raytrace`'s GPU frame, in this test."""
-    from renderer import cli
+    from renderer.cli import compare
 
     def stand_in(frame):
-        monkeypatch.setattr(cli, "_raytrace_gpu", lambda scene, size, kind, options, frames=1:
-                            (frame, 1.0, {"GL_RENDERER": "llvmpipe (stand-in)", "context": "stand-in"}))
+        monkeypatch.setattr(compare, "_render_gpu", lambda scene, args, frames=1:
+                            (frame, 1.0, {"GL_RENDERER": "llvmpipe (stand-in)", "context": "stand-in"},
+                             None))
     return stand_in
 
 

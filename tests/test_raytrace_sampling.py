@@ -24,6 +24,7 @@ from renderer.core.ray_sampling import (DEFAULT_ADAPTIVE_THRESHOLD, MAX_SAMPLES,
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import poisson_disk, regular_grid
 from renderer.core.scene_file import scene_from_dict
+from renderer.gpu.defines import sampling_defines
 
 F32 = np.float32
 Y, X = np.mgrid[0:6, 0:8].astype(np.uint32)          # a few pixels (x, y), row 0 at the bottom
@@ -112,7 +113,7 @@ def test_glsl_sample_offsets_are_the_twin_bit_for_bit(gl_contexts):
              (ray_sampling("poisson", 5), [1, 4], [0])]
     for kind, ctx in gl_contexts.items():
         for sampling, ks, firsts in cases:
-            with ShaderProbe(ctx, "raytrace_sampling.frag", sampling.defines(), (width, height), 2) as shader:
+            with ShaderProbe(ctx, "raytrace_sampling.frag", sampling_defines(sampling), (width, height), 2) as shader:
                 shader.write(sampling.uniforms())
                 for k in ks:
                     for first in firsts:
@@ -266,11 +267,12 @@ def test_command_line_adaptive(tmp_path, capsys):
     assert "raytrace adaptive up to 8 spp: mean " in capsys.readouterr().err and out.is_file()
     for bad, reason in [(["--pattern", "adaptive", "--spp", "2"], "--spp 2 --pattern adaptive: adaptive sampling "
                                                                   "needs at least 4"),
-                        (["--pattern", "jittered", "--adaptive-threshold", "0.1"], "--adaptive-threshold is for "
-                                                                                  "--pattern adaptive"),
+                        (["--pattern", "jittered", "--adaptive-threshold", "0.1"],
+                         "--adaptive-threshold 0.1 --pattern jittered: an adaptive threshold is for the "
+                         "adaptive pattern, not jittered"),
                         (["--pattern", "adaptive", "--spp", "4", "--adaptive-threshold", "-1"], "finite"),
                         (["--seed", "-3"], "--seed -3: the seed must be"),
-                        (["--pattern", "sobol"], "invalid choice")]:
+                        (["--pattern", "sobol"], "--pattern sobol: sample pattern must be one of")]:
         assert main(["render", "sphere", "--method", "raytrace", "--size", "8x8", "-o", str(tmp_path / "x.png"),
                      *bad]) == 2, bad
         assert reason in capsys.readouterr().err, bad

@@ -84,6 +84,7 @@ def test_the_timing_check_sees_an_unsourced_figure():
 CHECKS = """
 assert scene.name == "sphere", scene.name
 assert frame.rgba8.shape == (480, 640, 4) and expected.rgba8.shape == (480, 640, 4)
+assert traced.rgba8.shape == (480, 640, 4) and traced.samples.max() == 4
 assert (frame.rgba8[..., 3] == 255).mean() > 0.05 and (expected.rgba8[..., 3] == 255).mean() > 0.05
 print("README example ran")
 """

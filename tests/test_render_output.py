@@ -94,10 +94,10 @@ def test_the_default_name_takes_the_formats_suffix(tmp_path, cli_here):
 
 def test_the_gpu_pass_runs_on_the_renderers_own_context(tmp_path, cli_here, monkeypatch):
     """One context per render: the output pass is made on the rasteriser's."""
-    from renderer.gpu import output, pipeline
+    from renderer.gpu import base, output
     made, passes = [], []
-    make_context, output_pass = pipeline.make_context, output.OutputPass
-    monkeypatch.setattr(pipeline, "make_context", lambda kind: made.append(make_context(kind)) or made[-1])
+    make_context, output_pass = base.make_context, output.OutputPass
+    monkeypatch.setattr(base, "make_context", lambda kind: made.append(make_context(kind)) or made[-1])
     monkeypatch.setattr(output, "OutputPass", lambda ctx: passes.append(ctx) or output_pass(ctx))
     result = cli_here(*ARGS, "-o", tmp_path / "o.png", "--bits", "2", "--dither", "bayer2")
     assert result.returncode == 0, result.stderr
@@ -120,21 +120,22 @@ DITHERS = "none, bayer2, bayer4, bayer8, blue-noise, floyd-steinberg, jarvis-jud
     (["--halftone", "1.5"], "--halftone 1.5: the cell must be at least 2 pixels wide, got 1.5"),
     (["--halftone", "6:x"], "--halftone 6:x: write CELL or CELL:ANGLE, e.g. 6 or 6:15"),
     (["--format", "tiff"], "--format tiff: unknown; one of png8, png16, exr, npy"),
-    (["--format", "png8", "--bits", "12"], "--bits 12: png8 holds at most 8 bits per channel; use png16"),
+    (["--format", "png8", "--bits", "12"], "--bits 12 --format png8: png8 holds at most 8 bits per channel; use png16"),
     (["-o", "{D}/o.exr", "--bits", "4"],
      "--bits 4: exr holds float colour unquantised; quantise to png8 or png16"),
     (["-o", "{D}/o.npy", "--dither", "bayer8"], "--dither bayer8: npy holds float colour unquantised"),
-    (["--halftone", "6", "--dither", "bayer4"], "--halftone and --dither bayer4: choose one"),
-    (["--halftone", "6", "--bits", "2"], "--bits 2: a half-tone prints binary inks (1 bit per channel)"),
-    (["--halftone", "6", "--format", "exr"], "--halftone: exr holds float colour; half-tones are png8 or png16"),
+    (["--halftone", "6", "--dither", "bayer4"], "--halftone 6 --dither bayer4: choose one"),
+    (["--halftone", "6", "--bits", "2"], "--bits 2 --halftone 6: a half-tone prints binary inks (1 bit per channel)"),
+    (["--halftone", "6", "--format", "exr"],
+     "--halftone 6 --format exr: exr holds float colour; half-tones are png8 or png16"),
     (["-o", "{D}/o.jpg", "--transfer", "srgb"],
      "{D}/o.jpg: --transfer writes .png (png8, png16), .exr or .npy files, not .jpg; name it o.png, "
      "or leave out --transfer for an image Pillow writes"),
     (["-o", "{D}/o.png", "--format", "npy"], "{D}/o.png: --format npy writes .npy files; name it o.npy"),
     (["--format", "exr", "--background", "transparent"],
-     "--background transparent: OpenEXR's alpha is premultiplied, and the frame's colour where "
-     "nothing is drawn is the background's under alpha 0; write --format npy (straight RGBA), "
-     "or add --alpha OUT.npy"),
+     "--format exr --background transparent: OpenEXR's alpha is premultiplied, and the frame's "
+     "colour where nothing is drawn is the background's under alpha 0; write format npy "
+     "(straight RGBA)"),
     (["--alpha", "{D}/a.jpg"],
      "{D}/a.jpg: --alpha writes the coverage as .png (8-bit grey) or .npy (float32); name the file e.g. alpha.png"),
     (["--depth", "{D}/d.png"],

@@ -35,6 +35,7 @@ from reference.raytrace.sampling import distributed_1d, distributed_2d
 from reference.raytrace.area_lights import area_light_point
 from renderer.core.light_areas import AREA_SHAPE_CODES
 from renderer.core.ray_sampling import LENS_DIMENSION, LIGHT_DIMENSION, TIME_DIMENSION, ray_sampling
+from renderer.gpu.defines import sampling_defines
 
 PI = np.pi
 SAMPLES_PER_PIXEL = 16
@@ -266,7 +267,7 @@ def test_glsl_warps_draw_the_twins_samples(gl_contexts):
     for kind, ctx in gl_contexts.items():
         for pattern in ("random", "jittered"):
             sampling = ray_sampling(pattern, 4)
-            with ShaderProbe(ctx, "raytrace_warp.frag", sampling.defines(), (width, height), 4,
+            with ShaderProbe(ctx, "raytrace_warp.frag", sampling_defines(sampling), (width, height), 4,
                              dtype="f4") as shader:
                 shader.write(sampling.uniforms())
                 for k in (0, 3):

@@ -2,12 +2,13 @@
 
 import re
 
+import numpy as np
 import pytest
 
 from renderer.core.resources import assets_dir, glsl_dir
 from renderer.core.scene import DirectionalLight, Material, PointLight, Scene
-from renderer.gpu.shaders import (ProgramCache, ShaderSourceError, ShaderVariant, program_source,
-                              program_sources, shader_source)
+from renderer.gpu.shaders import (FILE_CONSTANTS, ProgramCache, ShaderSourceError, ShaderVariant,
+                                  program_source, program_sources, shader_source)
 
 TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geometry.py",
          "fragment.glsl": "reference/fragment.py", "lighting.glsl": "reference/lighting.py"}
@@ -95,6 +96,32 @@ def test_defines_go_right_after_the_version_line(tmp_path):
     assert set(lines[2:4]) == {"#define TWO_SIDED", "#define NUM_POINT_LIGHTS 2"}
     assert lines[4] == "#line 3 0"                    # the author's line 3 keeps its number
     assert "LINEAR_OUTPUT" not in text                # False leaves a flag out
+
+
+def test_a_files_python_constants_are_defined_before_it_wherever_it_is_included(tmp_path):
+    """FILE_CONSTANTS: shadow/lookup.glsl's, right before its text (its line numbers kept),
+    in a test's shader that includes it too; a float as a decimal that reads back as it."""
+    write(tmp_path, {"main.frag": '#version 330 core\n#include "shadow/lookup.glsl"\nvoid main() {}\n'})
+    lines = shader_source("main.frag", directory=tmp_path).text.splitlines()
+    first = lines.index("#define SHADOW_MAX_SLOPE 16.0")
+    assert lines[first:first + 4] == ["#define SHADOW_MAX_SLOPE 16.0", "#define SHADOW_SQRT2 1.41421356",
+                                      "#define SHADOW_CREASE_CAP 1.0", "#line 1 1"]
+    with pytest.raises(ShaderSourceError, match="FILE_CONSTANTS"):
+        shader_source("main.frag", {"SHADOW_MAX_SLOPE": 8.0}, directory=tmp_path)
+    write(tmp_path, {"floats.frag": "#version 330 core\nvoid main() {}\n"})
+    text = shader_source("floats.frag", {"X": np.float32(0.1), "N": 3}, directory=tmp_path).text
+    assert f"#define X {float(np.float32(0.1))!r}" in text and "#define N 3" in text
+
+
+def test_the_shared_constants_are_written_only_in_python():
+    """Each FILE_CONSTANTS name and the output pass's (PASS_CONSTANTS, colour.comp's
+    GROUP_SIZE) is used in its file and #defined by no file of glsl/."""
+    from renderer.gpu.output import PASS_CONSTANTS
+    everything = "\n".join(p.read_text() for p in glsl_dir().rglob("*") if p.is_file())
+    for file, constants in FILE_CONSTANTS.items():
+        assert all(re.search(rf"\b{name}\b", (glsl_dir() / file).read_text()) for name in constants)
+    for name in {*PASS_CONSTANTS, *(n for c in FILE_CONSTANTS.values() for n in c)}:
+        assert re.search(rf"\b{name}\b", everything) and not re.search(rf"#\s*define\s+{name}\b", everything)
 
 
 def test_missing_version_line_is_an_error(tmp_path):

@@ -36,3 +36,12 @@ def test_wheel_carries_shaders_and_assets_and_renders_from_another_folder(tmp_pa
         [sys.executable, "-P", "-c", "import renderer; print(renderer.__file__)"],
         capture_output=True, text=True, env={"PYTHONPATH": str(site)}).stdout
     assert (elsewhere / "mesh_file.png").exists()
+    # Every method on every backend from the wheel (a package left out of it failed here once).
+    for method in ("raster", "raytrace"):
+        for backend in ("gpu", "reference"):
+            out = elsewhere / f"{method}-{backend}.png"
+            result = subprocess.run([sys.executable, "-P", "-m", "renderer", "render", "shadow_plane", "--size",
+                                     "16x12", "--method", method, "--backend", backend, "-o", str(out)],
+                                    capture_output=True, text=True, cwd=elsewhere,
+                                    env={"PYTHONPATH": str(site), "PATH": "/usr/bin:/bin"})
+            assert result.returncode == 0 and out.exists(), result.stderr

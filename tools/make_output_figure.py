@@ -34,12 +34,12 @@ def panels() -> list[tuple[str, np.ndarray]]:
     """(label, (H, W, 3) uint8 sRGB-encoded image) per panel."""
     from renderer.core.output_settings import OutputSettings, Transfer
     from renderer.core.scene_file import load_scene
-    from renderer.gpu import GpuRenderer
     from renderer.gpu.output import OutputPass
+    from renderer.methods import open_renderer
     from renderer.study.code_value_dither import code_value_dither
     from renderer.study.output_report import output_errors, output_settings
 
-    with GpuRenderer(load_scene(SCENE), *SIZE, context_kind="egl") as gpu:
+    with open_renderer(load_scene(SCENE), SIZE, context_kind="egl") as gpu:
         frame = gpu.render(linear=True, depth=False)
         stage = OutputPass(gpu.ctx)
         try:

@@ -31,8 +31,8 @@ def panels() -> list[tuple[str, np.ndarray]]:
     """(label, (H, W, 3) float64 linear colour in [0, 1]) per filter, then the truth's."""
     from renderer.core.builtin import builtin_scenes
     from renderer.core.scene_file import load_scene
-    from renderer.gpu import GpuRenderer
     from renderer.gpu.context import make_context
+    from renderer.methods import open_renderer
     from renderer.study.ground_truth import render_truth
     from renderer.study.texture_report import filter_name, with_texture_setting
 
@@ -41,7 +41,7 @@ def panels() -> list[tuple[str, np.ndarray]]:
     ctx = make_context("egl")
     out = []
     for setting in FILTERS:
-        with GpuRenderer(with_texture_setting(scene, "filter", setting), *SIZE, context=ctx) as gpu:
+        with open_renderer(with_texture_setting(scene, "filter", setting), SIZE, context=ctx) as gpu:
             image = np.clip(gpu.render(linear=True).linear[..., :3], 0.0, 1.0)
         rmse = math.sqrt(float(np.mean((image - truth) ** 2)))
         name = "anisotropic 2 to 16" if setting[0] == "anisotropic" else filter_name(setting)

@@ -4,7 +4,7 @@
 // and its chromaticity x, y, z. Image row r is texel row r (nothing flipped): the frame's row 0
 // is at the top.
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = GROUP_SIZE, local_size_y = GROUP_SIZE) in;   // renderer/gpu/colour.py's GROUP
 layout(rgba32f, binding = 0) uniform readonly image2D linear_image;
 layout(rgba32f, binding = 1) uniform writeonly image2D xyz_image;
 layout(rgba32f, binding = 2) uniform writeonly image2D chromaticity_image;

@@ -9,7 +9,7 @@
 // needs a test, and a source's share of its error comes from a table by its distances to
 // the image's edges (renormalised there: error_kernels.sender_weights). Alpha is the plain
 // nearest code of the linear transfer, as in output.comp.
-layout(local_size_x = 64) in;
+layout(local_size_x = WAVEFRONT_GROUP) in;      // renderer/gpu/output.py's, as MAX_TAPS
 
 layout(rgba32f, binding = 0) uniform readonly image2D u_linear;
 layout(rgba16ui, binding = 1) uniform writeonly uimage2D u_codes;
@@ -21,7 +21,6 @@ layout(rgba32f, binding = 2) uniform image2D u_error;
 // texture, not an SSBO: renderer/gpu/output.py says why.
 uniform sampler2D u_shares;
 
-const int MAX_TAPS = 12;              // Jarvis-Judice-Ninke's
 uniform ivec3 u_wavefront;            // (t, first row, last row)
 uniform int u_skew;                   // s
 uniform int u_reach;                  // r: how far an error travels, the border's width

@@ -2,8 +2,9 @@
 #version 430 core
 // The output stage (docs/conventions.md, "Output"): a frame's linear colour (rgba32f, row 0 at
 // the top, alpha = coverage) to N-bit codes (rgba16ui) or to encoded float colour (rgba32f,
-// FLOAT_OUTPUT), one invocation per pixel in 8 x 8 work groups. The method is a define
-// (renderer/core/output_settings.py, defines()), so a program holds only what it runs:
+// FLOAT_OUTPUT), one invocation per pixel in GROUP_SIZE x GROUP_SIZE work groups. The method
+// is a define (renderer/core/output_settings.py, defines()), so a program holds only what it
+// runs:
 //   (none)                  the nearest code, quantise.glsl
 //   DITHER_ORDERED=n        Bayer n x n thresholds, dither.glsl
 //   DITHER_BLUE_NOISE       a void-and-cluster mask's thresholds, dither.glsl
@@ -11,7 +12,7 @@
 //   FLOAT_OUTPUT            encode(), transfer.glsl
 // Alpha is always the plain nearest code of the linear transfer. Error diffusion has its own
 // program (error_diffusion.comp; it is sequential); a half-tone screens here (HALFTONE).
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = GROUP_SIZE, local_size_y = GROUP_SIZE) in;   // renderer/gpu/output.py's
 
 layout(rgba32f, binding = 0) uniform readonly image2D u_linear;
 #include "transfer.glsl"

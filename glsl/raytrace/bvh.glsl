@@ -8,13 +8,10 @@
 //   nodes:     texel 2i = [min.xyz, a], texel 2i + 1 = [max.xyz, count]; count > 0: a leaf of
 //              triangles a .. a + count - 1; count == 0: left child i + 1, right child a
 //   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, 0], [C.xyz, 0]
-// The builder keeps the depth below BVH_STACK_SIZE (renderer/core/bvh.py, MAX_DEPTH).
+// The builder keeps the depth below BVH_STACK_SIZE: renderer/core/bvh.py's MAX_DEPTH, defined
+// before this file (renderer/gpu/shaders.py, FILE_CONSTANTS).
 // Needs raytrace/intersect.glsl (ray_triangle).
 #include "raytrace/intersect.glsl"
-
-#ifndef BVH_STACK_SIZE
-#define BVH_STACK_SIZE 64
-#endif
 
 // 1 + 3 * 2^-23: the far end of a slab interval is widened by this (Ize, "Robust BVH Ray
 // Traversal", JCGT 2013) so that rounding does not lose a triangle on a box's face.
@@ -63,13 +60,22 @@ bool bvh_meets_root(sampler2D nodes, int root, vec3 O, vec3 inv_D, float s_min, 
                        s_min, s_max, near);
 }
 
-// Triangle j of the triangles texture: its vertices A, B, C and its original index.
-void bvh_triangle(sampler2D triangles, int j, out vec3 A, out vec3 B, out vec3 C, out int index) {
+// Whether the ray hits triangle j of the triangles texture (vertices A, B, C, original index)
+// with s_min < s' < s, nearer than the hit so far: (s, uv, triangle) then become that hit's
+// parameter, barycentric (u, v) and original index. Both walks test a leaf's triangles so.
+bool bvh_nearer_triangle(sampler2D triangles, int j, vec3 O, vec3 D, float s_min,
+                         inout float s, inout vec2 uv, inout int triangle) {
     vec4 a = bvh_texel(triangles, 3 * j);
-    A = a.xyz;
-    B = bvh_texel(triangles, 3 * j + 1).xyz;
-    C = bvh_texel(triangles, 3 * j + 2).xyz;
-    index = int(a.w);
+    float hit_s;
+    vec2 hit_uv;
+    bool hit = ray_triangle(O, D, a.xyz, bvh_texel(triangles, 3 * j + 1).xyz,
+                            bvh_texel(triangles, 3 * j + 2).xyz, s_min, s, hit_s, hit_uv);
+    if (hit) {
+        s = hit_s;
+        uv = hit_uv;
+        triangle = int(a.w);
+    }
+    return hit;
 }
 
 // The children left (node + 1) and right (a) of an interior node, and whether the ray meets
@@ -109,16 +115,7 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec
             int j = a;
             int end = a + count;
             do {
-                vec3 A, B, C;
-                int index;
-                bvh_triangle(triangles, j, A, B, C, index);
-                float hit_s;
-                vec2 hit_uv;
-                if (ray_triangle(O, D, A, B, C, s_min, s, hit_s, hit_uv)) {
-                    s = hit_s;
-                    uv = hit_uv;
-                    triangle = index;
-                }
+                bvh_nearer_triangle(triangles, j, O, D, s_min, s, uv, triangle);
                 ++j;
             } while (j < end);
         } else {
@@ -172,17 +169,14 @@ bool bvh_any_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec3 D,
         int count = bvh_node(nodes, node, a);
         bool descend = false;
         if (count > 0) {
+            float s = s_max;                        // stays: the first hit ends the walk
+            vec2 uv;
+            int triangle;
             int j = a;
-            int end = a + count;
             do {                                    // the test at the end: see bvh_closest_hit
-                vec3 A, B, C;
-                int index;
-                bvh_triangle(triangles, j, A, B, C, index);
-                float hit_s;
-                vec2 hit_uv;
-                hit = ray_triangle(O, D, A, B, C, s_min, s_max, hit_s, hit_uv);
+                hit = bvh_nearer_triangle(triangles, j, O, D, s_min, s, uv, triangle);
                 ++j;
-            } while (j < end && !hit);
+            } while (j < a + count && !hit);
         } else {
             int left, right;
             bool hit_left, hit_right;

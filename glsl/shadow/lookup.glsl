@@ -18,10 +18,12 @@
 // the normal term only where the light's map holds the object's own texels (its bit in
 // u_shadow_self_*: ShadowPlan.self_masks).
 
+// SHADOW_MAX_SLOPE (shadow_settings.MAX_SLOPE: tan(theta) is capped here), SHADOW_SQRT2
+// (shadow_settings.SQRT2: the normal offset's move across the map) and SHADOW_CREASE_CAP
+// (renderer/core/facets.py CREASE_CAP: a crease's slope is taken up to it) come from Python,
+// defined before this file (renderer/gpu/shaders.py, FILE_CONSTANTS).
+
 #include "lighting.glsl"
-#define SHADOW_MAX_SLOPE 16.0        // shadow_settings.MAX_SLOPE: tan(theta) is capped here
-#define SHADOW_SQRT2 1.41421356      // shadow_settings.SQRT2: the normal offset's move across the map
-#define SHADOW_CREASE_CAP 1.0        // renderer/core/facets.py CREASE_CAP: a crease's slope is taken up to 45 degrees
 
 vec3 shadow_facet_normal;            // the fragment's facet normal on the lit side (fragment.glsl)
 float shadow_crease;                 // how steeply its neighbours rise on that side (facets.py)

@@ -99,9 +99,15 @@ class Setting:
         return self.method == "raytrace"
 
     def tracer_options(self) -> dict:
-        """RayTracer's keyword arguments but the seed (each item's own)."""
+        """The ray tracer's options (RayOptions' fields) but the seed (each item's own)."""
         return {"samples": self.samples, "pattern": self.pattern, "max_depth": self.max_depth,
                 "adaptive_threshold": self.adaptive_threshold, "light_samples": self.light_samples}
+
+    def options(self, seed: int):
+        """The method's options object (renderer/methods: RasterOptions, RayOptions) for an
+        item of this setting drawn with `seed`, checked by its type's rules."""
+        from renderer.methods import method_options
+        return method_options(self.method, self.tracer_options() | {"seed": seed} if self.traced else {})
 
     def describe(self) -> dict:
         """The canonical description (manifest records, the job's identity)."""

@@ -24,15 +24,13 @@ from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSour
 from renderer.core import output_settings as stage
 from renderer.core.builtin import is_scene_name
 from renderer.core.jsonio import canonical_json
-from renderer.core.memory import check_raytrace_render, check_render
 from renderer.core.motion import declares_motion
 from renderer.core.paths import checked_path, output_stem
-from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS, ray_sampling
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import (MAX_NUMBER, TableReader, describe_value, read_scene,
                                       read_toml, scene_from_dict, with_overrides)
-from renderer.errors import SceneError, UserError
+from renderer.errors import OptionError, SceneError, UserError
+from renderer.methods import METHODS, method_options
 
 TOP_KEYS = ("name", "description", "seed", "size", "scenes", "settings")
 SCENE_KEYS = ("scene", "name", "cameras", "sweep")
@@ -46,7 +44,6 @@ TRACER_KEYS = ("samples", "pattern", "adaptive_threshold", "max_depth", "light_s
 OUTPUT_KEYS = ("name", "format", "transfer", "bits", "dither", "halftone")
 DEPTH_KEYS = ("name", "depth")
 DEPTH_FORMATS = ("npy", "exr")
-METHODS = ("raster", "raytrace")
 BACKGROUNDS = ("opaque", "transparent")
 
 DEFAULT_SIZE = (640, 480)            # as `renderer render`
@@ -69,10 +66,7 @@ def read_job(path) -> Job:
 def check_memory(scene, setting: Setting, backends) -> None:
     """A UserError when drawing `scene` with `setting` on `backends` would need more memory
     than the limit (renderer/core/memory.py)."""
-    if setting.traced:
-        check_raytrace_render(scene, setting.size, backends, setting.samples * setting.light_samples)
-    else:
-        check_render(scene, setting.size, backends)
+    METHODS[setting.method].check_memory(scene, setting.size, backends, setting.options(0))
 
 
 def _name(reader: TableReader, value: Any, key: str) -> str:
@@ -273,37 +267,35 @@ class _JobReader(TableReader):
         outputs = self.outputs(raw.get("outputs"), f"{key}.outputs", background)
         common = {"name": name, "method": method, "outputs": outputs, "background": background,
                   "size": self.size(raw["size"], f"{key}.size") if "size" in raw else size}
-        if method == "raster":
-            for option in TRACER_KEYS:
-                if option in raw:
-                    self.fail(f"{key}.{option}", "is for method = \"raytrace\"")
-            shading = None
-            if "shading" in raw:
-                shading = self.choice(raw["shading"], f"{key}.shading", "shading", SHADING_MODES)
-            return Setting(**common, shading=shading)
-        if "shading" in raw:
+        if "shading" in raw and method != "raster":
             self.fail(f"{key}.shading", "is for method = \"raster\" (the ray tracer shades "
                                         "every hit per pixel)")
-        options = {"samples": self.integer(raw.get("samples", 1), f"{key}.samples", 1, None),
-                   "pattern": self.choice(raw.get("pattern", "regular"), f"{key}.pattern",
-                                          "pattern", RAY_PATTERNS),
-                   "max_depth": self.integer(raw.get("max_depth", 4), f"{key}.max_depth", 0,
-                                             MAX_DEPTH_LIMIT),
-                   "light_samples": self.integer(raw.get("light_samples", 1), f"{key}.light_samples",
-                                                 1, MAX_LIGHT_SAMPLES),
-                   "adaptive_threshold": None}
-        if "adaptive_threshold" in raw:
-            if options["pattern"] != "adaptive":
-                self.fail(f"{key}.adaptive_threshold", f"is for pattern = \"adaptive\", not "
-                                                       f"{options['pattern']!r}")
-            options["adaptive_threshold"] = self.number(raw["adaptive_threshold"],
-                                                        f"{key}.adaptive_threshold", minimum=0.0)
-        try:
-            ray_sampling(options["pattern"], options["samples"], 0, options["adaptive_threshold"],
-                         options["light_samples"])
-        except ValueError as error:
-            self.fail(f"{key}.samples", str(error))
-        return Setting(**common, **options)
+        shading = None
+        if "shading" in raw:
+            shading = self.choice(raw["shading"], f"{key}.shading", "shading", SHADING_MODES)
+        try:                 # the method's rules, once (renderer/methods, RayOptions)
+            options = method_options(method, self.tracer_values(raw, key))
+        except OptionError as error:
+            self.fail(f"{key}.{error.fields[0]}", error.reason)
+        if method == "raster":
+            return Setting(**common, shading=shading)
+        return Setting(**common, **{field: getattr(options, field) for field in TRACER_KEYS})
+
+    def tracer_values(self, raw: dict, key: str) -> dict:
+        """The ray tracer's keys given, as values of their types (their ranges and how they go
+        together are RayOptions' to check)."""
+        values = {}
+        for option in TRACER_KEYS:
+            if option not in raw:
+                continue
+            where, value = f"{key}.{option}", raw[option]
+            if option == "pattern":
+                values[option] = self.string(value, where)
+            elif option == "adaptive_threshold":
+                values[option] = self.number(value, where)
+            else:
+                values[option] = self.integer(value, where, -2 ** 63, None)
+        return values
 
     def outputs(self, raw: Any, key: str, background: str) -> tuple[Output, ...]:
         if raw is None:
@@ -341,11 +333,9 @@ class _JobReader(TableReader):
                                             bits=bits, dither=dither,
                                             halftone=parsed("halftone", stage.parse_halftone),
                                             format=output_format)
-        except ValueError as error:                # its line names options as --option
-            self.fail(key, str(error).replace("--", ""))
-        if output_format == "exr" and background == "transparent":
-            self.fail(f"{key}.format", "exr with background = \"transparent\": OpenEXR's alpha is "
-                                       "premultiplied; write format = \"npy\" (straight RGBA)")
+            settings.check_background(background)
+        except OptionError as error:               # the rule's own words (OutputSettings)
+            self.fail(f"{key}.{error.fields[0]}", error.reason)
         suffix = stage.FORMATS[output_format]
         return Output(self.file_name(raw, key, suffix, default_output_name(settings, None)), settings)
 

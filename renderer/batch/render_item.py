@@ -35,6 +35,7 @@ from renderer.core.motion import moves
 from renderer.core.output_settings import INTEGER_FORMATS
 from renderer.core.scene import Scene
 from renderer.errors import UserError
+from renderer.methods import METHODS
 
 CACHED = 4                    # scenes and renderers kept per worker (least recently used go)
 
@@ -158,21 +159,16 @@ class ItemWorker:
                setting.traced and moves(scene))
         renderer = self._renderers.pop(key, None)
         if renderer is None:
-            ctx = self._context()
-            if setting.traced:
-                from renderer.gpu.raytracer import RayTracer
-                renderer = RayTracer(scene, *setting.size, context=ctx, seed=item.seed,
-                                     **setting.tracer_options())
-            else:
-                from renderer.gpu.pipeline import GpuRenderer
-                renderer = GpuRenderer(scene, *setting.size, context=ctx)
+            from renderer.methods import open_renderer
+            renderer = open_renderer(scene, setting.size, method=setting.method,
+                                     options=setting.options(item.seed), context=self._context())
             while len(self._renderers) >= CACHED:
                 self._renderers.popitem(last=False)[1].release()
         else:
             try:
                 renderer.scene.camera = scene.camera
                 renderer.update()
-                if setting.traced:
+                if METHODS[setting.method].seeded:
                     renderer.reseed(item.seed)
             except BaseException:
                 renderer.release()            # out of the cache already: not left holding GL objects
@@ -186,11 +182,8 @@ class ItemWorker:
         start = time.perf_counter()
         scene = item_scene(self._scene(item.scene), item)
         renderer = self._renderer(item, scene)
-        if setting.traced:
-            frame = renderer.render()
-        else:
-            depth = self.keep_frames or any(o.depth for o in setting.outputs)
-            frame = renderer.render(linear=True, depth=depth)
+        depth = self.keep_frames or any(o.depth for o in setting.outputs)
+        frame = renderer.render(linear=True, depth=depth)
         rendered = time.perf_counter()
         result = ItemResult(item.key, worker=self._worker())
         for path, output in zip(item.files, setting.outputs):
@@ -201,7 +194,7 @@ class ItemWorker:
         result.render_ms = (rendered - start) * 1000.0
         result.encode_ms = (time.perf_counter() - rendered) * 1000.0
         if self.keep_frames:             # what the reference is held against (no linear colour)
-            subpixel_bits = None if setting.traced else renderer.subpixel_bits
+            subpixel_bits = getattr(renderer, "subpixel_bits", None)     # the rasteriser's
             result.frame = (replace(frame, linear=None), subpixel_bits)
         return result
 
@@ -245,9 +238,8 @@ def reference_item(item: Item, frame, subpixel_bits: int | None) -> ReferenceRes
     try:
         scene = item_scene(load_source(item.scene), item)
         setting = item.setting
-        options = setting.tracer_options() | {"seed": item.seed} if setting.traced else None
         check = against_reference(scene, setting.size, frame, method=setting.method,
-                                  options=options, subpixel_bits=subpixel_bits)
+                                  options=setting.options(item.seed), subpixel_bits=subpixel_bits)
     except UserError as error:
         return ReferenceResult(error=error.line())
     except Exception:

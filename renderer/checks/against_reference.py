@@ -4,6 +4,7 @@ depth and shadow ties, grazing rays between float32 and float64), the comparison
 the pipeline tolerance, the heat map and the figures.
 
     check = against_reference(scene, (w, h), gpu_frame, method="raster", subpixel_bits=8)
+    check = against_reference(scene, (w, h), gpu_frame, method="raytrace", options=RayOptions(samples=4))
     check.figures          # the JSON object `renderer compare` prints, less GPU timing and GL
     check.failures         # what fails the tolerance (empty: it passes)
 """
@@ -20,6 +21,7 @@ from renderer.checks.compare import (compare_frames, depth_tie_pixels, either_pr
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.frame import Frame
 from renderer.core.jsonio import finite_or_none
+from renderer.methods import open_renderer
 
 
 @dataclass
@@ -31,28 +33,27 @@ class ReferenceCheck:
 
 
 def against_reference(scene, size, gpu_frame: Frame, *, method: str = "raster",
-                      options: dict | None = None, subpixel_bits: int | None = None,
+                      options=None, subpixel_bits: int | None = None,
                       threshold: int = PIPELINE_TOLERANCE.threshold) -> ReferenceCheck:
-    """Render the reference for `scene` at `size` (the ray tracer's `options` for method
-    raytrace; the GPU's `subpixel_bits` for the rasteriser) and compare `gpu_frame` with it."""
+    """Render the reference for `scene` at `size` by `method` with its `options` (None: the
+    method's defaults; the GPU's `subpixel_bits` for the rasteriser) and compare `gpu_frame`
+    with it."""
     tie, tie_depth, grazing, envelope_renders = None, None, 0, 0
     start = time.perf_counter()
+    twin = open_renderer(scene, size, method=method, backend="reference", options=options,
+                         subpixel_bits=subpixel_bits)
+    ref_frame = twin.render()
+    reference_ms = (time.perf_counter() - start) * 1000.0
+    # What the twin accepts besides its own colour differs by method (a real difference: the
+    # ray tracer's float32 and float64 trees, the rasteriser's texture lookups' envelope).
     if method == "raytrace":
-        from reference.raytrace.pipeline import render as reference_raytrace
-        from renderer.core.raytrace_scene import ray_scene
-        rs = ray_scene(scene)                    # the BVH built once, for both precisions
-        ref_frame = reference_raytrace(scene, *size, **options, rs=rs)
-        reference_ms = (time.perf_counter() - start) * 1000.0
         # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
-        # elsewhere the adaptive pattern's other decision, rgba8_tie).
-        truth = reference_raytrace(scene, *size, **options, dtype="float64", rs=rs)
-        tie, tie_depth, grazing = either_precision(ref_frame, truth)
+        # elsewhere the adaptive pattern's other decision, rgba8_tie). Same BVH, other precision.
+        twin.precision = "float64"
+        tie, tie_depth, grazing = either_precision(ref_frame, twin.render())
         expected = ref_frame.rgba8
     else:
-        import reference
         from renderer.checks.texture_bounds import accepted_colours
-        ref_frame = reference.render(scene, *size, subpixel_bits=subpixel_bits)
-        reference_ms = (time.perf_counter() - start) * 1000.0
         # Anisotropic lookups: the twin's range over the texture verifier's coordinate bound.
         accepted = accepted_colours(scene, ref_frame, *size, subpixel_bits=subpixel_bits)
         expected, tie, envelope_renders = accepted.rgba8, accepted.tie, accepted.displaced_renders

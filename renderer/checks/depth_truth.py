@@ -286,9 +286,9 @@ def depth_vs_truth(scene: Scene, width: int, height: int, context="auto",
     moderngl context to draw in; or take `frame`, a GPU Frame of this size with depth) and
     hold its depth against the ray casts."""
     if frame is None:
-        from renderer.gpu import GpuRenderer
+        from renderer.methods import open_renderer
         where = {"context_kind": context} if isinstance(context, str) else {"context": context}
-        with GpuRenderer(scene, width, height, **where) as gpu:
+        with open_renderer(scene, (width, height), **where) as gpu:
             frame = gpu.render(depth=True)
     kind = (frame.gl_info or {}).get("context", str(context))
     return compare_depth(scene, frame.depth, truth_depth(scene, width, height), kind)

@@ -36,8 +36,9 @@ from renderer.checks.compare import (DEFAULT_DEVIATION, DEFAULT_THRESHOLD, Compa
                                      channel_difference, compare_frames,
                                      position_deviation_mismatch)
 from renderer.core.frame import Frame
-from renderer.core.sampling import DEFAULT_SEED
+from renderer.core.ray_options import RayOptions
 from renderer.core.scene import Scene
+from renderer.methods import open_renderer
 from renderer.core.shadow_settings import Shadow
 from renderer.core.shadows import has_shadow_maps
 
@@ -188,53 +189,43 @@ class MethodComparison:
 
 
 def compare_methods(scene: Scene, width: int, height: int, *, context=None, context_kind: str = "auto",
-                    samples: int = 1, pattern: str = "regular", max_depth: int | None = None,
-                    seed: int = DEFAULT_SEED, adaptive_threshold: float | None = None,
-                    light_samples: int = 1, threshold: int = DEFAULT_THRESHOLD,
+                    options: RayOptions | None = None, threshold: int = DEFAULT_THRESHOLD,
                     deviation: int = DEFAULT_DEVIATION) -> MethodComparison:
     """Render CHAIN on the GPU in one GL context (`context`, else a new one of
-    `context_kind`) and explain where the rasteriser and the ray tracer (samples, pattern,
-    max_depth (default the ray tracer's), seed, adaptive_threshold, light_samples as RayTracer
-    takes them) differ."""
+    `context_kind`) and explain where the rasteriser and the ray tracer (its `options`,
+    default RayOptions()) differ."""
     from renderer.gpu.context import make_context, release_context
-    from renderer.gpu.pipeline import GpuRenderer
-    from renderer.gpu.raytracer import DEFAULT_MAX_DEPTH, RayTracer
-    max_depth = DEFAULT_MAX_DEPTH if max_depth is None else int(max_depth)
+    options = RayOptions() if options is None else options
     ctx = make_context(context_kind) if context is None else context
+
+    def frame_of(drawn: Scene, method: str = "raster", step: RayOptions | None = None) -> Frame:
+        with open_renderer(drawn, (width, height), method=method, options=step, context=ctx) as renderer:
+            return renderer.render()
+
     try:
-        frames = {}
-        with GpuRenderer(scene, width, height, context=ctx) as raster:
-            frames["raster"] = raster.render()
-        if set(scene.shading_modes()) == {"phong"}:
-            frames["phong"] = frames["raster"]
-        else:
-            with GpuRenderer(scene.with_shading("phong"), width, height, context=ctx) as raster:
-                frames["phong"] = raster.render()
-        if not has_shadow_maps(scene):
-            frames["unshadowed"] = frames["phong"]
-        else:
-            with GpuRenderer(without_shadow_maps(scene.with_shading("phong")), width, height,
-                             context=ctx) as raster:
-                frames["unshadowed"] = raster.render()
+        frames = {"raster": frame_of(scene)}
+        phong = scene.with_shading("phong")
+        frames["phong"] = frames["raster"] if set(scene.shading_modes()) == {"phong"} else frame_of(phong)
+        frames["unshadowed"] = (frames["phong"] if not has_shadow_maps(scene) else
+                                frame_of(without_shadow_maps(phong)))
         # What each ray-traced step sets; a step whose effective settings equal the last one's
         # reuses its frame (the sample offsets; no light: no shadow ray; nothing reflects: no bounce).
         lit = bool(scene.directional_lights or scene.point_lights)
         bounces = any(np.any(np.asarray(o.material.kr) > 0) or np.any(np.asarray(o.material.kt) > 0)
                       for o in scene.objects)
-        steps = {"centre": (1, "regular", 0, False), "samples": (samples, pattern, 0, False),
-                 "shadows": (samples, pattern, 0, True), "raytrace": (samples, pattern, max_depth, True)}
+        n, kind = options.samples, options.pattern
+        steps = {"centre": (1, "regular", 0, False), "samples": (n, kind, 0, False),
+                 "shadows": (n, kind, 0, True), "raytrace": (n, kind, options.max_depth, True)}
         renders = 1 + (frames["phong"] is not frames["raster"]) + (frames["unshadowed"] is not frames["phong"])
         last = None
         for name, (n, kind, depth, shadows) in steps.items():
             centre = n == 1 and kind == "regular"          # one ray through the pixel centre
-            sampling = "centre" if centre else (n, kind, seed, adaptive_threshold)
+            sampling = "centre" if centre else (n, kind, options.seed, options.adaptive_threshold)
             key = (sampling, depth if bounces else 0, shadows and lit)
             if key != last:
-                with RayTracer(scene, width, height, context=ctx, samples=n, pattern=kind,
-                               max_depth=depth, seed=seed, shadows=shadows,
-                               adaptive_threshold=None if centre else adaptive_threshold,
-                               light_samples=light_samples) as tracer:
-                    frame = tracer.render()
+                step = options.replace(samples=n, pattern=kind, max_depth=depth, shadows=shadows,
+                                       adaptive_threshold=None if centre else options.adaptive_threshold)
+                frame = frame_of(scene, "raytrace", step)
                 renders += 1
             frames[name], last = frame, key
     finally:
@@ -244,8 +235,8 @@ def compare_methods(scene: Scene, width: int, height: int, *, context=None, cont
     raster, raytrace = frames["raster"], frames["raytrace"]
     comparison = compare_frames(raster.rgba8, raytrace.rgba8, raster.depth, raytrace.depth,
                                 threshold=threshold, deviation=deviation)
-    settings = {"samples": samples, "pattern": pattern, "max_depth": max_depth, "seed": seed,
-                "adaptive_threshold": adaptive_threshold}
+    settings = {"samples": options.samples, "pattern": options.pattern, "max_depth": options.max_depth,
+                "seed": options.seed, "adaptive_threshold": options.adaptive_threshold}
     result = MethodComparison(scene.name, raster, raytrace, causes, comparison, settings, renders, [])
     result.notes = notes(scene, result.counts())
     return result

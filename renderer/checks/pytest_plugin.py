@@ -36,7 +36,6 @@ import pytest
 
 RESULTS_DEFAULT = "golden-results"
 
-METHODS = ("raster", "raytrace")          # check_scene's: the rasteriser, the ray tracer
 
 
 class GoldenWarning(UserWarning):
@@ -281,29 +280,28 @@ class GoldenChecker:
         `scene`: a renderer.core.scene.Scene, a built-in scene's name, or a scene file (relative
         paths are taken from the test file's folder). `context`: "auto", "egl", "osmesa" or
         a moderngl context to reuse. `shading`: render every material flat, gouraud or phong.
-        `method`: "raster" (renderer.gpu.GpuRenderer) or "raytrace" (renderer.gpu.raytracer.
-        RayTracer); `trace`, for "raytrace" only: the RayTracer's options (samples, pattern,
-        max_depth, seed, shadows).
+        `method`: "raster" or "raytrace" (renderer/methods, open_renderer); `trace`: the
+        method's options by field (RayOptions': samples, pattern, max_depth, seed, shadows...).
         """
         from renderer.errors import UserError
         from renderer.core.scene import Scene
 
-        if method not in METHODS:
-            pytest.fail(f"method must be one of {', '.join(METHODS)}, got {method!r}", pytrace=False)
-        if trace and method != "raytrace":
-            pytest.fail(f"{', '.join(sorted(trace))}: options of method=\"raytrace\"", pytrace=False)
-        if method == "raster":
-            from renderer.gpu.pipeline import GpuRenderer as Renderer
-        else:
-            from renderer.gpu.raytracer import RayTracer as Renderer
+        from renderer.errors import OptionError
+        from renderer.methods import method_options, open_renderer
+        try:
+            options, refused = method_options(method, trace), None
+        except OptionError as error:
+            options, refused = None, f"{error.fields[0]}: {error.reason}"
+        if refused is not None:                   # outside the except: one line, no chained cause
+            pytest.fail(refused, pytrace=False)
         try:
             if not isinstance(scene, Scene):
                 scene = self._load(scene)
             if shading is not None:
                 scene = scene.with_shading(shading)
             where = {"context_kind": context} if isinstance(context, str) else {"context": context}
-            with Renderer(scene, *size, **where, **trace) as renderer:
-                frame = renderer.render(depth=False) if method == "raster" else renderer.render()
+            with open_renderer(scene, size, method=method, options=options, **where) as renderer:
+                frame = renderer.render(depth=False)
         except UserError as error:
             _fail_plainly(error)
         self.check(frame, name, policy=policy, scene=scene.name)

@@ -44,9 +44,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-import reference
 from renderer.checks.compare import Envelope
 from renderer.core.frame import Frame
+from renderer.methods import open_renderer
 
 COORDINATE_BITS = 20                       # dEQP's coordBits for 2D filtering (see above)
 # (a, b): (s, t) moved by (a e(s), b e(t)); the box's corners, then the half box's.
@@ -92,14 +92,15 @@ class AcceptedColours:
     displaced_renders: int                # twin renders at displaced lookups (0: the exact compare)
 
 
-def accepted_colours(scene, frame: Frame, width: int, height: int, **render_options) -> AcceptedColours:
-    """What the twin accepts for `scene`, given its own `frame` (reference.render(scene,
-    width, height, **render_options)): that frame's colours, or where some material samples
-    anisotropically, their envelope with the renders at DISPLACEMENTS."""
+def accepted_colours(scene, frame: Frame, width: int, height: int,
+                     subpixel_bits: int | None = None) -> AcceptedColours:
+    """What the twin accepts for `scene`, given its own `frame` (the reference rasteriser's
+    at width x height with the GPU's `subpixel_bits`): that frame's colours, or where some
+    material samples anisotropically, their envelope with the renders at DISPLACEMENTS."""
     if not has_anisotropic(scene):
         return AcceptedColours(frame.rgba8, frame.rgba8_tie, 0)
-    frames = [frame] + [reference.render(scene, width, height, displace_lookup=displaced_lookup(d),
-                                         **render_options) for d in DISPLACEMENTS]
+    twin = open_renderer(scene, (width, height), backend="reference", subpixel_bits=subpixel_bits)
+    frames = [frame] + [twin.render(displace_lookup=displaced_lookup(d)) for d in DISPLACEMENTS]
     tie = None
     if any(f.rgba8_tie is not None for f in frames):
         tie = Envelope.of([f.rgba8 if f.rgba8_tie is None else f.rgba8_tie for f in frames])

@@ -41,7 +41,7 @@ import numpy as np
 
 BINS = 16
 MAX_LEAF_SIZE = 4
-MAX_DEPTH = 64                  # the GLSL's BVH_STACK_SIZE
+MAX_DEPTH = 64                  # the GLSL's BVH_STACK_SIZE (renderer/gpu/shaders.py defines it)
 TEXTURE_WIDTH = 1024
 MAX_EXACT_INDEX = 1 << 24       # float32 holds every integer below it
 

@@ -75,10 +75,3 @@ def declares_area_lights(scene: Scene) -> bool:
 def uses_area_lights(scene: Scene) -> bool:
     """Whether some point light has an area of size > 0 (the GLSL then compiles AREA_LIGHTS in)."""
     return any(light.area is not None and light.area.has_size for light in scene.point_lights)
-
-
-def area_light_defines(scene: Scene, every: bool = False) -> dict[str, object]:
-    """trace.glsl's and lighting.glsl's AREA_LIGHTS: where the scene uses area lights, or
-    `every` (the build that compiles every feature in) where it has point lights. (LIGHT_SAMPLES,
-    M, is the sampling rule's define.)"""
-    return {"AREA_LIGHTS": bool(scene.point_lights) and (every or uses_area_lights(scene))}

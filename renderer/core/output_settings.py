@@ -2,7 +2,8 @@
 "Outputs"): the display's transfer curve, the bit depth, dithering or half-toning, and the file
 format. One `OutputSettings` travels from the command line (or a caller) to both twins of the
 stage (renderer/gpu/output.py, reference/output/); each method is a word here and a GLSL
-define there (`defines()`), so a pass compiles only what its settings use.
+define there (renderer/gpu/defines.py, `output_defines`), so a pass compiles only what its
+settings use.
 
 Every parse_* function takes the user's text and returns the value, or raises ValueError with
 the reason alone (the caller names the option: `--bits 0: must be between 1 and 16`).
@@ -12,6 +13,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+
+from renderer.errors import OptionError
 
 MIN_BITS, MAX_BITS = 1, 16                 # bits per channel the stage quantises to
 
@@ -81,7 +84,7 @@ class OutputSettings:
     def __post_init__(self):
         problem = self.problem()
         if problem is not None:
-            raise ValueError(problem)
+            raise OptionError(*problem)
 
     @property
     def quantised(self) -> bool:
@@ -97,46 +100,42 @@ class OutputSettings:
             return 1
         return self.bits if self.bits is not None else INTEGER_FORMATS[self.format]
 
-    def problem(self) -> str | None:
-        """Why these settings cannot go together, in one line naming the option, or None."""
+    def problem(self) -> tuple[tuple[str, ...], str] | None:
+        """Why these settings cannot go together: (the fields concerned, the reason in words
+        that name no front end's spelling; renderer/errors.py, OptionError), or None."""
         if self.format not in FORMATS:
-            return f"--format {self.format}: unknown; one of {', '.join(FORMATS)}"
+            return ("format",), f"unknown; one of {', '.join(FORMATS)}"
         if self.dither not in DITHERS:
-            return f"--dither {self.dither}: unknown; one of {', '.join(DITHERS)}"
+            return ("dither",), f"unknown; one of {', '.join(DITHERS)}"
         if self.bits is not None:
             if not MIN_BITS <= self.bits <= MAX_BITS:
-                return f"--bits {self.bits}: must be between {MIN_BITS} and {MAX_BITS}"
+                return ("bits",), f"must be between {MIN_BITS} and {MAX_BITS}"
             if not self.quantised:
-                return (f"--bits {self.bits}: {self.format} holds float colour unquantised; "
-                        "quantise to png8 or png16")
+                return ("bits", "format"), (f"{self.format} holds float colour unquantised; "
+                                            "quantise to png8 or png16")
             if self.bits > INTEGER_FORMATS[self.format]:
-                return (f"--bits {self.bits}: {self.format} holds at most "
-                        f"{INTEGER_FORMATS[self.format]} bits per channel; use png16")
+                return ("bits", "format"), (f"{self.format} holds at most "
+                                            f"{INTEGER_FORMATS[self.format]} bits per channel; use png16")
         if self.dither != "none" and not self.quantised:
-            return f"--dither {self.dither}: {self.format} holds float colour unquantised"
+            return ("dither", "format"), f"{self.format} holds float colour unquantised"
         if self.halftone is not None:
             if not self.quantised:
-                return f"--halftone: {self.format} holds float colour; half-tones are png8 or png16"
+                return ("halftone", "format"), f"{self.format} holds float colour; half-tones are png8 or png16"
             if self.dither != "none":
-                return f"--halftone and --dither {self.dither}: choose one"
+                return ("halftone", "dither"), "choose one"
             if self.bits not in (None, 1):
-                return f"--bits {self.bits}: a half-tone prints binary inks (1 bit per channel)"
+                return ("bits", "halftone"), "a half-tone prints binary inks (1 bit per channel)"
         return None
 
-    def defines(self) -> dict[str, str]:
-        """The GLSL defines of the output pass for these settings (glsl/output/)."""
-        defines = {"TRANSFER_" + self.transfer.kind.upper(): "1"}
-        if self.halftone is not None:
-            defines["HALFTONE"] = "1"
-        elif self.dither in ORDERED:
-            defines["DITHER_ORDERED"] = str(ORDERED[self.dither])
-        elif self.dither == "blue-noise":
-            defines["DITHER_BLUE_NOISE"] = "1"
-        elif self.dither in ERROR_DIFFUSION:
-            defines["DITHER_ERROR_DIFFUSION"] = str(ERROR_DIFFUSION.index(self.dither))
-        if not self.quantised:
-            defines["FLOAT_OUTPUT"] = "1"
-        return defines
+    def check_background(self, background: str) -> None:
+        """OptionError where the file format cannot hold the frame's `background` as drawn."""
+        if self.format == "exr" and background == "transparent":
+            raise OptionError(("format", "background"), EXR_TRANSPARENT)
+
+
+# Why OpenEXR and a transparent background do not go together (OutputSettings.check_background).
+EXR_TRANSPARENT = ("OpenEXR's alpha is premultiplied, and the frame's colour where nothing is "
+                   "drawn is the background's under alpha 0; write format npy (straight RGBA)")
 
 
 def parse_transfer(text: str) -> Transfer:

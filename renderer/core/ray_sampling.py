@@ -1,6 +1,6 @@
 """Where the ray tracer samples a pixel (docs/conventions.md, "Sample positions"): the constants
-both twins read, glsl/raytrace/sampling.glsl (as #defines and uniforms, renderer/gpu/
-raytracer.py) and reference/raytrace/sampling.py.
+both twins read, glsl/raytrace/sampling.glsl (as #defines, renderer/gpu/defines.py, and uniforms,
+renderer/gpu/raytracer.py) and reference/raytrace/sampling.py.
 
 Sample k (0 .. N-1) of a frame is sample index first_sample + k, the counter of the PCG
 random numbers (glsl/raytrace/random.glsl), so successive frames draw new samples:
@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.errors import OptionError
 from renderer.core.sampling import DEFAULT_SEED, pattern as table_pattern, strata
 
 RAY_PATTERNS = ("regular", "random", "jittered", "poisson", "adaptive")
@@ -98,26 +99,6 @@ class RaySampling:
     def adaptive(self) -> bool:
         return self.threshold is not None
 
-    def defines(self) -> dict[str, object]:
-        """sampling.glsl's and raytrace.frag's compile-time constants."""
-        return {"NUM_SAMPLES": self.samples, "FIRST_SAMPLES": self.first_set,
-                "SAMPLE_TABLE": self.table is not None, "ADAPTIVE": self.adaptive,
-                "FIRST_COLUMNS": self.first_strata[0], "FIRST_ROWS": self.first_strata[1],
-                "REST_COLUMNS": self.rest_strata[0], "REST_ROWS": self.rest_strata[1],
-                **self.dimension_defines()}
-
-    def dimension_defines(self) -> dict[str, object]:
-        """distributed_2d's and distributed_1d's constants: the mode and the strata grids of
-        one point per sample (DIMENSION_*) and, with light_samples M > 1, of M (LIGHT_*)."""
-        mode = self.dimension_mode
-        defines = {"DIMENSION_RANDOM": mode == "random", "DIMENSION_CENTRES": mode == "centres",
-                   "DIMENSION_TABLE": mode == "table", "LIGHT_SAMPLES": self.light_samples}
-        for prefix, per_sample in (("DIMENSION", 1), ("LIGHT", self.light_samples)):
-            for name, which in (("FIRST", 0), ("REST", 1)):
-                columns, rows = self.dimension_grid(which, per_sample)
-                defines[f"{prefix}_{name}_COLUMNS"], defines[f"{prefix}_{name}_ROWS"] = columns, rows
-        return defines
-
     def uniforms(self) -> dict[str, np.ndarray]:
         """The per-tracer uniforms (u_first_sample is per frame)."""
         values = {"u_seed": np.uint32(self.seed)}
@@ -131,36 +112,39 @@ class RaySampling:
 def ray_sampling(pattern: str = "regular", samples: int = 1, seed: int = DEFAULT_SEED,
                  adaptive_threshold: float | None = None, light_samples: int = 1) -> RaySampling:
     """The rule of `pattern` with N = `samples` and M = `light_samples` points per area light
-    and hit; ValueError (its reason in one line) for an unknown pattern, N outside
+    and hit; OptionError (a ValueError naming the fields, its reason in one line) for an unknown pattern, N outside
     1..MAX_SAMPLES, a regular N that is not a perfect square, adaptive N < FIRST_SET, a seed
     that is not a uint32, a threshold with another pattern (adaptive: default
     DEFAULT_ADAPTIVE_THRESHOLD, finite and >= 0) or M outside 1..MAX_LIGHT_SAMPLES."""
     if pattern not in RAY_PATTERNS:
-        raise ValueError(f"sample pattern must be one of {', '.join(RAY_PATTERNS)}, got {pattern!r}")
+        raise OptionError("pattern", f"sample pattern must be one of {', '.join(RAY_PATTERNS)}, got {pattern!r}")
     n = int(samples)
     if not 1 <= n <= MAX_SAMPLES:
-        raise ValueError(f"samples per pixel must be between 1 and {MAX_SAMPLES}, got {samples}")
+        raise OptionError("samples", f"samples per pixel must be between 1 and {MAX_SAMPLES}, got {samples}")
     if not (isinstance(seed, (int, np.integer)) and 0 <= seed < UINT32_LIMIT):
-        raise ValueError(f"the seed must be a whole number from 0 to {UINT32_LIMIT - 1}, got {seed!r}")
+        raise OptionError("seed", f"the seed must be a whole number from 0 to {UINT32_LIMIT - 1}, got {seed!r}")
     if pattern != "adaptive" and adaptive_threshold is not None:
-        raise ValueError("an adaptive threshold is for the adaptive pattern")
+        raise OptionError(("adaptive_threshold", "pattern"), f"an adaptive threshold is for the adaptive "
+                                                             f"pattern, not {pattern}")
     table, threshold = None, None
     first, first_strata, rest_strata = n, (1, 1), (1, 1)
+    if pattern == "regular" and math.isqrt(n) ** 2 != n:
+        raise OptionError(("samples", "pattern"), f"a regular grid needs a perfect square sample count, got {n}")
     if pattern in TABLE_PATTERNS:
         table = np.asarray(table_pattern(pattern, n, int(seed)), np.float32)
     elif pattern == "jittered":
         first_strata = strata(n)
     elif pattern == "adaptive":
         if n < FIRST_SET:
-            raise ValueError(f"adaptive sampling needs at least {FIRST_SET} samples per pixel "
+            raise OptionError(("samples", "pattern"), f"adaptive sampling needs at least {FIRST_SET} samples per pixel "
                              f"(its first set), got {n}")
         threshold = DEFAULT_ADAPTIVE_THRESHOLD if adaptive_threshold is None else float(adaptive_threshold)
         if not (math.isfinite(threshold) and threshold >= 0):
-            raise ValueError(f"the adaptive threshold must be a finite number >= 0, got {adaptive_threshold!r}")
+            raise OptionError("adaptive_threshold", f"the adaptive threshold must be a finite number >= 0, got {adaptive_threshold!r}")
         first, first_strata = FIRST_SET, strata(FIRST_SET)
         rest_strata = strata(n - FIRST_SET) if n > FIRST_SET else (1, 1)
     if not (isinstance(light_samples, (int, np.integer)) and 1 <= light_samples <= MAX_LIGHT_SAMPLES):
-        raise ValueError(f"light samples per hit must be a whole number from 1 to {MAX_LIGHT_SAMPLES}, "
+        raise OptionError("light_samples", f"light samples per hit must be a whole number from 1 to {MAX_LIGHT_SAMPLES}, "
                          f"got {light_samples!r}")
     # Every N <= MAX_SAMPLES and M <= MAX_LIGHT_SAMPLES makes strata grids at most
     # MAX_STRATA_SIDE wide (tests/test_raytrace_distributed.py tries them all).

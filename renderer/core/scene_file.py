@@ -361,15 +361,22 @@ class TableReader:
         except OverflowError:          # TOML integers are unbounded
             self.fail(path, f"number too large: {str(value)[:20]}...")
 
+    def float32_number(self, value, path: str, item: int | None = None) -> float:
+        """A number (or list item `item`) as a float that is finite and within MAX_NUMBER."""
+        x = self.to_float(value, path)
+        if not math.isfinite(x):
+            self.fail(path, f"expected a finite number, got {show_number(x)}" if item is None else
+                      f"expected finite numbers, item {item} is {show_number(x)}")
+        if abs(x) > MAX_NUMBER:
+            self.fail(path, f"{show_number(x)} is {TOO_LARGE}" if item is None else
+                      f"item {item} is {show_number(x)}, {TOO_LARGE}")
+        return x
+
     def number(self, value: Any, path: str, *, minimum: float | None = None,
                above: float | None = None) -> float:
         if not _is_number(value):
             self.fail(path, f"expected a number, got {describe_value(value)}")
-        x = self.to_float(value, path)
-        if not math.isfinite(x):
-            self.fail(path, f"expected a finite number, got {show_number(x)}")
-        if abs(x) > MAX_NUMBER:
-            self.fail(path, f"{show_number(x)} is {TOO_LARGE}")
+        x = self.float32_number(value, path)
         if minimum is not None and x < minimum:
             self.fail(path, f"must be >= {minimum:g}, got {x:g}")
         if above is not None and x <= above:
@@ -402,11 +409,7 @@ class TableReader:
         for i, item in enumerate(value):
             if not _is_number(item):
                 self.fail(path, f"expected {expected}, item {i} is {describe_value(item)}")
-            x = self.to_float(item, path)
-            if not math.isfinite(x):
-                self.fail(path, f"expected finite numbers, item {i} is {show_number(x)}")
-            if abs(x) > MAX_NUMBER:
-                self.fail(path, f"item {i} is {show_number(x)}, {TOO_LARGE}")
+            x = self.float32_number(item, path, i)
             if minimum is not None and x < minimum:
                 self.fail(path, f"must be >= {minimum:g} in every component, "
                                 f"item {i} is {show_number(x)}")

@@ -21,7 +21,7 @@ from renderer.core.colour import D65_CHROMATICITY, RGB_TO_XYZ
 from renderer.gpu.context import activate, make_context, release_context
 from renderer.gpu.shaders import compute_program
 
-GROUP = 8                                 # colour.comp's local_size_x and local_size_y
+GROUP = 8                                 # colour.comp's local_size_x and local_size_y (#define GROUP_SIZE)
 
 
 class ColourPass:
@@ -34,7 +34,7 @@ class ColourPass:
         self.last_milliseconds = 0.0
         try:
             activate(self.ctx)
-            self.program = compute_program(self.ctx, "output/colour.comp")
+            self.program = compute_program(self.ctx, "output/colour.comp", {"GROUP_SIZE": GROUP})
             # GL reads a mat3 column by column: the columns of M are the rows of M's transpose.
             self.program["rgb_to_xyz_matrix"].write(RGB_TO_XYZ.T.astype(np.float32).tobytes())
             self.program["white_chromaticity"].value = tuple(D65_CHROMATICITY.astype(np.float32))

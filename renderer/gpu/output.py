@@ -11,7 +11,7 @@ so the shader's y is the image row from the top, the dither patterns' y. Quantis
 give codes in [0, 2^N - 1], N = settings.code_bits; float formats give encode(L) per RGB
 channel and alpha as it is.
 
-GL objects are made on first use and kept: a program per set of defines (settings.defines():
+GL objects are made on first use and kept: a program per set of defines (output_defines(settings):
 a program holds only the method it runs), the input and output images per size and kind,
 the quantisation tables per (transfer, bits) (renderer/core/quantise.py; one float texture,
 `table_texture`), the blue-noise ranks once (an SSBO), error diffusion's error image per size
@@ -43,11 +43,14 @@ from renderer.core.output_settings import ERROR_DIFFUSION, OutputSettings, Trans
 from renderer.core.quantise import (SRGB_A, SRGB_EXPONENT, SRGB_LINEAR_LIMIT, SRGB_SLOPE,
                                     code_values, decision_points)
 from renderer.gpu.context import activate
+from renderer.gpu.defines import output_defines
 from renderer.gpu.shaders import compute_program
 
 GROUP_SIZE = 8                       # output.comp's local_size_x and _y
 WAVEFRONT_GROUP = 64                 # error_diffusion.comp's local_size_x
-MAX_TAPS = 12                        # error_diffusion.comp's tap arrays
+MAX_TAPS = 12                        # error_diffusion.comp's tap arrays (Jarvis-Judice-Ninke's)
+# Every program of the pass is compiled with them as #defines: the GLSL holds no copy.
+PASS_CONSTANTS = {"GROUP_SIZE": GROUP_SIZE, "WAVEFRONT_GROUP": WAVEFRONT_GROUP, "MAX_TAPS": MAX_TAPS}
 LINEAR = Transfer("linear")
 # Bindings, as the GLSL declares them: images 0 (input), 1 (output) and 2 (error diffusion's
 # errors), texture units 0 (the tables), 1 (error diffusion's shares) and 2 (the half-tone's
@@ -105,13 +108,14 @@ class OutputPass:
     def program(self, settings: OutputSettings) -> moderngl.ComputeShader:
         """The compiled program that runs `settings` (made on first use)."""
         activate(self.ctx)              # another context may be current: compile on ours
-        defines = settings.defines()
+        defines = output_defines(settings)
         key = tuple(sorted(defines.items()))
         program = self._programs.get(key)
         if program is None:
             filename = ("output/error_diffusion.comp" if settings.dither in ERROR_DIFFUSION
                         else "output/output.comp")
-            program = self._programs[key] = compute_program(self.ctx, filename, defines)
+            program = self._programs[key] = compute_program(self.ctx, filename,
+                                                            defines | PASS_CONSTANTS)
         return program
 
     def _image_pair(self, width: int, height: int, quantised: bool):

@@ -75,7 +75,8 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from renderer.gpu.context import activate, context_kind, gl_function, make_context, release_context
+from renderer.gpu.base import ContextRenderer
+from renderer.gpu.context import activate, context_kind, gl_function
 from renderer.errors import ContextError, SystemFault
 from renderer.core.drawn import drawn_meshes, is_plane
 from renderer.core.facets import face_texture
@@ -190,7 +191,7 @@ class _Draw:
     count: int = -1                        # indices drawn (-1: all)
 
 
-class GpuRenderer:
+class GpuRenderer(ContextRenderer):
     """Renders one scene at one size through GLSL; see the module docstring."""
 
     def __init__(self, scene: Scene, width: int, height: int,
@@ -208,9 +209,7 @@ class GpuRenderer:
         self.prune_shadows = bool(prune_shadows)
         self.wireframe = False           # draw() draws edges only (a viewer's toggle)
         self._shadows = True             # the `shadows` switch
-        self._owns_context = context is None
-        self.ctx = make_context(context_kind) if context is None else context
-        self._released = False
+        self._open_context(context, context_kind)
         self._programs = ProgramCache(self.ctx)
         self._textures = TextureCache(self.ctx)
         self._objects: list[_ObjectBuffers] = []
@@ -357,15 +356,17 @@ class GpuRenderer:
         return vao
 
     # -- uniforms ----------------------------------------------------------------------------
-    def update(self) -> None:
+    def update(self, scene: Scene | None = None) -> None:
         """Recompute every uniform from the scene (camera, lights, materials, transforms), and
         what the camera pass draws of each analytic plane (its polygon in the view volume,
-        written into the buffers made for it)."""
-        scene = self.scene
+        written into the buffers made for it). `scene`: draw that Scene from now on, one of
+        the same objects (a copy with another camera or lights)."""
+        scene = self.scene if scene is None else scene
         if len(scene.objects) != len(self._objects) or any(
                 a is not b.obj for a, b in zip(scene.objects, self._objects)):
             raise ValueError("the scene's objects changed since this GpuRenderer was made; "
                              "make a new one")
+        self.scene = scene
         activate(self.ctx)          # new meshes and maps are made in this renderer's context
         for item in self._objects:
             if item.mesh is not item.obj.mesh:          # a new mesh object: upload it again
@@ -473,7 +474,7 @@ class GpuRenderer:
         return plan
 
     # -- rendering ---------------------------------------------------------------------------
-    def render(self, *, linear: bool = False, depth: bool = True, out: Frame | None = None,
+    def render(self, out: Frame | None = None, *, linear: bool = False, depth: bool = True,
                sample_offset: tuple = (0.0, 0.0), samples: int = 1) -> Frame:
         """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked.
 
@@ -603,13 +604,6 @@ class GpuRenderer:
             "context": context_kind(self.ctx), "depth_format": self.depth_format}
 
     @property
-    def gl_info(self) -> dict:
-        """GL_VENDOR, GL_RENDERER, GL_VERSION, the context kind ("egl", "osmesa", or
-        "external" for a context passed in) and the depth buffer's format. Asked once, when
-        the renderer is made; every frame it renders carries the same dict."""
-        return dict(self._gl_info)
-
-    @property
     def subpixel_bits(self) -> int:
         """GL_SUBPIXEL_BITS: vertices snap to 1 / 2^bits of a pixel (8 on llvmpipe)."""
         return int(self.ctx.info["GL_SUBPIXEL_BITS"])
@@ -668,14 +662,11 @@ class GpuRenderer:
         return [vao for item in self._objects for vao in item.vertex_arrays.values()]
 
     # -- lifetime ----------------------------------------------------------------------------
-    def release(self) -> None:
-        """Free every GL object; the context too if this renderer made it. Idempotent."""
-        if self._released:
-            return
-        self._released = True
+    def _free(self) -> None:
+        """Free every GL object (ContextRenderer.release: the context too if this renderer
+        made it); gl_info also names the depth buffer's format."""
         self._plans.clear()
         try:
-            activate(self.ctx)
             if self._shadow_maps is not None:
                 self._shadow_maps.release()
                 self._shadow_maps = None
@@ -689,18 +680,6 @@ class GpuRenderer:
         finally:
             self._objects, self._framebuffers, self._renderbuffers = [], {}, []
             self._multisample = {}
-            if self._owns_context:
-                release_context(self.ctx)
-
-    def __enter__(self) -> "GpuRenderer":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.release()
-
-    def __repr__(self) -> str:
-        state = "released" if self._released else context_kind(self.ctx)
-        return f"<GpuRenderer {self.scene.name!r} {self.width}x{self.height} {state}>"
 
 
 def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:

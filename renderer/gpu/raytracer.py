@@ -48,46 +48,43 @@ from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.motion import declares_motion, moves, scene_motion
 from renderer.core.gl_rules import check_light_count, to_unorm8
-from renderer.core.light_areas import area_light_defines, area_light_uniforms
-from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.ray_sampling import (check_first_sample,
-                                         ray_sampling)
+from renderer.core.light_areas import area_light_uniforms
+from renderer.core.ray_options import RayOptions
+from renderer.core.ray_sampling import check_first_sample
 from renderer.core.raytrace_scene import ray_scene
-from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import light_uniforms
 from renderer.gpu.bvh import texel_texture
-from renderer.gpu.context import activate, context_kind, make_context, release_context
+from renderer.gpu.base import ContextRenderer
+from renderer.gpu.context import activate, context_kind
+from renderer.gpu.declarations import program_uniforms, uniforms_to_write
+from renderer.gpu.defines import area_light_defines, sampling_defines
 from renderer.gpu.shaders import shader_source
 from renderer.gpu.textures import TextureCache
 
-DEFAULT_MAX_DEPTH = 4
+class RayTracer(ContextRenderer):
+    """Ray traces one scene at one size; see the module docstring. `options` (RayOptions,
+    renderer/core/ray_options.py), or its fields as keywords; the lens overrides are the
+    caller's to apply (RayOptions.scene_for: renderer/methods does)."""
 
-
-class RayTracer:
-    """Ray traces one scene at one size; see the module docstring."""
-
-    def __init__(self, scene: Scene, width: int, height: int, *,
-                 context: moderngl.Context | None = None, context_kind: str = "auto",
-                 samples: int = 1, pattern: str = "regular", max_depth: int = DEFAULT_MAX_DEPTH,
-                 seed: int = DEFAULT_SEED, shadows: bool = True, specialise: bool = True,
-                 adaptive_threshold: float | None = None, light_samples: int = 1):
+    def __init__(self, scene: Scene, width: int, height: int, options: RayOptions | None = None, *,
+                 context: moderngl.Context | None = None, context_kind: str = "auto", **fields):
+        if options is not None and fields:
+            raise TypeError(f"give RayOptions or its fields, not both ({', '.join(fields)})")
+        options = RayOptions(**fields) if options is None else options
         width, height = image_size(width, height)
-        if not 0 <= int(max_depth) <= MAX_DEPTH_LIMIT:
-            raise ValueError(f"max_depth must be between 0 and {MAX_DEPTH_LIMIT}, got {max_depth}")
         check_light_count(scene)
         self.scene = scene
         self.width, self.height = width, height
-        self.sampling = ray_sampling(pattern, samples, seed, adaptive_threshold, light_samples)
-        self.max_depth = int(max_depth)
-        self.shadows = bool(shadows)
-        self.specialise = bool(specialise)
-        self._owns_context = context is None
-        self.ctx = make_context(context_kind) if context is None else context
+        self.options = options
+        self.sampling = options.sampling
+        self.max_depth = options.max_depth
+        self.shadows = options.shadows
+        self.specialise = options.specialise
+        self._open_context(context, context_kind)
         self._resources: list = []
         self._image_textures = TextureCache(self.ctx)     # the materials' images, uploaded once
-        self._released = False
         try:
             activate(self.ctx)
             self._build()
@@ -129,7 +126,7 @@ class RayTracer:
             "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
             "LENS": scene.camera.has_lens or every,
-            **self.sampling.defines(),
+            **sampling_defines(self.sampling),
             **area_light_defines(scene, every),
             **self._motion_defines(rs),
             **({"TEXTURES": True, "NUM_TEXTURES": len(rs.textures.textures)} if rs.textures else {}),
@@ -142,16 +139,21 @@ class RayTracer:
             if old is not None:
                 self._resources.remove(old)
                 old.release()
+        fragment = shader_source("raytrace/raytrace.frag", self.defines)
         self.program = self.ctx.program(
-            vertex_shader=shader_source("raytrace/fullscreen.vert").text,
-            fragment_shader=shader_source("raytrace/raytrace.frag", self.defines).text)
+            vertex_shader=shader_source("raytrace/fullscreen.vert").text,   # no uniforms
+            fragment_shader=fragment.text)
+        self._fragment_text = fragment.text
         self._resources.append(self.program)
         self._vao = self.ctx.vertex_array(self.program, [])
         self._resources.append(self._vao)
 
     def _write_uniforms(self, rs) -> None:
-        """Camera rays, lights, shapes and the sample pattern; the textures' units."""
-        scene, program = self.scene, self.program
+        """Camera rays, lights, shapes and the sample pattern; the textures' units. Written are
+        the ones the program's #defines declare (uniforms_to_write: one the scene's
+        specialisation leaves out is not, and a name the GLSL declares nowhere, or a uniform it
+        declares that gets no value, is an error); self._uniforms_written names them."""
+        scene = self.scene
         matrices = scene.matrices(self.width, self.height)
         rays = camera_ray_uniforms(matrices.view, matrices.projection, self.width, self.height)
         values = {name: to_glsl(value) for name, value in rays.items()}
@@ -171,15 +173,15 @@ class RayTracer:
             values["u_plane_object"] = rs.plane_object.astype(np.int32).tobytes()
         values.update(self._motion_uniforms(rs))
         values.update(self._texture_uniforms(rs))
-        for name, value in values.items():
-            if name in program:
-                program[name].write(value)
-        for name, unit in self._units.items():
-            if name in program:
-                program[name].value = unit
-        if "u_textures" in program:
+        values.update({name: np.int32(unit).tobytes() for name, unit in self._units.items()})
+        if rs.textures is not None:
             units = [unit for unit, _ in self._image_units()]
-            program["u_textures"].write(np.asarray(units, np.int32).tobytes())
+            values["u_textures"] = np.asarray(units, np.int32).tobytes()
+        values["u_first_sample"] = np.uint32(0).tobytes()      # render() writes each frame's
+        self._uniforms_written = uniforms_to_write(self._fragment_text,
+                                                   program_uniforms(self.program), values)
+        for name in self._uniforms_written:
+            self.program[name].write(values[name])
 
     def _lens_values(self, matrices) -> dict:
         """The thin lens's uniforms (renderer/core/camera_rays.py, lens_uniforms) as float32
@@ -292,16 +294,24 @@ class RayTracer:
         self._resources += [*self._targets, self._fbo]
 
     # -- a viewer's changes ------------------------------------------------------------------
-    def update(self) -> None:
+    def update(self, scene: Scene | None = None) -> None:
         """Take the scene again after its camera, lights or materials changed in place (a
-        viewer's orbit and keys; its objects, meshes and shapes must be the ones this tracer
-        was made with): the image is then, bit for bit, that of a RayTracer made afresh for
-        the scene. Cheaper: the BVH's tree is kept and only refitted to the triangles relative
+        viewer's orbit and keys), or `scene`, a Scene of the same objects (its objects, meshes
+        and shapes must be the ones this tracer was made with): the image is then, bit for
+        bit, that of a RayTracer made afresh for the scene. Cheaper: the BVH's tree is kept and only refitted to the triangles relative
         to the new eye (renderer/core/raytrace_scene.py), the textures are written again in
         place, and the program is compiled again only when its #defines changed (a light
         switched on or off)."""
-        if self._released:
-            raise RuntimeError("this RayTracer was released")
+        self._check_alive()
+        previous = self.scene
+        self.scene = self.scene if scene is None else scene
+        try:
+            self._take_scene()
+        except BaseException:
+            self.scene = previous
+            raise
+
+    def _take_scene(self) -> None:
         now = self._surfaces_now()
         if len(now) != len(self._surfaces) or any(
                 a is not b for old, new in zip(self._surfaces, now) for a, b in zip(old, new)):
@@ -330,13 +340,12 @@ class RayTracer:
         those of a RayTracer made with `seed` (a batch's items). The seed and the table
         patterns' offsets drawn from it are uniforms, so nothing is compiled or rebuilt.
         ValueError (one line) for a seed that is not a uint32."""
-        if self._released:
-            raise RuntimeError("this RayTracer was released")
-        s = self.sampling
-        self.sampling = ray_sampling(s.pattern, s.samples, seed, s.threshold, s.light_samples)
+        self._check_alive()
+        self.options = self.options.replace(seed=seed)
+        self.sampling = self.options.sampling
         activate(self.ctx)
         for name, value in self.sampling.uniforms().items():
-            if name in self.program:
+            if name in self._uniforms_written:
                 self.program[name].write(value.tobytes())
 
     def _surfaces_now(self) -> list[tuple]:
@@ -357,20 +366,17 @@ class RayTracer:
         self._build_targets()
         self.update()
 
-    @property
-    def gl_info(self) -> dict:
-        return dict(self._gl_info)
-
-    def render(self, first_sample: int = 0) -> Frame:
+    def render(self, out: Frame | None = None, *, linear: bool = True, depth: bool = True,
+               first_sample: int = 0) -> Frame:
         """Trace the frame of sample indices first_sample .. first_sample + N - 1: rgba8,
         linear (average linear colour, alpha the coverage), depth and samples (traced per
-        pixel), row 0 at the top."""
-        if self._released:
-            raise RuntimeError("this RayTracer was released")
+        pixel), row 0 at the top. `linear` and `depth` are always traced (the Renderer
+        protocol's flags change nothing); `out`, an earlier frame, has its arrays written."""
+        self._check_alive()
         first_sample = check_first_sample(first_sample, self.sampling.samples)
         start = time.perf_counter()
         activate(self.ctx)
-        if "u_first_sample" in self.program:
+        if "u_first_sample" in self._uniforms_written:
             self.program["u_first_sample"].value = first_sample
         for unit, texture in self._textures:
             texture.use(unit)
@@ -383,37 +389,33 @@ class RayTracer:
         for unit, material_texture in images:     # no sampler state of ours left on the context
             self._image_textures.get(material_texture)[1].clear(unit)
         h, w = self.height, self.width
-        linear = np.frombuffer(self._fbo.read(components=4, attachment=0, dtype="f4"), np.float32).reshape(h, w, 4)
-        depth = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="f4"), np.float32).reshape(h, w)
-        linear = np.ascontiguousarray(linear[::-1])
-        depth = np.ascontiguousarray(depth[::-1])
+        reuse = (None, None) if out is None else (out.linear, out.depth)
+        colour = _flip_read(self._fbo, 0, (h, w, 4), reuse[0])
+        view_depth = _flip_read(self._fbo, 1, (h, w), reuse[1])
         if self.sampling.adaptive:
             traced = np.frombuffer(self._fbo.read(components=1, attachment=2, dtype="f4"), np.float32)
             samples = np.ascontiguousarray(traced.reshape(h, w)[::-1]).astype(np.int32)
         else:
             samples = np.full((h, w), self.sampling.samples, np.int32)
-        rgba8 = to_unorm8(linear)
-        rgba8[..., 3] = np.where(linear[..., 3] > 0, np.uint8(255), np.uint8(0))
-        return Frame(rgba8, linear, depth, (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info,
-                     samples=samples)
+        rgba8 = to_unorm8(colour)
+        rgba8[..., 3] = np.where(colour[..., 3] > 0, np.uint8(255), np.uint8(0))
+        return Frame(rgba8, colour, view_depth, (time.perf_counter() - start) * 1000.0,
+                     gl_info=self.gl_info, samples=samples)
 
-    def release(self) -> None:
-        """Free every GL object; the context too if this tracer made it. Idempotent."""
-        if self._released:
-            return
-        self._released = True
+    def _free(self) -> None:
         try:
-            activate(self.ctx)
             self._image_textures.release()
             for thing in reversed(self._resources):
                 thing.release()
         finally:
             self._resources = []
-            if self._owns_context:
-                release_context(self.ctx)
 
-    def __enter__(self) -> "RayTracer":
-        return self
 
-    def __exit__(self, *exc) -> None:
-        self.release()
+def _flip_read(fbo, attachment: int, shape: tuple, out: np.ndarray | None) -> np.ndarray:
+    """A float attachment read back, row 0 at the top, into `out` when it fits (a reused frame)."""
+    rows = np.frombuffer(fbo.read(components=shape[2] if len(shape) == 3 else 1,
+                                  attachment=attachment, dtype="f4"), np.float32).reshape(shape)
+    if out is not None and out.shape == shape and out.dtype == np.float32 and out.flags.writeable:
+        np.copyto(out, rows[::-1])
+        return out
+    return np.ascontiguousarray(rows[::-1])

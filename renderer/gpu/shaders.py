@@ -7,6 +7,9 @@ Shaders exist only as files in glsl/. A source is prepared in two steps:
    error);
 2. the variant's `#define`s go right after the `#version` line (GLSL allows nothing but
    comments before it).
+A file that shares constants with Python (FILE_CONSTANTS: a value written once, in Python) gets
+them as `#define`s right before its text, wherever it is compiled or included: it holds no
+copy of its own.
 `#line` directives keep compiler messages pointing at the right file and line: source-string
 0 is the main file, 1, 2, ... the included files in order (`ShaderSource.files`).
 
@@ -17,16 +20,19 @@ each variant once per context (the geometry shader only in the flat variant).
 from __future__ import annotations
 
 import functools
+import math
 import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Mapping
 
 import moderngl
+import numpy as np
 
-from renderer.core.facets import FACES_PER_ROW
+from renderer.core.bvh import MAX_DEPTH as BVH_MAX_DEPTH
+from renderer.core.facets import CREASE_CAP, FACES_PER_ROW
 from renderer.core.resources import glsl_dir
-from renderer.core.shadow_settings import shared_kernel
+from renderer.core.shadow_settings import MAX_SLOPE, SQRT2, shared_kernel
 from renderer.core.textures import MODULATED
 from renderer.gpu.uniforms import set_shadow_sampler_units
 
@@ -34,6 +40,16 @@ _INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
 _INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
 _VERSION = re.compile(r'^\s*#\s*version\b')
 _DEFINE_NAME = re.compile(r'^[A-Za-z_][A-Za-z0-9_]*$')
+
+
+# The constants a file of glsl/ shares with Python, by its path under glsl/.
+FILE_CONSTANTS: dict[str, dict[str, object]] = {
+    # the slope term's cap on tan(theta), the normal offset's move across the map (sqrt 2 as
+    # written), a crease's slope taken up to this
+    "shadow/lookup.glsl": {"SHADOW_MAX_SLOPE": MAX_SLOPE, "SHADOW_SQRT2": SQRT2,
+                           "SHADOW_CREASE_CAP": CREASE_CAP},
+    "raytrace/bvh.glsl": {"BVH_STACK_SIZE": BVH_MAX_DEPTH},    # the builder keeps the depth below
+}
 
 
 class ShaderSourceError(Exception):
@@ -86,10 +102,29 @@ def _expand(path: Path, files: list[Path], stack: tuple[Path, ...]) -> list[str]
             out.append(f"// {name_match.group(1)}: already included")
             continue
         files.append(target)
+        out.extend(_define_lines(file_constants(target)))
         out.append(f"#line 1 {len(files) - 1}")
         out.extend(_expand(target, files, stack + (target,)))
         out.append(f"#line {line_number + 1} {number}")
     return out
+
+
+def file_constants(path: Path) -> dict[str, object]:
+    """FILE_CONSTANTS of the file at `path` (none for a file outside glsl/)."""
+    try:
+        return FILE_CONSTANTS.get(path.resolve().relative_to(glsl_dir().resolve()).as_posix(), {})
+    except ValueError:
+        return {}
+
+
+def _define_value(value) -> str:
+    """A float as the shortest decimal that reads back as it (GLSL reads the nearest float32;
+    a float32 value exactly), else an int."""
+    if isinstance(value, (float, np.floating)):
+        if not math.isfinite(value):
+            raise ShaderSourceError(f"a #define must be finite, got {value}")
+        return repr(float(value))
+    return str(int(value))
 
 
 def _define_lines(defines: Mapping[str, object]) -> list[str]:
@@ -99,7 +134,8 @@ def _define_lines(defines: Mapping[str, object]) -> list[str]:
             raise ShaderSourceError(f"invalid #define name {name!r}")
         if value is None or value is False:
             continue
-        lines.append(f"#define {name}" if value is True else f"#define {name} {int(value)}")
+        lines.append(f"#define {name}" if value is True
+                     else f"#define {name} {_define_value(value)}")
     return lines
 
 
@@ -107,8 +143,10 @@ def shader_source(filename: str, defines: Mapping[str, object] | None = None,
                   directory: Path | None = None) -> ShaderSource:
     """The text of glsl/`filename`, includes expanded and `defines` placed after `#version`.
 
-    A define whose value is True is written as a bare `#define NAME`, an int as
-    `#define NAME value`; False or None leaves it out.
+    A define whose value is True is written as a bare `#define NAME`, a float as a decimal
+    that reads back as it, anything else as an int (`#define NAME value`); False or None
+    leaves it out. A define of one of FILE_CONSTANTS' names is an error: those come from Python
+    once.
     """
     items = tuple(sorted((defines or {}).items()))
     return _shader_source(filename, items, str(directory or glsl_dir()))
@@ -132,12 +170,16 @@ def _shader_source(filename: str, defines: tuple, directory: str) -> ShaderSourc
     path = (Path(directory) / filename).resolve()
     if not path.is_file():
         raise ShaderSourceError(f"shader file {filename!r} not found in {directory}")
+    shared = {name for constants in FILE_CONSTANTS.values() for name in constants}
+    if shared & dict(defines).keys():
+        raise ShaderSourceError(f"{filename}: {', '.join(sorted(shared & dict(defines).keys()))} "
+                                "come from renderer/gpu/shaders.py's FILE_CONSTANTS, not a define")
     files = [path]
     lines = _expand(path, files, (path,))
     version_at = next((i for i, line in enumerate(lines) if _VERSION.match(line)), None)
     if version_at is None:
         raise ShaderSourceError(f"{_display(path)}: no #version line")
-    injected = _define_lines(dict(defines))
+    injected = _define_lines(dict(defines) | file_constants(path))
     # The original line after #version keeps its number in compiler messages.
     injected.append(f"#line {version_at + 2} 0")
     lines[version_at + 1:version_at + 1] = injected

@@ -136,17 +136,12 @@ def image_source(path, colorspace: str | None, backend: str, context_kind: str) 
 
 def scene_source(scene, size, backend: str, context_kind: str) -> ColourSource:
     """The scene rasterised at `size` with its linear colour (unclamped), then measured."""
-    width, height = size
-    if backend == "gpu":
-        from renderer.gpu.pipeline import GpuRenderer
-        with GpuRenderer(scene, width, height, context_kind=context_kind) as gpu:
-            frame = gpu.render(linear=True, depth=False)
-            xyz, chromaticity, ms = measure_colour(frame.linear, backend, gpu.ctx)
-    else:
-        import reference
-        frame = reference.render(scene, width, height, linear=True, depth=False)
-        xyz, chromaticity, ms = measure_colour(frame.linear, backend)
+    from renderer.methods import open_renderer
+    with open_renderer(scene, size, backend=backend, context_kind=context_kind) as renderer:
+        frame = renderer.render(linear=True, depth=False)
+        # the colour pass on the GPU runs in the renderer's context (the reference has none)
+        xyz, chromaticity, ms = measure_colour(frame.linear, backend, getattr(renderer, "ctx", None))
     return ColourSource(scene.name, frame.linear, xyz, chromaticity, scene, {
         "kind": "scene", "source": scene.source or scene.name, "backend": backend,
-        "size": [width, height], "render_ms": round(frame.milliseconds, 3),
+        "size": list(size), "render_ms": round(frame.milliseconds, 3),
         "colour_pass_ms": round(ms, 3)})

@@ -28,16 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-import reference
-from reference.raytrace.pipeline import render as reference_raytrace
 from renderer.core.builtin import assets_dir, scene_description
 from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision
 from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
 from renderer.core.ray_depth import DEFAULT_MAX_DEPTH
-from renderer.core.raytrace_scene import ray_scene
+from renderer.core.ray_options import RayOptions
 from renderer.errors import SceneError
-from renderer.gpu.pipeline import GpuRenderer
-from renderer.gpu.raytracer import RayTracer
+from renderer.methods import open_renderer
 from renderer.core.imageio import outputs
 from renderer.core.jsonio import json_text
 from renderer.core.scene_file import load_scene
@@ -197,14 +194,14 @@ def measure_scene(scene, size: tuple[int, int], contexts: dict) -> dict:
     tolerance's figures, which accept either surface where the reference finds two closer
     in depth than GL can order (depth ties: `tie_pixels`); `truth` holds the same frame
     against the reference's own image alone, where z-fighting shows."""
-    width, height = size
     gpu_frames = {}
     for kind, ctx in contexts.items():
-        with GpuRenderer(scene, width, height, context=ctx) as gpu:
+        with open_renderer(scene, size, context=ctx) as gpu:
             gpu_frames[kind] = gpu.render(linear=True, depth=True)
             subpixel_bits = gpu.subpixel_bits
-    truth = reference.render(scene, width, height, dtype=np.float64, linear=True,
-                             subpixel_bits=subpixel_bits)
+    with open_renderer(scene, size, backend="reference", precision="float64",
+                       subpixel_bits=subpixel_bits) as twin:
+        truth = twin.render(linear=True)
     finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
     finite["reference"] = is_finite_frame(truth)
     per_context = {kind: compare_frames(frame.rgba8, truth.rgba8, frame.depth, truth.depth,
@@ -225,15 +222,15 @@ def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
     reference, which accepts the float32 reference's colour and depth at grazing pixels
     (`grazing_pixels`: where the two references' ray trees differ); `truth` without that.
     `samples` per pixel, regular pattern."""
-    width, height = size
-    options = {"max_depth": max_depth, "samples": samples, "pattern": pattern}
+    options = RayOptions(max_depth=max_depth, samples=samples, pattern=pattern)
     gpu_frames = {}
     for kind, ctx in contexts.items():
-        with RayTracer(scene, width, height, context=ctx, **options) as tracer:
+        with open_renderer(scene, size, method="raytrace", options=options, context=ctx) as tracer:
             gpu_frames[kind] = tracer.render()
-    rs = ray_scene(scene)                        # the BVH built once, for both precisions
-    truth = reference_raytrace(scene, width, height, dtype=np.float64, rs=rs, **options)
-    twin = reference_raytrace(scene, width, height, rs=rs, **options)
+    with open_renderer(scene, size, method="raytrace", backend="reference", options=options) as ref:
+        twin = ref.render()
+        ref.precision = "float64"                # the same BVH, for both precisions
+        truth = ref.render()
     tie, tie_depth, grazing = either_precision(truth, twin)
     finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
     finite["reference"] = is_finite_frame(truth) and is_finite_frame(twin)

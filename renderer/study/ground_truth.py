@@ -29,14 +29,14 @@ from pathlib import Path
 
 import numpy as np
 
-import reference
 from renderer.core.imageio import write_npy
 from renderer.core.light_areas import uses_area_lights
 from renderer.core.paths import output_stem
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
-from renderer.core.raytrace_scene import ray_scene
+from renderer.core.ray_options import RayOptions
 from renderer.core.sampling import DEFAULT_SEED
 from renderer.core.scene import Scene
+from renderer.methods import open_renderer
 from renderer.study.supersample import clamped
 from renderer.study.tessellation import FINEST, scene_at_level
 from renderer.study.texture_report import truth_textures
@@ -113,8 +113,9 @@ def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     if big_w * big_h > MAX_TRUTH_PIXELS:
         raise ValueError(f"a ground truth of {width}x{height} needs a {big_w}x{big_h} reference "
                          f"image; the most it renders is {MAX_TRUTH_PIXELS} pixels (320x240)")
-    frame = reference.render(truth_scene(scene), big_w, big_h, dtype=np.float64,
-                             linear=True, depth=False)
+    with open_renderer(truth_scene(scene), (big_w, big_h), backend="reference",
+                       precision="float64") as truth:
+        frame = truth.render(linear=True, depth=False)
     blocks = clamped(frame.linear[..., :3]).reshape(height, TRUTH_GRID, width, TRUTH_GRID, 3)
     return blocks.mean(axis=(1, 3))
 
@@ -127,14 +128,13 @@ def truth_light_samples(scene: Scene) -> int:
 
 def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     """(H, W, 3) float64: the ray tracer's truth rendered now (see the module docstring)."""
-    from reference.raytrace.pipeline import render
-    rs = ray_scene(scene)
+    options = RayOptions(samples=RAY_TRUTH_SAMPLES, pattern="jittered", max_depth=RAY_TRUTH_DEPTH,
+                         seed=RAY_TRUTH_SEED, light_samples=truth_light_samples(scene))
     total = np.zeros((height, width, 3))
-    for frame in range(RAY_TRUTH_PASSES):
-        total += render(scene, width, height, samples=RAY_TRUTH_SAMPLES, pattern="jittered",
-                        max_depth=RAY_TRUTH_DEPTH, seed=RAY_TRUTH_SEED, rs=rs, dtype=np.float64,
-                        first_sample=frame * RAY_TRUTH_SAMPLES,
-                        light_samples=truth_light_samples(scene)).linear[..., :3]
+    with open_renderer(scene, (width, height), method="raytrace", backend="reference",
+                       options=options, precision="float64") as truth:      # one BVH for every pass
+        for frame in range(RAY_TRUTH_PASSES):
+            total += truth.render(first_sample=frame * RAY_TRUTH_SAMPLES).linear[..., :3]
     return clamped(total / RAY_TRUTH_PASSES)
 
 

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.core.ray_options import RayOptions
 from renderer.core.ray_sampling import FIRST_SET
 from renderer.core.raytrace_scene import ray_scene
 from renderer.core.sampling import DEFAULT_SEED, PATTERNS
@@ -83,11 +84,11 @@ class RaySetting:
                 "pattern": self.pattern, "light_samples": self.light_samples,
                 "max_depth": self.max_depth, "threshold": self.threshold}
 
-    def options(self) -> dict:
-        """The keyword arguments of RayTracer and of the reference's render."""
-        return {"samples": self.samples, "pattern": self.pattern, "max_depth": self.max_depth,
-                "seed": DEFAULT_SEED, "adaptive_threshold": self.threshold,
-                "light_samples": self.light_samples}
+    def options(self) -> RayOptions:
+        """The ray tracer's options (either backend)."""
+        return RayOptions(samples=self.samples, pattern=self.pattern, max_depth=self.max_depth,
+                          seed=DEFAULT_SEED, adaptive_threshold=self.threshold,
+                          light_samples=self.light_samples)
 
 
 def ray_settings(sweep: RaySweep) -> list[RaySetting]:
@@ -120,17 +121,14 @@ class RaySceneRun:
 
     def timed(self, setting: RaySetting, runs: int) -> tuple[np.ndarray, float, float]:
         """(image (H, W, 3) float64 in [0, 1], mean samples traced per pixel, median ms)."""
-        if setting.backend == "gpu":
-            from renderer.gpu.raytracer import RayTracer
-            with RayTracer(self.scene, self.width, self.height, context=self.ctx,
-                           **setting.options()) as tracer:
-                frame, ms = median_timed(tracer.render, runs, warm_up=True)
-        else:
-            from reference.raytrace.pipeline import render
-            frame, ms = median_timed(
-                lambda: render(self.scene, self.width, self.height, rs=self.rs,
-                               dtype=np.dtype(setting.dtype), **setting.options()),
-                runs, warm_up=False)
+        from renderer.methods import open_renderer
+        with open_renderer(self.scene, (self.width, self.height), method="raytrace",
+                           backend=setting.backend, options=setting.options(), context=self.ctx,
+                           precision=setting.dtype) as tracer:
+            if setting.backend == "reference":
+                tracer.ray_scene = self.rs             # the scene's BVH, made once for every setting
+            # the GPU's first frame compiles; the reference's has nothing to warm
+            frame, ms = median_timed(tracer.render, runs, warm_up=setting.backend == "gpu")
         return clamped(frame.linear[..., :3]), float(frame.samples.mean()), ms
 
     def errors(self, setting: RaySetting, image: np.ndarray, truth: np.ndarray) -> dict:

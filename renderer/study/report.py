@@ -176,9 +176,9 @@ class SceneRun:
 
     def gpu(self, variant: tuple):
         if variant not in self._gpus:
-            from renderer.gpu.pipeline import GpuRenderer
-            self._gpus[variant] = GpuRenderer(self.drawn(variant), self.width, self.height,
-                                              context=self.ctx)
+            from renderer.methods import open_renderer
+            self._gpus[variant] = open_renderer(self.drawn(variant), (self.width, self.height),
+                                                context=self.ctx)
         return self._gpus[variant]
 
     def output(self) -> output_report.OutputRun:

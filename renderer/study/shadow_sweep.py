@@ -29,7 +29,7 @@ import numpy as np
 from renderer.checks.shadow_truth import EDGE_KEY, EDGE_PX, shadows_vs_truth
 from renderer.core.primitives import cube, uv_sphere
 from renderer.core.scene import Camera, DirectionalLight, Material, Scene, SceneObject, Transform
-from renderer.gpu.pipeline import GpuRenderer
+from renderer.methods import open_renderer
 
 ELEVATIONS = (1, 2, 5, 10, 20, 30, 45, 60, 75, 89)      # degrees above the ground
 LIGHT_AZIMUTH = 20.0          # degrees from +x towards +z: the light comes from the back left
@@ -65,11 +65,11 @@ def gpu_visibility(scene: Scene, size: tuple[int, int], ctx) -> np.ndarray:
     docstring; row 0 at the top); NaN where the light's terms are ~0 or nothing was drawn."""
     [light] = scene.directional_lights
     dark = replace(scene, directional_lights=[replace(light, intensity=(0.0, 0.0, 0.0))])
-    with GpuRenderer(scene, *size, context=ctx) as gpu:
+    with open_renderer(scene, size, context=ctx) as gpu:
         shadowed = gpu.render(linear=True).linear
         gpu.shadows = False
         unshadowed = gpu.render(linear=True).linear
-    with GpuRenderer(dark, *size, context=ctx) as gpu:
+    with open_renderer(dark, size, context=ctx) as gpu:
         ambient = gpu.render(linear=True).linear
     drawn = shadowed[..., 3] > 0
     term = (unshadowed[..., :3] - ambient[..., :3]).sum(axis=2).astype(np.float64)

@@ -18,9 +18,9 @@ from typing import Callable
 
 import numpy as np
 
-import reference
 from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.core.sampling import DEFAULT_SEED, jittered
+from renderer.methods import open_renderer
 
 Pass = Callable[[tuple], np.ndarray]          # (dx, dy) -> (H, W, 3) linear colour
 
@@ -40,9 +40,11 @@ def gpu_pass(gpu) -> Pass:
 def reference_pass(scene, width: int, height: int, *, dtype=np.float64,
                    subpixel_bits: int = SUBPIXEL_BITS) -> Pass:
     """Passes through the NumPy reference, in `dtype`."""
+    twin = open_renderer(scene, (width, height), backend="reference",
+                         precision=np.dtype(dtype).name, subpixel_bits=subpixel_bits)
+
     def render(offset) -> np.ndarray:
-        return reference.render(scene, width, height, dtype=dtype, subpixel_bits=subpixel_bits,
-                                linear=True, depth=False, sample_offset=tuple(offset)).linear[..., :3]
+        return twin.render(linear=True, depth=False, sample_offset=tuple(offset)).linear[..., :3]
     return render
 
 

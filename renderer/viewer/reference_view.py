@@ -26,8 +26,8 @@ from renderer.checks.compare import compare_frames, heat_map
 
 def _render_reference(scene, width: int, height: int):
     """Runs in the worker process (spawned: it shares nothing with the window's GL)."""
-    from reference.pipeline import render
-    frame = render(scene, width, height, depth=False)
+    from renderer.methods import open_renderer
+    frame = open_renderer(scene, (width, height), backend="reference").render(depth=False)
     return frame.rgba8, getattr(frame, "rgba8_tie", None), frame.milliseconds
 
 

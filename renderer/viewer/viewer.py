@@ -41,8 +41,8 @@ from renderer.checks.methods import without_shadow_maps
 from renderer.viewer.controls import (Controls, ViewState, apply_view, help_lines, light_names_of,
                                       shown_light, working_copy)
 from renderer.gpu.context import activate
-from renderer.gpu.pipeline import GpuRenderer
-from renderer.gpu.raytracer import RayTracer
+from renderer.core.ray_options import RayOptions
+from renderer.methods import METHODS, open_renderer
 from renderer.core.imageio import write_image
 from renderer.core.paths import output_stem
 from renderer.viewer.orbit import OrbitCamera
@@ -116,7 +116,7 @@ class Viewer:
             size = self.window.framebuffer_size
             self.controls.resize(*size)
             apply_view(self.state, self.authored, self.shown, self.orbit.camera)
-            self.gpu = GpuRenderer(self.shown, *size, context=self.ctx)
+            self.gpu = open_renderer(self.shown, size, context=self.ctx)
             self.gpu.wireframe = self.state.wireframe
             self.presenter = Presenter(self.ctx, buffering)
             self.background = BackgroundReference()
@@ -175,7 +175,7 @@ class Viewer:
         """Ask for the reference of the current view when it is wanted and not asked for yet,
         and take a finished one (`wait`: wait for it): its heat map against a GPU image of
         the same view."""
-        if self.state.reference == "off" or self.state.method == "raytrace":
+        if self.state.reference == "off" or self._progressive:
             return
         if self._requested != self._version:
             scene = working_copy(self.shown)
@@ -203,7 +203,7 @@ class Viewer:
         width, height = self.window.framebuffer_size
         screen.use()
         blit = self.presenter.blitter.copy
-        mode = "off" if self.state.method == "raytrace" or self._map_shown else self.state.reference
+        mode = "off" if self._progressive or self._map_shown else self.state.reference
         have_reference = self._reference_version >= 0
         whole = (0, 0, width, height)
         if mode != "off" or fit(shown.size, whole) != whole:
@@ -233,13 +233,13 @@ class Viewer:
 
     def _overlay_text(self) -> tuple:
         lines = []
-        if self.state.method == "raytrace":
+        if self._progressive:
             if self.state.reference != "off":
                 lines.append("reference view: off while ray tracing (it compares the rasteriser)")
         elif self.state.reference == "side-by-side":
             lines.append("left: GPU (GLSL)    right: NumPy reference")
         lines += self._map_lines
-        if self.state.reference != "off" and self.state.method == "raster" and not self._map_shown:
+        if self.state.reference != "off" and not self._progressive and not self._map_shown:
             current = self._reference_version == self._version
             if self._figures is not None and self._reference_version >= 0:
                 lines.append(figures_line(self._figures) + ("" if current else " (updating)"))
@@ -255,7 +255,7 @@ class Viewer:
         self._follow_changes()
         self._follow_reference()
         started = time.perf_counter()
-        drawn = self._trace() if self.state.method == "raytrace" else self.gpu.draw()
+        drawn = self._trace() if self._progressive else self.gpu.draw()
         drawn = self._shadow_map(drawn)
         self.ctx.finish()                     # so that draw_ms is the drawing, not queued work
         self.stats.draw_ms.append((time.perf_counter() - started) * 1000.0)
@@ -275,6 +275,12 @@ class Viewer:
             self.window.set_title(self.title())
             self._last_title = now
 
+    @property
+    def _progressive(self) -> bool:
+        """Whether the method shown refines over frames (the ray tracer: a mean of frames, no
+        reference view) rather than drawing each frame whole (the rasteriser)."""
+        return METHODS[self.state.method].progressive
+
     def _trace(self):
         """The ray tracer's frame: the tracer brought to the current view (made, or updated
         and the mean restarted, when the version moved on), one more frame added to the mean
@@ -282,8 +288,8 @@ class Viewer:
         size = (self.gpu.width, self.gpu.height)
         if self._tracer is None:
             started = time.perf_counter()
-            self._tracer = RayTracer(self.shown, *size, context=self.ctx,
-                                     samples=SAMPLES_PER_FRAME, pattern=PATTERN)
+            self._tracer = open_renderer(self.shown, size, method="raytrace", context=self.ctx,
+                                         options=RayOptions(samples=SAMPLES_PER_FRAME, pattern=PATTERN))
             rs = self._tracer.ray_scene
             self.say(f"ray tracer ready in {time.perf_counter() - started:.1f} s "
                      f"({len(rs.triangles):,} triangles, {len(rs.sphere_radius)} spheres, "
@@ -311,7 +317,7 @@ class Viewer:
             return drawn
         name = light_names_of(self.authored)[index]
         light_map = None if plan is None else plan.layout.get(*shown_light(self.state, self.authored, index))
-        if self.state.method == "raytrace":
+        if self._progressive:
             why = "off while ray tracing (the maps are the rasteriser's)"
         elif not self.state.shadows:
             why = "shadows are off (O)"
@@ -344,20 +350,20 @@ class Viewer:
     def idle(self) -> bool:
         """Nothing new to draw until an event comes: the ray tracer's mean of the current view
         is complete (the reference view is off while ray tracing)."""
-        return (self.state.method == "raytrace" and self._traced_version == self._version
+        return (self._progressive and self._traced_version == self._version
                 and self.accumulator.done)
 
     @property
     def samples(self) -> int | None:
         """The samples per pixel in the picture on the screen: the ray tracer's so far, None
         while rasterising."""
-        return self.accumulator.samples if self.state.method == "raytrace" else None
+        return self.accumulator.samples if self._progressive else None
 
     @property
     def figures(self) -> dict | None:
         """The reference view's figures (renderer/viewer/reference_view.py) for the view on the
         screen, or None when there are none for it (not asked for, or not ready)."""
-        if self.state.method == "raytrace":
+        if self._progressive:
             return None
         return self._figures if self._reference_version == self._version else None
 
@@ -370,7 +376,7 @@ class Viewer:
         latency = self.presenter.latency_ms
         latency_text = "" if latency is None else f", latency {latency:.1f} ms"
         tracing = ""
-        if self.state.method == "raytrace":
+        if self._progressive:
             tracing = f" | ray tracing: {self.accumulator.samples} spp" + (
                 " (done)" if self.accumulator.done else "")
         shadows = f" | shadows {'on' if self.state.shadows else 'off'}"
@@ -424,7 +430,7 @@ class Viewer:
             if orbit:
                 self.orbit.orbit(orbit, 0.0)
                 self.state.camera_changed = True
-            if last and self.state.reference != "off" and self.state.method == "raster":
+            if last and self.state.reference != "off" and not self._progressive:
                 self._follow_changes()        # the last frame's view, orbit step included
                 self._follow_reference(wait=True)
                 self._last_swap = None        # the wait is not a frame time

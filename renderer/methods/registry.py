@@ -1,0 +1,45 @@
+"""What a method is to the rest of the product (renderer/methods/__init__.py registers them):
+its name and title, its options type, how it opens on each backend, and what it needs checked
+before any work. A front end asks the Method, never `if method == ...`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from renderer.errors import OptionError
+
+BACKENDS = ("gpu", "reference")
+
+
+@dataclass(frozen=True)
+class Method:
+    """One way of making an image from a scene.
+
+    open_gpu(scene, width, height, options, context, context_kind) and
+    open_reference(scene, width, height, options, precision, subpixel_bits) return a Renderer
+    (renderer/gpu/base.py); check_memory(scene, size, backends, options) refuses, in one line,
+    what would not fit (renderer/core/memory.py); words(options, frame) says how a frame was
+made in a few words for a front end's line ("" for nothing to say). `progressive`: successive frames bring new
+    samples (render(first_sample=k)), so a viewer refines while the view is still; `seeded`:
+    the frames depend on a seed (reseed(seed), a batch item's own)."""
+    name: str
+    title: str
+    options: type
+    open_gpu: Callable
+    open_reference: Callable
+    check_memory: Callable
+    words: Callable = lambda options, frame: ""
+    progressive: bool = False
+    seeded: bool = False
+
+    def options_from(self, given: dict, owners: dict[str, str]):
+        """This method's options from the fields `given` (those not given keep their defaults);
+        OptionError for a field that only another method takes (`owners`: field -> method)."""
+        fields = set(self.options.__dataclass_fields__)
+        for name in given:
+            if name not in fields:
+                owner = owners.get(name)
+                raise OptionError(name, f"is for method {owner}, not {self.name}" if owner else
+                                  f"is no option of method {self.name}")
+        return self.options(**given)

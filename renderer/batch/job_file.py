@@ -243,10 +243,11 @@ class _JobReader(TableReader):
         frames = self.integer(raw["frames"], f"{key}.frames", 1, MAX_COUNT)
         step = self.number(raw.get("step", 1.0), f"{key}.step", above=0.0)
         exposure = self.number(raw.get("exposure", 0.0), f"{key}.exposure", minimum=0.0)
-        raster = [s.name for s in settings if not s.traced]
-        if raster:
+        still = [s for s in settings if not METHODS[s.method].shutter]
+        if still:
             self.fail(key, f"an animation is the ray tracer's (motion during the shutter; the "
-                           f"rasteriser draws time 0), but setting {raster[0]!r} is method raster")
+                           f"{METHODS[still[0].method].title} draws time 0), but setting "
+                           f"{still[0].name!r} is method {still[0].method}")
         if not declares_motion(scene):
             self.fail(key, "nothing in the scene moves (no object has a velocity or "
                            "angular_velocity): every frame would be the same")

@@ -154,9 +154,9 @@ class ItemWorker:
     def _renderer(self, item: Item, scene: Scene):
         """The renderer for the item, its scene's camera set and updated (made if needed)."""
         setting = item.setting
-        key = (item.scene.digest, setting.shading, setting.method, setting.size,
-               tuple(sorted(setting.tracer_options().items())) if setting.traced else (),
-               setting.traced and moves(scene))
+        # the options but the seed (reseeded below), and whether something moves (a tracer's layout)
+        key = (item.scene.digest, setting.shading, setting.method, setting.size, setting.options(0),
+               moves(scene))
         renderer = self._renderers.pop(key, None)
         if renderer is None:
             from renderer.methods import open_renderer

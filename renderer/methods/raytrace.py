@@ -78,4 +78,4 @@ def _words(options: RayOptions, frame: Frame) -> str:
 
 
 METHOD = Method("raytrace", "ray tracer", RayOptions, _open_gpu, _open_reference, _check_memory,
-                _words, progressive=True, seeded=True)
+                _words, progressive=True, seeded=True, shutter=True)

@@ -22,7 +22,9 @@ class Method:
     what would not fit (renderer/core/memory.py); words(options, frame) says how a frame was
 made in a few words for a front end's line ("" for nothing to say). `progressive`: successive frames bring new
     samples (render(first_sample=k)), so a viewer refines while the view is still; `seeded`:
-    the frames depend on a seed (reseed(seed), a batch item's own)."""
+    the frames depend on a seed (reseed(seed), a batch item's own); `shutter`: objects move
+during the camera's shutter (motion blur; a method without it draws time 0), so an
+animation's frames differ."""
     name: str
     title: str
     options: type
@@ -32,6 +34,7 @@ made in a few words for a front end's line ("" for nothing to say). `progressive
     words: Callable = lambda options, frame: ""
     progressive: bool = False
     seeded: bool = False
+    shutter: bool = False
 
     def options_from(self, given: dict, owners: dict[str, str]):
         """This method's options from the fields `given` (those not given keep their defaults);

@@ -25,10 +25,9 @@ import glfw
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene import Camera, Scene
 from renderer.core.shadow_settings import scene_has_shadows
+from renderer.methods import METHODS
 
 REFERENCE_MODES = ("off", "side-by-side", "difference")     # C cycles in this order
-METHODS = ("raster", "raytrace")                            # M toggles
-METHOD_NAMES = {"raster": "rasteriser", "raytrace": "ray tracer"}
 ORBIT_DEGREES_PER_PIXEL = 0.4
 SHADING_NAMES = {None: "as authored", "flat": "flat", "gouraud": "Gouraud", "phong": "Phong"}
 LIGHT_KEYS = 9                                              # keys 1 to 9
@@ -189,7 +188,7 @@ def help_lines(state: ViewState | None = None, light_names: list[str] | None = N
                   f"  shading: {SHADING_NAMES[state.shading]}, wireframe: "
                   f"{_on_off(state.wireframe)}, two-sided lighting: {two_sided}",
                   f"  reference view: {state.reference}, v-sync: {_on_off(state.vsync)}, "
-                  f"buffering: {_buffering(state.buffering)}, method: {METHOD_NAMES[state.method]}",
+                  f"buffering: {_buffering(state.buffering)}, method: {METHODS[state.method].title}",
                   f"  shadows: {_on_off(state.shadows)}, shadow map view: "
                   + ("off" if state.shadow_map is None or not light_names
                      else light_names[state.shadow_map])]
@@ -350,12 +349,11 @@ class Controls:
         self._say(f"reference view: {self.state.reference}")
 
     def _method(self) -> None:
-        self._set("method", METHODS[1 - METHODS.index(self.state.method)])
-        if self.state.method == "raytrace":
-            self._say("method: ray tracer; it refines while the view is still (the title "
-                      "counts the samples per pixel)")
-        else:
-            self._say("method: rasteriser")
+        names = list(METHODS)                    # M steps through them in registration order
+        self._set("method", names[(names.index(self.state.method) + 1) % len(names)])
+        shown = METHODS[self.state.method]
+        self._say(f"method: {shown.title}" + ("; it refines while the view is still (the title "
+                                               "counts the samples per pixel)" if shown.progressive else ""))
 
     def _shadows(self) -> None:
         self._set("shadows", not self.state.shadows)

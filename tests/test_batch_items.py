@@ -73,7 +73,7 @@ def test_items_are_scenes_then_cameras_then_sweep_points_then_settings(tmp_path)
     assert items[8].scene.overrides == (("materials.red_plastic.kd", [0, 1, 0]),)
     assert items[6].scene.digest != items[8].scene.digest          # another sweep point
     assert items[6].scene.digest == items[10].scene.digest         # another pose only
-    assert (items[0].setting.shading, items[1].setting.samples) == ("flat", 4)
+    assert (items[0].setting.options.shading, items[1].setting.options.samples) == ("flat", 4)
 
 
 def test_a_scene_without_cameras_or_sweep_has_one_item_per_setting_with_fixed_key_parts(tmp_path):

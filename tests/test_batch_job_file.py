@@ -59,6 +59,8 @@ MISTAKES = {
                          "(its first set), got 2"),
     "method": (SPHERE + '[[settings]]\nmethod = "raytrce"\n', "settings[0].method: unknown method "
                "'raytrce'; did you mean 'raytrace'? expected one of: raster, raytrace"),
+    "shading for the ray tracer": (SPHERE + '[[settings]]\nmethod = "raytrace"\nshading = "flat"\n',
+                                   "settings[0].shading: is for method raster, not raytrace"),
     "bits": (SPHERE + '[[settings]]\noutputs = [{ format = "png8", bits = 12 }]\n',
              "settings[0].outputs[0].bits: png8 holds at most 8 bits per channel; use png16"),
     "exr transparent": (SPHERE + '[[settings]]\nbackground = "transparent"\noutputs = [{ format = "exr" }]\n',

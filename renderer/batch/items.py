@@ -80,43 +80,32 @@ def default_output_name(output_settings: OutputSettings | None, depth: str | Non
 @dataclass(frozen=True)
 class Setting:
     """How an item is rendered: a [[settings]] entry of the job file (docs/batch-format.md).
-    The ray tracer's options (samples ... light_samples) are None for the rasteriser;
-    `shading` (raster only) replaces every material's shading, None keeps the scene's."""
+    `options` is the method's options object (renderer/methods: RasterOptions, whose
+    `shading` replaces every material's shading; RayOptions, whose seed each item replaces
+    with its own: options_for)."""
     name: str
-    method: str                                  # "raster" | "raytrace"
+    method: str                                  # a renderer/methods METHODS name
     size: tuple[int, int]
     outputs: tuple[Output, ...] = DEFAULT_OUTPUTS
     background: str = "opaque"                   # "opaque" (RGB) | "transparent" (RGBA)
-    shading: str | None = None
-    samples: int | None = None
-    pattern: str | None = None
-    adaptive_threshold: float | None = None
-    max_depth: int | None = None
-    light_samples: int | None = None
+    options: Any = None                          # None: the method's defaults
 
-    @property
-    def traced(self) -> bool:
-        return self.method == "raytrace"
+    def __post_init__(self):
+        if self.options is None:
+            from renderer.methods import method_options
+            object.__setattr__(self, "options", method_options(self.method))
 
-    def tracer_options(self) -> dict:
-        """The ray tracer's options (RayOptions' fields) but the seed (each item's own)."""
-        return {"samples": self.samples, "pattern": self.pattern, "max_depth": self.max_depth,
-                "adaptive_threshold": self.adaptive_threshold, "light_samples": self.light_samples}
-
-    def options(self, seed: int):
-        """The method's options object (renderer/methods: RasterOptions, RayOptions) for an
-        item of this setting drawn with `seed`, checked by its type's rules."""
-        from renderer.methods import method_options
-        return method_options(self.method, self.tracer_options() | {"seed": seed} if self.traced else {})
+    def options_for(self, seed: int):
+        """The options an item drawn with `seed` renders with (the seed where the method has one)."""
+        from renderer.methods import METHODS
+        return self.options.replace(seed=seed) if METHODS[self.method].seeded else self.options
 
     def describe(self) -> dict:
-        """The canonical description (manifest records, the job's identity)."""
+        """The canonical description (manifest records, the job's identity): the fields a
+        job gives, the options' SETTING_FIELDS among them."""
         data = {"name": self.name, "method": self.method, "size": list(self.size),
                 "background": self.background}
-        if self.traced:
-            data |= self.tracer_options()
-        else:
-            data["shading"] = self.shading
+        data |= {name: getattr(self.options, name) for name in self.options.SETTING_FIELDS}
         return data | {"outputs": [output.describe() for output in self.outputs]}
 
 

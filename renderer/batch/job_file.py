@@ -38,9 +38,9 @@ CAMERA_KINDS = ("orbit", "poses", "animation")
 ORBIT_KEYS = ("views", "elevation")
 POSE_KEYS = ("eye", "look", "up")
 ANIMATION_KEYS = ("frames", "step", "exposure")
-SETTING_KEYS = ("name", "method", "size", "background", "shading", "samples", "pattern",
-                "adaptive_threshold", "max_depth", "light_samples", "outputs")
-TRACER_KEYS = ("samples", "pattern", "adaptive_threshold", "max_depth", "light_samples")
+# The methods' options a [[settings]] table may give (their SETTING_FIELDS), in registration order.
+OPTION_KEYS = tuple(dict.fromkeys(f for m in METHODS.values() for f in m.options.SETTING_FIELDS))
+SETTING_KEYS = ("name", "method", "size", "background", *OPTION_KEYS, "outputs")
 OUTPUT_KEYS = ("name", "format", "transfer", "bits", "dither", "halftone")
 DEPTH_KEYS = ("name", "depth")
 DEPTH_FORMATS = ("npy", "exr")
@@ -66,7 +66,7 @@ def read_job(path) -> Job:
 def check_memory(scene, setting: Setting, backends) -> None:
     """A UserError when drawing `scene` with `setting` on `backends` would need more memory
     than the limit (renderer/core/memory.py)."""
-    METHODS[setting.method].check_memory(scene, setting.size, backends, setting.options(0))
+    METHODS[setting.method].check_memory(scene, setting.size, backends, setting.options)
 
 
 def _name(reader: TableReader, value: Any, key: str) -> str:
@@ -268,29 +268,21 @@ class _JobReader(TableReader):
         outputs = self.outputs(raw.get("outputs"), f"{key}.outputs", background)
         common = {"name": name, "method": method, "outputs": outputs, "background": background,
                   "size": self.size(raw["size"], f"{key}.size") if "size" in raw else size}
-        if "shading" in raw and method != "raster":
-            self.fail(f"{key}.shading", "is for method = \"raster\" (the ray tracer shades "
-                                        "every hit per pixel)")
-        shading = None
-        if "shading" in raw:
-            shading = self.choice(raw["shading"], f"{key}.shading", "shading", SHADING_MODES)
-        try:                 # the method's rules, once (renderer/methods, RayOptions)
-            options = method_options(method, self.tracer_values(raw, key))
+        try:                 # the method's rules, once (renderer/methods: its options type)
+            options = method_options(method, self.option_values(raw, key))
         except OptionError as error:
             self.fail(f"{key}.{error.fields[0]}", error.reason)
-        if method == "raster":
-            return Setting(**common, shading=shading)
-        return Setting(**common, **{field: getattr(options, field) for field in TRACER_KEYS})
+        return Setting(**common, options=options)
 
-    def tracer_values(self, raw: dict, key: str) -> dict:
-        """The ray tracer's keys given, as values of their types (their ranges and how they go
-        together are RayOptions' to check)."""
+    def option_values(self, raw: dict, key: str) -> dict:
+        """The methods' option keys given, as values of their types (their ranges, and which
+        method takes them, are the options types' to check)."""
         values = {}
-        for option in TRACER_KEYS:
-            if option not in raw:
-                continue
+        for option in (option for option in OPTION_KEYS if option in raw):
             where, value = f"{key}.{option}", raw[option]
-            if option == "pattern":
+            if option == "shading":
+                values[option] = self.choice(value, where, "shading", SHADING_MODES)
+            elif option == "pattern":
                 values[option] = self.string(value, where)
             elif option == "adaptive_threshold":
                 values[option] = self.number(value, where)

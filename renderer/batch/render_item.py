@@ -78,10 +78,9 @@ def load_source(source: SceneSource) -> Scene:
 
 
 def item_scene(base: Scene, item: Item) -> Scene:
-    """A new Scene object for `item`: the shading the setting asks for and the item's camera
-    (objects and meshes shared with `base`)."""
-    shading = item.setting.shading
-    scene = base.with_shading(shading) if shading is not None else replace(base)
+    """A new Scene object for `item` with the item's camera (objects and meshes shared with
+    `base`); what the setting's options change of it (a shading) open_renderer applies."""
+    scene = replace(base)
     scene.camera = item.camera.camera(base.camera)
     return scene
 
@@ -155,13 +154,12 @@ class ItemWorker:
         """The renderer for the item, its scene's camera set and updated (made if needed)."""
         setting = item.setting
         # the options but the seed (reseeded below), and whether something moves (a tracer's layout)
-        key = (item.scene.digest, setting.shading, setting.method, setting.size, setting.options(0),
-               moves(scene))
+        key = (item.scene.digest, setting.method, setting.size, setting.options, moves(scene))
         renderer = self._renderers.pop(key, None)
         if renderer is None:
             from renderer.methods import open_renderer
             renderer = open_renderer(scene, setting.size, method=setting.method,
-                                     options=setting.options(item.seed), context=self._context())
+                                     options=setting.options_for(item.seed), context=self._context())
             while len(self._renderers) >= CACHED:
                 self._renderers.popitem(last=False)[1].release()
         else:
@@ -239,7 +237,7 @@ def reference_item(item: Item, frame, subpixel_bits: int | None) -> ReferenceRes
         scene = item_scene(load_source(item.scene), item)
         setting = item.setting
         check = against_reference(scene, setting.size, frame, method=setting.method,
-                                  options=setting.options(item.seed), subpixel_bits=subpixel_bits)
+                                  options=setting.options_for(item.seed), subpixel_bits=subpixel_bits)
     except UserError as error:
         return ReferenceResult(error=error.line())
     except Exception:

@@ -33,23 +33,24 @@ from pathlib import Path
 from renderer.batch.items import ITEMS_FOLDER, Item, Job, expand, job_identity
 from renderer.batch.manifest import MANIFEST, Manifest, Resume, header_for, read_manifest
 from renderer.batch.job_file import check_memory
+from renderer.methods import METHODS
 from renderer.batch.render_item import ItemResult, ItemWorker, item_scene, load_source, reference_item
 from renderer.cluster.executor import batch_size, batches_of, worker_label
 from renderer.core.imageio import check_folder, check_outputs, outputs
 
 COMPARE_FILES = ("gpu.png", "reference.png", "diff.png")
 ITEM_OVERHEAD_S = 0.02            # per item: camera update, read-back, hashing
-RASTER_PIXEL_S = 2.5e-7           # per pixel, with the output stage and PNG encoding
-TRACED_SAMPLE_S = 1.5e-7          # per pixel, sample and light sample
+# Per pixel and sample (Method.samples: the ray tracer's samples times light samples), with
+# the output stage and PNG encoding; a method not measured costs the most of them.
+PIXEL_SAMPLE_S = {"raster": 2.5e-7, "raytrace": 1.5e-7}
 
 
 def item_seconds(item: Item) -> float:
     """A rough cost of one item on llvmpipe (module docstring), for batch sizes only."""
     setting = item.setting
     pixels = setting.size[0] * setting.size[1]
-    if setting.traced:
-        return ITEM_OVERHEAD_S + pixels * TRACED_SAMPLE_S * setting.samples * setting.light_samples
-    return ITEM_OVERHEAD_S + pixels * RASTER_PIXEL_S
+    per_sample = PIXEL_SAMPLE_S.get(setting.method, max(PIXEL_SAMPLE_S.values()))
+    return ITEM_OVERHEAD_S + pixels * per_sample * METHODS[setting.method].samples(setting.options)
 
 
 def compare_files(item: Item) -> tuple[str, ...]:

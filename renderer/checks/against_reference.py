@@ -55,7 +55,8 @@ def against_reference(scene, size, gpu_frame: Frame, *, method: str = "raster",
     else:
         from renderer.checks.texture_bounds import accepted_colours
         # Anisotropic lookups: the twin's range over the texture verifier's coordinate bound.
-        accepted = accepted_colours(scene, ref_frame, *size, subpixel_bits=subpixel_bits)
+        # (the scene as the options draw it: a setting's shading)
+        accepted = accepted_colours(twin.scene, ref_frame, *size, subpixel_bits=subpixel_bits)
         expected, tie, envelope_renders = accepted.rgba8, accepted.tie, accepted.displaced_renders
     tolerance = replace(PIPELINE_TOLERANCE, threshold=threshold)
     result = compare_frames(gpu_frame.rgba8, expected, gpu_frame.depth, ref_frame.depth,

@@ -32,7 +32,7 @@ def run(args) -> int:
     """extremes.json and extremes.md in --out; status 1 when a case fails (as authored)."""
     from renderer.core.builtin import resolve_scene
     from renderer.gpu.context import make_context, release_context
-    from renderer.study.extremes import all_pass, extreme_scenes, measure_extremes, write_report
+    from renderer.study.extremes import CASES, all_pass, extreme_scenes, measure_extremes, write_report
     from renderer.study.shadow_sweep import measure_sweep, sweep_acne
     from renderer.core.scene_file import load_scene
     from renderer.core.imageio import check_folder, check_outputs
@@ -45,7 +45,7 @@ def run(args) -> int:
     try:
         for kind in kinds:
             contexts[kind] = make_context(kind)
-        methods = ("raster", "raytrace") if args.method == "both" else (args.method,)
+        methods = tuple(CASES) if args.method == "both" else (args.method,)
         cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods)
         sweep = None if args.no_sweep or "raster" not in methods else measure_sweep(args.size, contexts)
     finally:

@@ -47,17 +47,16 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """The scenes checked, the sweep run, one line saying what was written."""
-    from renderer.core.builtin import builtin_scenes, made_for_raytracing
+    from renderer.core.builtin import builtin_scenes, made_for
     from renderer.study.report import run_report
     from renderer.core.imageio import check_folder, check_outputs
-    from renderer.study.report_settings import QUICK_SCENES, RAY_QUICK_SCENES
+    from renderer.study.report_settings import QUICK_SCENES_OF
     check_outputs(check_folder(args.out) / "report.md", args.out / "results.csv")
-    traced = args.method == "raytrace"
     if args.scenes or args.quick:
-        names = args.scenes or (RAY_QUICK_SCENES if traced else QUICK_SCENES)
+        names = args.scenes or QUICK_SCENES_OF[args.method]
         scenes = [load(name) for name in names]
     else:                  # the built-in scenes made for the method (their descriptions say)
-        scenes = [load(name) for name in builtin_scenes() if made_for_raytracing(name) == traced]
+        scenes = [load(name) for name in builtin_scenes() if made_for(name) == args.method]
         if not scenes:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")

@@ -93,6 +93,12 @@ def scene_descriptions() -> dict[str, str]:
     return {name: scene_description(path) for name, path in builtin_scenes().items()}
 
 
+def made_for(scene: str) -> str:
+    """The method (renderer/methods' name) the built-in scene or scene file is made for:
+    "raytrace" where its description says RAYTRACE_MARK, else "raster"."""
+    return "raytrace" if made_for_raytracing(scene) else "raster"
+
+
 def made_for_raytracing(scene: str) -> bool:
     """Whether the built-in scene (by name) or scene file (by path) is made for the ray tracer:
     its description says RAYTRACE_MARK. `renderer report` with no scenes reports these with

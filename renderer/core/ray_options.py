@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, fields
+from typing import ClassVar
 
 from renderer.core.ray_depth import DEFAULT_MAX_DEPTH, MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import RaySampling, ray_sampling
@@ -41,6 +42,10 @@ class RayOptions:
     focus_distance: float | None = None
     shadows: bool = True
     specialise: bool = True
+    # The fields a batch job's [[settings]] gives (renderer/batch/job_file.py): a setting's
+    # identity (the seed is each item's own).
+    SETTING_FIELDS: ClassVar[tuple[str, ...]] = ("samples", "pattern", "max_depth",
+                                                 "adaptive_threshold", "light_samples")
 
     def __post_init__(self):
         if isinstance(self.max_depth, bool) or not isinstance(self.max_depth, int) \

@@ -61,8 +61,12 @@ def _open_reference(scene, width, height, options, precision, subpixel_bits):
     return ReferenceRayTracer(scene, width, height, options, precision)
 
 
+def _samples(options: RayOptions) -> int:
+    return options.samples * options.light_samples
+
+
 def _check_memory(scene, size, backends, options: RayOptions) -> None:
-    check_raytrace_render(scene, size, backends, options.samples * options.light_samples)
+    check_raytrace_render(scene, size, backends, _samples(options))
 
 
 def samples_fired(frame: Frame) -> str:
@@ -78,4 +82,4 @@ def _words(options: RayOptions, frame: Frame) -> str:
 
 
 METHOD = Method("raytrace", "ray tracer", RayOptions, _open_gpu, _open_reference, _check_memory,
-                _words, progressive=True, seeded=True, shutter=True)
+                _words, _samples, progressive=True, seeded=True, shutter=True)

@@ -20,7 +20,9 @@ class Method:
     open_reference(scene, width, height, options, precision, subpixel_bits) return a Renderer
     (renderer/gpu/base.py); check_memory(scene, size, backends, options) refuses, in one line,
     what would not fit (renderer/core/memory.py); words(options, frame) says how a frame was
-made in a few words for a front end's line ("" for nothing to say). `progressive`: successive frames bring new
+made in a few words for a front end's line ("" for nothing to say); samples(options) is
+what a frame's work per pixel scales with (the ray tracer's samples times light samples;
+memory estimates and a batch's costs). `progressive`: successive frames bring new
     samples (render(first_sample=k)), so a viewer refines while the view is still; `seeded`:
     the frames depend on a seed (reseed(seed), a batch item's own); `shutter`: objects move
 during the camera's shutter (motion blur; a method without it draws time 0), so an
@@ -32,6 +34,7 @@ animation's frames differ."""
     open_reference: Callable
     check_memory: Callable
     words: Callable = lambda options, frame: ""
+    samples: Callable = lambda options: 1
     progressive: bool = False
     seeded: bool = False
     shutter: bool = False

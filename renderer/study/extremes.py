@@ -267,25 +267,32 @@ def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: d
         except SceneError as error:
             cases.append(base | {"refused": error.line(), "passes": True})
             continue
-        description = scene_description(path)
-        if method == "raytrace":
-            depths = RAYTRACE_DEPTHS.get(name, (DEFAULT_MAX_DEPTH,))
-            samples, pattern = RAYTRACE_SAMPLING.get(name, (1, "regular"))
-            for depth in depths:
-                case = name if len(depths) == 1 else f"{name} (max depth {depth})"
-                cases.append(base | {"case": case, "tests": description, "max_depth": depth,
-                                     "samples": samples, "pattern": pattern}
-                             | measure_ray_traced(scene, size, contexts, depth, samples, pattern))
-            continue
-        cases.append(base | {"tests": description, "reversed_z": scene.camera.reversed_z}
-                     | measure_scene(scene, size, contexts))
-        if scene.camera.reversed_z:
-            standard = replace(scene, camera=replace(scene.camera, reversed_z=False))
-            cases.append(base | {"case": f"{name} (reversed_z off)", "tests": description,
-                                 "reversed_z": False, "stability": "none: the 'before' of the "
-                                 "row above", "before": True}
-                         | measure_scene(standard, size, contexts))
+        cases += CASES[method](name, scene, base | {"tests": scene_description(path)}, size, contexts)
     return cases
+
+
+def _ray_cases(name: str, scene, base: dict, size, contexts) -> list[dict]:
+    """One case per depth of RAYTRACE_DEPTHS, at the scene's RAYTRACE_SAMPLING."""
+    depths = RAYTRACE_DEPTHS.get(name, (DEFAULT_MAX_DEPTH,))
+    samples, pattern = RAYTRACE_SAMPLING.get(name, (1, "regular"))
+    return [base | {"case": name if len(depths) == 1 else f"{name} (max depth {depth})",
+                    "max_depth": depth, "samples": samples, "pattern": pattern}
+            | measure_ray_traced(scene, size, contexts, depth, samples, pattern) for depth in depths]
+
+
+def _raster_cases(name: str, scene, base: dict, size, contexts) -> list[dict]:
+    """The case as authored and, for a reversed-Z scene, the same with it off (its 'before')."""
+    cases = [base | {"reversed_z": scene.camera.reversed_z} | measure_scene(scene, size, contexts)]
+    if scene.camera.reversed_z:
+        standard = replace(scene, camera=replace(scene.camera, reversed_z=False))
+        cases.append(base | {"case": f"{name} (reversed_z off)", "reversed_z": False,
+                             "stability": "none: the 'before' of the row above", "before": True}
+                     | measure_scene(standard, size, contexts))
+    return cases
+
+
+# Each method's cases, by the name renderer/methods registers it under.
+CASES = {"raster": _raster_cases, "raytrace": _ray_cases}
 
 
 # -------------------------------------------------------------------------- the report

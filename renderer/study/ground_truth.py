@@ -25,7 +25,9 @@ compared with. A frame at a time bounds the memory (the reference holds a frame'
 from __future__ import annotations
 
 import hashlib
+from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -92,19 +94,20 @@ def scene_digest(scene: Scene) -> str:
 
 
 def cache_path(scene: Scene, width: int, height: int, cache_dir, method: str = "raster") -> Path:
-    """Where the truth of `method` ("raster" or "raytrace") is cached: named after the scene
-    and size, keyed by the content of the scene it draws and the truth's recipe."""
-    if method == "raster":
-        drawn, stem = truth_scene(scene), output_stem(scene)
-        recipe = f"grid={TRUTH_GRID} v{TRUTH_VERSION}"
-    else:
-        drawn, stem = scene, f"{output_stem(scene)}-raytrace"
-        recipe = (f"jittered={RAY_TRUTH_SAMPLES}x{RAY_TRUTH_PASSES} depth={RAY_TRUTH_DEPTH} "
-                  f"seed={RAY_TRUTH_SEED} v{RAY_TRUTH_VERSION}")
-        if truth_light_samples(scene) > 1:          # (other scenes keep their cached truths)
-            recipe += f" light_samples={truth_light_samples(scene)}"
+    """Where the truth of `method` (a key of TRUTHS) is cached: named after the scene and
+    size, keyed by the content of the scene it draws and the truth's recipe."""
+    truth = truth_of(method)
+    drawn, stem, recipe = truth.drawn(scene), output_stem(scene) + truth.suffix, truth.recipe(scene)
     key = hashlib.sha256(f"{scene_digest(drawn)} {width}x{height} {recipe}".encode()).hexdigest()[:24]
     return Path(cache_dir) / f"{stem}-{width}x{height}-{key}.npy"
+
+
+def _ray_recipe(scene: Scene) -> str:
+    recipe = (f"jittered={RAY_TRUTH_SAMPLES}x{RAY_TRUTH_PASSES} depth={RAY_TRUTH_DEPTH} "
+              f"seed={RAY_TRUTH_SEED} v{RAY_TRUTH_VERSION}")
+    if truth_light_samples(scene) > 1:          # (other scenes keep their cached truths)
+        recipe += f" light_samples={truth_light_samples(scene)}"
+    return recipe
 
 
 def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:
@@ -138,9 +141,30 @@ def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
     return clamped(total / RAY_TRUTH_PASSES)
 
 
+@dataclass(frozen=True)
+class Truth:
+    """A method's ground truth (module docstring): the scene it draws, what its cache files'
+    names add to the scene's, its recipe (part of the cache key) and how it is rendered."""
+    drawn: Callable[[Scene], Scene]
+    suffix: str
+    recipe: Callable[[Scene], str]
+    render: Callable[[Scene, int, int], np.ndarray]
+
+
+# Each method's truth, by the name renderer/methods registers it under.
+TRUTHS = {"raster": Truth(truth_scene, "", lambda scene: f"grid={TRUTH_GRID} v{TRUTH_VERSION}", render_truth),
+          "raytrace": Truth(lambda scene: scene, "-raytrace", _ray_recipe, render_ray_truth)}
+
+
+def truth_of(method: str) -> Truth:
+    if method not in TRUTHS:
+        raise ValueError(f"no ground truth is made for method {method!r}; one of {', '.join(TRUTHS)}")
+    return TRUTHS[method]
+
+
 def render_ground_truth(scene: Scene, width: int, height: int, method: str = "raster") -> np.ndarray:
     """The truth of `method` rendered now, uncached (a plain function: a task elsewhere)."""
-    return (render_truth if method == "raster" else render_ray_truth)(scene, width, height)
+    return truth_of(method).render(scene, width, height)
 
 
 def ground_truths(scenes: list, width: int, height: int, cache_dir, method: str = "raster",

@@ -283,14 +283,20 @@ class RasterStudy:
         return report_markdown(result, plots, size, sweep, quick)
 
 
+def _ray_study():
+    from renderer.study.ray_report import RayStudy      # (it imports this module)
+    return RayStudy()
+
+
+# Each method's sweep, by the name renderer/methods registers it under.
+STUDIES = {"raster": RasterStudy, "raytrace": _ray_study}
+
+
 def study(method: str):
-    """The sweep of `method`: "raster" or "raytrace"."""
-    if method == "raytrace":
-        from renderer.study.ray_report import RayStudy
-        return RayStudy()
-    if method == "raster":
-        return RasterStudy()
-    raise ValueError(f"method must be raster or raytrace, got {method!r}")
+    """The sweep of `method` (a key of STUDIES)."""
+    if method not in STUDIES:
+        raise ValueError(f"no report is made for method {method!r}; one of {', '.join(STUDIES)}")
+    return STUDIES[method]()
 
 
 @dataclass

@@ -60,6 +60,7 @@ TEXTBOOK_SLOPES = {                  # RMSE against N (Mitchell 1996; docs/repor
 RAY_DEFAULT_SIZE = (160, 120)
 RAY_QUICK_SIZE = (64, 48)
 RAY_QUICK_SCENES = ("classic",)
+QUICK_SCENES_OF = {"raster": QUICK_SCENES, "raytrace": RAY_QUICK_SCENES}     # --quick's, by method
 RAY_MAX_SIZE = (320, 240)            # its ground truth traces 1024 rays per pixel in float64
 RAY_BASE_SAMPLES = 16                # jittered, for the knobs other than antialiasing
 RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "light_samples",

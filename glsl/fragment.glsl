@@ -111,6 +111,12 @@ layout(location = 1) out vec4 out_linear_color;
 // The terms of the side seen (`back`: a two-sided back face), each light's weighed by its
 // visibility at P with the lit normal N, added to the ambient term in lighting()'s order. The
 // varyings' names (AMBIENT, ...: flat's or Gouraud's) are lighting.glsl's.
+// Light i's term of the side lit: KIND_BACK's where `back` (two-sided), else KIND_FRONT's.
+#ifdef TWO_SIDED
+#define SIDED_TERM(KIND, ROWS, i) (back ? LIGHT_TERM(KIND##_BACK, ROWS, i) : LIGHT_TERM(KIND##_FRONT, ROWS, i))
+#else
+#define SIDED_TERM(KIND, ROWS, i) LIGHT_TERM(KIND##_FRONT, ROWS, i)
+#endif
 vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
 #ifdef TEXTURED
     vec3 color = AMBIENT + MODULATED_AMBIENT * texel;
@@ -118,26 +124,12 @@ vec3 shadowed_terms(vec3 P, vec3 N, bool back) {
     vec3 color = AMBIENT;
 #endif
 #if NUM_DIRECTIONAL_TERMS > 0
-    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i) {
-#ifdef TWO_SIDED
-        vec3 term = back ? LIGHT_TERM(DIRECTIONAL_TERMS_BACK, DIRECTIONAL_TERM_ROWS, i)
-                         : LIGHT_TERM(DIRECTIONAL_TERMS_FRONT, DIRECTIONAL_TERM_ROWS, i);
-#else
-        vec3 term = LIGHT_TERM(DIRECTIONAL_TERMS_FRONT, DIRECTIONAL_TERM_ROWS, i);
-#endif
-        color += shadowed_directional(i, P, N, term);
-    }
+    for (int i = 0; i < DIRECTIONAL_LIGHTS; ++i)
+        color += shadowed_directional(i, P, N, SIDED_TERM(DIRECTIONAL_TERMS, DIRECTIONAL_TERM_ROWS, i));
 #endif
 #if NUM_POINT_TERMS > 0
-    for (int i = 0; i < POINT_LIGHTS; ++i) {
-#ifdef TWO_SIDED
-        vec3 term = back ? LIGHT_TERM(POINT_TERMS_BACK, POINT_TERM_ROWS, i)
-                         : LIGHT_TERM(POINT_TERMS_FRONT, POINT_TERM_ROWS, i);
-#else
-        vec3 term = LIGHT_TERM(POINT_TERMS_FRONT, POINT_TERM_ROWS, i);
-#endif
-        color += shadowed_point(i, P, N, term);
-    }
+    for (int i = 0; i < POINT_LIGHTS; ++i)
+        color += shadowed_point(i, P, N, SIDED_TERM(POINT_TERMS, POINT_TERM_ROWS, i));
 #endif
     return color;
 }
@@ -196,28 +188,22 @@ void main() {
 #else
     vec3 color = shadowed_terms(P, N, back);
 #endif
-#elif defined(SHADING_FLAT)
+#else
+    // The colours lit per face (flat: geometry.glsl's f_*) or per vertex (Gouraud: vertex.glsl's v_*).
+#ifdef SHADING_FLAT
+#define LIT(name) f_##name
+#else
+#define LIT(name) v_##name
+#endif
 #ifdef TWO_SIDED
-    vec3 color = BACK_FACE_LIT ? f_color_back : f_color_front;
+    vec3 color = BACK_FACE_LIT ? LIT(color_back) : LIT(color_front);
 #ifdef TEXTURED
-    color += (BACK_FACE_LIT ? f_modulated_back : f_modulated_front) * texel;
+    color += (BACK_FACE_LIT ? LIT(modulated_back) : LIT(modulated_front)) * texel;
 #endif
 #else
-    vec3 color = f_color_front;
+    vec3 color = LIT(color_front);
 #ifdef TEXTURED
-    color += f_modulated_front * texel;
-#endif
-#endif
-#else
-#ifdef TWO_SIDED
-    vec3 color = BACK_FACE_LIT ? v_color_back : v_color_front;
-#ifdef TEXTURED
-    color += (BACK_FACE_LIT ? v_modulated_back : v_modulated_front) * texel;
-#endif
-#else
-    vec3 color = v_color_front;
-#ifdef TEXTURED
-    color += v_modulated_front * texel;
+    color += LIT(modulated_front) * texel;
 #endif
 #endif
 #endif

@@ -186,6 +186,31 @@ def test_every_variant_compiles_and_is_cached(gl_contexts):
         cache.release()
 
 
+def test_a_uniform_the_variant_declares_is_given_a_value_or_the_draw_is_refused(gl_contexts):
+    """The rasteriser writes every uniform a program's #defines declare (GpuRenderer._plan asks
+    ProgramCache.check_values): one left without a value would read zero, silently."""
+    from renderer.core.builtin import resolve_scene
+    from renderer.core.scene_file import load_scene
+    from renderer.gpu.context import activate
+    from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values
+    ctx = gl_contexts["egl"]
+    activate(ctx)
+    scene = load_scene(resolve_scene("sphere"))
+    matrices = scene.matrices(16, 12)
+    obj = scene.objects[0]
+    names = (frame_uniform_values(scene, matrices).keys()
+             | object_uniform_values(obj, matrices.objects[0]).keys())
+    cache = ProgramCache(ctx)
+    try:
+        variant = ShaderVariant.for_material(scene, obj.material, False)
+        cache.get(variant)
+        cache.check_values(variant, names)                      # every one has its value
+        with pytest.raises(ShaderSourceError, match="no value for u_ambient, which its GLSL declares"):
+            cache.check_values(variant, names - {"u_ambient"})
+    finally:
+        cache.release()
+
+
 def test_resource_folders_are_found():
     assert (glsl_dir() / "vertex.glsl").is_file()
     assert assets_dir().is_dir() and assets_dir().name == "assets"

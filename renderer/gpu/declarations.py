@@ -23,7 +23,11 @@ from typing import Iterable
 
 import moderngl
 
-from renderer.gpu.shaders import ShaderSourceError
+
+class ShaderSourceError(Exception):
+    """A GLSL file that cannot be assembled (missing include, include cycle, no #version),
+    a program that does not compile, or uniforms that do not match a renderer's values; the
+    message names the file and line, or the uniforms. (renderer/gpu/shaders.py raises it too.)"""
 
 
 @dataclass(frozen=True)

@@ -454,6 +454,9 @@ class GpuRenderer(ContextRenderer):
             variant = self._variant(item.obj, linear)
             vao = self._vertex_array(item, variant)
             program = programs[variant] = self._programs.get(variant)
+            # Every uniform the variant declares gets a value (ShaderSourceError otherwise);
+            # one the compiler dropped as unused is not written.
+            self._programs.check_values(variant, item.uniform_bytes.keys() | self._frame_uniforms.keys())
             uploads = [(program[name], data) for name, data in item.uniform_bytes.items()
                        if program.get(name, None) is not None]
             cull = CULL_FLAGS[item.obj.cull]

@@ -34,7 +34,11 @@ from renderer.core.facets import CREASE_CAP, FACES_PER_ROW
 from renderer.core.resources import glsl_dir
 from renderer.core.shadow_settings import MAX_SLOPE, SQRT2, shared_kernel
 from renderer.core.textures import MODULATED
-from renderer.gpu.uniforms import set_shadow_sampler_units
+from renderer.gpu.declarations import ShaderSourceError, selected_uniforms
+from renderer.gpu.uniforms import SHADOW_MAPS_UNITS, set_shadow_sampler_units
+
+# The samplers set_shadow_sampler_units points at their units when a program is linked.
+SAMPLERS_SET_AT_LINK = frozenset(f"u_{kind}_shadow_maps" for kind in SHADOW_MAPS_UNITS)
 
 _INCLUDE = re.compile(r'^\s*#\s*include\b(.*)$')
 _INCLUDE_NAME = re.compile(r'^\s*"([^"]+)"\s*(//.*)?$')
@@ -50,11 +54,6 @@ FILE_CONSTANTS: dict[str, dict[str, object]] = {
                            "SHADOW_CREASE_CAP": CREASE_CAP},
     "raytrace/bvh.glsl": {"BVH_STACK_SIZE": BVH_MAX_DEPTH},    # the builder keeps the depth below
 }
-
-
-class ShaderSourceError(Exception):
-    """A GLSL file that cannot be assembled (missing include, include cycle, no #version),
-    or a program that does not compile; the message names the file and line."""
 
 
 @dataclass(frozen=True)
@@ -353,6 +352,7 @@ class ProgramCache:
     def __init__(self, ctx: moderngl.Context):
         self.ctx = ctx
         self._programs: dict[ShaderVariant, moderngl.Program] = {}
+        self._declared: dict[ShaderVariant, frozenset[str]] = {}
 
     def get(self, variant: ShaderVariant) -> moderngl.Program:
         program = self._programs.get(variant)
@@ -369,7 +369,18 @@ class ProgramCache:
                 f"{i}={name}" for i, name in enumerate(s.files)) for stage, s in sources.items())
             raise ShaderSourceError(f"{variant} does not compile (source strings {legend}):\n{exc}")
         set_shadow_sampler_units(self.ctx, program)
+        self._declared[variant] = frozenset().union(*(selected_uniforms(s.text) for s in sources.values()))
         return program
+
+    def check_values(self, variant: ShaderVariant, names) -> None:
+        """ShaderSourceError naming the uniforms the variant's #defines declare that `names`
+        (the values a renderer writes, and the samplers it points at units) leave without a
+        value. Those the #defines leave out, or the compiler dropped, need none; a value for a
+        name no GLSL file declares is the GLSL contract test's to catch."""
+        missing = self._declared[variant] - set(names) - SAMPLERS_SET_AT_LINK
+        if missing:
+            raise ShaderSourceError(f"{variant}: no value for {', '.join(sorted(missing))}, which "
+                                    "its GLSL declares")
 
     def items(self):
         return self._programs.items()

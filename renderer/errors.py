@@ -12,6 +12,9 @@ import math
 import unicodedata
 
 
+INTERRUPTED = 130       # the exit status after Ctrl-C (128 + SIGINT, as a shell says it)
+
+
 class UserError(Exception):
     """A mistake in the user's input (a scene file, a mesh, an option), not a bug."""
 

@@ -181,9 +181,38 @@ def test_a_killed_command_resumes_to_the_same_job(ray_executor, job_file, undist
         command.kill()
     done_before = len(records(out))
     assert KILL_AFTER <= done_before < len(hashes(undisturbed))
+    assert_resumes(job_file, out, ray_executor.address, done_before, undisturbed)
+
+
+def assert_resumes(job_file: Path, out: Path, address: str, done: int, undisturbed: Path) -> None:
+    """The same command run again skips the `done` items and finishes the undisturbed job."""
     again = subprocess.run([sys.executable, "-m", "renderer", "batch", str(job_file), "--out",
-                            str(out), "--address", ray_executor.address],
+                            str(out), "--address", address],
                            cwd=ROOT, capture_output=True, text=True, timeout=180)
     assert again.returncode == 0, again.stderr
-    assert f"{done_before} already complete" in again.stderr
+    assert f"{done} already complete" in again.stderr
     assert_same_job(out, undisturbed)
+
+
+def test_ctrl_c_on_ray_is_one_line_and_status_130_then_the_job_resumes(ray_executor, job_file,
+                                                                        undisturbed, tmp_path):
+    # SIGINT to the driver mid-job (issue 30): the calls in flight are cancelled, so Ray says
+    # nothing of the actors killed with them; the lock goes; the same command finishes.
+    out = tmp_path / "out"
+    command = batch_command(job_file, out, "--address", ray_executor.address)
+    try:
+        wait_for_records(out, KILL_AFTER, command)
+        command.send_signal(signal.SIGINT)
+        stdout, stderr = command.communicate(timeout=60)
+    finally:
+        command.kill()
+    done = len(records(out))
+    assert command.returncode == 130, stderr
+    said = [line for line in stderr.replace("\r", "\n").splitlines() if line and "%|" not in line]
+    total = len(hashes(undisturbed))
+    assert said == [f"renderer: interrupted; {done} of {total} items done; run the same "
+                    f"command to resume"]
+    assert stdout == "" and KILL_AFTER <= done < total
+    listed = {path for outputs in hashes(out).values() for path, _ in outputs}
+    assert files_in(out) == listed | {MANIFEST}, "a file the manifest does not list"
+    assert_resumes(job_file, out, ray_executor.address, done, undisturbed)

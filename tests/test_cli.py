@@ -366,3 +366,39 @@ def test_view_refuses_a_screenshot_name_before_opening_a_window(tmp_path, capsys
         f"renderer: {shot}: cannot write .xyz images; use .png, .jpg, .webp, .tif, .bmp or another "
         f"suffix Pillow writes"]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_ctrl_c_is_one_line_and_status_130_with_nothing_written(tmp_path, capsys, monkeypatch):
+    # Any command: KeyboardInterrupt mid-write leaves no file and no temporary (issue 30).
+    from renderer.cli import main, render
+    from renderer.core.imageio import outputs
+
+    def interrupted(args):
+        with outputs() as out:
+            out.png(tmp_path / "half.png", np.zeros((4, 4, 3), np.uint8))
+            raise KeyboardInterrupt
+    monkeypatch.setattr(render, "run", interrupted)
+    assert main(["render", "-o", str(tmp_path / "x.png")]) == 130
+    assert capsys.readouterr().err == "renderer: interrupted\n"
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_a_long_render_in_one_line(tmp_path):
+    # SIGINT to the process mid-render (the reference ray tracer: minutes of NumPy).
+    import signal
+    import subprocess
+    import sys
+    import time
+    command = subprocess.Popen([sys.executable, "-m", "renderer", "render", "--backend", "reference",
+                                "--method", "raytrace", "--spp", "64", "--size", "400x300",
+                                "-o", str(tmp_path / "r.png")], stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        time.sleep(2.0)
+        command.send_signal(signal.SIGINT)
+        out, err = command.communicate(timeout=60)
+    finally:
+        command.kill()
+    assert (command.returncode, out, err) == (130, "", "renderer: interrupted\n")
+    assert list(tmp_path.iterdir()) == []

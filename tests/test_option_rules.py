@@ -56,6 +56,8 @@ RULES = {
                             'outputs = [{ halftone = "6", dither = "bayer4" }]',
                             lambda: OutputSettings(halftone=parse_halftone("6"), dither="bayer4")),
     "halftone 1.5": (["--halftone", "1.5"], 'outputs = [{ halftone = "1.5" }]', None),
+    "halftone 100000": (["--halftone", "100000"], 'outputs = [{ halftone = "100000" }]', None),
+    "halftone 8:1e300": (["--halftone", "8:1e300"], 'outputs = [{ halftone = "8:1e300" }]', None),
     "transfer gamma -2": (["--transfer", "gamma:-2"], 'outputs = [{ transfer = "gamma:-2" }]', None),
     "exr transparent": (["--format", "exr", "--background", "transparent"],
                         'background = "transparent"\noutputs = [{ format = "exr" }]',

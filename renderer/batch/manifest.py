@@ -24,25 +24,34 @@ same pixels to other bytes. Paths are relative to DIR, with '/'.
 
 Resume (`read_manifest`): a record counts when its key is one of the job's items, its
 outputs start with the item's files (with --compare, the comparison's too), and every file
-it lists exists with that SHA-256; the other items are
-rendered again. A line that is not whole JSON (the last one, cut by a kill) is ignored, and
-`Manifest.begin` rewrites the file with the header and the records that count. A manifest
-whose header is another job's (or not a batch manifest at all) is a UserError naming
-DIR/manifest.jsonl, exit status 2, before anything is written: a job never mixes its files
-with another's.
+it lists exists with that SHA-256; the other items are rendered again. A line that is not
+whole JSON (the last one, cut by a kill) is ignored, and `Manifest.begin` rewrites the file
+with the header and the records that count. A manifest whose header is another job's (or
+not a batch manifest at all) is a UserError naming DIR/manifest.jsonl, exit status 2,
+before anything is written: a job never mixes its files with another's.
+
+A tampered record is never followed: one with a path that leaves DIR (absolute, '..',
+through a symbolic link) or names something other than a regular file (a FIFO, a device,
+a link) is dropped unread, said in one warning line for all of them (`Resume.warning`), and
+its item rendered again; no file outside DIR is read or hashed (folder.py). The manifest
+itself is read as a user's file (renderer/core/user_files.py: a regular file within its
+cap), never through a link.
 """
 
 from __future__ import annotations
 
-import hashlib
 import json
 import os
+import stat
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from renderer import __version__
+from renderer.batch.folder import file_kind, regular_inside, sha256_inside
 from renderer.core.imageio import outputs, remove_stale_temporaries
 from renderer.core.jsonio import to_json
+from renderer.core.paths import show_path
+from renderer.core.user_files import MANIFEST_FILE, FileRefused, open_user_file, read_capped, refuse
 from renderer.errors import SystemFault, UserError
 
 MANIFEST = "manifest.jsonl"
@@ -51,11 +60,8 @@ FORMAT = 1
 
 
 def file_sha256(path: Path) -> str | None:
-    """SHA-256 of a file's bytes, None when it cannot be read."""
-    try:
-        return hashlib.sha256(path.read_bytes()).hexdigest()
-    except OSError:
-        return None
+    """SHA-256 of a regular file's bytes (a link is not followed), None when it cannot be read."""
+    return sha256_inside(path.parent, path.name)
 
 
 def header_for(job, identity: str, count: int) -> dict:
@@ -72,14 +78,32 @@ class Resume:
     header: dict
     records: dict[str, dict] = field(default_factory=dict)
     rewrite: bool = True             # no manifest yet, or lines to drop
+    refused: int = 0                 # records dropped for a path outside DIR or not a file
+
+    def warning(self) -> str | None:
+        """The one line for the records dropped unread, or None."""
+        if not self.refused:
+            return None
+        records = "record names" if self.refused == 1 else "records name"
+        return (f"warning: {self.path}: {self.refused} {records} a file outside the output "
+                f"folder or not a regular file; dropped unread, their items are rendered again")
 
 
 def _lines(path: Path) -> list[str] | None:
-    try:
-        return path.read_text(encoding="utf-8").split("\n")
-    except FileNotFoundError:
+    """The manifest's lines, None when there is none. Read as a user's file (a regular file
+    within its cap, user_files.py), and never through a symbolic link."""
+    kind = file_kind(path)
+    if kind is None:
         return None
-    except (OSError, UnicodeDecodeError) as error:
+    if kind == stat.S_IFLNK:
+        raise UserError("is a symbolic link, not a batch manifest; give another --out",
+                        file=show_path(path))
+    try:
+        with open_user_file(path, MANIFEST_FILE) as handle:
+            return read_capped(handle, MANIFEST_FILE).decode("utf-8").split("\n")
+    except FileRefused as refused:
+        raise refuse(refused, path) from None
+    except UnicodeDecodeError as error:
         raise UserError(f"cannot read it as a batch manifest ({error}); give another --out",
                         file=str(path)) from None
 
@@ -115,15 +139,26 @@ def read_manifest(out: Path, header: dict, wanted: dict[str, list[str]]) -> Resu
         return Resume(path, header)
     _check_header(path, _parsed(lines[0]), header)
     body, dropped = lines[1:], lines[-1] != ""      # whole lines end with a line break
-    records = {}
+    records, refused = {}, 0
     for line in body[:-1] if not dropped else body:
         record = _parsed(line)
-        if isinstance(record, dict) and _counts(out, record, wanted):
+        listed = record.get("outputs") if isinstance(record, dict) else None
+        if isinstance(listed, list) and not _confined(out, listed):
+            refused += 1
+            dropped = True
+        elif isinstance(record, dict) and _counts(out, record, wanted):
             dropped |= record["key"] in records      # a later record of a key wins
             records[record["key"]] = record
         else:
             dropped = True
-    return Resume(path, header, records, rewrite=dropped)
+    return Resume(path, header, records, rewrite=dropped, refused=refused)
+
+
+def _confined(out: Path, listed: list) -> bool:
+    """Whether every path the record lists stays in DIR and is a regular file or missing
+    (folder.regular_inside: looked at, not opened)."""
+    return all(regular_inside(out, o.get("path")) is not False for o in listed
+               if isinstance(o, dict))
 
 
 def _counts(out: Path, record: dict, wanted: dict[str, list[str]]) -> bool:
@@ -134,7 +169,7 @@ def _counts(out: Path, record: dict, wanted: dict[str, list[str]]) -> bool:
     if files is None or not isinstance(listed, list) or not all(isinstance(o, dict) for o in listed) \
             or [o.get("path") for o in listed][:len(files)] != files:
         return False
-    return all(file_sha256(out / str(o["path"])) == o.get("sha256") for o in listed)
+    return all(sha256_inside(out, o["path"]) == o.get("sha256") for o in listed)
 
 
 class Manifest:
@@ -156,9 +191,11 @@ class Manifest:
         return self
 
     def append(self, record: dict) -> None:
-        line = to_json(record) + "\n"
-        try:
-            with open(self.path, "a", encoding="utf-8") as handle:
+        line = (to_json(record) + "\n").encode("utf-8")
+        try:                    # not through a link: begin() put a regular file here
+            fd = os.open(self.path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_NOFOLLOW
+                         | os.O_NONBLOCK | os.O_CLOEXEC, 0o666)
+            with os.fdopen(fd, "wb") as handle:
                 handle.write(line)
                 handle.flush()
                 os.fsync(handle.fileno())

@@ -1,9 +1,10 @@
 """Running a job: plan (check everything, read what DIR holds), then render the rest on an
 executor's workers and write each item as its result arrives.
 
-    plan = plan_job(job, out, compare=False)     # UserError before anything is written
-    with open_executor(address, workers) as executor:
-        summary = run_plan(plan, executor)       # or run_job(job, out, executor)
+    with locked(out) as out:                     # one driver per DIR (folder.py)
+        plan = plan_job(job, out, compare=False) # UserError before anything is written
+        with open_executor(address, workers) as executor:
+            summary = run_plan(plan, executor)   # or run_job(job, out, executor)
 
 Only this driver writes: each item's files in one `outputs()` transaction (all or none),
 then its manifest record (renderer/batch/manifest.py). A worker killed mid-item leaves
@@ -19,17 +20,26 @@ TARGET_BATCH_SECONDS. Nothing of the result depends on the batches.
 With --compare every item is also drawn by the NumPy reference (executor.tasks, plain
 tasks) and compared as `renderer compare` does: its gpu.png, reference.png and diff.png go
 to the item's compare/ folder and the figures into its record.
+
+Every file goes under DIR through real folders only (folder.check_inside, at the plan and
+again before each item is written). Ctrl-C (KeyboardInterrupt) while the items render is
+raised again as Interrupted, which says how many of the job's items are complete: the
+items written so far keep their files and records, the one being written is all or none.
 """
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hashlib
+import signal
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from renderer.batch.folder import check_inside, locked
 from renderer.batch.items import ITEMS_FOLDER, Item, Job, expand, job_identity
 from renderer.batch.manifest import MANIFEST, Manifest, Resume, header_for, read_manifest
 from renderer.batch.job_file import check_memory
@@ -68,9 +78,10 @@ class Plan:
     compare: bool = False
 
 
-def plan_job(job: Job, out, *, compare: bool = False) -> Plan:
+def plan_job(job: Job, out, *, compare: bool = False, say=None) -> Plan:
     """Check the output folder, every output name and DIR's manifest (another job's is a
-    UserError); the items whose records do not count are the ones to do."""
+    UserError); the items whose records do not count are the ones to do. `say` gets the
+    warning line for records dropped unread (manifest.Resume.warning)."""
     out = check_folder(out)
     items = expand(job)
     if compare:                      # the reference's memory too (job_file checked the GPU's)
@@ -78,8 +89,11 @@ def plan_job(job: Job, out, *, compare: bool = False) -> Plan:
             check_memory(item_scene(load_source(item.scene), item), item.setting, ["gpu", "reference"])
     wanted = {item.key: [*item.files, *(compare_files(item) if compare else ())] for item in items}
     check_outputs(out / MANIFEST, *(out / path for paths in wanted.values() for path in paths))
+    check_inside(out, (path for paths in wanted.values() for path in paths))
     header = header_for(job, job_identity(job, items), len(items))
     resume = read_manifest(out, header, wanted)
+    if resume.warning() is not None:
+        (say or say_above_bar)(resume.warning())
     todo = [item for item in items if item.key not in resume.records]
     return Plan(job, out, items, todo, resume, compare)
 
@@ -138,15 +152,34 @@ class _Writer:
     def write(self, item: Item, result: ItemResult, extra: dict[str, bytes] | None = None,
               compare: dict | None = None) -> None:
         files = dict(result.files) | (extra or {})
-        with outputs() as written:                    # the item's files: all or none
-            for path, data in files.items():
-                written.bytes(self.out / path, data)
-        self.manifest.append(_record(item, result, files, compare))
-        self.summary.done += 1
+        check_inside(self.out, files)                 # no link made since the plan
+        with _interrupts_held():                      # files, record and count: all or none
+            with outputs() as written:                # the item's files: all or none
+                for path, data in files.items():
+                    written.bytes(self.out / path, data)
+            self.manifest.append(_record(item, result, files, compare))
+            self.summary.done += 1
         label = worker_label(result.worker)
         counts = self.summary.workers.setdefault(label, [0, 0.0])
         counts[0] += 1
         counts[1] += result.render_ms + result.encode_ms
+
+
+@contextlib.contextmanager
+def _interrupts_held():
+    """Ctrl-C held off while the block runs (in the main thread), then raised: an item is
+    written with its record and counted, or not at all, and the count said is the manifest's."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught = []
+    previous = signal.signal(signal.SIGINT, lambda number, frame: caught.append(number))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+        if caught:
+            raise KeyboardInterrupt
 
 
 def _above_bar(text: str) -> None:
@@ -166,11 +199,33 @@ def _bar(total: int, unit: str, progress: bool):
                 disable=not progress or total == 0)
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C while a job's items rendered: how many of them are complete (written before,
+    or now), for the one line `renderer batch` ends with (status 130)."""
+
+    def __init__(self, complete: int, items: int):
+        super().__init__(complete, items)
+        self.complete, self.items = complete, items
+
+    def line(self) -> str:
+        return (f"interrupted; {self.complete} of {self.items} items done; run the same "
+                f"command to resume")
+
+
 def run_plan(plan: Plan, executor, *, context_kind: str = "auto", progress: bool = True,
              say=say_above_bar) -> Summary:
-    """Render and write the plan's items on `executor` (renderer/cluster/executor.py)."""
-    start = time.perf_counter()
+    """Render and write the plan's items on `executor` (renderer/cluster/executor.py);
+    Ctrl-C is raised as Interrupted."""
     summary = Summary(len(plan.items), len(plan.items) - len(plan.todo), where=executor.describe())
+    try:
+        return _run(plan, executor, summary, context_kind, progress, say)
+    except KeyboardInterrupt:
+        raise Interrupted(summary.skipped + summary.done, summary.items) from None
+
+
+def _run(plan: Plan, executor, summary: Summary, context_kind: str, progress: bool,
+         say) -> Summary:
+    start = time.perf_counter()
     writer = _Writer(plan, summary, say)
     todo = sorted(plan.todo, key=lambda item: item.group)          # stable: file order within
     size = batch_size(max(map(item_seconds, todo), default=0.0), len(todo), executor.workers)
@@ -210,6 +265,8 @@ def _compare(held, executor, writer: _Writer, progress: bool) -> None:
 
 def run_job(job: Job, out, executor, *, compare: bool = False, context_kind: str = "auto",
             progress: bool = True, say=say_above_bar) -> Summary:
-    """plan_job then run_plan: the job's items not yet complete in `out`, rendered and written."""
-    return run_plan(plan_job(job, out, compare=compare), executor, context_kind=context_kind,
-                    progress=progress, say=say)
+    """plan_job then run_plan, `out` locked: the job's items not yet complete in `out`,
+    rendered and written."""
+    with locked(out) as out:
+        return run_plan(plan_job(job, out, compare=compare, say=say), executor,
+                        context_kind=context_kind, progress=progress, say=say)

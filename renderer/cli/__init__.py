@@ -5,7 +5,9 @@ A user's mistake (bad scene, bad output name, no GL) is one line on stderr and e
 2, with nothing written; an option argparse refuses is its reason on one line and the
 command's usage on the next, also status 2; a write the system refuses (read-only, disk full,
 I/O error: errors.SystemFault) is one line and status 1, with nothing written either; a bug
-keeps its traceback. `compare` exits 1 when the images fail the pipeline tolerance.
+keeps its traceback. Ctrl-C is one line, "renderer: interrupted" (batch says how many items
+are done), and status 130 (errors.INTERRUPTED), with nothing half-written; the viewer takes
+it as Esc. `compare` exits 1 when the images fail the pipeline tolerance.
 
 Every command writes its files through one transaction (renderer/core/imageio.py, `outputs`):
 its output names are checked before any work, and its files are renamed into place together.
@@ -24,7 +26,7 @@ import sys
 from renderer import __version__
 from renderer.cli import batch, colour, compare, extremes, render, report, scenes, shaders, view
 from renderer.cli.options import Parser
-from renderer.errors import UsageError, UserError, escaped
+from renderer.errors import INTERRUPTED, UsageError, UserError, escaped
 
 # The commands in the order `renderer --help` lists them.
 COMMANDS = {"render": render, "view": view, "compare": compare, "shaders": shaders, "report": report,
@@ -76,3 +78,6 @@ def main(argv=None) -> int:
     except BrokenPipeError:              # `renderer scenes | head`: the reader left, not an error
         sys.stdout = open(os.devnull, "w")
         return 0
+    except KeyboardInterrupt:            # Ctrl-C: one line (batch says its own), no traceback
+        print("renderer: interrupted", file=sys.stderr)
+        return INTERRUPTED

@@ -17,7 +17,9 @@ def add_parser(sub) -> None:
                     "whole and recorded in --out/manifest.jsonl (SHA-256 of every file); a re-run "
                     "with the same --out skips the items already complete. Exit status: 0 when "
                     "every item was written, 1 when some failed (a re-run tries them again), 2 "
-                    "for bad input, with nothing written.")
+                    "for bad input, with nothing written, or a DIR another batch is writing "
+                    "(one driver per DIR: a lock file in it), 130 after Ctrl-C (a re-run "
+                    "resumes).")
     batch.add_argument("job", metavar="JOB.toml", help="the job file (docs/batch-format.md)")
     batch.add_argument("--out", type=output_path, required=True, metavar="DIR",
                        help="folder for the items' files and manifest.jsonl")
@@ -38,15 +40,28 @@ def add_parser(sub) -> None:
 
 def run(args) -> int:
     """`renderer batch`: everything checked (job file, scenes, outputs, --out's manifest)
-    before the executor starts (renderer/batch/run.py); the summary on stderr."""
+    before the executor starts (renderer/batch/run.py), --out locked for this driver
+    (renderer/batch/folder.py); the summary on stderr. Ctrl-C: one line saying how many
+    items are done, status 130."""
+    from renderer.batch.folder import locked
     from renderer.batch.job_file import read_job
-    from renderer.batch.run import plan_job, run_plan
+    from renderer.batch.run import Interrupted, plan_job, run_plan
     from renderer.cluster.executor import InProcessExecutor, open_executor
-    plan = plan_job(read_job(args.job), args.out, compare=args.compare)
-    # Nothing left to render (a finished job run again): no workers to start.
-    opened = open_executor(args.address, args.workers) if plan.todo else InProcessExecutor()
-    with opened as executor:
-        summary = run_plan(plan, executor, context_kind=args.context)
+    from renderer.errors import INTERRUPTED
+    job = read_job(args.job)
+    with locked(args.out) as out:
+        plan = plan_job(job, out, compare=args.compare)
+        done = Interrupted(len(plan.items) - len(plan.todo), len(plan.items))
+        try:
+            # Nothing left to render (a finished job run again): no workers to start.
+            opened = open_executor(args.address, args.workers) if plan.todo else InProcessExecutor()
+            with opened as executor:
+                summary = run_plan(plan, executor, context_kind=args.context)
+                done = Interrupted(summary.skipped + summary.done, summary.items)
+        except KeyboardInterrupt as stop:       # while the workers start, render or stop
+            print(f"renderer: {(stop if isinstance(stop, Interrupted) else done).line()}",
+                  file=sys.stderr)
+            return INTERRUPTED
     for line in summary.lines():
         print(f"renderer {line}", file=sys.stderr)
     return 1 if summary.failed else 0

@@ -34,7 +34,9 @@ this way). Faults: actors restart without limit (max_restarts=-1) and retry thei
 failing MAX_ATTEMPTS times raises BatchFailed (a batch that kills its process every time
 takes the batch queued behind it on the same actor down with it, so BatchFailed may name
 either). An exception raised by the worker's own code is not a fault but a bug (or a
-UserError): it is raised here at once, as in-process.
+UserError): it is raised here at once, as in-process. A map or tasks left early (that
+error, or Ctrl-C in the driver) cancels its calls still in flight before the actors go, so
+that Ray retries none of them and prints nothing of them.
 """
 
 from __future__ import annotations
@@ -212,6 +214,15 @@ def _schedule(actors: list, batches: list[list]) -> Iterator[tuple[int, list]]:
         submit(actor)
 
 
+def _cancel(pending: dict) -> None:
+    """Cancel the calls still queued or running, so that killing their actors next (map's
+    end) retries none of them: Ray would say so on stdout, a line per call."""
+    import ray
+    for ref in pending:
+        with contextlib.suppress(Exception):
+            ray.cancel(ref)
+
+
 def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tuple, Any]]:
     """(tag, result) for each call of `pending` ({ObjectRef: (index, ...)}, which grows as
     the caller submits more) as it finishes: the ray.wait loop. A call lost to a fault
@@ -220,22 +231,26 @@ def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tu
     raised by the work itself is raised here (_get)."""
     import ray
     failures: Counter[int] = Counter()
-    while pending:
-        [ref], _ = ray.wait(list(pending), num_returns=1)
-        tag = pending.pop(ref)
-        try:
-            result = _get(ref)
-        except ray.exceptions.RayTaskError:
-            raise                           # the work's own error: a bug, not a fault
-        except ray.exceptions.RayError as exc:
-            failures[tag[0]] += 1
-            if failures[tag[0]] >= MAX_ATTEMPTS:
-                raise BatchFailed(f"{what} {tag[0]} failed {MAX_ATTEMPTS} times on Ray: its "
-                                  f"worker's process was lost each time ({type(exc).__name__}; "
-                                  f"out of memory, or a crash in the GL driver?)") from exc
-            again(tag)
-            continue
-        yield tag, result
+    try:
+        while pending:
+            [ref], _ = ray.wait(list(pending), num_returns=1)
+            tag = pending.pop(ref)
+            try:
+                result = _get(ref)
+            except ray.exceptions.RayTaskError:
+                raise                           # the work's own error: a bug, not a fault
+            except ray.exceptions.RayError as exc:
+                failures[tag[0]] += 1
+                if failures[tag[0]] >= MAX_ATTEMPTS:
+                    raise BatchFailed(f"{what} {tag[0]} failed {MAX_ATTEMPTS} times on Ray: "
+                                      f"its worker's process was lost each time "
+                                      f"({type(exc).__name__}; out of memory, or a crash in "
+                                      f"the GL driver?)") from exc
+                again(tag)
+                continue
+            yield tag, result
+    finally:                                    # left early (an error, Ctrl-C): calls go
+        _cancel(pending)
 
 
 def _get(ref):

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from renderer.core import resources
 from renderer.core.paths import checked_path
+from renderer.core.user_files import SCENE_FILE, FileRefused, open_user_file, read_user_file
 from renderer.errors import SceneError
 
 DEFAULT_SCENE = "sphere"
@@ -64,8 +65,12 @@ def resolve_scene(arg: str | None) -> Path:
         return path
     if is_scene_name(arg) and arg in scenes:
         return scenes[arg]
-    if path.is_dir():
-        raise SceneError("is a directory, not a scene file", file=arg)
+    if path.exists():           # a folder, a FIFO, a device: the opener says which
+        try:
+            open_user_file(path, SCENE_FILE).close()
+        except FileRefused as refused:
+            raise SceneError(refused.reason, file=arg) from None
+        return path
     close = difflib.get_close_matches(arg, list(scenes), n=1, cutoff=0.6)
     hint = f"did you mean {close[0]!r}? " if close else ""
     raise SceneError(f"no such scene file or built-in scene; {hint}"
@@ -73,10 +78,12 @@ def resolve_scene(arg: str | None) -> Path:
 
 
 def scene_description(path: Path) -> str:
-    """The scene's one-line `description` key ("" if it has none or cannot be read)."""
+    """The scene's one-line `description` key ("" if it has none or cannot be read: read
+    through renderer/core/user_files.py, as a scene file is)."""
     try:
-        data = tomllib.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):     # TOMLDecodeError, UnicodeDecodeError are ValueErrors
+        data = tomllib.loads(read_user_file(path, SCENE_FILE).decode("utf-8"))
+    # TOMLDecodeError and UnicodeDecodeError are ValueErrors
+    except (FileRefused, ValueError, RecursionError):
         return ""
     description = data.get("description", "")
     return " ".join(description.split()) if isinstance(description, str) else ""

@@ -43,6 +43,11 @@ BINS = 16
 MAX_LEAF_SIZE = 4
 MAX_DEPTH = 64                  # the GLSL's BVH_STACK_SIZE (renderer/gpu/shaders.py defines it)
 TEXTURE_WIDTH = 1024
+# Triangles binned at once by a SAH split: the (chunk, 3, BINS, 3) float64 temporaries of a
+# node's bin bounds take 1152 bytes a triangle, 38 MiB a chunk, where a 5-million-triangle
+# root once asked for 5.4 GiB at once (issue 30). Bin bounds are minima and maxima: the
+# same in any grouping, so the tree is the same.
+SAH_CHUNK = 1 << 15
 MAX_EXACT_INDEX = 1 << 24       # float32 holds every integer below it
 
 
@@ -89,10 +94,14 @@ def _sah_split(centroids, tri_min, tri_max, bins):
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         scale = np.where(extent > 0, bins / np.where(extent > 0, extent, 1.0), 0.0)
         index = np.minimum(((centroids - cmin) * scale).astype(np.int64), bins - 1)   # (n, 3)
-    onehot = index[:, :, None] == np.arange(bins)                                      # (n, 3, B)
-    counts = onehot.sum(0)                                                             # (3, B)
-    lo = np.where(onehot[..., None], tri_min[:, None, None, :], np.inf).min(0)         # (3, B, 3)
-    hi = np.where(onehot[..., None], tri_max[:, None, None, :], -np.inf).max(0)
+    counts = np.zeros((3, bins), np.int64)
+    lo, hi = np.full((3, bins, 3), np.inf), np.full((3, bins, 3), -np.inf)            # (3, B, 3)
+    for start in range(0, n, SAH_CHUNK):        # the (chunk, 3, B, 3) temporaries stay bounded
+        part = slice(start, start + SAH_CHUNK)
+        onehot = index[part, :, None] == np.arange(bins)                              # (c, 3, B)
+        counts += onehot.sum(0)
+        np.minimum(lo, np.where(onehot[..., None], tri_min[part, None, None, :], np.inf).min(0), out=lo)
+        np.maximum(hi, np.where(onehot[..., None], tri_max[part, None, None, :], -np.inf).max(0), out=hi)
     left_n = np.cumsum(counts, axis=1)[:, :-1]                                         # (3, B-1)
     right_n = n - left_n
     left_lo = np.minimum.accumulate(lo, axis=1)[:, :-1]

@@ -23,6 +23,7 @@ from pathlib import Path
 from urllib.parse import unquote
 
 from renderer.core import gl_rules
+from renderer.core.user_files import MESH_FILE, FileRefused, read_resource, read_user_file
 from renderer.core.textures import MaterialTexture, Sampler, texture_from_bytes
 from renderer.errors import SceneError
 
@@ -63,7 +64,10 @@ def base_colour_texture(path, *, source: str | None = None,
 
 def _read(path: Path) -> tuple[dict, bytes]:
     """The JSON header and the GLB's binary chunk (b"" for .gltf)."""
-    data = path.read_bytes()
+    try:
+        data = read_user_file(path, MESH_FILE)
+    except FileRefused as refused:
+        raise _Problem(refused.reason) from None
     binary = b""
     if data[:4] == GLB_MAGIC:
         offset, chunks = 12, {}
@@ -120,7 +124,7 @@ def _base_colour(header: dict, material):
 
 def _image_bytes(header: dict, binary: bytes, index: int, folder: Path) -> bytes:
     """The encoded image `index`: a buffer view (of the GLB's chunk or a buffer's uri) or its
-    own uri (a data: URI or a file beside the glTF)."""
+    own uri (a data: URI or a file in the glTF's own folder: `_uri_bytes`)."""
     try:
         image = header["images"][index]
         if "bufferView" in image:
@@ -135,13 +139,17 @@ def _image_bytes(header: dict, binary: bytes, index: int, folder: Path) -> bytes
 
 
 def _uri_bytes(uri: str, folder: Path) -> bytes:
+    """A buffer's or image's bytes: a data: URI's, or those of the file the uri names in the
+    glTF's own `folder` (docs/scene-format.md: an absolute path, or one that leaves the
+    folder, is refused, as trimesh refuses such buffers), read through user_files."""
+    if not isinstance(uri, str):
+        raise _Problem(f"a uri is {type(uri).__name__}, not a string")
     if uri.startswith("data:"):
         try:
             return base64.b64decode(uri.split(",", 1)[1])
         except (IndexError, ValueError) as exc:
             raise _Problem(f"a data URI could not be decoded: {exc}") from None
-    target = folder / unquote(uri)
     try:
-        return target.read_bytes()
-    except OSError as exc:
-        raise _Problem(f"{target}: cannot read: {exc.strerror or exc}") from None
+        return read_resource(folder, unquote(uri), "uri")
+    except FileRefused as refused:
+        raise _Problem(refused.reason) from None

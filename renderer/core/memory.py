@@ -118,7 +118,12 @@ def reference_bytes(width: int, height: int, triangles: int, *, linear: bool = F
 # about 55 MiB over a chunk of 65,536 camera rays, doubled for scenes of many triangles):
 RAYTRACE_FIXED = 128 * MIB
 RAYTRACE_BYTES_PER_PIXEL = 64                   # float colour and depth targets, read-back, rgba8
-RAYTRACE_BYTES_PER_TRIANGLE = 640               # ray_scene (float64), BVH, textures
+# Per triangle: ray_scene (float64), the BVH and its build (its SAH bins in bounded chunks:
+# renderer/core/bvh.py), and on the GPU the float textures and their upload. Measured on a
+# 488,600-triangle uv_sphere at 64x48 (peak RSS over the scene's, 2026-12-03): GPU 1,069 and
+# reference 641 bytes a triangle; rounded up.
+RAYTRACE_GPU_BYTES_PER_TRIANGLE = 1280
+RAYTRACE_BYTES_PER_TRIANGLE = 768
 RAYTRACE_REFERENCE_BYTES_PER_CAMERA_RAY = 64    # windows, O, D, colour, hit, s of every sample
 RAYTRACE_REFERENCE_CHUNK_RAYS = 1 << 16         # reference/raytrace/pipeline.py, CHUNK_RAYS
 RAYTRACE_REFERENCE_WORKING_BYTES_PER_RAY = 2048
@@ -127,7 +132,7 @@ RAYTRACE_REFERENCE_WORKING_BYTES_PER_RAY = 2048
 def raytrace_gpu_bytes(width: int, height: int, triangles: int, *, samples: int = 1) -> int:
     """The GPU ray tracer (renderer/gpu/raytracer.py): samples are looped in the shader, so
     they cost nothing here."""
-    return RAYTRACE_FIXED + width * height * RAYTRACE_BYTES_PER_PIXEL + triangles * RAYTRACE_BYTES_PER_TRIANGLE
+    return RAYTRACE_FIXED + width * height * RAYTRACE_BYTES_PER_PIXEL + triangles * RAYTRACE_GPU_BYTES_PER_TRIANGLE
 
 
 def raytrace_reference_bytes(width: int, height: int, triangles: int, *, samples: int = 1) -> int:

@@ -25,7 +25,9 @@ the mesh, that scene file and its key). What it checks:
 from __future__ import annotations
 
 import contextlib
+import io
 import logging
+import os
 import warnings
 from pathlib import Path
 
@@ -34,6 +36,8 @@ import trimesh
 
 from renderer.core import memory
 from renderer.core.paths import checked_path
+from renderer.core.user_files import (MESH_FILE, FileRefused, confined, open_user_file,
+                                      read_capped, read_resource)
 from renderer.errors import SceneError, show_number
 from renderer.core.scene import Mesh
 from renderer.core.uv_rules import weld_corners
@@ -87,24 +91,13 @@ def load_mesh(path, *, source: str | None = None, key: str | None = None,
 
 
 def _load_checked(path: Path, crease_angle: float) -> Mesh:
-    if not path.exists():
-        raise _MeshProblem("mesh file not found")
-    if not path.is_file():
-        raise _MeshProblem("is not a file")
+    data = _read_file(path)
     suffix = path.suffix.lower()
-    if suffix not in MESH_SUFFIXES:
-        raise _MeshProblem(f"unsupported mesh format {suffix or '(no suffix)'!r}; "
-                           f"expected one of {', '.join(MESH_SUFFIXES)}")
-    # Checked before parsing: the parsers take up to MESH_PARSE_FACTOR times the file's size.
-    size = path.stat().st_size
-    too_much = memory.over_limit(size * memory.MESH_PARSE_FACTOR)
-    if too_much:
-        raise _MeshProblem(f"a mesh file of {memory.show(size)} {too_much}")
     if suffix == ".obj":
-        _check_obj_face_indices(path)
+        _check_obj_face_indices(data)
     if suffix == ".ply":
-        _check_ascii_ply_face_indices(path)
-    positions, faces, file_normals, uvs = _read_with_trimesh(path)
+        _check_ascii_ply_face_indices(data)
+    positions, faces, file_normals, uvs = _read_with_trimesh(path, data)
     _check_geometry(positions, faces)
     _check_uvs(uvs)
     if file_normals is not None:
@@ -119,6 +112,50 @@ def _load_checked(path: Path, crease_angle: float) -> Mesh:
         return Mesh(positions, normals, creased, str(path))
     vertex, creased, uvs = weld_corners(creased, uvs[faces])
     return Mesh(positions[vertex], normals[vertex], creased, str(path), uvs=uvs)
+
+
+def _read_file(path: Path) -> bytes:
+    """The mesh file's bytes, read through renderer/core/user_files.py (a regular file, at
+    most its cap), after its suffix and its size against the memory limit are checked."""
+    try:
+        with open_user_file(path, MESH_FILE) as handle:
+            suffix = path.suffix.lower()
+            if suffix not in MESH_SUFFIXES:
+                raise _MeshProblem(f"unsupported mesh format {suffix or '(no suffix)'!r}; "
+                                   f"expected one of {', '.join(MESH_SUFFIXES)}")
+            # Checked before parsing: the parsers take up to MESH_PARSE_FACTOR times the size.
+            size = os.fstat(handle.fileno()).st_size
+            too_much = memory.over_limit(size * memory.MESH_PARSE_FACTOR)
+            if too_much:
+                raise _MeshProblem(f"a mesh file of {memory.show(size)} {too_much}")
+            return read_capped(handle, MESH_FILE)
+    except FileRefused as refused:
+        raise _MeshProblem(refused.reason) from None
+
+
+class _ConfinedResolver(trimesh.resolvers.FilePathResolver):
+    """What trimesh reads beside a mesh file (an OBJ's MTL and its images, a .gltf's buffers
+    and images): files in the mesh file's own folder only (user_files.confined), read
+    through user_files (regular files, at most GLTF_RESOURCE's cap). trimesh's own resolver
+    also tries the name's last part in the folder, and opens FIFOs and devices."""
+
+    def __init__(self, source: str, owner: str):
+        super().__init__(source)
+        self.owner = owner                       # "glTF", "OBJ": the refusals name it
+        self.what = "uri" if owner == "glTF" else "file"
+
+    def get(self, name: str) -> bytes:
+        try:
+            return read_resource(Path(self.parent), name.strip(), self.what, self.owner)
+        except FileRefused as refused:
+            raise _MeshProblem(refused.reason) from None
+
+    def namespaced(self, namespace: str) -> "_ConfinedResolver":
+        try:
+            inner = confined(Path(self.parent), namespace, "folder", self.owner)
+        except FileRefused as refused:
+            raise _MeshProblem(refused.reason) from None
+        return _ConfinedResolver(str(inner / "_"), self.owner)
 
 
 @contextlib.contextmanager
@@ -143,12 +180,11 @@ def _neither(kind: str) -> str:
     return f"could not be read as {kind}: not a valid {kind} file (neither binary {kind} nor text)"
 
 
-def _neither_binary_nor_text(path: Path, kind: str) -> bool:
+def _neither_binary_nor_text(data: bytes, kind: str) -> bool:
     """Whether an OBJ (text only) or STL file is neither UTF-8 text nor, for STL, the binary
     layout (an 84-byte header and count, then 50 bytes per triangle)."""
     if kind not in ("OBJ", "STL"):
         return False
-    data = path.read_bytes()
     try:
         data.decode("utf-8")
         return False
@@ -157,19 +193,24 @@ def _neither_binary_nor_text(path: Path, kind: str) -> bool:
     return kind == "OBJ" or len(data) < 84 or len(data) != 84 + 50 * int.from_bytes(data[80:84], "little")
 
 
-def _read_with_trimesh(path: Path):
+def _read_with_trimesh(path: Path, data: bytes):
     """(positions (V, 3), faces (F, 3), normals (V, 3) or None, UVs (V, 2) or None) of every
-    triangle mesh in the file.
+    triangle mesh in the file (its bytes `data`; what it names beside it through
+    _ConfinedResolver).
 
     process=False keeps the file's vertices and normals as written (no merging, no repair).
     """
     kind = path.suffix.lower()[1:].upper()
-    if _neither_binary_nor_text(path, kind):
+    if _neither_binary_nor_text(data, kind):
         # Said before trimesh sees the file: with charset_normalizer installed (Ray's extra
         # brings it) trimesh "decodes" any bytes as some code page and reads what it can.
         raise _MeshProblem(_neither(kind))
     try:
-        loaded = trimesh.load_scene(str(path), process=False)
+        loaded = trimesh.load_scene(io.BytesIO(data), file_type=path.suffix.lower()[1:],
+                                    resolver=_ConfinedResolver(str(path), _owner(kind)),
+                                    process=False)
+    except _MeshProblem:
+        raise
     except ImportError:
         # trimesh falls back to guessing a text encoding (charset_normalizer, not installed)
         # when a file is neither its binary layout nor UTF-8 text.
@@ -209,6 +250,11 @@ def _read_with_trimesh(path: Path):
     return (np.concatenate(positions), np.concatenate(faces),
             np.concatenate(normals) if all_have_normals else None,
             np.concatenate(uvs) if all_have_uvs else None)
+
+
+def _owner(kind: str) -> str:
+    """How the refusals name the mesh file whose resources they are ("glTF" for GLB too)."""
+    return "glTF" if kind in ("GLTF", "GLB") else kind
 
 
 def _file_uvs(geometry: trimesh.Trimesh) -> np.ndarray | None:
@@ -269,12 +315,9 @@ def _first(bad: np.ndarray, rows: np.ndarray) -> tuple[int, str]:
     return i, ", ".join(show_number(x) for x in rows[i])
 
 
-def _check_obj_face_indices(path: Path) -> None:
+def _check_obj_face_indices(data: bytes) -> None:
     """Check every `f` line's vertex indices lie in 1..V or -V..-1 (OBJ counts from 1)."""
-    try:
-        lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError as exc:
-        raise _MeshProblem(f"could not be read: {exc.strerror or exc}")
+    lines = data.decode("utf-8", errors="replace").splitlines()
     statements = [line.split() for line in lines]
     vertex_count = sum(1 for fields in statements if fields and fields[0] == "v")
     for number, fields in enumerate(statements, start=1):
@@ -293,15 +336,10 @@ def _check_obj_face_indices(path: Path) -> None:
                     f"or -1 to -{vertex_count} counting back)")
 
 
-def _check_ascii_ply_face_indices(path: Path) -> None:
+def _check_ascii_ply_face_indices(data: bytes) -> None:
     """Check an ASCII PLY's face indices as written, in Python integers: trimesh narrows them
     to the header's type first (an index of 2**31 + 10 would come out as -2147483648).
     Binary PLY cannot hold a value its type does not; trimesh reads those as they are."""
-    try:
-        with open(path, "rb") as handle:
-            data = handle.read()
-    except OSError as exc:
-        raise _MeshProblem(f"could not be read: {exc.strerror or exc}")
     end = data.find(b"end_header")
     if end < 0:
         return                                       # trimesh says what is wrong

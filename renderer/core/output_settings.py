@@ -29,6 +29,13 @@ DITHERS = ("none", *ORDERED, "blue-noise", *ERROR_DIFFUSION)
 # classic screen angles, in degrees, added to the user's angle: C 15, M 75, Y 0, K 45.
 INK_ANGLES = {"c": 15.0, "m": 75.0, "y": 0.0, "k": 45.0}
 MIN_CELL = 2.0                             # pixels: a smaller cell has no room for a spot
+# pixels: a cell of 256 is a dot per 256 x 256 pixels, already coarser than any print
+# screen (newsprint's 85 lines an inch is a 3.5-pixel cell at 300 dpi); a larger one is a
+# typo, and one of 1e300 is not even a float32, the GPU screen's arithmetic.
+MAX_CELL = 256.0
+# degrees: a screen turned by a + 360 is the screen turned by a, so one turn either way
+# says every angle; far larger values lose precision in the turn's sine and cosine.
+ANGLE_RANGE = (-360.0, 360.0)
 
 # Files the stage writes: 8- or 16-bit PNG (integer codes), float32 OpenEXR or NumPy (the
 # encoded colour unquantised). The suffix of the output name names the format by default.
@@ -165,7 +172,8 @@ def parse_bits(text: str) -> int:
 
 
 def parse_halftone(text: str) -> Halftone:
-    """'CELL' or 'CELL:ANGLE': a cell at least MIN_CELL pixels wide, an angle in degrees."""
+    """'CELL' or 'CELL:ANGLE': a cell MIN_CELL to MAX_CELL pixels wide, an angle in degrees
+    within ANGLE_RANGE."""
     cell_text, _, angle_text = text.partition(":")
     try:
         cell = float(cell_text)
@@ -174,6 +182,10 @@ def parse_halftone(text: str) -> Halftone:
         raise ValueError("write CELL or CELL:ANGLE, e.g. 6 or 6:15") from None
     if not (math.isfinite(cell) and cell >= MIN_CELL):
         raise ValueError(f"the cell must be at least {MIN_CELL:g} pixels wide, got {cell_text}")
-    if not math.isfinite(angle):
-        raise ValueError(f"the angle must be a finite number of degrees, got {angle_text}")
+    if cell > MAX_CELL:
+        raise ValueError(f"the cell must be {MIN_CELL:g} to {MAX_CELL:g} pixels wide, got "
+                         f"{cell_text}")
+    low, high = ANGLE_RANGE
+    if not (math.isfinite(angle) and low <= angle <= high):
+        raise ValueError(f"the angle must be {low:g} to {high:g} degrees, got {angle_text}")
     return Halftone(cell, angle)

@@ -34,6 +34,7 @@ from renderer.errors import SceneError, UserError, show_number
 from renderer.core import memory
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
 from renderer.core.paths import checked_path
+from renderer.core.user_files import SCENE_FILE, USER_FILE_CAPS, FileRefused, read_user_file
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core import shapes
@@ -142,19 +143,17 @@ def read_scene(scene) -> tuple[dict, Path]:
 
 def read_toml(path: Path, what: str = "scene file", error: type[UserError] = SceneError) -> dict:
     """A TOML file's parsed tables; each way of failing is one `error` line naming the file
-    (not found, a folder, not UTF-8, unreadable, a syntax error, nested too deeply). `what`
-    names the kind of file in the reasons ("scene file", "job file")."""
+    (not found, not a regular file, over its size cap, not UTF-8, unreadable, a syntax error,
+    nested too deeply: renderer/core/user_files.py reads it). `what` names the kind of file
+    in the reasons ("scene file", "job file"), and is its kind for the size cap."""
+    kind = what if what in USER_FILE_CAPS else SCENE_FILE
     source = str(path)
     try:
-        return tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except FileNotFoundError:
-        raise error(f"{what} not found", file=source) from None
-    except IsADirectoryError:
-        raise error(f"is a directory, not a {what}", file=source) from None
+        return tomllib.loads(read_user_file(path, kind).decode("utf-8-sig"))
+    except FileRefused as refused:
+        raise error(refused.reason, file=source) from None
     except UnicodeDecodeError as exc:
         raise error(f"not UTF-8 text (byte {exc.start}); a {what} is TOML", file=source) from None
-    except OSError as exc:
-        raise error(f"cannot read: {exc.strerror or exc}", file=source) from None
     except tomllib.TOMLDecodeError as exc:
         raise error(_toml_syntax_reason(exc), file=source) from None
     except RecursionError:               # tomllib recurses once per level of nesting

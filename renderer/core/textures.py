@@ -19,13 +19,13 @@ neither makes a level of its own. Conventions (docs/conventions.md, "Texture coo
 
 from __future__ import annotations
 
-import io
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from renderer.core import gl_rules, memory
+from renderer.core import gl_rules
+from renderer.core.user_files import IMAGE_FILE, FileRefused, open_image, read_user_file
 from renderer.errors import SceneError
 
 WRAPS = ("repeat", "clamp", "mirror")      # GL_REPEAT, GL_CLAMP_TO_EDGE, GL_MIRRORED_REPEAT
@@ -235,12 +235,10 @@ def load_texture(path, colorspace: str = "srgb", *, source: str | None = None,
     8-bit images are read as c / 255 per channel (greyscale and palettes expanded to RGB);
     16-bit greyscale as c / 65535; alpha is dropped."""
     path = Path(path)
-    if not path.exists():
-        _image_problem("image file not found", path, source, key)
-    if not path.is_file():
-        _image_problem("is not a file", path, source, key)
-    with open(path, "rb") as handle:
-        data = handle.read()
+    try:
+        data = read_user_file(path, IMAGE_FILE)
+    except FileRefused as refused:
+        _image_problem(refused.reason, path, source, key)
     return texture_from_bytes(data, str(path), colorspace, source=source, key=key)
 
 
@@ -248,28 +246,21 @@ def texture_from_bytes(data: bytes, name: str, colorspace: str = "srgb", *, tint
                        source: str | None = None, key: str | None = None) -> Texture:
     """An encoded image (PNG or JPEG bytes) as a Texture named `name`, with load_texture's
     checks and errors (`name` stands for the file in them)."""
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image
 
     if len(data) == 0:
         _image_problem("image is empty (0 bytes)", name, source, key)
     try:
-        with Image.open(io.BytesIO(data)) as image:
-            width, height = image.size
-            if width == 0 or height == 0:
-                _image_problem(f"image has no texels ({width} x {height})", name, source, key)
-            largest = gl_rules.GL_MIN_MAX_TEXTURE_SIZE
-            if max(width, height) > largest:
-                _image_problem(f"image is {width} x {height}; a texture is at most {largest} "
-                               f"texels on a side (GL_MAX_TEXTURE_SIZE)", name, source, key)
-            too_much = memory.over_limit(width * height * TEXTURE_BYTES_PER_TEXEL)
-            if too_much:
-                _image_problem(f"a {width} x {height} texture {too_much}", name, source, key)
+        # the header's size checked (a side, the memory limit) before anything is decoded;
+        # Pillow's own bomb check, which refuses sides a texture may have, is replaced
+        with open_image(data, max_side=gl_rules.GL_MIN_MAX_TEXTURE_SIZE,
+                        bytes_per_pixel=TEXTURE_BYTES_PER_TEXEL, what="texture",
+                        side="texels on a side (GL_MAX_TEXTURE_SIZE)") as image:
             image.load()
             codes, largest_code = _codes(image)
-    except UnidentifiedImageError:
-        _image_problem("could not be read as an image: not a format Pillow knows (PNG, JPEG)",
-                       name, source, key)
-    except (OSError, SyntaxError, ValueError, Image.DecompressionBombError) as exc:
+    except FileRefused as refused:
+        _image_problem(refused.reason, name, source, key)
+    except (OSError, SyntaxError, ValueError, EOFError, Image.DecompressionBombError) as exc:
         reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
         _image_problem(f"could not be read as an image (PNG or JPEG): {reason}", name, source, key)
     # Decoded through a table of every code's value (the same formula, once per code).

@@ -5,6 +5,9 @@ anything is allocated.
     .venv/bin/python benchmarks/bench_memory.py            # sizes up to 2048x2048 (a minute or two)
     .venv/bin/python benchmarks/bench_memory.py --full     # and 4096x4096
 
+"gpu rt" and "reference rt" rows: a 488,600-triangle mesh ray traced at 64x64 (the estimate:
+renderer/core/memory.py's raytrace_*_bytes).
+
 Each case runs in a new process; the figure is its peak resident memory (ru_maxrss) above
 what the process held after importing and building the scene, so that the baseline of
 Python, NumPy and the scene is left out; the estimate is the same difference.
@@ -22,7 +25,9 @@ CHILD = r"""
 import json, resource, sys, warnings
 warnings.simplefilter("ignore")
 backend, width, height, segments = sys.argv[1], int(sys.argv[2]), int(sys.argv[3]), int(sys.argv[4])
+method = sys.argv[5] if len(sys.argv) > 5 else "raster"
 import reference.pipeline, renderer.gpu.pipeline     # open_renderer's backends, loaded before the baseline
+import reference.raytrace.pipeline, renderer.gpu.raytracer
 from renderer.core import memory
 from renderer.core.scene_file import scene_from_dict
 from renderer.methods import open_renderer
@@ -33,22 +38,20 @@ scene = scene_from_dict({
                  "mesh": {"primitive": "uv_sphere", "segments": segments, "rings": segments // 2}}]})
 triangles = sum(o.mesh.triangle_count for o in scene.objects)
 before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-if backend == "gpu":
-    with open_renderer(scene, (width, height), context_kind="egl") as gpu:
-        frame = gpu.render(depth=True)
-    estimate = memory.gpu_bytes(width, height, triangles)
-else:
-    frame = open_renderer(scene, (width, height), backend="reference").render()
-    estimate = memory.reference_bytes(width, height, triangles)
+with open_renderer(scene, (width, height), method=method, backend=backend, context_kind="egl") as r:
+    frame = r.render(depth=True)
+estimate = {("raster", "gpu"): memory.gpu_bytes, ("raster", "reference"): memory.reference_bytes,
+            ("raytrace", "gpu"): memory.raytrace_gpu_bytes,
+            ("raytrace", "reference"): memory.raytrace_reference_bytes}[method, backend](width, height, triangles)
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
 print(json.dumps({"triangles": triangles, "measured": peak - before, "estimate": estimate}))
 """
 
 
-def measure(backend: str, width: int, height: int, segments: int) -> dict:
+def measure(backend: str, width: int, height: int, segments: int, method: str = "raster") -> dict:
     start = time.perf_counter()
     result = subprocess.run([sys.executable, "-c", CHILD, backend, str(width), str(height),
-                             str(segments)], capture_output=True, text=True, check=True)
+                             str(segments), method], capture_output=True, text=True, check=True)
     return json.loads(result.stdout.splitlines()[-1]) | {"seconds": time.perf_counter() - start}
 
 
@@ -72,11 +75,14 @@ def main() -> None:
     sizes = [256, 1024, 2048] + ([4096] if args.full else [])
     print(f"{'backend':10} {'size':>11} {'triangles':>10} {'measured MiB':>13} {'estimate MiB':>13} "
           f"{'estimate/measured':>18} {'s':>6}")
-    cases = [(b, s, 8) for b in ("gpu", "reference") for s in sizes]
-    cases += [(b, 256, segments) for b in ("gpu", "reference") for segments in (256, 1024)]
-    for backend, size, segments in cases:
-        r = measure(backend, size, size, segments)
-        print(f"{backend:10} {f'{size}x{size}':>11} {r['triangles']:>10,} {r['measured'] / mib:>13.0f} "
+    cases = [(b, s, 8, "raster") for b in ("gpu", "reference") for s in sizes]
+    cases += [(b, 256, segments, "raster") for b in ("gpu", "reference") for segments in (256, 1024)]
+    # A large mesh ray traced (ray_scene, the BVH and its build, the GPU's float textures).
+    cases += [(b, 64, 700, "raytrace") for b in ("gpu", "reference")]
+    for backend, size, segments, method in cases:
+        r = measure(backend, size, size, segments, method)
+        name = backend if method == "raster" else f"{backend} rt"
+        print(f"{name:10} {f'{size}x{size}':>11} {r['triangles']:>10,} {r['measured'] / mib:>13.0f} "
               f"{r['estimate'] / mib:>13.0f} {r['estimate'] / max(r['measured'], 1):>18.2f} "
               f"{r['seconds']:>6.1f}")
     r = refusal(16384, 16384, "1G")

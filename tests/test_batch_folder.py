@@ -227,6 +227,41 @@ def test_a_record_naming_a_file_outside_out_or_not_a_file_is_dropped_unread(
     assert files(outside) == {"victim.txt"} and (outside / "victim.txt").read_text() == CANARY
 
 
+@pytest.mark.parametrize("key", [["a"], {"k": 1}, 5, None])
+def test_a_record_whose_key_is_not_a_string_is_dropped(key, job_file, finished, tmp_path,
+                                                       monkeypatch):
+    """Found by tests/test_fuzz.py (gen_manifests): a record's key of a list was looked up in a
+    dict, a TypeError traceback. Such a record counts for nothing; its item is rendered again."""
+    out = copy(finished, tmp_path)
+    header, *lines_ = (out / MANIFEST).read_text().splitlines()
+    record = json.loads(lines_[0])
+    record["key"] = key
+    (out / MANIFEST).write_text("\n".join([header, json.dumps(record), *lines_[1:]]) + "\n")
+    status, said = batch_here(job_file, out, monkeypatch)
+    assert status == 0, said
+    assert any(line.startswith("renderer batch: 2 items: 1 rendered, 1 already complete, 0 failed")
+               for line in said), said
+    assert set(records(out)) == set(KEYS)
+
+
+@pytest.mark.parametrize("line", ['{"render_ms": NaN}', '{"render_ms": -Infinity}',
+                                  '{"render_ms": ' + "[" * 100_000 + "]" * 100_000 + "}"])
+def test_a_record_that_is_not_json_as_written_is_dropped(line, job_file, finished, tmp_path,
+                                                         monkeypatch):
+    """Found by tests/test_fuzz.py (gen_manifests): a record holding NaN (Python's parser takes
+    it) was kept, and rewriting the manifest for another dropped record raised ValueError
+    (to_json writes no NaN), a traceback. Deep nesting raised RecursionError."""
+    out = copy(finished, tmp_path)
+    header, first, second = (out / MANIFEST).read_text().splitlines()
+    first = first[:-1] + ", " + line[1:]                    # the record, with one key more
+    (out / MANIFEST).write_text("\n".join([header, first, second, "{cut"]) + "\n")
+    status, said = batch_here(job_file, out, monkeypatch)
+    assert status == 0, said
+    assert any(line.startswith("renderer batch: 2 items: 1 rendered, 1 already complete, 0 failed")
+               for line in said), said
+    assert set(records(out)) == set(KEYS)
+
+
 @pytest.mark.parametrize("kind", ["fifo", "link"])
 def test_a_manifest_that_is_not_a_regular_file_is_refused_unread(kind, job_file, outside,
                                                                  tmp_path, monkeypatch):
@@ -258,6 +293,28 @@ def test_a_second_driver_is_refused_naming_the_first(job_file, tmp_path, monkeyp
         f"{os.getpid()} on {holder['host']}, since {started}); wait for it to end, or give "
         f"another --out"])
     assert not out.exists()                           # made for the lock, removed with it
+
+
+@pytest.mark.parametrize("kind", ["folder", "socket", "fifo"])
+def test_a_lock_file_that_is_not_a_regular_file_is_the_users_one_line(kind, job_file, tmp_path,
+                                                                       monkeypatch):
+    """Found by tests/test_fuzz.py (gen_manifests): a folder or a socket where the lock file
+    goes was a system failure (status 1, "cannot make the lock file ...: is a directory"),
+    a FIFO the user's (status 2): each is something in the user's folder, status 2."""
+    import socket
+    out = tmp_path / "out"
+    out.mkdir()
+    if kind == "folder":
+        (out / LOCK_NAME).mkdir()
+    elif kind == "fifo":
+        os.mkfifo(out / LOCK_NAME)
+    else:
+        with socket.socket(socket.AF_UNIX) as sock:
+            sock.bind(str(out / LOCK_NAME))
+    status, said = batch_here(job_file, out, monkeypatch)
+    assert (status, said) == (2, [f"renderer: {out}: {LOCK_NAME} is not a regular file; "
+                                  f"remove it"])
+    assert files(out) == {LOCK_NAME}
 
 
 def test_the_lock_goes_when_a_driver_fails(job_file, finished, tmp_path, monkeypatch):

@@ -75,7 +75,8 @@ MISTAKES = {
     "size": ('size = [0, 10]\n' + SPHERE, "size[0]: must be >= 1, got 0"),
     "too many items": (SPHERE + '[scenes.sweep]\n' + "".join(
         f'"camera.fov_y{i}" = [{", ".join(["30"] * 100)}]\n' for i in range(4)),
-        "scenes[0].sweep: 100,000,000 sweep points; a job has at most 1,000,000 items"),
+        "scenes[0].sweep: 100,000,000 sweep points; a job has at most 10,000 (each is a "
+        "scene, built and checked before the first frame)"),
 }
 
 

@@ -5,7 +5,8 @@ a scene file and mesh files written into a fresh folder and a command line, run 
 through `renderer.cli.main(argv)`. What must hold for every case (`check_outcome`):
 
 - exit 0: every requested output complete (the image opens with Pillow and has the size, the
-  depth .npy loads with the shape, compare's/shaders' folders hold their files), nothing else
+  depth .npy loads with the shape, compare's/shaders'/colour's folders hold their files, a
+  batch's manifest a record for each item with its files whole), nothing else
   written anywhere in the case's folder; stderr only "renderer: warning: ..." and "wrote ..."
   lines; a default-named output is one image directly in the working folder, never a name
   taken from the scene's `name`;
@@ -16,7 +17,12 @@ through `renderer.cli.main(argv)`. What must hold for every case (`check_outcome
   a Python warning (in a real process it is two lines on stderr), "Traceback" anywhere, more
   than RUNAWAY_SECONDS or RUNAWAY_BYTES of address space over what the process had.
 
-Every class of issue 13 is a generator in CLASSES (`make_case` picks one per seed).
+Every class of issue 13 is a generator in CLASSES (`make_case` picks one per seed), and since
+issue 30 the files a user names besides scenes and meshes: textures and `renderer colour`'s
+images (declared sizes, bombs, cut-short and corrupt streams, .npy headers), glTF JSON and its
+URIs, job files and tampered `renderer batch` folders (run in this process, without Ray),
+special files (FIFO, folder, socket, /dev/zero, links) where a file is expected. No output
+may quote CANARY, which such cases leave in the files they must not read.
 The generated cases are the full run's (--all, what CI runs): the default run holds each class
 by its hand-written cases (docs/bad-input.md names their files) and this checker by its own
 tests below, in under a second instead of the cases' 4 s.
@@ -91,6 +97,11 @@ class Case:
     unreadable: list[str] = field(default_factory=list)       # folders chmod 000
     cwd: str = "w"                              # relative working folder (made)
     name_class: bool = False                    # a scene `name` case: exit 2 only if it names `name`
+    # relative path -> "fifo", "dir", "socket", "dangling link", "link:fifo" or "link:TARGET"
+    # (TARGET relative to the case's folder, or absolute): made by `materialise`
+    specials: dict[str, str] = field(default_factory=dict)
+    finished: str | None = None                 # a finished batch of MANIFEST_JOB copied here
+    tamper: list = field(default_factory=list)  # then these changes (gen_manifests) made to it
 
     def describe(self) -> str:
         lines = [f"seed {self.seed}: {self.kind}", f"argv: {self.argv!r}", f"cwd: {self.cwd}"]
@@ -98,6 +109,8 @@ class Case:
             shown = data[:600]
             more = f" ... ({len(data)} bytes)" if len(data) > 600 else ""
             lines.append(f"--- {path}:\n{shown!r}{more}")
+        if self.specials or self.finished:
+            lines.append(f"specials: {self.specials} finished: {self.finished} tamper: {self.tamper}")
         if self.dirs or self.unreadable:
             lines.append(f"dirs: {self.dirs} unreadable: {self.unreadable}")
         return "\n".join(lines)
@@ -668,6 +681,386 @@ OUTPUT_OPTION_VALUES = (      # taken or refused; a taken one writes a PNG (_che
 )
 
 
+# ---- issue 30: files a user names (textures, glTF resources, job files, manifests, special files)
+
+CANARY = "canary-30f2: the contents of another file"    # no error line may ever quote it
+SPECIAL_KINDS = ("fifo", "dir", "socket", "/dev/zero", "link:/dev/zero", "link:fifo",
+                 "dangling link", "link to the real file")
+
+
+def png_bytes(rng: random.Random, size=None, mode=None) -> bytes:
+    """A small, valid PNG (Pillow, deterministic for a seed)."""
+    from PIL import Image
+    mode = mode or rng.choice(("RGB", "RGBA", "L", "LA", "P", "I;16", "1"))
+    w, h = size or (rng.randint(1, 9), rng.randint(1, 9))
+    image = Image.new(mode, (w, h))
+    image.putdata([rng.randrange(2 if mode == "1" else 65536 if mode == "I;16" else 256)
+                   if mode in ("L", "P", "I;16", "1") else
+                   tuple(rng.randrange(256) for _ in mode)
+                   for _ in range(w * h)])
+    out = io.BytesIO()
+    image.save(out, "PNG")
+    return out.getvalue()
+
+
+def jpeg_bytes(rng: random.Random, size=None) -> bytes:
+    from PIL import Image
+    w, h = size or (rng.randint(1, 16), rng.randint(1, 16))
+    image = Image.new(rng.choice(("RGB", "L")), (w, h), rng.randrange(256))
+    out = io.BytesIO()
+    image.save(out, "JPEG", quality=rng.choice((10, 90)), progressive=rng.random() < 0.3)
+    return out.getvalue()
+
+
+def _png_chunk(kind: bytes, data: bytes) -> bytes:
+    import zlib
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+
+def png_declaring(width: int, height: int, *, depth=8, colour=2, rows=2, crc=True) -> bytes:
+    """A PNG whose IHDR declares width x height and whose IDAT holds only `rows` rows (of
+    zeros, compressed): a decompression bomb when the rows are all there, a lie when not."""
+    import zlib
+    ihdr = struct.pack(">IIBBBBB", width & 0xFFFFFFFF, height & 0xFFFFFFFF, depth, colour, 0, 0, 0)
+    head = _png_chunk(b"IHDR", ihdr)
+    if not crc:
+        head = head[:-4] + b"\0\0\0\0"
+    channels = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}.get(colour, 3)
+    row = 1 + (width * channels * depth + 7) // 8
+    body = zlib.compress(b"\0" * min(row * rows, 1 << 22), 9)
+    return b"\x89PNG\r\n\x1a\n" + head + _png_chunk(b"IDAT", body) + _png_chunk(b"IEND", b"")
+
+
+def jpeg_declaring(rng: random.Random, width: int, height: int) -> bytes:
+    """A valid small JPEG with its frame header's (SOF) size changed."""
+    data = bytearray(jpeg_bytes(rng, (8, 8)))
+    for marker in (b"\xff\xc0", b"\xff\xc2"):
+        at = data.find(marker)
+        if at >= 0:
+            data[at + 5:at + 9] = struct.pack(">HH", height & 0xFFFF, width & 0xFFFF)
+    return bytes(data)
+
+
+def npy_declaring(shape, dtype="<f4", body=b"", fortran=False) -> bytes:
+    header = repr({"descr": dtype, "fortran_order": fortran, "shape": tuple(shape)}).encode()
+    header += b" " * (63 - (len(header) + 10) % 64) + b"\n"
+    return b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header + body
+
+
+def _image_for(rng: random.Random, what: str, suffix: str) -> bytes:
+    return bad_image(rng, suffix, what)[1]
+
+
+def bad_image(rng: random.Random, suffix: str = ".png", what: str | None = None) -> tuple[str, bytes]:
+    """(what, bytes) of an image that lies, bombs, is cut short or corrupt, or is fine."""
+    what = what or rng.choice(("valid", "valid", "declares 50000x50000", "declares 65000x65000 jpeg",
+                       "declares 20000x4", "declares 16384x16384", "declares 0x0",
+                       "declares 2^31 wide", "1-bit bomb 50000x50000", "grey bomb 3000x3000",
+                       "grey 1200x1200 (fits)", "bad IHDR CRC", "rows missing", "truncated",
+                       "bytes mutated", "empty", "text", "16-bit depth 1 colour 3 lie",
+                       "bad colour type"))
+    valid = jpeg_bytes(rng) if suffix == ".jpg" else png_bytes(rng)
+    data = {
+        "valid": lambda: valid,
+        "declares 50000x50000": lambda: png_declaring(50000, 50000),
+        "declares 65000x65000 jpeg": lambda: jpeg_declaring(rng, 65000, 65000),
+        "declares 20000x4": lambda: png_declaring(20000, 4, rows=4),
+        "declares 16384x16384": lambda: png_declaring(16384, 16384, depth=16, colour=6),
+        "declares 0x0": lambda: png_declaring(0, 0),
+        "declares 2^31 wide": lambda: png_declaring(1 << 31, 1),
+        "1-bit bomb 50000x50000": lambda: png_declaring(50000, 50000, depth=1, colour=0, rows=50),
+        "grey bomb 3000x3000": lambda: png_declaring(3000, 3000, colour=0, rows=3000),
+        "grey 1200x1200 (fits)": lambda: png_declaring(1200, 1200, colour=0, rows=1200),
+        "bad IHDR CRC": lambda: png_declaring(8, 8, crc=False, rows=8),
+        "rows missing": lambda: png_declaring(64, 64, rows=3),
+        "truncated": lambda: valid[:rng.randrange(max(1, len(valid)))],
+        "bytes mutated": lambda: mutate_bytes(rng, valid),
+        "empty": lambda: b"",
+        "text": lambda: b"not an image at all\n" + CANARY.encode(),
+        "16-bit depth 1 colour 3 lie": lambda: png_declaring(8, 8, depth=16, colour=3, rows=8),
+        "bad colour type": lambda: png_declaring(8, 8, colour=5, rows=8),
+    }[what]()
+    return what, data
+
+
+COLOUR_REFUSES = ("declares 50000x50000", "declares 65000x65000 jpeg", "declares 0x0",
+                  "declares 2^31 wide", "1-bit bomb 50000x50000", "grey bomb 3000x3000",
+                  "truncated", "empty", "text", "bad IHDR CRC")
+
+
+def _special(rng: random.Random, real: str) -> str:
+    """A kind from SPECIAL_KINDS (`real`: the relative path of a real file for the link)."""
+    kind = rng.choice(SPECIAL_KINDS)
+    return f"link:{real}" if kind == "link to the real file" else kind
+
+
+def textured_scene(image: str, rng: random.Random) -> dict:
+    texture = {"image": image}
+    if rng.random() < 0.3:
+        texture["colorspace"] = rng.choice(("linear", "srgb"))
+    if rng.random() < 0.3:
+        texture["filter"] = rng.choice(("nearest", "bilinear", "trilinear"))
+    mesh = rng.choice(({"primitive": "uv_sphere", "segments": 8, "rings": 4},
+                       {"primitive": "cube"}, {"primitive": "plane"}))
+    return small_scene([{"name": "a", "mesh": mesh, "material": "t"}],
+                       materials={"t": {"texture": texture}})
+
+
+def gen_textures(rng, seed) -> Case:
+    """A texture image (a scene's material) or `renderer colour`'s input that lies about its
+    size, is a bomb, is cut short or corrupt; now and then a special file."""
+    suffix = rng.choice((".png", ".png", ".jpg"))
+    what, data = bad_image(rng, suffix)
+    files = {"s/t" + suffix: data, "outside/secret.txt": CANARY.encode()}
+    specials = {}
+    path = "t" + suffix
+    if rng.random() < 0.15:
+        kind = _special(rng, "s/t" + suffix)
+        what = f"special: {kind}"
+        if kind == "/dev/zero":
+            path = kind
+        else:
+            path = "sp" + suffix
+            specials["s/sp" + suffix] = kind
+    if rng.random() < 0.2:
+        # renderer colour's image: one it refuses (a colour report takes 2-3 s to write; the
+        # hand-written tests, test_colour_command.py, have those)
+        if what not in COLOUR_REFUSES:
+            what = rng.choice(COLOUR_REFUSES)
+            files["s/t" + suffix] = _image_for(rng, what, suffix)
+        if rng.random() < 0.3:
+            path = "a.npy"
+            what, files["s/a.npy"] = rng.choice((
+                ("npy declares 50000x50000x4", npy_declaring((50000, 50000, 4))),
+                ("npy declares (2^40, 1, 3)", npy_declaring((1 << 40, 1, 3))),
+                ("npy object dtype", npy_declaring((2, 2, 3), "|O"))
+                if rng.random() < 0.5 else ("npy 4x4x3 cut short", npy_declaring((4, 4, 3), body=b"\0" * 20)),
+                ("npy bytes mutated", mutate_bytes(rng, npy_declaring((50000, 50000, 4)))),
+                ))
+        argv = ["colour", path if path.startswith("/") else "{D}/s/" + path, "--out", "{D}/w/col",
+                "--backend", "reference"]
+        return Case(seed, f"colour image: {what} ({path})", argv, files, specials=specials)
+    return scene_case(rng, seed, f"texture {path}: {what}", textured_scene(path, rng), files,
+                      specials=specials)
+
+
+def gltf_document(rng: random.Random, image_uri=None, buffer_uri=None) -> dict:
+    """A one-triangle glTF with TEXCOORD_0 and a base-colour texture, its buffer a data: URI
+    (or `buffer_uri`), its image `image_uri` (default a file beside it, t.png)."""
+    import base64
+    positions = struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, 1, 0)
+    uvs = struct.pack("<6f", 0, 0, 1, 0, 0, 1)
+    blob = positions + uvs
+    buffer = {"byteLength": len(blob),
+              "uri": buffer_uri or "data:application/octet-stream;base64,"
+              + base64.b64encode(blob).decode()}
+    return {
+        "asset": {"version": "2.0"},
+        "scene": 0, "scenes": [{"nodes": [0]}], "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "TEXCOORD_0": 1},
+                                    "material": 0}]}],
+        "materials": [{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0},
+                                                "baseColorFactor": [1, 1, 1, 1]}}],
+        "textures": [{"source": 0, "sampler": 0}],
+        "samplers": [{"wrapS": 10497, "wrapT": 10497}],
+        "images": [{"uri": image_uri or "t.png"}],
+        "buffers": [buffer],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 36},
+                        {"buffer": 0, "byteOffset": 36, "byteLength": 24}],
+        "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+                       "min": [0, 0, 0], "max": [1, 1, 0]},
+                      {"bufferView": 1, "componentType": 5126, "count": 3, "type": "VEC2"}],
+    }
+
+
+ODD_URIS = ("t.png", "t%2Epng", "./t.png", "sub/../t.png", "../outside/secret.txt",
+            "%2e%2e/outside/secret.txt", "..%2Foutside%2Fsecret.txt", "{D}/s/model/t.png",
+            "/etc/passwd", "/dev/zero", "file:///etc/passwd", "http://example.invalid/t.png",
+            "sp.png", "t.png\0x", "", ".", "..", "sub", "x" * 300 + ".png",
+            "data:image/png;base64,", "data:", "data:image/png;base64,!!!",
+            "data:image/png,plain", "%ZZ", "link_out.png", "t%20space.png", "C:\\t.png")
+
+
+def gen_gltf(rng, seed) -> Case:
+    """A .gltf mesh file with odd or escaping image and buffer URIs, data: URIs, missing
+    buffers and mutated JSON."""
+    import base64
+    import json
+    image = png_bytes(rng, mode="RGB")
+    doc = gltf_document(rng)
+    what = rng.choice(("image uri", "image uri", "buffer uri", "data: image", "missing buffer",
+                       "mutated", "mutated", "valid", "image special"))
+    specials = {"s/model/link_out.png": "link:outside/secret.txt"}
+    if what == "image uri":
+        uri = rng.choice(ODD_URIS)
+        doc["images"][0]["uri"] = uri
+        what = f"image uri {uri[:40]!r}"
+    elif what == "buffer uri":
+        uri = rng.choice(ODD_URIS + ("b.bin",))
+        doc["buffers"][0]["uri"] = uri
+        what = f"buffer uri {uri[:40]!r}"
+    elif what == "data: image":
+        kind, data = bad_image(rng)
+        doc["images"][0]["uri"] = "data:image/png;base64," + base64.b64encode(data).decode()
+        what = f"data: image ({kind})"
+    elif what == "missing buffer":
+        op = rng.randrange(4)
+        if op == 0:
+            del doc["buffers"]
+        elif op == 1:
+            doc["bufferViews"][rng.randrange(2)]["buffer"] = rng.choice((1, -1, 2 ** 40, "0"))
+        elif op == 2:
+            doc["bufferViews"][1]["byteLength"] = rng.choice((1 << 40, 0, -1, 10 ** 30))
+        else:
+            doc["images"][0] = {"bufferView": rng.choice((5, 0, 1)), "mimeType": "image/png"}
+        what = f"missing buffer ({op})"
+    elif what == "mutated":
+        doc = mutate_scene(rng, doc)
+    elif what == "image special":
+        kind = _special(rng, "s/model/t.png")
+        doc["images"][0]["uri"] = kind if kind == "/dev/zero" else "sp.png"
+        if kind != "/dev/zero":
+            specials["s/model/sp.png"] = kind
+        what = f"image special {kind}"
+    text = json.dumps(doc).replace("{D}", "@D@").encode()
+    files = {"s/model/m.gltf": text, "s/model/t.png": image, "s/model/t space.png": image,
+             "s/model/b.bin": base64.b64decode(gltf_document(rng)["buffers"][0]["uri"].split(",")[1]),
+             "s/model/sub/k": b"", "s/outside/secret.txt": CANARY.encode(),
+             "outside/secret.txt": CANARY.encode()}
+    data = small_scene([{"name": "a", "mesh": {"file": "model/m.gltf"}}])
+    return scene_case(rng, seed, f"glTF: {what}", data, files, specials=specials)
+
+
+def job_document(rng: random.Random, scene: str = "sphere") -> dict:
+    """A small job (one or two items) of docs/batch-format.md, for `renderer batch`."""
+    entry = {"scene": scene}
+    r = rng.random()
+    if r < 0.3:
+        entry["cameras"] = {"orbit": {"views": rng.choice((1, 2)),
+                                      **({"elevation": 20.0} if rng.random() < 0.3 else {})}}
+    elif r < 0.5:
+        entry["cameras"] = {"poses": [{"eye": [0.0, 1.0, 4.0], "look": [0.0, 0.0, 0.0]}]}
+    elif r < 0.55:
+        entry["cameras"] = {"animation": {"frames": 1, "step": 0.5}}
+    if rng.random() < 0.3:
+        entry["sweep"] = rng.choice(({"camera.fov_y": [30.0, 50.0]},
+                                     {"objects[0].material.kd": [[0.8, 0.2, 0.2]]},
+                                     {"camera.eye": [[0.0, 0.0, 4.0]]}))
+    setting = rng.choice(({"name": "raster"}, {"method": "raster", "shading": "flat"},
+                          {"name": "rt", "method": "raytrace", "samples": 1, "max_depth": 1}))
+    if rng.random() < 0.4:
+        setting["outputs"] = rng.choice((
+            [{"format": "png8", "transfer": "srgb"}],
+            [{"format": "png16", "bits": 12, "dither": "bayer4"}, {"depth": "npy"}],
+            [{"format": "npy", "name": "c.npy"}],
+            [{"format": "png8", "halftone": "6:15", "name": "h.png"}]))
+    job = {"seed": rng.choice((0, 5, (1 << 64) - 1)), "size": [8, 6], "scenes": [entry],
+           "settings": [setting]}
+    if rng.random() < 0.3:
+        job["name"] = rng.choice(("j", "", "../x", "a\nb", "x" * 300))
+    return job
+
+
+def batch_argv(job: str = "{D}/s/job.toml", out: str = "{D}/w/out") -> list[str]:
+    return ["batch", job, "--out", out, "--context", "egl"]
+
+
+def gen_job_files(rng, seed) -> Case:
+    """A job file for `renderer batch`: small and valid, or with random keys and values in
+    its scenes, cameras, sweeps and settings."""
+    scene = rng.choice(("sphere", "sphere", "scene.toml", "hierarchy", "nosuch", "../s/scene.toml"))
+    job = job_document(rng, scene)
+    what = "valid"
+    if rng.random() < 0.7:
+        job = mutate_scene(rng, job)
+        what = "mutated"
+    files = {"s/job.toml": toml_document(job), "s/scene.toml": toml_document(small_scene())}
+    return Case(seed, f"job file ({what}, scene {scene})", batch_argv(), files)
+
+
+MANIFEST_JOB = toml_document({"seed": 5, "size": [8, 6],
+                              "scenes": [{"scene": "sphere", "cameras": {"orbit": {"views": 2}}}],
+                              "settings": [{"name": "raster"}]})
+RECORD_PATHS = ("../../outside/victim.txt", "{D}/outside/victim.txt", "/etc/shadow", "/dev/zero",
+                "items/fifo", "items/link", "items/dir", "", "items", ".", "items/./x",
+                "items//a", "items/../manifest.jsonl", "manifest.jsonl", "x\0y", 5, None,
+                ["items"], "items/sock")
+
+
+def gen_manifests(rng, seed) -> Case:
+    """`renderer batch` resuming a finished --out whose manifest (or folder) is tampered with."""
+    ops = []
+    for _ in range(rng.randint(1, 2)):
+        op = rng.choice(("record path", "record path", "sha", "truncate", "bytes", "header",
+                         "record", "delete file", "manifest special", "lock special",
+                         "items link", "long line", "stray"))
+        if op == "record path":
+            ops.append((op, rng.randrange(2), rng.choice(RECORD_PATHS)))
+        elif op in ("sha", "delete file"):
+            ops.append((op, rng.randrange(2)))
+        elif op == "header":
+            ops.append((op, rng.choice(("job", "format", "items", "manifest", "name", "renderer")),
+                        random_value(rng)))
+        elif op in ("manifest special", "lock special"):
+            ops.append((op, rng.choice(("fifo", "dir", "socket", "link:/dev/zero", "link:victim",
+                                        "dangling link", "garbage"))))
+        else:
+            ops.append((op, rng.randrange(1 << 30)))
+    files = {"s/job.toml": MANIFEST_JOB, "outside/victim.txt": CANARY.encode()}
+    kinds = ", ".join(str(o[:3])[:60] for o in ops)
+    return Case(seed, f"tampered manifest: {kinds}", batch_argv(), files, finished="w/out",
+                tamper=ops)
+
+
+def gen_special_files(rng, seed) -> Case:
+    """A FIFO, a folder, a socket, /dev/zero or a link where a file is expected: the scene
+    argument, a mesh file, a job file, a job's scene, `renderer colour`'s image."""
+    where = rng.choice(("scene argument", "mesh file", "job file", "job scene", "colour input",
+                        "glTF buffer", "batch --out"))
+    kind = rng.choice(SPECIAL_KINDS)
+    real = {"scene argument": "s/scene.toml", "mesh file": "s/m.obj", "job file": "s/job.toml",
+            "job scene": "s/scene.toml", "colour input": "s/bomb.png",
+            "glTF buffer": "s/model/b.bin", "batch --out": "w/outdir"}[where]
+    suffix = Path(real).suffix
+    special = {"glTF buffer": "s/model/sp.bin", "batch --out": "w/sp"}.get(where, "s/sp" + suffix)
+    path = "/dev/zero" if kind == "/dev/zero" else "{D}/" + special
+    specials = {} if kind == "/dev/zero" else \
+        {special: f"link:{real}" if kind == "link to the real file" else kind}
+    files = {"s/scene.toml": toml_document(small_scene()), "s/m.obj": obj_bytes(),
+             "s/t.png": png_bytes(rng, (4, 3), "RGB"), "s/bomb.png": png_declaring(50000, 50000),
+             "s/job.toml": toml_document(job_document(random.Random(seed), "scene.toml"))}
+    dirs = ["w/outdir"]
+    if where == "scene argument":
+        argv = command_for(rng, path)
+    elif where == "mesh file":
+        rel = path if path.startswith("/") else Path(special).name
+        data = small_scene([{"name": "a", "mesh": {"file": rel}}])
+        files["s/scene.toml"] = toml_document(data)
+        argv = command_for(rng, "{D}/s/scene.toml")
+    elif where == "job file":
+        argv = batch_argv(path)
+    elif where == "job scene":
+        rel = path if path.startswith("/") else Path(special).name
+        files["s/job.toml"] = toml_document(job_document(rng, rel))
+        argv = batch_argv()
+    elif where == "colour input":
+        argv = ["colour", path, "--out", "{D}/w/col", "--backend", "reference"]
+    elif where == "glTF buffer":
+        import base64
+        doc = gltf_document(rng, image_uri="data:image/png;base64,"
+                            + base64.b64encode(files["s/t.png"]).decode(),
+                            buffer_uri=path if path.startswith("/") else "sp.bin")
+        files["s/model/b.bin"] = base64.b64decode(gltf_document(rng)["buffers"][0]["uri"].split(",")[1])
+        files["s/model/m.gltf"] = __import__("json").dumps(doc).encode()
+        files["s/scene.toml"] = toml_document(small_scene([{"name": "a",
+                                                            "mesh": {"file": "model/m.gltf"}}]))
+        argv = command_for(rng, "{D}/s/scene.toml")
+    else:
+        argv = batch_argv(out=path)
+    return Case(seed, f"special file: {kind} as the {where}", argv, files, dirs=dirs,
+                specials=specials)
+
+
 CLASSES = {                  # name: (generator, weight)
     "valid": (gen_valid, 10),
     "mutated_scene": (gen_mutated_scene, 22),
@@ -681,6 +1074,12 @@ CLASSES = {                  # name: (generator, weight)
     "resources": (gen_resources, 3),
     "mesh_mutation": (gen_mesh_mutation, 9),
     "options": (gen_options, 8),
+    # issue 30: the files a user names
+    "textures": (gen_textures, 5),
+    "gltf": (gen_gltf, 4),
+    "job_files": (gen_job_files, 3),      # batch in this process: ~0.05 s a case, GL warm
+    "manifests": (gen_manifests, 3),
+    "special_files": (gen_special_files, 4),
 }
 
 
@@ -806,11 +1205,15 @@ def check_outcome(case: Case, outcome: Outcome, before: dict, after: dict, root:
     text = outcome.stdout + outcome.stderr
     if "Traceback" in text:
         problems.append("'Traceback' in the output")
+    if CANARY in text:
+        problems.append("an error or output line quotes another file's contents (the canary)")
     new = sorted(p for p in after if p not in before)
     changed = sorted(p for p in after if p in before and after[p] != before[p] and not after[p][0])
     gone = sorted(p for p in before if p not in after)
-    lines = outcome.stderr.splitlines()
+    lines = stderr_lines(case, outcome)
     code = outcome.code
+    if case.argv[:1] == ["batch"]:              # a stale lock file is taken over and removed
+        gone = [p for p in gone if Path(p).name != ".renderer-batch.lock"]
     if gone:
         problems.append(f"files removed: {gone}")
     if code in (1, 2):
@@ -836,7 +1239,10 @@ def check_outcome(case: Case, outcome: Outcome, before: dict, after: dict, root:
 def _check_success(case: Case, outcome: Outcome, new, changed, root: Path) -> list[str]:
     problems = []
     argv = [a.replace("{D}", str(root)) for a in case.argv]
-    for line in outcome.stderr.splitlines():
+    batch = argv[:1] == ["batch"]
+    for line in stderr_lines(case, outcome):
+        if batch and line.startswith("renderer batch: ") and " items" in line:
+            continue                            # its summary
         if not (line.startswith("renderer: warning: ") or line.startswith("wrote ")):
             problems.append(f"on success, a stderr line that is neither a warning nor 'wrote': "
                             f"{line[:200]!r}")
@@ -893,10 +1299,58 @@ def _check_success(case: Case, outcome: Outcome, new, changed, root: Path) -> li
         if not shader_files and "objects: " in outcome.stdout:
             problems.append("shaders listed variants but wrote no shader files")
         expected |= shader_files
+    elif command in ("colour", "batch"):
+        out = os.path.relpath(os.path.realpath(os.path.join(root / case.cwd, _opt(argv, "--out"))),
+                              os.path.realpath(root))
+        if command == "colour":
+            for name in ("chromaticity.png", "luminance.png", "munsell.md", "colour.json"):
+                expected.add(str(Path(out, name)))
+                if not (root / out / name).is_file():
+                    problems.append(f"colour: {out}/{name} missing")
+        else:
+            problems += _check_batch(root / out, stderr_lines(case, outcome))
+            expected |= {p for p in files if p == out or p.startswith(out + "/")}
     extra = sorted(files - expected)
     if extra:
         problems.append(f"files written that were not asked for: {extra}")
     return problems
+
+
+def stderr_lines(case: Case, outcome: Outcome) -> list[str]:
+    """stderr's lines; for `renderer batch`, but its progress bar's (tqdm, redrawn with \\r)
+    and the note that it runs in this process (in_this_process)."""
+    if case.argv[:1] != ["batch"]:
+        return outcome.stderr.splitlines()
+    return [line for line in outcome.stderr.replace("\r", "\n").splitlines()
+            if line and "%|" not in line and "Ray is not installed" not in line]
+
+
+def _check_batch(out: Path, lines: list[str]) -> list[str]:
+    """A finished batch folder: a record for each of the job's items (its summary line
+    says how many) and each record's files there, whole."""
+    import json
+    import re
+    try:
+        header, *records = [json.loads(line) for line in
+                            (out / "manifest.jsonl").read_text().splitlines()]
+    except (OSError, ValueError) as exc:
+        return [f"batch: the manifest does not read: {exc!r}"]
+    items = [int(m.group(1)) for line in lines if (m := re.match(r"renderer batch: (\d+) items: ", line))]
+    keys = {record.get("key") for record in records}
+    if len(items) != 1 or len(keys) != items[0] or len(records) != len(keys):
+        return [f"batch: {len(records)} records of {len(keys)} keys for {items} items"]
+    problems = []
+    for record in records:
+        for output in record["outputs"]:
+            path = out / output["path"]
+            if path.suffix == ".png":
+                problems += _check_image(path, _PNG_ANY)
+            elif not path.is_file():
+                problems.append(f"batch: {output['path']} missing")
+    return problems
+
+
+_PNG_ANY = None                         # _check_image: any size
 
 
 def _check_image(path: Path, size) -> list[str]:
@@ -904,7 +1358,7 @@ def _check_image(path: Path, size) -> list[str]:
     try:
         with Image.open(path) as image:
             image.load()
-            if image.size != tuple(size):
+            if size is not None and image.size != tuple(size):
                 return [f"{path.name}: size {image.size}, expected {tuple(size)}"]
     except Exception as exc:                     # noqa: BLE001
         return [f"image {path} missing or unreadable: {exc!r}"]
@@ -925,9 +1379,143 @@ def materialise(case: Case, root: Path) -> list[str]:
     for rel, data in case.files.items():
         (root / rel).parent.mkdir(parents=True, exist_ok=True)
         (root / rel).write_bytes(data)
+    for rel, data in case.files.items():
+        if b"@D@" in data:                      # a file naming a path in the case's folder
+            (root / rel).write_bytes(data.replace(b"@D@", str(root).encode()))
+    for rel, kind in case.specials.items():
+        make_special(root, rel, kind)
+    if case.finished:
+        shutil.copytree(finished_batch(), root / case.finished, symlinks=True)
+        tamper_batch(case, root / case.finished, root)
     for rel in case.unreadable:
         os.chmod(root / rel, 0)
     return [a.replace("{D}", str(root)) for a in case.argv]
+
+
+def make_special(root: Path, rel: str, kind: str) -> None:
+    """A FIFO, folder, socket or link at root/rel (Case.specials)."""
+    import socket
+    path = root / rel
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if kind == "fifo":
+        os.mkfifo(path)
+    elif kind == "dir":
+        path.mkdir()
+    elif kind == "socket":
+        with socket.socket(socket.AF_UNIX) as sock:
+            try:
+                sock.bind(str(path))
+            except OSError:                     # a path too long for AF_UNIX: a FIFO instead
+                os.mkfifo(path)
+    elif kind == "dangling link":
+        path.symlink_to(root / "nowhere")
+    elif kind == "link:fifo":
+        os.mkfifo(path.with_name(path.name + ".fifo"))
+        path.symlink_to(path.with_name(path.name + ".fifo"))
+    elif kind.startswith("link:"):
+        target = kind[5:]
+        path.symlink_to(target if target.startswith("/") else root / target)
+    elif kind == "garbage":
+        path.write_bytes(b"{not json\n" + CANARY.encode())
+    else:
+        raise ValueError(kind)
+
+
+_FINISHED: list[Path] = []
+
+
+def finished_batch() -> Path:
+    """MANIFEST_JOB rendered once in this process (outside any case's guard), its --out."""
+    if not _FINISHED:
+        import atexit
+        import tempfile
+
+        import renderer.cluster.executor as executor
+        from renderer.cli import main
+        folder = Path(tempfile.mkdtemp(prefix="fuzz-batch-"))
+        atexit.register(shutil.rmtree, folder, ignore_errors=True)
+        (folder / "job.toml").write_bytes(MANIFEST_JOB)
+        real = executor.ray_available
+        executor.ray_available = lambda: False
+        try:
+            with contextlib.redirect_stderr(io.StringIO()):
+                code = main(batch_argv(str(folder / "job.toml"), str(folder / "out")))
+        finally:
+            executor.ray_available = real
+        assert code == 0, "the manifest cases' job does not render"
+        _FINISHED.append(folder / "out")
+    return _FINISHED[0]
+
+
+def tamper_batch(case: Case, out: Path, root: Path) -> None:
+    """Case.tamper's changes to a finished batch folder (gen_manifests)."""
+    import json
+    rng = random.Random(case.seed)
+    manifest = out / "manifest.jsonl"
+    for op, *args in case.tamper:
+        if manifest.is_symlink() or not manifest.is_file():
+            break
+        header, *records = manifest.read_bytes().split(b"\n")[:3]
+        records = [r for r in records if r]
+        if op in ("record path", "sha", "delete file", "record") and len(records) > args[0] % 2:
+            index = args[0] % 2
+            try:
+                record = json.loads(records[index])
+                record["outputs"][0]["path"]
+            except (ValueError, KeyError, IndexError, TypeError):
+                continue                        # no longer a record (an earlier change)
+            if op == "record path":
+                path = args[1]
+                path = path.replace("{D}", str(root)) if isinstance(path, str) else path
+                record["outputs"][0]["path"] = path
+                items = out / "items"
+                for name, kind in (("fifo", "fifo"), ("dir", "dir"), ("sock", "socket"),
+                                   ("link", "link:outside/victim.txt")):
+                    if not (items / name).exists() and not (items / name).is_symlink():
+                        make_special(root, str((items / name).relative_to(root)), kind)
+            elif op == "sha":
+                record["outputs"][0]["sha256"] = "0" * 64
+            elif op == "delete file":
+                with contextlib.suppress(OSError, TypeError):
+                    (out / record["outputs"][0]["path"]).unlink()
+            else:
+                record = mutate_scene(rng, record)
+            records[index] = json.dumps(record).encode()
+        elif op == "header":
+            try:
+                data = json.loads(header)
+            except ValueError:
+                continue
+            if not isinstance(data, dict):
+                continue
+            data[args[0]] = args[1] if not isinstance(args[1], Raw) else str(args[1])
+            header = json.dumps(data).encode()
+        elif op == "truncate":
+            records[-1] = records[-1][:args[0] % max(1, len(records[-1]))]
+        elif op == "bytes":
+            text = mutate_bytes(rng, b"\n".join([header, *records]) + b"\n")
+            manifest.write_bytes(text)
+            continue
+        elif op == "long line":
+            records.append(b'{"key": "' + b"k" * (1 << 21) + b'"')
+        elif op == "stray":
+            (out / "items" / "stray.txt").write_bytes(b"s")
+        elif op == "items link":
+            if (out / "items").is_symlink():
+                continue
+            shutil.rmtree(out / "items")
+            (out / "items").symlink_to(root / "outside")
+            continue
+        elif op in ("manifest special", "lock special"):
+            target = manifest if op == "manifest special" else out / ".renderer-batch.lock"
+            if target.is_dir() and not target.is_symlink():
+                shutil.rmtree(target)
+            elif target.exists() or target.is_symlink():
+                target.unlink()
+            kind = {"link:victim": "link:outside/victim.txt"}.get(args[0], args[0])
+            make_special(root, str(target.relative_to(root)), kind)
+            continue
+        manifest.write_bytes(b"\n".join([header, *records]) + b"\n")
 
 
 def run_case(case: Case, root: Path, main=None) -> list[str]:
@@ -935,15 +1523,12 @@ def run_case(case: Case, root: Path, main=None) -> list[str]:
     if main is None:
         from renderer.cli import main
     argv = materialise(case, root)
-    if any(f.endswith("scene.toml") for f in case.files):       # names with "{D}" in them
-        scene = root / "s" / "scene.toml"
-        if scene.exists():
-            scene.write_bytes(scene.read_bytes().replace(b"@D@", str(root).encode()))
     before = snapshot(root)
     old_cwd = os.getcwd()
     os.chdir(root / case.cwd)
     try:
-        outcome = run_main(main, argv)
+        with in_this_process(argv):
+            outcome = run_main(main, argv)
     finally:
         os.chdir(old_cwd)
         _unlock(root)
@@ -956,6 +1541,37 @@ def run_case(case: Case, root: Path, main=None) -> list[str]:
         problems.append(f"exit {outcome.code!r} in {outcome.seconds:.2f} s; stderr: "
                         f"{outcome.stderr[:500]!r}")
     return problems
+
+
+_WARM: set[str] = set()
+
+
+@contextlib.contextmanager
+def in_this_process(argv):
+    """`renderer batch` without Ray (its jobs in this process, as where Ray is not
+    installed); `renderer colour`'s first run (seconds of imports and tables) made once
+    outside the guard, so that a case's time is its own."""
+    import renderer.cluster.executor as executor
+    command = argv[0] if argv else None
+    if command == "colour" and "colour" not in _WARM:
+        import tempfile
+
+        from PIL import Image
+
+        from renderer.cli import main
+        _WARM.add("colour")
+        with tempfile.TemporaryDirectory() as folder, \
+                contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+            Image.new("RGB", (4, 3)).save(Path(folder, "t.png"))
+            main(["colour", str(Path(folder, "t.png")), "--out", str(Path(folder, "c")),
+                  "--backend", "reference"])
+    real = executor.ray_available
+    if command == "batch":
+        executor.ray_available = lambda: False
+    try:
+        yield
+    finally:
+        executor.ray_available = real
 
 
 def run_seeds(seeds, tmp_path: Path) -> None:

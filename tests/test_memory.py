@@ -17,7 +17,7 @@ MIB = 1 << 20
 def test_the_estimates_by_hand():
     assert memory.gpu_bytes(1000, 1000, 0) == 128 * MIB + 32 * 10 ** 6
     assert memory.gpu_bytes(1000, 1000, 10, linear=True, samples=4) == \
-        128 * MIB + (32 + 48 + 8 * 4) * 10 ** 6 + 160 * 10
+        128 * MIB + (32 + 48 + 8 * 4) * 10 ** 6 + 896 * 10
     # The reference's working set is one band of at most 2^20 pixels, whatever the size:
     small, large = memory.reference_bytes(1000, 1000, 0), memory.reference_bytes(10000, 10000, 0)
     assert small == 64 * MIB + 12 * 10 ** 6 + 320 * 10 ** 6

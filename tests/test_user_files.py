@@ -173,6 +173,35 @@ def test_a_file_over_its_kinds_cap_is_refused_before_it_is_read(tmp_path, monkey
     assert read_user_file(tmp_path / "small.toml", user_files.SCENE_FILE) == b"a = 1\n"
 
 
+def test_a_read_asks_for_the_files_size_not_its_kinds_cap(tmp_path, monkeypatch):
+    """A read of n bytes takes n bytes before it reads one: asked for a mesh file's 4 GiB cap,
+    every mesh read failed under an address-space limit (test_fuzz.py's 1 GiB guard: a
+    MemoryError for a 100-byte OBJ). A file that grows after its stat is read on, to the cap."""
+    asked = []
+
+    class Recording:
+        def __init__(self, handle):
+            self.handle = handle
+
+        def __getattr__(self, name):
+            return getattr(self.handle, name)
+
+        def read(self, n=-1):
+            asked.append(n)
+            return self.handle.read(n)
+
+    (tmp_path / "m.obj").write_bytes(b"v 0 0 0\n" * 10)
+    with open_user_file(tmp_path / "m.obj", user_files.MESH_FILE) as handle:
+        assert user_files.read_capped(Recording(handle), user_files.MESH_FILE) == b"v 0 0 0\n" * 10
+    assert max(asked) <= 81
+    monkeypatch.setitem(USER_FILE_CAPS, user_files.SCENE_FILE, 2048)
+    (tmp_path / "s.toml").write_text("a = 1\n")
+    with open_user_file(tmp_path / "s.toml", user_files.SCENE_FILE) as handle:
+        (tmp_path / "s.toml").write_text("# " + "x" * 3070)           # grew after the stat
+        with pytest.raises(FileRefused, match="grew past 2 kB while read"):
+            user_files.read_capped(handle, user_files.SCENE_FILE)
+
+
 def test_every_kind_states_its_cap():
     source = (ROOT / "renderer/core/user_files.py").read_text()
     assert set(USER_FILE_CAPS) == {user_files.SCENE_FILE, user_files.JOB_FILE, user_files.MESH_FILE,
@@ -312,6 +341,17 @@ def test_a_gltf_image_outside_its_folder_is_refused(refused, work, uri):
     assert line.endswith("a glTF's resources are data: URIs or files in its own folder")
 
 
+@pytest.mark.parametrize("uri", ["t.png\0x", "t.png%00x"])
+def test_a_gltf_image_uri_with_a_null_byte_is_one_line(refused, work, uri):
+    """Found by tests/test_fuzz.py (gen_gltf): Path.resolve raised ValueError (embedded null
+    byte), a traceback."""
+    triangle_gltf(work / "model", uri)
+    scene(work, mesh='{ file = "model/model.gltf" }')
+    line = refused(*render("s.toml"), cwd=work)
+    assert line == ("renderer: s.toml: objects[0].mesh.file: model/model.gltf: uri 't.png\\\\x00x' "
+                    "contains a null byte, which no file name holds"), line
+
+
 @pytest.mark.parametrize("uri, reason", [
     ("OUTSIDE", "leaves the glTF's folder; a glTF's resources are data: URIs or files in its "
                 "own folder"),
@@ -367,6 +407,21 @@ def test_colour_refuses_a_declared_size_over_the_limit_before_decoding(refused, 
     line = refused("colour", name, "--backend", "reference", "--out", "o", cwd=work)
     assert line.startswith(f"renderer: {name}: a {declared} image needs about ")
     assert "over the limit of" in line
+
+
+@pytest.mark.parametrize("header, says", [
+    # an unclosed bracket: NumPy's retry as a Python 2 header raised tokenize.TokenError
+    (b"{'descr': '<f4', 'fortran_order': False, 'shape': (500\x8f4, 0}\x00 ( \n",
+     "could not be read as a .npy array: "),
+    # a newline inside the header: read on the retry, with NumPy's UserWarning on stderr
+    (b"{'descr': '<f4', 'fortran_order': False, 'shape': (50000, 50000, 4)}  \n" + b" " * 36
+     + b"\n", "a 50000 x 50000 image needs about "),
+])
+def test_colour_refuses_a_mangled_npy_header_in_one_line(refused, work, header, says):
+    """Found by tests/test_fuzz.py (gen_textures, a .npy's bytes mutated)."""
+    (work / "a.npy").write_bytes(b"\x93NUMPY\x01\x00" + struct.pack("<H", len(header)) + header)
+    line = refused("colour", "a.npy", "--backend", "reference", "--out", "o", cwd=work)
+    assert line.startswith(f"renderer: a.npy: {says}"), line
 
 
 @pytest.mark.parametrize("kind", ["fifo", "folder", "npy objects"])

@@ -167,6 +167,8 @@ def _open_lock(path: Path, out: Path) -> int:
     except OSError as error:
         if error.errno == errno.ELOOP:
             raise UserError(f"{LOCK_NAME} is a symbolic link; remove it", file=str(out)) from None
+        if error.errno in (errno.EISDIR, errno.ENXIO, errno.ENODEV):   # a folder, a socket, a device
+            raise UserError(f"{LOCK_NAME} is not a regular file; remove it", file=str(out)) from None
         raise SystemFault(f"cannot make the lock file {LOCK_NAME}: {_reason(error)}",
                           file=str(out)) from None
     if not stat.S_ISREG(os.fstat(fd).st_mode):

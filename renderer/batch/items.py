@@ -2,6 +2,7 @@
 
     job = read_job("job.toml")            # renderer/batch/job_file.py: checked, scenes loaded
     items = expand(job)                   # file order; stable keys; seeds from (job seed, key)
+    for item in iter_items(job): ...      # the same, made one at a time (bounded memory)
 
 An item's key names it everywhere (its folder, its manifest record, its seed):
 
@@ -28,6 +29,7 @@ from __future__ import annotations
 
 import hashlib
 import itertools
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -200,20 +202,53 @@ class Item:
         return (self.scene.digest, self.setting.name)
 
 
-def expand(job: Job) -> list[Item]:
-    """The job's items in file order (module docstring)."""
-    items = []
+def iter_items(job: Job) -> Iterator[Item]:
+    """The job's items in file order (module docstring), made one at a time: a stream whose
+    memory does not grow with the job (`expand` keeps them all)."""
     for entry in job.scenes:
         for camera, (index, point), setting in itertools.product(
                 entry.cameras, enumerate(entry.points), job.settings):
             key = f"{entry.name}/{camera.part}/{numbered('sweep', index)}/{setting.name}"
             files = tuple(f"{ITEMS_FOLDER}/{key}/{output.name}" for output in setting.outputs)
-            items.append(Item(key, item_seed(job.seed, key), point, camera, setting, files))
-    return items
+            yield Item(key, item_seed(job.seed, key), point, camera, setting, files)
 
 
-def job_identity(job: Job, items: list[Item]) -> str:
+def item_count(job: Job) -> int:
+    """How many items `iter_items` makes, without making them."""
+    return sum(len(entry.cameras) * len(entry.points) for entry in job.scenes) * len(job.settings)
+
+
+def expand(job: Job) -> list[Item]:
+    """The job's items in file order, as a list (iter_items)."""
+    return list(iter_items(job))
+
+
+def job_identity(job: Job, items: Iterable[Item]) -> str:
     """SHA-256 of the canonical expanded items (keys, seeds, scenes' contents, cameras,
-    settings): a manifest in DIR belongs to this job when its header carries the same."""
-    text = canonical_json({"seed": job.seed, "items": [item.describe() for item in items]})
-    return hashlib.sha256(text.encode()).hexdigest()
+    settings): a manifest in DIR belongs to this job when its header carries the same.
+
+    The text hashed is canonical_json({"seed": SEED, "items": [item.describe(), ...]}),
+    fed to the hash item by item: each item's text is put together from its camera's,
+    sweep point's and setting's texts (made once each), as json.dumps would write it, so
+    neither the whole text nor the items need be held (tests/test_batch_items.py holds it
+    to the one-piece text)."""
+    digest = hashlib.sha256(b'{"items":[')
+    texts: dict[tuple[str, int], str] = {}       # (what, id) -> canonical text, made once
+
+    def text(what: str, part, describe) -> str:
+        found = texts.get((what, id(part)))
+        if found is None:
+            found = texts[what, id(part)] = canonical_json(describe(part))
+            held.append(part)                    # its id stays its own while cached
+        return found
+
+    held: list = []
+    for n, item in enumerate(items):
+        digest.update((("," if n else "") + '{"camera":' + text("camera", item.camera, CameraSpec.describe)
+                       + ',"key":' + canonical_json(item.key) + ',"overrides":'
+                       + text("overrides", item.scene, lambda source: dict(source.overrides))
+                       + ',"scene":' + canonical_json(item.scene.digest) + ',"seed":' + str(item.seed)
+                       + ',"setting":' + text("setting", item.setting, Setting.describe)
+                       + "}").encode())
+    digest.update(f'],"seed":{canonical_json(job.seed)}}}'.encode())
+    return digest.hexdigest()

@@ -8,6 +8,11 @@ values are checked where they stand. Every scene is read and every sweep point's
 applied and built here, on the driver, before anything is rendered: a bad scene, a bad
 override value, an animation of a still scene or an output the output stage refuses fails
 the job before its first frame, naming the job file and the key.
+
+Bounded: the job's items and sweep points are counted from the job file alone, before any
+scene is read, and a job over MAX_ITEMS items or MAX_SCENES scenes to build is refused
+then, with its count (in well under a second). Each sweep point's scene is built, checked
+and dropped (its SceneSource keeps the overrides and the digest), so a job holds no scenes.
 """
 
 from __future__ import annotations
@@ -49,7 +54,13 @@ BACKGROUNDS = ("opaque", "transparent")
 DEFAULT_SIZE = (640, 480)            # as `renderer render`
 MAX_SIDE = 16384                     # pixels, as --size
 MAX_COUNT = 100_000                  # orbit views, animation frames, sweep values per key
-MAX_ITEMS = 1_000_000                # a typo should not plan a billion frames
+# Items in a job: each is planned on the driver (its key, files and output names checked, its
+# record looked up), ~0.1 ms each: 100,000 items are planned in seconds; a typo should not
+# plan a billion frames.
+MAX_ITEMS = 100_000
+# Scenes a job builds, one per [[scenes]] entry and sweep point: each is built and checked
+# before the first frame (a few ms for a small scene), so a job is checked in bounded time.
+MAX_SCENES = 10_000
 SEED_LIMIT = 2 ** 64
 MAX_ELEVATION = 89.0                 # degrees: camera_paths keeps the eye 1 degree off the poles
 # A name that is one path component: scenes' and settings' names are parts of item keys.
@@ -101,12 +112,21 @@ class _JobReader(TableReader):
         raw_settings = self.entries(data.get("settings", [{}]), "settings")
         settings = tuple(self.setting(raw, f"settings[{i}]", size) for i, raw in enumerate(raw_settings))
         _unique(self, [(s.name, f"settings[{i}].name") for i, s in enumerate(settings)], "the setting name")
-        scenes = tuple(self.scene_entry(raw, f"scenes[{i}]", settings)
-                       for i, raw in enumerate(self.entries(data["scenes"], "scenes")))
-        _unique(self, [(s.name, f"scenes[{i}].name") for i, s in enumerate(scenes)], "the scene name")
-        count = sum(len(s.points) * len(s.cameras) for s in scenes) * len(settings)
+        # First what each entry asks for, from the job file alone (no scene read), so that a
+        # job over the limits is refused at once; then each entry's scene and sweep points.
+        asked = [self.scene_request(raw, f"scenes[{i}]")
+                 for i, raw in enumerate(self.entries(data["scenes"], "scenes"))]
+        count = sum(len(cameras) * points for _, _, _, points, cameras in asked) * len(settings)
         if count > MAX_ITEMS:
             self.fail("scenes", f"the job has {count:,} items; at most {MAX_ITEMS:,}")
+        built = sum(points for _, _, _, points, _ in asked)
+        if built > MAX_SCENES:
+            self.fail("scenes", f"the job has {built:,} scenes to build (one per entry and "
+                                f"sweep point); at most {MAX_SCENES:,}, each built and checked "
+                                f"before the first frame")
+        scenes = tuple(self.scene_entry(*request, f"scenes[{i}]", settings)
+                       for i, request in enumerate(asked))
+        _unique(self, [(s.name, f"scenes[{i}].name") for i, s in enumerate(scenes)], "the scene name")
         return Job(str(self.path), name, seed, scenes, settings,
                    self.string(data.get("description", ""), "description"))
 
@@ -123,19 +143,38 @@ class _JobReader(TableReader):
 
     # ---- [[scenes]]
 
-    def scene_entry(self, raw: dict, key: str, settings: tuple[Setting, ...]) -> SceneEntry:
+    def scene_request(self, raw: dict, key: str):
+        """What a [[scenes]] entry asks for, checked without reading its scene: (the table,
+        the scene's name or file, the sweep's axes, its point count, the cameras)."""
         raw = self.table(raw, key, SCENE_KEYS)
         if "scene" not in raw:
             self.fail(key, "needs scene = NAME (a built-in scene) or FILE (relative to the job file)")
-        data, path = self.read_scene(raw["scene"], f"{key}.scene")
-        points = [self.point(data, path, overrides, f"{key}.sweep")
-                  for overrides in self.sweep(raw.get("sweep"), f"{key}.sweep")]
-        name = _name(self, raw["name"], f"{key}.name") if "name" in raw else output_stem(points[0][1])
-        cameras = self.cameras(raw.get("cameras"), f"{key}.cameras", points[0][1], settings)
-        for _, scene in points:
+        scene = self.string(raw["scene"], f"{key}.scene")
+        axes = self.sweep_axes(raw.get("sweep"), f"{key}.sweep")
+        points = math.prod(len(values) for _, values in axes)
+        if points > MAX_SCENES:                # before building any of them
+            self.fail(f"{key}.sweep", f"{points:,} sweep points; a job has at most "
+                                      f"{MAX_SCENES:,} (each is a scene, built and checked "
+                                      f"before the first frame)")
+        return raw, scene, axes, points, self.cameras(raw.get("cameras"), f"{key}.cameras")
+
+    def scene_entry(self, raw: dict, scene_name: str, axes: list, count: int, cameras,
+                    key: str, settings: tuple[Setting, ...]) -> SceneEntry:
+        """The entry's scene read and every sweep point built and checked (its memory for
+        each setting too), one at a time: only the points' SceneSources are kept."""
+        data, path = self.read_scene(scene_name, f"{key}.scene")
+        points, first = [], None
+        for overrides in self.sweep_points(axes):
+            source, scene = self.point(data, path, overrides, f"{key}.sweep")
+            if first is None:                  # the entry's rules that need its scene
+                first = scene
+                if cameras[0].kind == "frame":
+                    self.animated(f"{key}.cameras.animation", scene, settings)
             for setting in settings:
                 self.memory(scene, setting, key)
-        return SceneEntry(name, tuple(source for source, _ in points), cameras)
+            points.append(source)              # the scene itself is dropped: none is held
+        name = _name(self, raw["name"], f"{key}.name") if "name" in raw else output_stem(first)
+        return SceneEntry(name, tuple(points), cameras)
 
     def memory(self, scene, setting: Setting, key: str) -> None:
         """The GPU's memory for the scene and setting, under the limit (core/memory.py)."""
@@ -144,28 +183,30 @@ class _JobReader(TableReader):
         except UserError as error:
             self.fail(key, f"setting {setting.name!r}: {error.reason}")
 
-    def read_scene(self, value: Any, key: str) -> tuple[dict, Path]:
-        text = self.string(value, key)
+    def read_scene(self, text: str, key: str) -> tuple[dict, Path]:
         beside = self.path.parent / text           # a path is relative to the job file
         try:
             return read_scene(text if is_scene_name(text) and not beside.is_file() else beside)
         except SceneError as error:
             self.fail(key, error.line())
 
-    def sweep(self, raw: Any, key: str) -> list[dict]:
-        """The sweep's points: one dict of overrides each, the first key varying slowest."""
+    def sweep_axes(self, raw: Any, key: str) -> list[tuple[str, list]]:
+        """The sweep's axes, (key path, values) in file order; none without a sweep."""
         if raw is None:
-            return [{}]
+            return []
         if not isinstance(raw, dict):
             self.fail(key, f"expected a table of key paths = [values], got {describe_value(raw)}")
         axes = list(self.flat_sweep(raw, key).items())
         if not axes:
             self.fail(key, "expected at least one key path = [values]")
-        points = math.prod(len(values) for _, values in axes)
-        if points > MAX_ITEMS:                 # before building any of them
-            self.fail(key, f"{points:,} sweep points; a job has at most {MAX_ITEMS:,} items")
-        return [dict(zip((path for path, _ in axes), values))
-                for values in itertools.product(*(values for _, values in axes))]
+        return axes
+
+    @staticmethod
+    def sweep_points(axes: list[tuple[str, list]]):
+        """The sweep's points, one dict of overrides each, the first key varying slowest,
+        made one at a time; one point without overrides when there is no sweep."""
+        for values in itertools.product(*(values for _, values in axes)):
+            yield dict(zip((path for path, _ in axes), values))
 
     def flat_sweep(self, raw: dict, key: str, prefix: str = "") -> dict[str, list]:
         """Key paths to their values; TOML's dotted keys (camera.aperture = [...]) arrive as
@@ -196,7 +237,9 @@ class _JobReader(TableReader):
         digest = hashlib.sha256(canonical_json(changed).encode()).hexdigest()
         return SceneSource(str(path.resolve()), tuple(overrides.items()), digest), scene
 
-    def cameras(self, raw: Any, key: str, scene, settings) -> tuple[CameraSpec, ...]:
+    def cameras(self, raw: Any, key: str) -> tuple[CameraSpec, ...]:
+        """The entry's cameras, from the job file alone (an animation's rules that need the
+        scene and the settings: `animated`)."""
         if raw is None:
             return (CameraSpec("camera"),)
         raw = self.table(raw, key, CAMERA_KINDS)
@@ -220,7 +263,7 @@ class _JobReader(TableReader):
         if kind == "poses":
             poses = self.entries(value, where)
             return tuple(self.pose(pose, f"{where}[{k}]", k) for k, pose in enumerate(poses))
-        return self.animation(value, where, scene, settings)
+        return self.animation(value, where)
 
     def pose(self, raw: dict, key: str, index: int) -> CameraSpec:
         raw = self.table(raw, key, POSE_KEYS)
@@ -236,13 +279,21 @@ class _JobReader(TableReader):
             self.fail(f"{key}.up", "must not be zero length; up says which way is up in the image")
         return CameraSpec("pose", index, eye=eye, look=look, up=up)
 
-    def animation(self, raw: Any, key: str, scene, settings) -> tuple[CameraSpec, ...]:
+    def animation(self, raw: Any, key: str) -> tuple[CameraSpec, ...]:
         raw = self.table(raw, key, ANIMATION_KEYS)
         if "frames" not in raw:
             self.fail(key, "needs frames = N")
         frames = self.integer(raw["frames"], f"{key}.frames", 1, MAX_COUNT)
         step = self.number(raw.get("step", 1.0), f"{key}.step", above=0.0)
         exposure = self.number(raw.get("exposure", 0.0), f"{key}.exposure", minimum=0.0)
+        last = (frames - 1) * step + exposure
+        if last > MAX_NUMBER:
+            self.fail(key, f"the last frame's shutter closes at {last:g}, past {MAX_NUMBER:g}")
+        return tuple(CameraSpec("frame", t, shutter=(t * step, t * step + exposure))
+                     for t in range(frames))
+
+    def animated(self, key: str, scene, settings) -> None:
+        """An animation's rules that need the scene and the settings."""
         still = [s for s in settings if not METHODS[s.method].shutter]
         if still:
             self.fail(key, f"an animation is the ray tracer's (motion during the shutter; the "
@@ -251,11 +302,6 @@ class _JobReader(TableReader):
         if not declares_motion(scene):
             self.fail(key, "nothing in the scene moves (no object has a velocity or "
                            "angular_velocity): every frame would be the same")
-        last = (frames - 1) * step + exposure
-        if last > MAX_NUMBER:
-            self.fail(key, f"the last frame's shutter closes at {last:g}, past {MAX_NUMBER:g}")
-        return tuple(CameraSpec("frame", t, shutter=(t * step, t * step + exposure))
-                     for t in range(frames))
 
     # ---- [[settings]]
 

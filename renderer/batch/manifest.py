@@ -109,10 +109,17 @@ def _lines(path: Path) -> list[str] | None:
 
 
 def _parsed(line: str):
+    """The line's JSON, or None when it is not JSON as written here: NaN and Infinity, which
+    Python's parser takes but to_json never writes (and refuses when the file is rewritten),
+    are not; nor is nesting too deep to parse."""
     try:
-        return json.loads(line)
-    except ValueError:
+        return json.loads(line, parse_constant=_no_constant)
+    except (ValueError, RecursionError):
         return None
+
+
+def _no_constant(name: str):
+    raise ValueError(f"{name} is not JSON")
 
 
 def _check_header(path: Path, found, header: dict) -> None:
@@ -164,7 +171,8 @@ def _confined(out: Path, listed: list) -> bool:
 def _counts(out: Path, record: dict, wanted: dict[str, list[str]]) -> bool:
     """Whether the record lists the item's files first (then maybe more: a record made with
     --compare counts for a run without) and every file it lists is as recorded."""
-    files = wanted.get(record.get("key"))
+    key = record.get("key")
+    files = wanted.get(key) if isinstance(key, str) else None     # a list is no key (unhashable)
     listed = record.get("outputs")
     if files is None or not isinstance(listed, list) or not all(isinstance(o, dict) for o in listed) \
             or [o.get("path") for o in listed][:len(files)] != files:

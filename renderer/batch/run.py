@@ -32,6 +32,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import os
 import signal
 import sys
 import threading
@@ -88,7 +89,7 @@ def plan_job(job: Job, out, *, compare: bool = False, say=None) -> Plan:
         for item in {(item.scene.digest, item.setting.name): item for item in items}.values():
             check_memory(item_scene(load_source(item.scene), item), item.setting, ["gpu", "reference"])
     wanted = {item.key: [*item.files, *(compare_files(item) if compare else ())] for item in items}
-    check_outputs(out / MANIFEST, *(out / path for paths in wanted.values() for path in paths))
+    check_outputs(out / MANIFEST, *(out / path for paths in _to_check(out, wanted) for path in paths))
     check_inside(out, (path for paths in wanted.values() for path in paths))
     header = header_for(job, job_identity(job, items), len(items))
     resume = read_manifest(out, header, wanted)
@@ -96,6 +97,18 @@ def plan_job(job: Job, out, *, compare: bool = False, say=None) -> Plan:
         (say or say_above_bar)(resume.warning())
     todo = [item for item in items if item.key not in resume.records]
     return Plan(job, out, items, todo, resume, compare)
+
+
+def _to_check(out: Path, wanted: dict[str, list[str]]):
+    """The items' files for check_outputs: the first item's (its folders on the way are
+    every item's, and where one is not a folder the line says so as for any output) and
+    those of items whose folder is already there (a folder where a file goes). The files of
+    an item whose folder is not there yet are new names under real folders (check_inside),
+    each its own (keys and names are unique): asking for each would cost a job of many
+    items seconds of stat calls."""
+    for n, (key, paths) in enumerate(wanted.items()):
+        if n == 0 or os.path.lexists(out / ITEMS_FOLDER / key):
+            yield paths
 
 
 @dataclass

@@ -7,11 +7,11 @@ llvmpipe (peak resident memory over the process's baseline) and rounded up:
 
     GPU path     renderbuffers, read-back staging and the output arrays: 32 bytes a pixel
                  (+48 for linear colour, +8 a sample for MSAA), plus the context's own
-                 ~128 MiB; 160 bytes a triangle (the scene's float64 mesh and the float32
-                 vertex and index buffers)
+                 ~128 MiB; 896 bytes a triangle (the scene's float64 mesh, the float32
+                 vertex and index buffers, the facets' texture)
     reference    the output arrays, 8 bytes a pixel (+16 linear, +4 for a depth-tie image),
                  and a working set of 320 bytes a pixel of one band of at most TILE_PIXELS
-                 (reference/pipeline.py draws a large frame band by band); 640 bytes a
+                 (reference/pipeline.py draws a large frame band by band); 1280 bytes a
                  triangle (vertex outputs, clipping, window triangles, all float64)
     mesh files   parsing takes up to 16 times the file's size (trimesh's text parsers)
 
@@ -34,13 +34,17 @@ GPU_FIXED = 128 * MIB
 GPU_BYTES_PER_PIXEL = 32
 GPU_LINEAR_BYTES_PER_PIXEL = 48
 GPU_BYTES_PER_SAMPLE_PIXEL = 8
-GPU_BYTES_PER_TRIANGLE = 160
+# Per triangle (the scene's float64 mesh, the float32 vertex and index buffers, the facets'
+# normals and creases texture, the frame's plan): measured 742 bytes on a 1,046,528-triangle
+# uv_sphere at 256x256 (benchmarks/bench_memory.py, 2026-12-03; 160 before was from before the
+# shadow maps' facets), rounded up.
+GPU_BYTES_PER_TRIANGLE = 896
 
 REFERENCE_FIXED = 64 * MIB
 REFERENCE_OUTPUT_BYTES_PER_PIXEL = 12          # rgba8, depth and a possible tie image
 REFERENCE_LINEAR_BYTES_PER_PIXEL = 16
 REFERENCE_WORKING_BYTES_PER_PIXEL = 320        # of one band
-REFERENCE_BYTES_PER_TRIANGLE = 640
+REFERENCE_BYTES_PER_TRIANGLE = 1280                # measured 1,118 as above (640 before)
 # A reference frame of more pixels than this is drawn in bands of at most this many
 # (reference/pipeline.py), so that its working set stays bounded.
 REFERENCE_TILE_PIXELS = 1 << 20

@@ -67,10 +67,12 @@ USER_FILE_CAPS = {
     IMAGE_FILE: 2 * GIB + 64 * MIB,
     # a 16384 x 16384 float32 RGBA frame (4 GiB) and its header.
     ARRAY_FILE: 4 * GIB + MIB,
-    # a job's records (at most 1,000,000 items, renderer/batch/job_file.py MAX_ITEMS) of
-    # well under 1 kB each.
+    # a job's records (at most 100,000 items, renderer/batch/job_file.py MAX_ITEMS) of
+    # well under 1 kB each, with room to spare.
     MANIFEST_FILE: 1 * GIB,
 }
+
+READ_CHUNK = 64 * MIB          # read_capped: a file that grew is read on in these
 
 # What a file that is not a regular file is, as the refusal says it.
 _NOT_REGULAR = ((stat.S_ISDIR, "a directory"), (stat.S_ISFIFO, "a named pipe (FIFO)"),
@@ -143,8 +145,24 @@ def read_capped(handle: BinaryIO, kind: str, cap: int | None = None) -> bytes:
     """The rest of `handle`, refused if it is more than the kind's cap (a file that grew
     after it was checked is not read on)."""
     cap = USER_FILE_CAPS[kind] if cap is None else cap
+    # Asked for what the file holds (and a byte more, to see it end), never for the cap:
+    # a read of n bytes takes n bytes of memory before it reads one (a 4 GiB cap would
+    # take 4 GiB for a 100-byte file, or fail under an address-space limit).
     try:
-        data = handle.read(cap + 1)
+        try:
+            want = os.fstat(handle.fileno()).st_size - handle.tell() + 1
+        except (AttributeError, OSError, ValueError):      # not a file: read in chunks
+            want = READ_CHUNK
+        chunks, total = [], 0
+        while total <= cap:
+            asked = max(1, min(want, cap + 1 - total))
+            block = handle.read(asked)
+            chunks.append(block)
+            total += len(block)
+            if len(block) < asked:                         # its end
+                break
+            want = READ_CHUNK                              # it grew: on, up to the cap
+        data = b"".join(chunks)
     except OSError as exc:
         raise FileRefused(f"cannot read: {exc.strerror or exc}") from None
     if len(data) > cap:
@@ -162,6 +180,9 @@ def confined(folder: Path, uri: str, what: str, owner: str = "glTF") -> Path:
     rule = f"a {owner}'s resources are data: URIs or files in its own folder"
     if not uri or os.path.isabs(uri):
         raise FileRefused(f"{what} {show_path(uri)!r} is not a relative path; {rule}")
+    if "\0" in uri:                                     # (resolve would raise ValueError)
+        raise FileRefused(f"{what} {show_path(uri)!r} contains a null byte, which no file "
+                          f"name holds")
     target = (root / uri).resolve()
     if not target.is_relative_to(root):
         raise FileRefused(f"{what} {show_path(uri)!r} leaves the {owner}'s folder; {rule}")
@@ -253,16 +274,22 @@ def _first_line(exc: BaseException) -> str:
 def npy_header(handle: BinaryIO) -> tuple[tuple[int, ...], object]:
     """(shape, dtype) from a .npy file's header, the handle left at its start; a FileRefused
     for a file that is not one (or holds Python objects, which are never loaded)."""
+    import tokenize
+
     from numpy.lib import format as npy_format
 
     try:
-        version = npy_format.read_magic(handle)
-        read = {(1, 0): npy_format.read_array_header_1_0,
-                (2, 0): npy_format.read_array_header_2_0}.get(version)
-        if read is None:
-            raise ValueError(f"unsupported .npy format version {version}")
-        shape, _, dtype = read(handle)
-    except (ValueError, OSError, EOFError) as exc:
+        # NumPy retries a header it cannot parse as one written by Python 2 (tokenize, with
+        # its own errors) and warns when that works: neither reaches the user
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            version = npy_format.read_magic(handle)
+            read = {(1, 0): npy_format.read_array_header_1_0,
+                    (2, 0): npy_format.read_array_header_2_0}.get(version)
+            if read is None:
+                raise ValueError(f"unsupported .npy format version {version}")
+            shape, _, dtype = read(handle)
+    except (ValueError, OSError, EOFError, SyntaxError, tokenize.TokenError) as exc:
         raise FileRefused(f"could not be read as a .npy array: {_first_line(exc)}") from None
     if dtype.hasobject:
         raise FileRefused("holds Python objects, not numbers; a .npy image holds numbers")

@@ -3,6 +3,7 @@ the output stage (docs/conventions.md, "Output") when any of its options is give
 
 from __future__ import annotations
 
+import contextlib
 import sys
 import time
 from pathlib import Path
@@ -131,13 +132,31 @@ def render_frame(args, scene, settings):
     from renderer.methods import open_renderer
     linear = settings is not None or (args.alpha is not None and args.alpha.suffix.lower() == ".npy")
     with open_renderer(scene, args.size, method=args.method, backend=args.backend,
-                       options=args.options, context_kind=args.context) as renderer:
-        frame = renderer.render(depth=True, linear=linear)
+                       options=args.options, context_kind=args.context) as renderer, \
+            progress_bar(args, renderer.height) as progress:
+        frame = renderer.render(depth=True, linear=linear, progress=progress)
         if settings is None:
             return frame, None, 0.0
         start = time.perf_counter()
         staged = _output_stage(args.backend, renderer).apply(frame.linear, settings)
         return frame, staged, (time.perf_counter() - start) * 1000.0
+
+
+@contextlib.contextmanager
+def progress_bar(args, rows: int):
+    """progress(rows done, rows) for Renderer.render: a bar on stderr (tqdm) for a frame that
+    takes more than two seconds (a ray-traced render of many samples), when stderr is a
+    terminal and not --quiet; it goes when the frame is done."""
+    from tqdm import tqdm
+    bar = tqdm(total=rows, unit="row", file=sys.stderr, delay=2.0, leave=False, dynamic_ncols=True,
+               disable=args.quiet or not sys.stderr.isatty())
+
+    def progress(done: int, total: int) -> None:
+        bar.update(done - bar.n)
+    try:
+        yield progress
+    finally:
+        bar.close()
 
 
 def _output_stage(backend: str, renderer):

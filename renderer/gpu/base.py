@@ -32,6 +32,8 @@ class Renderer(Protocol):
     (unclamped, alpha the coverage) and the depth (view depth, docs/conventions.md) when asked
     (a method that computes them anyway returns them always). `out`, an earlier frame of the
     same renderer, has its arrays written instead of new ones (a loop over many frames).
+    `progress(rows done, rows)` is called as the frame advances (the GPU ray tracer's bands),
+    and at least once when it is done.
     update(scene=None): take the scene again after its camera, lights or materials changed
     in place, or `scene`, another Scene of the same objects; resize(width, height);
     release() (idempotent), and the context manager that calls it; gl_info: what drew it."""
@@ -40,7 +42,7 @@ class Renderer(Protocol):
     height: int
 
     def render(self, out: Frame | None = None, *, linear: bool = False,
-               depth: bool = True) -> Frame: ...
+               depth: bool = True, progress=None) -> Frame: ...
 
     def update(self, scene: Scene | None = None) -> None: ...
 

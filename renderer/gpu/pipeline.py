@@ -478,7 +478,7 @@ class GpuRenderer(ContextRenderer):
 
     # -- rendering ---------------------------------------------------------------------------
     def render(self, out: Frame | None = None, *, linear: bool = False, depth: bool = True,
-               sample_offset: tuple = (0.0, 0.0), samples: int = 1) -> Frame:
+               sample_offset: tuple = (0.0, 0.0), samples: int = 1, progress=None) -> Frame:
         """Draw the scene; rgba8 always, the unclamped linear colour and depth as asked.
 
         `sample_offset` (dx, dy) samples each pixel that far from its centre (pixels, GL window
@@ -503,6 +503,8 @@ class GpuRenderer(ContextRenderer):
             linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
         if depth:
             depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
+        if progress is not None:                 # one draw: done at once
+            progress(self.height, self.height)
         return Frame(rgba8, linear_color, depth_map, (time.perf_counter() - start) * 1000.0,
                      gl_info=self._gl_info)
 

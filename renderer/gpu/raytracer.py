@@ -63,6 +63,11 @@ from renderer.gpu.defines import area_light_defines, sampling_defines
 from renderer.gpu.shaders import shader_source
 from renderer.gpu.textures import TextureCache
 
+# Samples a band of rows holds (render()): a few tenths of a second of llvmpipe's tracing,
+# short enough for Ctrl-C and a progress bar, long enough that the bands cost nothing.
+BAND_SAMPLES = 1 << 21
+
+
 class RayTracer(ContextRenderer):
     """Ray traces one scene at one size; see the module docstring. `options` (RayOptions,
     renderer/core/ray_options.py), or its fields as keywords; the lens overrides are the
@@ -367,11 +372,16 @@ class RayTracer(ContextRenderer):
         self.update()
 
     def render(self, out: Frame | None = None, *, linear: bool = True, depth: bool = True,
-               first_sample: int = 0) -> Frame:
+               first_sample: int = 0, progress=None) -> Frame:
         """Trace the frame of sample indices first_sample .. first_sample + N - 1: rgba8,
         linear (average linear colour, alpha the coverage), depth and samples (traced per
         pixel), row 0 at the top. `linear` and `depth` are always traced (the Renderer
-        protocol's flags change nothing); `out`, an earlier frame, has its arrays written."""
+        protocol's flags change nothing); `out`, an earlier frame, has its arrays written.
+
+        A frame of more than BAND_SAMPLES samples is traced in bands of rows (the scissor
+        box; every pixel is traced on its own, so the image is the same), each finished
+        before the next starts: Ctrl-C stops it after the band in flight, and
+        `progress(rows done, rows)` is called after each band."""
         self._check_alive()
         first_sample = check_first_sample(first_sample, self.sampling.samples)
         start = time.perf_counter()
@@ -385,7 +395,7 @@ class RayTracer(ContextRenderer):
             self._image_textures.bind(material_texture, unit)
         self._fbo.use()
         self.ctx.viewport = (0, 0, self.width, self.height)
-        self._vao.render(vertices=3)
+        self._trace_bands(progress)
         for unit, material_texture in images:     # no sampler state of ours left on the context
             self._image_textures.get(material_texture)[1].clear(unit)
         h, w = self.height, self.width
@@ -401,6 +411,30 @@ class RayTracer(ContextRenderer):
         rgba8[..., 3] = np.where(colour[..., 3] > 0, np.uint8(255), np.uint8(0))
         return Frame(rgba8, colour, view_depth, (time.perf_counter() - start) * 1000.0,
                      gl_info=self.gl_info, samples=samples)
+
+    def bands(self) -> list[tuple[int, int]]:
+        """(first row from the bottom, rows) of each band render() traces: whole rows, about
+        BAND_SAMPLES samples (camera samples times light samples) each."""
+        per_row = self.width * self.sampling.samples * self.sampling.light_samples
+        rows = max(1, BAND_SAMPLES // per_row)
+        return [(y, min(rows, self.height - y)) for y in range(0, self.height, rows)]
+
+    def _trace_bands(self, progress) -> None:
+        bands = self.bands()
+        if len(bands) == 1:                      # the frame at once, as small frames always were
+            self._vao.render(vertices=3)
+            if progress is not None:
+                progress(self.height, self.height)
+            return
+        try:
+            for y, rows in bands:
+                self.ctx.scissor = (0, y, self.width, rows)
+                self._vao.render(vertices=3)
+                self.ctx.finish()                # done before Python runs on (and Ctrl-C is seen)
+                if progress is not None:
+                    progress(y + rows, self.height)
+        finally:
+            self.ctx.scissor = None
 
     def _free(self) -> None:
         try:

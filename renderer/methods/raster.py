@@ -21,8 +21,7 @@ class ReferenceRaster(ReferenceRenderer):
         super().__init__(scene, width, height, options, precision)
         self.subpixel_bits = subpixel_bits
 
-    def render(self, out: Frame | None = None, *, linear: bool = False, depth: bool = True,
-               **extra) -> Frame:
+    def _frame(self, *, linear: bool, depth: bool, **extra) -> Frame:
         import reference
         if self.subpixel_bits is not None:
             extra["subpixel_bits"] = self.subpixel_bits

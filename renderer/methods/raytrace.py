@@ -42,8 +42,7 @@ class ReferenceRayTracer(ReferenceRenderer):
     def reseed(self, seed: int) -> None:
         self.options = self.options.replace(seed=seed)
 
-    def render(self, out: Frame | None = None, *, linear: bool = True, depth: bool = True,
-               first_sample: int = 0) -> Frame:
+    def _frame(self, *, linear: bool, depth: bool, first_sample: int = 0) -> Frame:
         from reference.raytrace.pipeline import render
         o = self.options
         return render(self.scene, self.width, self.height, samples=o.samples, pattern=o.pattern,

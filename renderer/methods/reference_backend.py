@@ -27,7 +27,14 @@ class ReferenceRenderer:
         return np.dtype(self.precision)
 
     def render(self, out: Frame | None = None, *, linear: bool = False, depth: bool = True,
-               **extra) -> Frame:
+               progress=None, **extra) -> Frame:
+        """The twin's frame (`progress` told once, when it is done)."""
+        frame = self._frame(linear=linear, depth=depth, **extra)
+        if progress is not None:
+            progress(self.height, self.height)
+        return frame
+
+    def _frame(self, *, linear: bool, depth: bool, **extra) -> Frame:
         raise NotImplementedError
 
     def update(self, scene: Scene | None = None) -> None:

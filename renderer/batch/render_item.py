@@ -192,7 +192,7 @@ class ItemWorker:
         result.render_ms = (rendered - start) * 1000.0
         result.encode_ms = (time.perf_counter() - rendered) * 1000.0
         if self.keep_frames:             # what the reference is held against (no linear colour)
-            subpixel_bits = getattr(renderer, "subpixel_bits", None)     # the rasteriser's
+            subpixel_bits = renderer.subpixel_bits                     # the GPU's snapping
             result.frame = (replace(frame, linear=None), subpixel_bits)
         return result
 

@@ -60,8 +60,8 @@ def add_parser(sub) -> None:
 
 
 def _render_gpu(scene, args, frames=1):
-    """(the median frame's Frame, its milliseconds, gl_info, the GPU's subpixel bits for the
-    reference: None where the method has no rasterisation) of `frames` GPU frames."""
+    """(the median frame's Frame, its milliseconds, gl_info, the context's subpixel bits for
+    the reference rasteriser) of `frames` GPU frames."""
     from renderer.methods import open_renderer
     with open_renderer(scene, args.size, method=args.method, options=args.options,
                        context_kind=args.context) as renderer:
@@ -70,7 +70,7 @@ def _render_gpu(scene, args, frames=1):
             frame = renderer.render(depth=True)
             timings.append(frame.milliseconds)
         # Read while the context is alive: afterwards it no longer knows its kind.
-        return frame, statistics.median(timings), renderer.gl_info, getattr(renderer, "subpixel_bits", None)
+        return frame, statistics.median(timings), renderer.gl_info, renderer.subpixel_bits
 
 
 def run_methods(args) -> int:

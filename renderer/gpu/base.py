@@ -98,6 +98,12 @@ class ContextRenderer:
         frame it renders carries the same dict."""
         return dict(self._gl_info)
 
+    @property
+    def subpixel_bits(self) -> int:
+        """GL_SUBPIXEL_BITS of this renderer's context: vertices snap to 1 / 2^bits of a pixel
+        (8 on llvmpipe); the reference rasteriser is told it (ReferenceRaster)."""
+        return int(self.ctx.info["GL_SUBPIXEL_BITS"])
+
     def __enter__(self):
         return self
 

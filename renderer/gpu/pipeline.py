@@ -76,6 +76,7 @@ import moderngl
 import numpy as np
 
 from renderer.gpu.base import ContextRenderer
+from renderer.gpu.readback import flip_into, usable
 from renderer.gpu.context import activate, context_kind, gl_function
 from renderer.errors import ContextError, SystemFault
 from renderer.core.drawn import drawn_meshes, is_plane
@@ -497,10 +498,10 @@ class GpuRenderer(ContextRenderer):
         # GL returns rows bottom-up: read into staging arrays made once, then write each
         # output flipped (row 0 at the top) into a C-contiguous array the caller keeps.
         reuse = (out.rgba8, out.linear, out.depth) if out is not None else (None, None, None)
-        rgba8 = _flip_into(self._read(fbo, 0, np.uint8), reuse[0])
+        rgba8 = flip_into(self._read(fbo, 0, np.uint8), reuse[0])
         linear_color = depth_map = None
         if linear:
-            linear_color = _flip_into(self._read(fbo, 1, np.float32), reuse[1])
+            linear_color = flip_into(self._read(fbo, 1, np.float32), reuse[1])
         if depth:
             depth_map = self._depth_from_window(self._read(fbo, -1, np.float32)[::-1], reuse[2])
         if progress is not None:                 # one draw: done at once
@@ -609,11 +610,6 @@ class GpuRenderer(ContextRenderer):
             "context": context_kind(self.ctx), "depth_format": self.depth_format}
 
     @property
-    def subpixel_bits(self) -> int:
-        """GL_SUBPIXEL_BITS: vertices snap to 1 / 2^bits of a pixel (8 on llvmpipe)."""
-        return int(self.ctx.info["GL_SUBPIXEL_BITS"])
-
-    @property
     def sample_counts(self) -> list[int]:
         """The MSAA sample counts render(samples=...) can use: multisample_counts(ctx)."""
         return multisample_counts(self.ctx)
@@ -687,22 +683,6 @@ class GpuRenderer(ContextRenderer):
             self._multisample = {}
 
 
-def _usable(out: np.ndarray | None, like: np.ndarray) -> np.ndarray | None:
-    """`out` if it can take a result shaped and typed like `like`, else None (a new array)."""
-    if out is not None and out.shape == like.shape and out.dtype == like.dtype and out.flags.c_contiguous:
-        return out
-    return None
-
-
-def _flip_into(bottom_up: np.ndarray, out: np.ndarray | None) -> np.ndarray:
-    """Rows reversed (row 0 at the top), written into `out` when usable, else a new array."""
-    target = _usable(out, bottom_up)
-    if target is None:
-        return bottom_up[::-1].copy()
-    np.copyto(target, bottom_up[::-1])
-    return target
-
-
 def _depth_conversion(projection: np.ndarray, shape: tuple[int, int], reversed_z: bool = False):
     """A function from window depth z_w (float32, any strides) to a C-contiguous array of
     -z_eye (+inf where z_w is the depth buffer's clear value: 1, or 0 with reversed-Z), for the projection
@@ -728,7 +708,7 @@ def _depth_conversion(projection: np.ndarray, shape: tuple[int, int], reversed_z
         b_tail = np.float32(b - float(b_head))
 
         def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-            out = np.add(window_depth, b_head, out=_usable(out, window_depth))
+            out = np.add(window_depth, b_head, out=usable(out, window_depth))
             out += b_tail
             np.divide(a, out, out=out)
             np.copyto(out, np.inf, where=np.equal(window_depth, cleared, out=mask))
@@ -738,7 +718,7 @@ def _depth_conversion(projection: np.ndarray, shape: tuple[int, int], reversed_z
         t = np.float32((p23 - t_ndc) / p22)
 
         def convert(window_depth: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
-            out = np.multiply(window_depth, s, out=_usable(out, window_depth))
+            out = np.multiply(window_depth, s, out=usable(out, window_depth))
             out += t
             np.copyto(out, np.inf, where=np.equal(window_depth, cleared, out=mask))
             return out

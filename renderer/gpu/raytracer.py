@@ -57,6 +57,7 @@ from renderer.core.transforms import to_glsl
 from renderer.core.uniforms import light_uniforms
 from renderer.gpu.bvh import texel_texture
 from renderer.gpu.base import ContextRenderer
+from renderer.gpu.readback import flip_into
 from renderer.gpu.context import activate, context_kind
 from renderer.gpu.declarations import program_uniforms, uniforms_to_write
 from renderer.gpu.defines import area_light_defines, sampling_defines
@@ -449,7 +450,4 @@ def _flip_read(fbo, attachment: int, shape: tuple, out: np.ndarray | None) -> np
     """A float attachment read back, row 0 at the top, into `out` when it fits (a reused frame)."""
     rows = np.frombuffer(fbo.read(components=shape[2] if len(shape) == 3 else 1,
                                   attachment=attachment, dtype="f4"), np.float32).reshape(shape)
-    if out is not None and out.shape == shape and out.dtype == np.float32 and out.flags.writeable:
-        np.copyto(out, rows[::-1])
-        return out
-    return np.ascontiguousarray(rows[::-1])
+    return flip_into(rows, out)

@@ -186,7 +186,8 @@ def scene_source(scene, size, backend: str, context_kind: str) -> ColourSource:
     with open_renderer(scene, size, backend=backend, context_kind=context_kind) as renderer:
         frame = renderer.render(linear=True, depth=False)
         # the colour pass on the GPU runs in the renderer's context (the reference has none)
-        xyz, chromaticity, ms = measure_colour(frame.linear, backend, getattr(renderer, "ctx", None))
+        xyz, chromaticity, ms = measure_colour(frame.linear, backend,
+                                               renderer.ctx if backend == "gpu" else None)
     return ColourSource(scene.name, frame.linear, xyz, chromaticity, scene, {
         "kind": "scene", "source": scene.source or scene.name, "backend": backend,
         "size": list(size), "render_ms": round(frame.milliseconds, 3),

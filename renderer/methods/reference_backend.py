@@ -28,7 +28,8 @@ class ReferenceRenderer:
 
     def render(self, out: Frame | None = None, *, linear: bool = False, depth: bool = True,
                progress=None, **extra) -> Frame:
-        """The twin's frame (`progress` told once, when it is done)."""
+        """The twin's frame (`progress` told once, when it is done); `out` is taken for the
+        protocol's sake and not reused: the twin's arrays are its own, made afresh each frame."""
         frame = self._frame(linear=linear, depth=depth, **extra)
         if progress is not None:
             progress(self.height, self.height)

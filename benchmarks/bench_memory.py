@@ -8,6 +8,12 @@ anything is allocated.
 "gpu rt" and "reference rt" rows: a 488,600-triangle mesh ray traced at 64x64 (the estimate:
 renderer/core/memory.py's raytrace_*_bytes).
 
+Then whole commands under a limit (renderer/study/peak_memory.py): `renderer render` of a
+large mesh file (loaded, merged and creased, then ray traced or rasterised) and of a large
+texture, each with --max-memory set to the command's own estimate (the larger of loading's
+step and the renderers' Need), and the 5,005,448-triangle PLY refused at 3G and 5G: the
+estimate, the limit and the whole process's measured peak (VmHWM).
+
 Each case runs in a new process; the figure is its peak resident memory (ru_maxrss) above
 what the process held after importing and building the scene, so that the baseline of
 Python, NumPy and the scene is left out; the estimate is the same difference.
@@ -19,7 +25,11 @@ import argparse
 import json
 import subprocess
 import sys
+import tempfile
 import time
+from pathlib import Path
+
+from common import machine, revision
 
 CHILD = r"""
 import json, resource, sys, warnings
@@ -88,6 +98,55 @@ def main() -> None:
     r = refusal(16384, 16384, "1G")
     print(f"\nrenderer render sphere --size 16384x16384 --max-memory 1G: status {r['status']} in "
           f"{r['seconds']:.1f} s, peak {r['peak'] / mib:.0f} MiB (the whole process)\n  {r['line']}")
+    under_limits()
+
+
+def under_limits() -> None:
+    """Whole commands under --max-memory (module docstring)."""
+    from renderer.core import memory
+    from renderer.core.textures import TEXTURE_BYTES_PER_TEXEL
+    from renderer.methods import METHODS
+    from renderer.study.peak_memory import grid_scene, measure_command, texture_scene
+    mib = 1 << 20
+    print(f"\nWhole commands, renderer render at 64x48 (peak: VmHWM of the process)\n"
+          f"{'case':44} {'estimate MiB':>12} {'limit':>6} {'peak MiB':>9} {'peak/limit':>10} "
+          f"{'status':>6} {'s':>6}")
+
+    def row(case, estimate, limit, *args):
+        run = measure_command("render", *args, "--size", "64x48", "--max-memory", limit, "-q",
+                              "-o", Path(folder) / "out.png")
+        share = run.peak / memory.parse_size(limit)
+        print(f"{case:44} {estimate / mib:>12.0f} {limit:>6} {run.peak / mib:>9.0f} {share:>10.2f} "
+              f"{run.status:>6} {run.seconds:>6.1f}", flush=True)
+        if run.status:
+            print(f"  {run.stderr.strip()}")
+
+    def method_options(method):
+        return ["--method", method, "--backend", backend]
+
+    with tempfile.TemporaryDirectory() as folder:
+        scene, triangles = grid_scene(Path(folder), 707)
+        for method, backend in (("raytrace", "gpu"), ("raytrace", "reference"), ("raster", "gpu"),
+                                ("raster", "reference")):
+            need = METHODS[method].need((64, 48), [backend], METHODS[method].options())
+            estimate = max(memory.PROCESS_BYTES + triangles * memory.MESH_BUILD_BYTES_PER_TRIANGLE,
+                           need.bytes_for(triangles))
+            row(f"{triangles:,}-triangle PLY, {method} {backend}", estimate,
+                f"{estimate // mib + 1}M", scene, *method_options(method))
+        scene = texture_scene(Path(folder), 4096)
+        for method, backend in (("raster", "gpu"), ("raster", "reference"), ("raytrace", "gpu")):
+            need = METHODS[method].need((64, 48), [backend], METHODS[method].options())
+            estimate = max(memory.PROCESS_BYTES + 4096 * 4096 * TEXTURE_BYTES_PER_TEXEL,
+                           need.bytes_for(2))
+            row(f"4096x4096 texture, {method} {backend}", estimate, f"{estimate // mib + 1}M",
+                scene, *method_options(method))
+        scene, triangles = grid_scene(Path(folder), 1582)
+        backend = "gpu"
+        need = METHODS["raytrace"].need((64, 48), ["gpu"], METHODS["raytrace"].options())
+        for limit in ("3G", "5G"):
+            row(f"{triangles:,}-triangle PLY, raytrace gpu", need.bytes_for(triangles), limit,
+                scene, *method_options("raytrace"))
+    print(f"\n{machine()}; {revision()}; {time.strftime('%Y-%m-%d')}")
 
 
 if __name__ == "__main__":

@@ -132,4 +132,4 @@ def test_an_out_that_is_a_file_is_refused(batch, tmp_path):
     (tmp_path / "out").write_text("x")
     result = batch(SPHERE)
     assert (result.returncode, result.stderr) == (
-        2, "renderer: out: out is not a folder, so nothing can be written in it\n")
+        2, "renderer: out: is not a folder, so nothing can be written in it\n")

@@ -72,8 +72,9 @@ RUNAWAY_SECONDS = 5.0               # a case running longer is a runaway
 RUNAWAY_BYTES = 1 << 30             # address space a case may add (RLIMIT_AS): more is a runaway
 # The renderer's own memory limit during a case (renderer/core/memory.py), well inside the
 # runaway cap: a case asking for more must be refused with one line, not run out of memory.
-# (The default limit is half the machine's memory, which the cap would cut short.)
-FUZZ_MEMORY_LIMIT = 384 << 20
+# (The default limit is half the machine's memory, which the cap would cut short.) The limit
+# counts the process's own PROCESS_BYTES too: a case may add 384 MiB.
+FUZZ_MEMORY_LIMIT = memory.PROCESS_BYTES + (384 << 20)
 GPU_FRACTION = 0.04                 # cases run through the GL backend (render --backend gpu, compare)
 # --max-memory is being added on another branch; switch this on (or FUZZ_MAX_MEMORY=1) when it is in.
 WITH_MAX_MEMORY = os.environ.get("FUZZ_MAX_MEMORY", "") not in ("", "0")

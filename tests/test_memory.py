@@ -50,8 +50,8 @@ def test_a_size_over_the_limit_is_refused_before_rendering(capsys, tmp_path, mon
     assert cli.main(["render", "sphere", "--size", "16384x16384", "--max-memory", "1G",
                      "-o", str(out)]) == 2
     assert capsys.readouterr().err.splitlines() == [
-        "renderer: rendering sphere at 16384x16384 (3,968 triangles) on gpu needs about 8.1 GiB "
-        "of memory, over the limit of 1.0 GiB (set by --max-memory)"]
+        "renderer: rendering sphere at 16384x16384 on gpu needs about 8.3 GiB of memory, over the "
+        "limit of 1.0 GiB (set by --max-memory)"]
     assert list(tmp_path.iterdir()) == []
 
 
@@ -80,8 +80,8 @@ def test_primitives_are_refused_before_they_are_built(monkeypatch):
         scene_from_dict({"objects": [{"name": "a", "mesh": big}]})
     assert info.value.line() == (
         "<dict>: objects[0].mesh: the scene's primitives up to here make up to 2,097,152 "
-        "triangles: building them needs about 512 MiB of memory, over the limit of 256 MiB "
-        "(set by --max-memory)")
+        "triangles: building them needs about 512 MiB of memory (704 MiB with the process's "
+        "own), over the limit of 256 MiB (set by --max-memory)")
     assert built == []
 
 
@@ -99,7 +99,7 @@ def test_a_mesh_file_is_refused_before_it_is_parsed(monkeypatch):
         load_scene_with_mesh(bowl)
     assert info.value.line() == (
         f"<dict>: objects[0].mesh.file: {bowl}: a mesh file of 27 kB needs about 430 kB of "
-        f"memory, over the limit of 98 kB (set by --max-memory)")
+        f"memory (192 MiB with the process's own), over the limit of 98 kB (set by --max-memory)")
 
 
 def load_scene_with_mesh(path):

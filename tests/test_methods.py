@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from renderer.core import memory
+
 from renderer.core.frame import Frame
 from renderer.core.raster_options import RasterOptions
 from renderer.core.ray_options import RayOptions
@@ -126,12 +128,13 @@ def test_a_new_method_is_one_registration(monkeypatch, sphere_scene):
         return open_renderer(scene, (width, height), backend="reference")
 
     fake = Method("flat", "flat colour", RasterOptions, open_either, open_either,
-                  lambda scene, size, backends, options: None)
+                  lambda size, backends, options: memory.raster_need(size, backends))
     monkeypatch.setitem(METHODS, "flat", fake)
     with open_renderer(sphere_scene, (8, 6), method="flat", options=RasterOptions(specialise=False)) as r:
         assert r.render().rgba8.shape == (6, 8, 4)
     assert opened == [("sphere", 8, 6, RasterOptions(specialise=False))]
     assert method_options("flat", {"prune_shadows": False}) == RasterOptions(prune_shadows=False)
+    METHODS["flat"].check_memory(sphere_scene, (8, 6), ["gpu"], RasterOptions())
 
 
 @pytest.fixture

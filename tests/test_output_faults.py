@@ -288,7 +288,7 @@ def test_an_output_folder_that_is_a_file_is_refused_before_any_work(command, tmp
     monkeypatch.chdir(tmp_path)
     (tmp_path / "taken").write_text("keep me\n")
     assert main([*command, "--out", "taken"]) == 2
-    assert one_line(capsys) == "renderer: taken: taken is not a folder, so nothing can be written in it"
+    assert one_line(capsys) == "renderer: taken: is not a folder, so nothing can be written in it"
     assert (tmp_path / "taken").read_text() == "keep me\n" and leftovers(tmp_path) == []
 
 

@@ -46,3 +46,25 @@ def test_ctrl_c_stops_a_long_ray_traced_render_in_one_line(tmp_path):
     stopped = time.perf_counter() - sent
     assert (child.returncode, err) == (130, "renderer: interrupted\n")
     assert stopped < 10 and not out.exists() and sorted(p.name for p in tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("options", [dict(samples=4), dict(samples=9, pattern="adaptive")],
+                         ids=["regular", "adaptive"])
+def test_the_reference_ray_tracer_reports_progress_by_chunk(monkeypatch, options):
+    """The twin traces its rays a chunk at a time (CHUNK_RAYS): it says how far it is after
+    each, in rows as the GPU does, the same frame whatever the chunk."""
+    import reference.raytrace.pipeline as pipeline
+    from renderer.core.builtin import resolve_scene
+    from renderer.core.ray_options import RayOptions
+    from renderer.core.scene_file import load_scene
+    from renderer.methods import open_renderer
+    scene = load_scene(resolve_scene("classic"))
+    with open_renderer(scene, (37, 23), method="raytrace", backend="reference",
+                       options=RayOptions(**options)) as tracer:
+        whole = tracer.render()
+        monkeypatch.setattr(pipeline, "CHUNK_RAYS", 400)
+        seen = []
+        chunked = tracer.render(progress=lambda done, rows: seen.append((done, rows)))
+    assert len(seen) >= 5 and seen[-1] == (23, 23) and {rows for _, rows in seen} == {23}
+    assert [done for done, _ in seen] == sorted(done for done, _ in seen)
+    assert np.array_equal(whole.rgba8, chunked.rgba8)

@@ -193,10 +193,10 @@ def test_shape_refusal_through_the_command_line(tmp_path, cli_here):
 
 
 def test_shape_tessellation_counts_against_memory():
-    # SCENE_BYTES_PER_TRIANGLE 256: 768,000 bytes hold 3000 triangles; 1280 + 1280 fit, a
-    # third sphere's 3840 does not; nor does one of 5120 (subdivisions 4)
+    # SCENE_BYTES_PER_TRIANGLE 256: 768,000 bytes (beside the process's own) hold 3000
+    # triangles; 1280 + 1280 fit, a third sphere's 3840 does not; nor does one of 5120
     sphere = {"type": "sphere"}
-    with memory.limit_set(3000 * memory.SCENE_BYTES_PER_TRIANGLE):
+    with memory.limit_set(memory.PROCESS_BYTES + 3000 * memory.SCENE_BYTES_PER_TRIANGLE):
         load({"objects": [{"shape": sphere}, {"shape": sphere}]})
         line = refusal({"objects": [{"shape": sphere}, {"shape": sphere}, {"shape": sphere}]})
         assert line.startswith("s.toml: objects[2].shape: the scene's primitives up to here "

@@ -33,15 +33,15 @@ SECONDS = 10                              # each refusal is milliseconds; a hang
 
 # --------------------------------------------------------------------------- helpers
 
-def png_header(width: int, height: int) -> bytes:
+def png_header(width: int, height: int, rows: bytes = b"\0" * 64) -> bytes:
     """A few bytes of PNG whose header declares width x height, 1-bit grey (IHDR, a short
-    IDAT, IEND): a bomb of 300 bytes a row had it been real."""
+    IDAT of `rows`, IEND): a bomb of 300 bytes a row had it been real."""
     def chunk(kind, data):
         return (struct.pack(">I", len(data)) + kind + data
                 + struct.pack(">I", zlib.crc32(kind + data) & 0xFFFFFFFF))
     header = struct.pack(">IIBBBBB", width, height, 1, 0, 0, 0, 0)
     return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header)
-            + chunk(b"IDAT", zlib.compress(b"\0" * 64)) + chunk(b"IEND", b""))
+            + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b""))
 
 
 def jpeg_header(width: int, height: int) -> bytes:
@@ -220,8 +220,9 @@ def test_pillow_does_not_refuse_a_side_the_docs_allow():
     Pillow's setting is as it was afterwards."""
     from PIL import Image
     before = Image.MAX_IMAGE_PIXELS
+    whole = png_header(16384, 16384, rows=b"\0" * (16384 * (1 + 16384 // 8)))   # every row there
     with memory.limit_set(1 << 40):
-        with open_image(png_header(16384, 16384), max_side=16384, bytes_per_pixel=1) as image:
+        with open_image(whole, max_side=16384, bytes_per_pixel=1) as image:
             assert image.size == (16384, 16384)
         with pytest.raises(FileRefused, match="at most 16384 pixels on a side"):
             open_image(png_header(16385, 4), max_side=16384, bytes_per_pixel=1)
@@ -283,6 +284,63 @@ def test_a_texture_whose_header_is_a_bomb_is_one_line_without_pillows_warning(re
     assert refused(*render("s.toml"), cwd=work).endswith(
         "wide.png: image is 20000 x 4; a texture is at most 16384 texels on a side "
         "(GL_MAX_TEXTURE_SIZE)")
+
+
+def short_png(rows_written: int, width: int = 16, height: int = 16, interlace: int = 0) -> bytes:
+    """An RGB PNG whose header says width x height and whose compressed data ends, properly,
+    after `rows_written` rows (no interlace) or short of its last pass's final 4 bytes."""
+    import struct
+    import zlib
+
+    def chunk(kind: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    row = b"\x00" + bytes([200, 10, 10]) * width
+    if interlace:
+        passes = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2), (0, 1, 1, 2))
+        data = b"".join((b"\x00" + bytes(3 * -(-(width - x0) // dx))) * -(-(height - y0) // dy)
+                        for x0, y0, dx, dy in passes if width > x0 and height > y0)
+        data = data[:len(data) - 4 * (rows_written < height)]
+    else:
+        data = row * rows_written
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, interlace)
+    return (b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(data))
+            + chunk(b"IEND", b""))
+
+
+def test_a_png_with_rows_missing_is_refused_not_drawn_black(refused, work):
+    """Pillow decodes such a file without a word, the missing rows black."""
+    (work / "short.png").write_bytes(short_png(8))
+    scene(work, image="short.png")
+    assert refused(*render("s.toml"), cwd=work).endswith(
+        "short.png: is truncated: its image data holds 392 of the 784 bytes its header's "
+        "16 x 16 pixels need (rows are missing)")
+    line = refused("colour", "short.png", "--backend", "reference", "--out", "o", cwd=work)
+    assert line == ("renderer: short.png: is truncated: its image data holds 392 of the 784 bytes "
+                    "its header's 16 x 16 pixels need (rows are missing)")
+
+
+def test_whole_pngs_pass_the_row_count_interlaced_or_not():
+    import io
+
+    from renderer.core.user_files import png_data_problem
+    assert png_data_problem(io.BytesIO(short_png(16))) is None
+    for width, height in ((1, 1), (3, 5), (13, 9)):               # Adam7's empty passes too
+        assert png_data_problem(io.BytesIO(short_png(height, width, height, interlace=1))) is None
+        assert "is truncated" in png_data_problem(io.BytesIO(short_png(0, width, height, interlace=1)))
+
+
+def test_a_jpeg_cut_short_is_one_line(refused, work):
+    import io
+
+    from PIL import Image
+    noise = np.random.default_rng(0).integers(0, 255, (64, 64, 3), dtype=np.uint8)
+    encoded = io.BytesIO()
+    Image.fromarray(noise).save(encoded, "JPEG")
+    (work / "cut.jpg").write_bytes(encoded.getvalue()[:len(encoded.getvalue()) // 2])
+    scene(work, image="cut.jpg")
+    assert "cut.jpg: could not be read as an image (PNG or JPEG): image file is truncated" in \
+        refused(*render("s.toml"), cwd=work)
 
 
 @pytest.mark.parametrize("kind", ["fifo", "device"])
@@ -479,6 +537,8 @@ ALLOWED = {
     ("renderer/batch/folder.py", "*"): "the batch's own --out folder, opened without following "
                                        "links (issue 30's batch part)",
     ("renderer/batch/manifest.py", "*"): "the batch's own manifest in --out",
+    ("renderer/study/peak_memory.py", "*"): "the files its measurements make in their own "
+                                            "temporary folders",
 }
 
 

@@ -55,10 +55,11 @@ DECISION_MARGIN = 2.0 ** -12
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
            max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
            rs=None, first_sample: int = 0, adaptive_threshold: float | None = None,
-           dtype=F32, light_samples: int = 1) -> Frame:
+           dtype=F32, light_samples: int = 1, progress=None) -> Frame:
     """The frame (module docstring) of sample indices first_sample .. first_sample + N - 1;
     `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays; `dtype`
-    float32 (the GPU's twin) or float64."""
+    float32 (the GPU's twin) or float64; `progress(share done)`, if given, after each chunk of
+    rays (an adaptive frame's first set fills half, its refinement the rest)."""
     start = time.perf_counter()
     t = np.dtype(dtype).type
     rs = rs if rs is not None else ray_scene(scene)
@@ -73,9 +74,16 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
     lens = _lens(cam, matrices.view, t)
     y, x = np.divmod(np.arange(width * height, dtype=np.uint32), np.uint32(width))  # row 0 at the bottom
 
-    def traced(pixels, ks):
+    refining = sampling.adaptive and sampling.samples > sampling.first_set
+
+    def told(share: float) -> None:
+        if progress is not None:
+            progress(share)
+
+    def traced(pixels, ks, shares=(0.0, 1.0)):
         """Each sample k of `ks` at each pixel of `pixels` (flat indices): colour (S, P, 3),
-        hit (S, P), s (S, P), and the hash of each ray tree mixed with its k (S, P)."""
+        hit (S, P), s (S, P), and the hash of each ray tree mixed with its k (S, P).
+        `shares`: the part of the frame's progress its chunks go from and to."""
         if len(pixels) == 0:
             return (np.zeros((len(ks), 0, 3), t), np.zeros((len(ks), 0), bool),
                     np.zeros((len(ks), 0), t), np.zeros((len(ks), 0), np.uint64))
@@ -89,11 +97,14 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
             O, D = thin_lens_ray(lens_point(owners.x, owners.y, owners.k, first_sample, sampling, t),
                                  O, D, lens)
         trees = np.zeros(len(O), np.uint64)
-        parts = [trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near, cam.far,
-                       scene.background, max_depth, shadows, trees[i:i + CHUNK_RAYS],
-                       RaySamples(*(a[i:i + CHUNK_RAYS] for a in (owners.x, owners.y, owners.k)),
-                                  first_sample, sampling), areas)
-                 for i in range(0, len(O), CHUNK_RAYS)]
+        parts = []
+        for i in range(0, len(O), CHUNK_RAYS):
+            parts.append(trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near,
+                               cam.far, scene.background, max_depth, shadows,
+                               trees[i:i + CHUNK_RAYS],
+                               RaySamples(*(a[i:i + CHUNK_RAYS] for a in (owners.x, owners.y, owners.k)),
+                                          first_sample, sampling), areas))
+            told(shares[0] + (shares[1] - shares[0]) * min(i + CHUNK_RAYS, len(O)) / len(O))
         colour, hit, s = (np.concatenate(part) for part in zip(*parts))
         trees = mix64(trees.reshape(len(ks), -1) + np.asarray(ks, np.uint64)[:, None])
         return (colour.reshape(len(ks), len(pixels), 3), hit.reshape(len(ks), -1),
@@ -108,20 +119,21 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
                 tree + trees.sum(0, dtype=np.uint64))
 
     everywhere = np.arange(width * height)
-    colour, hit, s, trees = traced(everywhere, range(sampling.first_set))
+    colour, hit, s, trees = traced(everywhere, range(sampling.first_set), (0.0, 0.5 if refining else 1.0))
     empty = (np.zeros((width * height, 3), t), np.zeros(width * height, bool),
              np.full(width * height, t(np.inf)), np.zeros(width * height, np.uint64))
     first = accumulate(empty, colour, hit, s, trees)
     count = np.full(width * height, sampling.first_set, np.int32)
     decided, other = (first, count), None
-    if sampling.adaptive and sampling.samples > sampling.first_set:
+    if refining:
         clamped = np.clip(colour, t(0), t(1))
         spread = (clamped.max(0) - clamped.min(0)).max(-1)
         threshold = t(F32(sampling.threshold))
         refine = spread > threshold
         near = np.abs(spread.astype(np.float64) - float(threshold)) <= DECISION_MARGIN
         more = np.flatnonzero(refine | near)
-        rest = accumulate([a[more] for a in first], *traced(more, range(sampling.first_set, sampling.samples)))
+        rest = accumulate([a[more] for a in first], *traced(more, range(sampling.first_set, sampling.samples),
+                                                            (0.5, 1.0)))
 
         def taking(which):                   # the first set everywhere, refined at `which`
             state = [a.copy() for a in first]

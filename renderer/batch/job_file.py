@@ -26,6 +26,7 @@ from typing import Any
 
 from renderer.batch.items import (CameraSpec, Job, Output, SceneEntry, SceneSource, Setting,
                                   default_output_name)
+from renderer.core import memory
 from renderer.core import output_settings as stage
 from renderer.core.builtin import is_scene_name
 from renderer.core.jsonio import canonical_json
@@ -74,10 +75,15 @@ def read_job(path) -> Job:
     return _JobReader(path).job(data)
 
 
+def need(setting: Setting, backends) -> memory.Need:
+    """What drawing a scene with `setting` on `backends` takes (renderer/core/memory.py)."""
+    return METHODS[setting.method].need(setting.size, backends, setting.options)
+
+
 def check_memory(scene, setting: Setting, backends) -> None:
     """A UserError when drawing `scene` with `setting` on `backends` would need more memory
     than the limit (renderer/core/memory.py)."""
-    METHODS[setting.method].check_memory(scene, setting.size, backends, setting.options)
+    need(setting, backends).check(scene)
 
 
 def _name(reader: TableReader, value: Any, key: str) -> str:
@@ -164,8 +170,10 @@ class _JobReader(TableReader):
         each setting too), one at a time: only the points' SceneSources are kept."""
         data, path = self.read_scene(scene_name, f"{key}.scene")
         points, first = [], None
+        needs = [need(setting, ["gpu"]) for setting in settings]
         for overrides in self.sweep_points(axes):
-            source, scene = self.point(data, path, overrides, f"{key}.sweep")
+            with memory.planned(*needs):       # a mesh too big for a setting: refused unbuilt
+                source, scene = self.point(data, path, overrides, f"{key}.sweep")
             if first is None:                  # the entry's rules that need its scene
                 first = scene
                 if cameras[0].kind == "frame":

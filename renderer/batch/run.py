@@ -43,10 +43,11 @@ from pathlib import Path
 from renderer.batch.folder import check_inside, locked
 from renderer.batch.items import ITEMS_FOLDER, Item, Job, expand, job_identity
 from renderer.batch.manifest import MANIFEST, Manifest, Resume, header_for, read_manifest
-from renderer.batch.job_file import check_memory
+from renderer.batch.job_file import need
 from renderer.methods import METHODS
 from renderer.batch.render_item import ItemResult, ItemWorker, item_scene, load_source, reference_item
 from renderer.cluster.executor import batch_size, batches_of, worker_label
+from renderer.core import memory
 from renderer.core.imageio import check_folder, check_outputs, outputs
 
 COMPARE_FILES = ("gpu.png", "reference.png", "diff.png")
@@ -87,7 +88,10 @@ def plan_job(job: Job, out, *, compare: bool = False, say=None) -> Plan:
     items = expand(job)
     if compare:                      # the reference's memory too (job_file checked the GPU's)
         for item in {(item.scene.digest, item.setting.name): item for item in items}.values():
-            check_memory(item_scene(load_source(item.scene), item), item.setting, ["gpu", "reference"])
+            both = need(item.setting, ["gpu", "reference"])
+            with memory.planned(both):
+                scene = load_source(item.scene)
+            both.check(item_scene(scene, item))
     wanted = {item.key: [*item.files, *(compare_files(item) if compare else ())] for item in items}
     check_outputs(out / MANIFEST, *(out / path for paths in _to_check(out, wanted) for path in paths))
     check_inside(out, (path for paths in wanted.values() for path in paths))

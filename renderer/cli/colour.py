@@ -4,7 +4,7 @@ an image or a scene's frame (renderer/study/colour_report.py)."""
 from __future__ import annotations
 
 from renderer.cli.options import load, output_path, parse_size
-from renderer.core.memory import check_render
+from renderer.core.memory import raster_need
 
 COLOUR_SIZE = (320, 240)             # `renderer colour`'s frame of a scene
 
@@ -45,9 +45,8 @@ def run(args) -> int:
     else:
         if args.colorspace is not None:
             args.parser.error("--colorspace says how an image is encoded; a scene's frame is linear")
-        scene = load(args.source)
         size = args.size or COLOUR_SIZE
-        check_render(scene, size, [args.backend])
+        scene = load(args.source, raster_need(size, [args.backend]))
         source = scene_source(scene, size, args.backend, args.context)
     written = write_colour_report(source, out)
     pixels = int(source.covered.sum())

@@ -13,7 +13,7 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.cli.options import (channel_threshold, check_raytrace_options, load, load_traced,
                                   memory_option, output_path, raytrace_options, scene_options,
                                   warn_if_nothing_drawn)
-from renderer.core.memory import check_render
+from renderer.core.memory import raster_need
 from renderer.errors import UserError
 
 
@@ -81,10 +81,9 @@ def run_methods(args) -> int:
     from renderer.core.jsonio import json_text
     from renderer.core.paths import output_stem
     from renderer.methods import METHODS
-    scene = load_traced(args)
-    for chosen in METHODS.values():
-        chosen.check_memory(scene, args.size, ["gpu"], args.options if chosen.options is type(args.options)
-                            else chosen.options())
+    scene = load_traced(args, *(chosen.need(args.size, ["gpu"], args.options if chosen.options
+                                            is type(args.options) else chosen.options())
+                                for chosen in METHODS.values()))
     out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
     names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
     check_outputs(*names)
@@ -112,12 +111,11 @@ def run_shadows(args) -> int:
         args.parser.error(f"--shadows-vs-truth measures the rasteriser's shadow maps; leave out "
                           f"--method {args.method}")
     check_raytrace_options(args)
-    scene = load(args.scene)
+    scene = load(args.scene, raster_need(args.size, ["reference"]))
     if not has_shadow_maps(scene):
         raise UserError("the scene has no shadow maps to hold against ray-cast truth (no light "
                         "with shadows on, nothing that casts or nothing that receives)",
                         file=scene.source or scene.name)
-    check_render(scene, args.size, ["reference"])
     names = _measurement_files(args, scene, "shadows", "shadow_truth")
     return _write_measurement(names, shadows_vs_truth(scene, *args.size))
 
@@ -159,8 +157,7 @@ def run_depth(args) -> int:
         args.parser.error(f"--depth-vs-truth measures the rasteriser's depth; leave out "
                           f"--method {args.method}")
     check_raytrace_options(args)
-    scene = load(args.scene)
-    check_render(scene, args.size, ["gpu"])
+    scene = load(args.scene, raster_need(args.size, ["gpu"]))
     names = _measurement_files(args, scene, "depth", "depth_truth")
     return _write_measurement(names, depth_vs_truth(scene, *args.size, context=args.context))
 
@@ -183,8 +180,7 @@ def run(args) -> int:
     check_raytrace_options(args)
     if args.methods:
         return run_methods(args)
-    scene = load_traced(args)
-    method(args.method).check_memory(scene, args.size, ["gpu", "reference"], args.options)
+    scene = load_traced(args, method(args.method).need(args.size, ["gpu", "reference"], args.options))
     out = check_folder(args.out or Path(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)

@@ -135,10 +135,22 @@ def memory_size(text: str) -> int:
         raise argparse.ArgumentTypeError(str(error)) from None
 
 
-def load(scene_arg):
+def load(scene_arg, *needs):
+    """The scene named on the command line, read for a command that will then take each of
+    `needs` (renderer/core/memory.py Need): refused in one line as soon as its triangles are
+    known to need more than the memory limit, before they are built, and checked whole once
+    read."""
+    from renderer.core import memory
     from renderer.core.builtin import resolve_scene
     from renderer.core.scene_file import load_scene
-    return load_scene(resolve_scene(scene_arg))
+    path = resolve_scene(scene_arg)
+    for need in needs:                     # a size too large for any scene: said first
+        need.check_unread(Path(path).stem)
+    with memory.planned(*needs):
+        scene = load_scene(path)
+    for need in needs:
+        need.check(scene)
+    return scene
 
 
 # RayOptions' fields -> the command line's options (renderer/core/ray_options.py holds the rules).
@@ -187,10 +199,10 @@ def check_raytrace_options(args) -> None:
         args.parser.error(spelled(error, args))
 
 
-def load_traced(args):
-    """The scene, checked against the lens overrides (an aperture on a parallel camera: one
-    line naming the option, status 2); open_renderer applies them."""
-    scene = load(args.scene)
+def load_traced(args, *needs):
+    """The scene (`load`, for `needs`), checked against the lens overrides (an aperture on a
+    parallel camera: one line naming the option, status 2); open_renderer applies them."""
+    scene = load(args.scene, *needs)
     try:
         args.options.scene_for(scene)
     except OptionError as error:

@@ -206,9 +206,8 @@ def run(args) -> int:
     check_plane_suffixes(args)
     check_outputs(args.output, args.depth, args.alpha)   # a folder, a file as parent, one file twice
     check_raytrace_options(args)
-    scene = load_traced(args)
     chosen = method(args.method)
-    chosen.check_memory(scene, args.size, [args.backend], args.options)
+    scene = load_traced(args, chosen.need(args.size, [args.backend], args.options))
     suffix = ".png" if settings is None else FORMATS[settings.format]
     output = args.output or Path(f"{output_stem(scene)}{suffix}")
     check_outputs(output, args.depth, args.alpha)

@@ -4,7 +4,7 @@ that prints frame-time statistics and writes a screenshot."""
 from __future__ import annotations
 
 from renderer.cli.options import DEFAULT_SIZE, load, memory_option, output_path, parse_size, positive_int
-from renderer.core.memory import check_render
+from renderer.core.memory import raster_need
 
 
 def add_parser(sub) -> None:
@@ -43,9 +43,9 @@ def run(args) -> int:
     from renderer.viewer.reference_view import figures_line
     from renderer.viewer.viewer import Viewer
     from renderer.methods import METHODS
-    scene = load(args.scene)
-    check_render(scene, args.size, ["gpu"])          # the viewer's rasteriser is always made
-    METHODS[args.method].check_memory(scene, args.size, ["gpu"], METHODS[args.method].options())
+    chosen = METHODS[args.method]
+    scene = load(args.scene, raster_need(args.size, ["gpu"]),    # the viewer's rasteriser is always made
+                 chosen.need(args.size, ["gpu"], chosen.options()))
     if args.frames is None and args.stats is not None:
         args.parser.error("--stats needs --frames (the scripted mode)")
     if args.screenshot is not None:          # before the window opens: a screenshot is RGB

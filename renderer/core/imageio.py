@@ -147,8 +147,9 @@ def check_folder(folder) -> Path:
     for path in (folder, *folder.parents):
         try:
             if path.exists() or path.is_symlink():
-                if not path.is_dir():
-                    raise UserError(f"{path} is not a folder, so nothing can be written in it",
+                if not path.is_dir():         # named once: "out: is not a folder, ..."
+                    which = "is" if path == folder else f"{path} is"
+                    raise UserError(f"{which} not a folder, so nothing can be written in it",
                                     file=str(folder))
                 break
         except OSError as error:

@@ -13,10 +13,20 @@ llvmpipe (peak resident memory over the process's baseline) and rounded up:
                  and a working set of 320 bytes a pixel of one band of at most TILE_PIXELS
                  (reference/pipeline.py draws a large frame band by band); 1280 bytes a
                  triangle (vertex outputs, clipping, window triangles, all float64)
-    mesh files   parsing takes up to 16 times the file's size (trimesh's text parsers)
+    mesh files   parsing takes up to 16 times the file's size (trimesh's text parsers);
+                 building the parsed mesh (merging, crease normals) up to 1024 bytes a
+                 triangle at its peak, and the built mesh holds 192
 
 The limit is half of the machine's physical memory unless set (`renderer ... --max-memory`,
 or `limit_set`); `check` raises the one-line UserError when an estimate is over it.
+
+A command knows what it will do before it reads its scene, but not how many triangles the
+scene holds. It says what it will need (`planned(need, ...)`, a Need per method, size and
+backends); the scene reader counts triangles as they become known (a TriangleTally: a mesh
+file's once it is parsed, a primitive's before it is built) and refuses as soon as the count
+would take the command over the limit, before the mesh is built (building a 5-million-
+triangle mesh takes half a minute and 4.6 GiB). So the peak of the whole command, loading
+included, stays under the limit: the larger of loading's peak and rendering's.
 """
 
 from __future__ import annotations
@@ -24,6 +34,8 @@ from __future__ import annotations
 import contextlib
 import os
 import re
+from dataclasses import dataclass
+from typing import Callable
 
 from renderer.errors import UserError
 
@@ -51,6 +63,16 @@ REFERENCE_TILE_PIXELS = 1 << 20
 
 MESH_PARSE_FACTOR = 16                          # bytes of memory per byte of mesh file
 SCENE_BYTES_PER_TRIANGLE = 256                  # building a primitive (float64 mesh + temporaries)
+# A mesh file's triangles once parsed: building them (renderer/core/meshio.py: checks, merged
+# vertices, crease normals) peaks at 931 bytes a triangle over what was held before, and the
+# built mesh holds 140 (5,005,448 triangles of a binary PLY without normals, peak and
+# resident memory after, 2026-12-03); rounded up.
+MESH_BUILD_BYTES_PER_TRIANGLE = 1024
+MESH_HELD_BYTES_PER_TRIANGLE = 192
+# What a command holds before its scene and its renderers: Python, NumPy, Pillow, trimesh and
+# the GL libraries (`renderer render` refusing a scene peaks at 135 MiB); rounded up. A Need
+# counts it and the scene's meshes, so that the whole process stays under the limit.
+PROCESS_BYTES = 192 * MIB
 
 DEFAULT_FRACTION = 0.5                          # of physical memory
 _limit: int | None = None
@@ -125,9 +147,11 @@ RAYTRACE_BYTES_PER_PIXEL = 64                   # float colour and depth targets
 # Per triangle: ray_scene (float64), the BVH and its build (its SAH bins in bounded chunks:
 # renderer/core/bvh.py), and on the GPU the float textures and their upload. Measured on a
 # 488,600-triangle uv_sphere at 64x48 (peak RSS over the scene's, 2026-12-03): GPU 1,069 and
-# reference 641 bytes a triangle; rounded up.
+# reference 641 bytes a triangle; but after loading a 999,698-triangle PLY (merged and
+# creased, benchmarks/bench_memory.py's whole commands) the reference's peak was 829 bytes a
+# triangle over the process and the mesh held (what loading left in the heap); rounded up.
 RAYTRACE_GPU_BYTES_PER_TRIANGLE = 1280
-RAYTRACE_BYTES_PER_TRIANGLE = 768
+RAYTRACE_BYTES_PER_TRIANGLE = 1024
 RAYTRACE_REFERENCE_BYTES_PER_CAMERA_RAY = 64    # windows, O, D, colour, hit, s of every sample
 RAYTRACE_REFERENCE_CHUNK_RAYS = 1 << 16         # reference/raytrace/pipeline.py, CHUNK_RAYS
 RAYTRACE_REFERENCE_WORKING_BYTES_PER_RAY = 2048
@@ -149,15 +173,19 @@ def raytrace_reference_bytes(width: int, height: int, triangles: int, *, samples
             + triangles * RAYTRACE_BYTES_PER_TRIANGLE)
 
 
-def over_limit(needed: int) -> str | None:
+def over_limit(needed: int, *, loading: bool = False) -> str | None:
     """None when `needed` bytes fit under the limit, else the end of a refusal:
-    "needs about 19.1 GiB of memory, over the limit of 12.0 GiB (...)"."""
+    "needs about 19.1 GiB of memory, over the limit of 12.0 GiB (...)". `loading`: `needed`
+    is one step of reading a scene (a file, a texture), taken on top of the process's own
+    PROCESS_BYTES, which count against the limit too and are said beside it."""
     allowed = limit()
-    if needed <= allowed:
+    total = needed + PROCESS_BYTES if loading else needed
+    if total <= allowed:
         return None
     origin = "set by --max-memory" if _limit is not None else \
         f"half of this machine's {show(physical_memory())}; --max-memory changes it"
-    return f"needs about {show(needed)} of memory, over the limit of {show(allowed)} ({origin})"
+    besides = f" ({show(total)} with the process's own)" if loading else ""
+    return f"needs about {show(needed)} of memory{besides}, over the limit of {show(allowed)} ({origin})"
 
 
 def check(needed: int, what: str, *, file: str | None = None) -> None:
@@ -167,23 +195,117 @@ def check(needed: int, what: str, *, file: str | None = None) -> None:
         raise UserError(f"{what} {reason}", file=file)
 
 
-def check_render(scene, size, backends) -> None:
-    """One line, before any rendering, when rasterising `scene` at `size` on each of
-    `backends` ("gpu", "reference") would need more than the limit."""
+@dataclass(frozen=True)
+class Need:
+    """What a command will take to draw a scene, known before the scene is read: `bytes_for`
+    a scene of that many triangles (those it counts: an analytic shape's own triangles only
+    when `shapes`, since the ray tracer intersects the shape itself). `verb`, `setting` and
+    `backends` word the refusal: "ray tracing NAME at 64x48, 1 spp (N triangles) on gpu"."""
+    verb: str
+    setting: str
+    backends: tuple[str, ...]
+    bytes_for: Callable[[int], int]
+    shapes: bool = True
+
+    def counted(self, meshes: int, shapes: int) -> int:
+        return meshes + (shapes if self.shapes else 0)
+
+    def words(self, name: str | None, triangles: int | None, *, so_far: bool = False) -> str:
+        named = f" {name}" if name else ""
+        count = "" if triangles is None else f" ({triangles:,} triangles{' so far' if so_far else ''})"
+        return f"{self.verb}{named} {self.setting}{count} on {' and '.join(self.backends)}"
+
+    def check_unread(self, name: str) -> None:
+        """One line before the scene `name` is read, when the command is over the limit with
+        no triangles at all (its size alone)."""
+        check(self.bytes_for(0), self.words(name, None))
+
+    def check(self, scene) -> None:
+        """One line, before any rendering, when drawing `scene` would need more than the limit."""
+        meshes = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is None)
+        shapes = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is not None)
+        triangles = self.counted(meshes, shapes)
+        check(self.bytes_for(triangles), self.words(scene.name, triangles))
+
+
+def raster_need(size, backends) -> Need:
+    """The rasteriser at `size` on each of `backends` ("gpu", "reference")."""
     # Every object's mesh is held, an analytic plane's square too (the shadow passes draw it);
     # the polygon the camera pass draws for a plane instead (renderer/core/drawn.py) adds at
     # most 4 triangles, a few kilobytes, below these figures' rounding.
-    triangles = sum(obj.mesh.triangle_count for obj in scene.objects)
     estimate = {"gpu": gpu_bytes, "reference": reference_bytes}
-    needed = sum(estimate[backend](*size, triangles) for backend in backends)
-    check(needed, f"rendering {scene.name} at {size[0]}x{size[1]} ({triangles:,} triangles) "
-                  f"on {' and '.join(backends)}")
+    return Need("rendering", f"at {size[0]}x{size[1]}", tuple(backends),
+                lambda triangles: _whole(triangles, *(estimate[b](*size, triangles) for b in backends)))
+
+
+def raytrace_need(size, backends, samples: int) -> Need:
+    """The ray tracer at `size` and `samples` per pixel (its triangles: meshes only)."""
+    estimate = {"gpu": raytrace_gpu_bytes, "reference": raytrace_reference_bytes}
+    return Need("ray tracing", f"at {size[0]}x{size[1]}, {samples} spp", tuple(backends),
+                lambda triangles: _whole(triangles, *(estimate[b](*size, triangles, samples=samples)
+                                                      for b in backends)),
+                shapes=False)
+
+
+def _whole(triangles: int, *renderers: int) -> int:
+    """A command's peak: the process, the scene's meshes held, and its renderers' estimates
+    (each measured over the process and the scene)."""
+    return PROCESS_BYTES + triangles * MESH_HELD_BYTES_PER_TRIANGLE + sum(renderers)
+
+
+def check_render(scene, size, backends) -> None:
+    """One line, before any rendering, when rasterising `scene` at `size` on each of
+    `backends` ("gpu", "reference") would need more than the limit."""
+    raster_need(size, backends).check(scene)
 
 
 def check_raytrace_render(scene, size, backends, samples) -> None:
     """check_render for the ray tracer at `samples` per pixel (its triangles: meshes only)."""
-    triangles = sum(obj.mesh.triangle_count for obj in scene.objects if obj.shape is None)
-    estimate = {"gpu": raytrace_gpu_bytes, "reference": raytrace_reference_bytes}
-    needed = sum(estimate[backend](*size, triangles, samples=samples) for backend in backends)
-    check(needed, f"ray tracing {scene.name} at {size[0]}x{size[1]}, {samples} spp "
-                  f"({triangles:,} triangles) on {' and '.join(backends)}")
+    raytrace_need(size, backends, samples).check(scene)
+
+
+_planned: tuple[Need, ...] = ()
+
+
+@contextlib.contextmanager
+def planned(*needs: Need):
+    """While a command reads its scene: what it will then need (each of `needs`, checked
+    after reading anyway), so that the scene reader's TriangleTally refuses a scene too large
+    for it as soon as its triangle count is known, before building it."""
+    global _planned
+    before, _planned = _planned, tuple(needs)
+    try:
+        yield
+    finally:
+        _planned = before
+
+
+class TriangleTally:
+    """The triangles one scene reader has counted so far: mesh files' (`meshes`) and analytic
+    shapes' (`shapes`). Each count is checked, before those triangles are built, against the
+    limit: building them on top of what is held, and what the planned command needs."""
+
+    def __init__(self):
+        self.meshes = 0
+        self.shapes = 0
+
+    def held(self) -> int:
+        return (self.meshes + self.shapes) * MESH_HELD_BYTES_PER_TRIANGLE
+
+    def add(self, count: int, *, shape: bool = False,
+            build_bytes_per_triangle: int = MESH_BUILD_BYTES_PER_TRIANGLE) -> str | None:
+        """Count `count` more triangles, about to be built: None when they fit, else why not
+        (the end of a one-line refusal, after the file or key it names)."""
+        too_much = over_limit(self.held() + count * build_bytes_per_triangle, loading=True)
+        if too_much:
+            return f"building its {count:,} triangles {too_much}"
+        if shape:
+            self.shapes += count
+        else:
+            self.meshes += count
+        for need in _planned:             # (one over the limit unread: refused before reading)
+            triangles = need.counted(self.meshes, self.shapes)
+            too_much = over_limit(need.bytes_for(triangles))
+            if too_much:
+                return f"{need.words(None, triangles, so_far=True)} {too_much}"
+        return None

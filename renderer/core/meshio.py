@@ -65,7 +65,8 @@ class _MeshProblem(Exception):
 
 
 def load_mesh(path, *, source: str | None = None, key: str | None = None,
-              crease_angle: float = DEFAULT_CREASE_ANGLE) -> Mesh:
+              crease_angle: float = DEFAULT_CREASE_ANGLE,
+              tally: memory.TriangleTally | None = None) -> Mesh:
     """Read and check a triangle mesh file.
 
     path:   the mesh file.
@@ -74,6 +75,9 @@ def load_mesh(path, *, source: str | None = None, key: str | None = None,
             "scene.toml: objects[2].mesh.file: /abs/knot.obj: 4 faces index ...".
     crease_angle: degrees, 0 < angle <= 180, for a file without normals (see
             `crease_vertex_normals`); a file with normals keeps its own.
+    tally:  the scene's triangles so far (renderer/core/memory.py): once the file is parsed,
+            its triangles are counted there and refused, before the mesh is built, when
+            building them or the command planned would go over the memory limit.
     """
     if not 0.0 < crease_angle <= 180.0:
         raise ValueError(f"crease_angle must be in (0, 180] degrees, got {crease_angle!r}")
@@ -83,14 +87,14 @@ def load_mesh(path, *, source: str | None = None, key: str | None = None,
         path = checked_path(path, key=key, error=SceneError)
     try:
         with _quiet_libraries():
-            return _load_checked(path, crease_angle)
+            return _load_checked(path, crease_angle, memory.TriangleTally() if tally is None else tally)
     except _MeshProblem as problem:
         if source is not None:
             raise SceneError(f"{path}: {problem}", file=source, key=key) from None
         raise SceneError(str(problem), file=str(path), key=key) from None
 
 
-def _load_checked(path: Path, crease_angle: float) -> Mesh:
+def _load_checked(path: Path, crease_angle: float, tally: memory.TriangleTally) -> Mesh:
     data = _read_file(path)
     suffix = path.suffix.lower()
     if suffix == ".obj":
@@ -98,6 +102,10 @@ def _load_checked(path: Path, crease_angle: float) -> Mesh:
     if suffix == ".ply":
         _check_ascii_ply_face_indices(data)
     positions, faces, file_normals, uvs = _read_with_trimesh(path, data)
+    del data
+    too_much = tally.add(len(faces))              # before building: half a minute at 5M
+    if too_much:
+        raise _MeshProblem(too_much)
     _check_geometry(positions, faces)
     _check_uvs(uvs)
     if file_normals is not None:
@@ -125,7 +133,7 @@ def _read_file(path: Path) -> bytes:
                                    f"expected one of {', '.join(MESH_SUFFIXES)}")
             # Checked before parsing: the parsers take up to MESH_PARSE_FACTOR times the size.
             size = os.fstat(handle.fileno()).st_size
-            too_much = memory.over_limit(size * memory.MESH_PARSE_FACTOR)
+            too_much = memory.over_limit(size * memory.MESH_PARSE_FACTOR, loading=True)
             if too_much:
                 raise _MeshProblem(f"a mesh file of {memory.show(size)} {too_much}")
             return read_capped(handle, MESH_FILE)

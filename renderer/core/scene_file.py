@@ -446,6 +446,7 @@ class _Reader(TableReader):
         super().__init__(source)
         self.base_dir = base_dir
         self.primitive_triangles = 0      # so far, for the memory check before building more
+        self.tally = memory.TriangleTally()    # every mesh's, against the command's plan
         self.textures: dict = {}          # each image, checker and mesh file's texture, made once
 
     # ---- the scene
@@ -848,10 +849,15 @@ class _Reader(TableReader):
                 self.fail(path, f"the plane's square reaches {show_number(foot + args['size'])} "
                                 f"from the origin, beyond |x| <= {MAX_NUMBER:g} (float32)")
         self.primitive_triangles += shapes.TRIANGLES[kind](**args)
-        too_much = memory.over_limit(self.primitive_triangles * memory.SCENE_BYTES_PER_TRIANGLE)
+        too_much = memory.over_limit(self.primitive_triangles * memory.SCENE_BYTES_PER_TRIANGLE,
+                                     loading=True)
         if too_much:
             self.fail(path, f"the scene's primitives up to here make up to "
                             f"{self.primitive_triangles:,} triangles: building them {too_much}")
+        too_much = self.tally.add(shapes.TRIANGLES[kind](**args), shape=True,
+                                  build_bytes_per_triangle=memory.SCENE_BYTES_PER_TRIANGLE)
+        if too_much:
+            self.fail(path, too_much)
         if kind == "sphere":
             mesh = shapes.sphere_mesh(shape, **args)
         else:
@@ -911,10 +917,15 @@ class _Reader(TableReader):
         # Refused before it is built: a few segment counts at their maxima make tens of
         # millions of triangles (renderer/core/memory.py).
         self.primitive_triangles += PRIMITIVE_TRIANGLES[name](**kwargs)
-        too_much = memory.over_limit(self.primitive_triangles * memory.SCENE_BYTES_PER_TRIANGLE)
+        too_much = memory.over_limit(self.primitive_triangles * memory.SCENE_BYTES_PER_TRIANGLE,
+                                     loading=True)
         if too_much:
             self.fail(path, f"the scene's primitives up to here make up to "
                             f"{self.primitive_triangles:,} triangles: building them {too_much}")
+        too_much = self.tally.add(PRIMITIVE_TRIANGLES[name](**kwargs),
+                                  build_bytes_per_triangle=memory.SCENE_BYTES_PER_TRIANGLE)
+        if too_much:
+            self.fail(path, too_much)
         mesh = build(**kwargs)
         if mesh.triangle_count == 0:
             self.fail(path, "the primitive has no triangles with these arguments")
@@ -930,7 +941,7 @@ class _Reader(TableReader):
 
     def mesh_file(self, value: Any, path: str, crease_angle: float = DEFAULT_CREASE_ANGLE) -> Mesh:
         return load_mesh(self.find_file(value, path, "mesh"), source=self.source, key=path,
-                         crease_angle=crease_angle)
+                         crease_angle=crease_angle, tally=self.tally)
 
     def mesh_file_texture(self, value: Any, path: str) -> MaterialTexture | None:
         """A glTF/GLB mesh file's base-colour texture (renderer/core/gltf_texture.py), made

@@ -67,7 +67,7 @@ def _checker(reader, raw: Any, path: str, cache: dict) -> Texture:
     resolution = CHECKER_DEFAULTS["resolution"]
     if "resolution" in raw:
         resolution = reader.integer(raw["resolution"], key("resolution"), 1, largest)
-    too_much = memory.over_limit(resolution * resolution * TEXTURE_BYTES_PER_TEXEL)
+    too_much = memory.over_limit(resolution * resolution * TEXTURE_BYTES_PER_TEXEL, loading=True)
     if too_much:
         reader.fail(key("resolution"), f"a {resolution} x {resolution} texture {too_much}")
     squares = CHECKER_DEFAULTS["squares"]

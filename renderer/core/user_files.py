@@ -232,7 +232,7 @@ def image_size_problem(width: int, height: int, *, max_side: int | None,
         return f"image has no pixels ({width} x {height})"
     if max_side is not None and max(width, height) > max_side:
         return f"image is {width} x {height}; {_article(what)} {what} is at most {max_side} {side}"
-    too_much = memory.over_limit(width * height * bytes_per_pixel)
+    too_much = memory.over_limit(width * height * bytes_per_pixel, loading=True)
     if too_much:
         return f"a {width} x {height} {what} {too_much}"
     return None
@@ -258,10 +258,80 @@ def open_image(source, *, max_side: int | None, bytes_per_pixel: int, what: str 
         raise FileRefused(f"could not be read as an image: {_first_line(exc)}") from None
     problem = image_size_problem(*image.size, max_side=max_side,
                                  bytes_per_pixel=bytes_per_pixel, what=what, side=side)
+    if problem is None and image.format == "PNG":
+        problem = png_data_problem(stream)
     if problem:
         image.close()
         raise FileRefused(problem)
     return image
+
+
+# Adam7's passes: (first column, first row, column step, row step).
+_ADAM7 = ((0, 0, 8, 8), (4, 0, 8, 8), (0, 4, 4, 8), (2, 0, 4, 4), (0, 2, 2, 4), (1, 0, 2, 2),
+          (0, 1, 1, 2))
+_PNG_CHANNELS = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}       # by colour type
+_INFLATE_STEP = 16 << 20                             # bytes of output inflated at a time
+
+
+def png_data_problem(stream) -> str | None:
+    """Why a PNG's image data does not hold the rows its header declares, or None. Pillow
+    draws missing rows black without a word when the compressed stream ends early but
+    properly (a file cut and mended, a writer that stopped): the IDAT stream is inflated
+    here, a bounded step at a time and counted, never held, and its length held against the
+    header's rows (Adam7's seven passes for an interlaced file). The stream's position is
+    put back."""
+    import struct
+    import zlib
+
+    start = stream.tell()
+    try:
+        stream.seek(0)
+        if stream.read(8) != b"\x89PNG\r\n\x1a\n":
+            return None                                 # Pillow's own checks said PNG
+        expected, inflater, inflated = None, zlib.decompressobj(), 0
+        while True:
+            head = stream.read(8)
+            if len(head) < 8:
+                break
+            length, kind = struct.unpack(">I4s", head)
+            if kind == b"IHDR" and length >= 13:
+                width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", stream.read(13))
+                stream.seek(length - 13 + 4, 1)
+                bits = _PNG_CHANNELS.get(colour, 4) * depth
+                passes = _ADAM7 if interlace else ((0, 0, 1, 1),)
+                expected = 0
+                for x0, y0, dx, dy in passes:
+                    columns, rows = -(-(width - x0) // dx), -(-(height - y0) // dy)
+                    if columns > 0 and rows > 0:
+                        expected += rows * (1 + -(-columns * bits // 8))
+            elif kind == b"IDAT":
+                left = length
+                while left > 0 and not inflater.eof:
+                    block = stream.read(min(left, 1 << 20))
+                    if not block:
+                        break
+                    left -= len(block)
+                    while block and not inflater.eof:
+                        inflated += len(inflater.decompress(block, _INFLATE_STEP))
+                        block = inflater.unconsumed_tail
+                stream.seek(left + 4, 1)
+            elif kind == b"IEND":
+                break
+            else:
+                stream.seek(length + 4, 1)
+        while not inflater.eof:                         # what the last step left inflated
+            more = inflater.decompress(b"", _INFLATE_STEP)
+            if not more:
+                break
+            inflated += len(more)
+    except (OSError, struct.error, zlib.error):
+        return None                                     # Pillow's decode will say what is wrong
+    finally:
+        stream.seek(start)
+    if expected is not None and inflated < expected:
+        return (f"is truncated: its image data holds {inflated:,} of the {expected:,} bytes "
+                f"its header's {width} x {height} pixels need (rows are missing)")
+    return None
 
 
 def _first_line(exc: BaseException) -> str:

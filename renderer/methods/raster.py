@@ -5,7 +5,7 @@ pipeline behind the same protocol."""
 from __future__ import annotations
 
 from renderer.core.frame import Frame
-from renderer.core.memory import check_render
+from renderer.core.memory import raster_need
 from renderer.core.raster_options import RasterOptions
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
@@ -21,7 +21,7 @@ class ReferenceRaster(ReferenceRenderer):
         super().__init__(scene, width, height, options, precision)
         self.subpixel_bits = subpixel_bits
 
-    def _frame(self, *, linear: bool, depth: bool, **extra) -> Frame:
+    def _frame(self, *, linear: bool, depth: bool, progress=None, **extra) -> Frame:
         import reference
         if self.subpixel_bits is not None:
             extra["subpixel_bits"] = self.subpixel_bits
@@ -39,8 +39,8 @@ def _open_reference(scene, width, height, options, precision, subpixel_bits):
     return ReferenceRaster(scene, width, height, options, precision, subpixel_bits)
 
 
-def _check_memory(scene, size, backends, options) -> None:
-    check_render(scene, size, backends)
+def _need(size, backends, options):
+    return raster_need(size, backends)
 
 
-METHOD = Method("raster", "rasteriser", RasterOptions, _open_gpu, _open_reference, _check_memory)
+METHOD = Method("raster", "rasteriser", RasterOptions, _open_gpu, _open_reference, _need)

@@ -6,7 +6,7 @@ overrides open_renderer applies to the scene before either backend sees it."""
 from __future__ import annotations
 
 from renderer.core.frame import Frame
-from renderer.core.memory import check_raytrace_render
+from renderer.core.memory import raytrace_need
 from renderer.core.ray_options import RayOptions
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
@@ -42,13 +42,15 @@ class ReferenceRayTracer(ReferenceRenderer):
     def reseed(self, seed: int) -> None:
         self.options = self.options.replace(seed=seed)
 
-    def _frame(self, *, linear: bool, depth: bool, first_sample: int = 0) -> Frame:
+    def _frame(self, *, linear: bool, depth: bool, progress=None, first_sample: int = 0) -> Frame:
         from reference.raytrace.pipeline import render
         o = self.options
+        rows = self.height
+        told = None if progress is None else (lambda share: progress(int(rows * share), rows))
         return render(self.scene, self.width, self.height, samples=o.samples, pattern=o.pattern,
                       max_depth=o.max_depth, seed=o.seed, shadows=o.shadows, rs=self.ray_scene,
                       first_sample=first_sample, adaptive_threshold=o.adaptive_threshold,
-                      dtype=self.dtype, light_samples=o.light_samples)
+                      dtype=self.dtype, light_samples=o.light_samples, progress=told)
 
 
 def _open_gpu(scene, width, height, options: RayOptions, context, context_kind):
@@ -64,8 +66,8 @@ def _samples(options: RayOptions) -> int:
     return options.samples * options.light_samples
 
 
-def _check_memory(scene, size, backends, options: RayOptions) -> None:
-    check_raytrace_render(scene, size, backends, _samples(options))
+def _need(size, backends, options: RayOptions):
+    return raytrace_need(size, backends, _samples(options))
 
 
 def samples_fired(frame: Frame) -> str:
@@ -80,5 +82,5 @@ def _words(options: RayOptions, frame: Frame) -> str:
     return f"raytrace {options.samples} spp"
 
 
-METHOD = Method("raytrace", "ray tracer", RayOptions, _open_gpu, _open_reference, _check_memory,
+METHOD = Method("raytrace", "ray tracer", RayOptions, _open_gpu, _open_reference, _need,
                 _words, _samples, progressive=True, seeded=True, shutter=True)

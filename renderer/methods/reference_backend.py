@@ -28,14 +28,15 @@ class ReferenceRenderer:
 
     def render(self, out: Frame | None = None, *, linear: bool = False, depth: bool = True,
                progress=None, **extra) -> Frame:
-        """The twin's frame (`progress` told once, when it is done); `out` is taken for the
-        protocol's sake and not reused: the twin's arrays are its own, made afresh each frame."""
-        frame = self._frame(linear=linear, depth=depth, **extra)
+        """The twin's frame (`progress(rows done, rows)` told as the method can, and when it
+        is done); `out` is taken for the protocol's sake and not reused: the twin's arrays are
+        its own, made afresh each frame."""
+        frame = self._frame(linear=linear, depth=depth, progress=progress, **extra)
         if progress is not None:
             progress(self.height, self.height)
         return frame
 
-    def _frame(self, *, linear: bool, depth: bool, **extra) -> Frame:
+    def _frame(self, *, linear: bool, depth: bool, progress=None, **extra) -> Frame:
         raise NotImplementedError
 
     def update(self, scene: Scene | None = None) -> None:

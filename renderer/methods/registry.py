@@ -18,8 +18,9 @@ class Method:
 
     open_gpu(scene, width, height, options, context, context_kind) and
     open_reference(scene, width, height, options, precision, subpixel_bits) return a Renderer
-    (renderer/gpu/base.py); check_memory(scene, size, backends, options) refuses, in one line,
-    what would not fit (renderer/core/memory.py); words(options, frame) says how a frame was
+    (renderer/gpu/base.py); need(size, backends, options) is what drawing a scene will take
+    (a renderer/core/memory.py Need: planned while the scene is read, checked once it is, by
+    check_memory, which refuses in one line what would not fit); words(options, frame) says how a frame was
 made in a few words for a front end's line ("" for nothing to say); samples(options) is
 what a frame's work per pixel scales with (the ray tracer's samples times light samples;
 memory estimates and a batch's costs). `progressive`: successive frames bring new
@@ -32,12 +33,16 @@ animation's frames differ."""
     options: type
     open_gpu: Callable
     open_reference: Callable
-    check_memory: Callable
+    need: Callable
     words: Callable = lambda options, frame: ""
     samples: Callable = lambda options: 1
     progressive: bool = False
     seeded: bool = False
     shutter: bool = False
+
+    def check_memory(self, scene, size, backends, options) -> None:
+        """One line (a UserError) when drawing `scene` would need more than the memory limit."""
+        self.need(size, backends, options).check(scene)
 
     def options_from(self, given: dict, owners: dict[str, str]):
         """This method's options from the fields `given` (those not given keep their defaults);

@@ -20,7 +20,8 @@ import numpy as np
 from renderer.core.output_settings import Transfer
 from renderer.core.quantise import decode
 from renderer.core.user_files import (ARRAY_FILE, IMAGE_FILE, FileRefused, image_size_problem,
-                                      npy_header, open_image, open_user_file, read_capped, refuse)
+                                      npy_header, open_image, open_user_file, png_data_problem,
+                                      read_capped, refuse)
 from renderer.errors import UserError
 
 FLOAT_SUFFIXES = (".exr", ".npy")
@@ -85,6 +86,9 @@ def _read_pixels(path: Path) -> tuple[np.ndarray, bool]:
         header = png.Reader(file=handle)
         header.preamble()                       # the chunks before the image data: IHDR's size
         _check_size(header.width, header.height)
+        missing = png_data_problem(handle)      # rows missing: said as such, not as a shape
+        if missing:
+            raise FileRefused(missing)
         handle.seek(0)
         codes, bits, _ = read_png(read_capped(handle, IMAGE_FILE))
         return _as_rgba(codes / np.array([(1 << b) - 1 for b in bits], np.float64)), False

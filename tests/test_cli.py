@@ -31,9 +31,10 @@ def test_render_default_scene_writes_png_and_depth(tmp_path, cli):
 def test_render_without_output_names_the_file_after_the_scene(tmp_path, cli):
     result = cli("render", "--size", "32x24", "--backend", "reference", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert (tmp_path / "sphere.png").exists()
+    assert [p.name for p in tmp_path.iterdir()] == ["out"]          # nothing loose in the folder
+    assert (tmp_path / "out" / "sphere.png").exists()
     assert result.stdout == ""
-    assert re.fullmatch(r"wrote sphere\.png \(32x24, reference, \d+\.\d ms\)\n", result.stderr)
+    assert re.fullmatch(r"wrote out/sphere\.png \(32x24, reference, \d+\.\d ms\)\n", result.stderr)
 
 
 def test_render_says_where_it_wrote_on_stderr_unless_quiet(tmp_path, capsys, monkeypatch):
@@ -42,12 +43,12 @@ def test_render_says_where_it_wrote_on_stderr_unless_quiet(tmp_path, capsys, mon
     assert main(["render", "--size", "16x12", "--backend", "reference", "--depth", "d.npy"]) == 0
     out, err = capsys.readouterr()
     assert out == ""
-    assert re.fullmatch(r"wrote sphere\.png and d\.npy \(16x12, reference, \d+\.\d ms\)\n", err)
+    assert re.fullmatch(r"wrote out/sphere\.png and d\.npy \(16x12, reference, \d+\.\d ms\)\n", err)
     for quiet in ("--quiet", "-q"):
-        (tmp_path / "sphere.png").unlink()
+        (tmp_path / "out" / "sphere.png").unlink()
         assert main(["render", "--size", "16x12", "--backend", "reference", quiet]) == 0
         assert capsys.readouterr() == ("", "")
-        assert (tmp_path / "sphere.png").exists()
+        assert (tmp_path / "out" / "sphere.png").exists()
 
 
 # The full run's (--all), about 1.5 s: in the default run `renderer compare` with a real GPU

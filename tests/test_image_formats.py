@@ -188,3 +188,21 @@ def test_shapes_a_format_cannot_hold_are_refused():
         write_png(io.BytesIO(), np.zeros((2, 2)), 8, 8)
     with pytest.raises(ValueError, match="OpenEXR"):
         write_exr(io.BytesIO(), np.zeros((2, 2, 2), np.float32))
+
+
+@pytest.mark.parametrize("suffix", [".exr", ".npy"])
+def test_the_suffix_alone_names_a_float_format(tmp_path, suffix):
+    """`render -o x.exr` (the README's example, with --depth and --alpha) writes the frame's
+    linear colour as float32, with no --format: the format follows -o's suffix."""
+    from renderer import cli
+    out = tmp_path / f"s{suffix}"
+    assert cli.main(["render", "sphere", "--size", "16x12", "-q", "-o", str(out),
+                     "--depth", str(tmp_path / "depth.exr"), "--alpha", str(tmp_path / "alpha.png")]) == 0
+    image = read_exr(out) if suffix == ".exr" else np.load(out)
+    assert image.dtype == np.float32 and image.shape == (12, 16, 3)
+    assert (tmp_path / "depth.exr").exists() and (tmp_path / "alpha.png").exists()
+    with_format = tmp_path / f"f{suffix}"
+    assert cli.main(["render", "sphere", "--size", "16x12", "-q", "-o", str(with_format),
+                     "--format", suffix[1:]]) == 0
+    again = read_exr(with_format) if suffix == ".exr" else np.load(with_format)
+    assert same_bits(image, again)

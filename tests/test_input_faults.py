@@ -233,13 +233,13 @@ def test_the_scene_name_never_decides_where_render_writes(capsys, tmp_path, monk
 def test_default_names_of_compare_and_shaders_come_from_the_file(capsys, work):
     (work / "s.toml").write_text(f'name = "../evil"\n[[objects]]\n{CUBE}')
     assert main(["shaders", "s.toml"]) == 0
-    assert (work / "shaders-s").is_dir()
-    assert not (work.parent / "evil").exists() and not list(work.glob("shaders-.*"))
+    assert (work / "out" / "shaders-s").is_dir()
+    assert not (work.parent / "evil").exists() and not list(work.glob("**/shaders-.*"))
 
 
 def test_a_built_in_scene_writes_under_its_name(capsys, work):
     assert main(render("-q")) == 0
-    assert [p.name for p in work.iterdir()] == ["sphere.png"]
+    assert [p.relative_to(work).as_posix() for p in work.rglob("*")] == ["out", "out/sphere.png"]
 
 
 # -- 3. more lights than GL guarantees uniform storage for ------------------------------------

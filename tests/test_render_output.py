@@ -89,7 +89,7 @@ def test_depth_and_alpha_planes(tmp_path, cli_here):
 def test_the_default_name_takes_the_formats_suffix(tmp_path, cli_here):
     result = cli_here(*ARGS, "--backend", "reference", "--format", "exr", cwd=tmp_path)
     assert result.returncode == 0, result.stderr
-    assert [p.name for p in tmp_path.iterdir()] == ["sphere.exr"]
+    assert [p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")] == ["out", "out/sphere.exr"]
 
 
 def test_the_gpu_pass_runs_on_the_renderers_own_context(tmp_path, cli_here, monkeypatch):

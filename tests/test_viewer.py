@@ -256,7 +256,7 @@ def test_s_saves_a_screenshot(viewer, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     press(viewer, glfw.KEY_S)
     viewer.frame()
-    saved = sorted(tmp_path.glob("view-coloured_lights-*.png"))
+    saved = sorted((tmp_path / "out").glob("view-coloured_lights-*.png"))
     assert len(saved) == 1
     assert_matches(read_png(saved[0])[..., :3], headless(scene("coloured_lights")))
 

@@ -33,7 +33,7 @@ def add_parser(sub) -> None:
     scene_options(compare)
     raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
-                                                   "(default: compare-SCENE_NAME)")
+                                                   "(default: out/compare-SCENE_NAME)")
     compare.add_argument("--methods", action="store_true",
                          help="the rasteriser against the ray tracer (--spp, --pattern, --max-depth, "
                               "--seed), both on the GPU: where they differ and why (shadows, "
@@ -79,12 +79,12 @@ def run_methods(args) -> int:
     from renderer.checks.methods import cause_image, compare_methods
     from renderer.core.imageio import check_folder, check_outputs, outputs
     from renderer.core.jsonio import json_text
-    from renderer.core.paths import output_stem
+    from renderer.core.paths import default_output, output_stem
     from renderer.methods import METHODS
     scene = load_traced(args, *(chosen.need(args.size, ["gpu"], args.options if chosen.options
                                             is type(args.options) else chosen.options())
                                 for chosen in METHODS.values()))
-    out = check_folder(args.out or Path(f"compare-methods-{output_stem(scene)}"))
+    out = check_folder(args.out or default_output(f"compare-methods-{output_stem(scene)}"))
     names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
     check_outputs(*names)
     result = compare_methods(scene, *args.size, context_kind=args.context, threshold=args.threshold,
@@ -124,8 +124,8 @@ def _measurement_files(args, scene, folder: str, stem: str) -> list[Path]:
     """A measurement's image and figures, STEM.png and STEM.json, in --out (default
     compare-FOLDER-SCENE), checked before anything is rendered."""
     from renderer.core.imageio import check_folder, check_outputs
-    from renderer.core.paths import output_stem
-    out = check_folder(args.out or Path(f"compare-{folder}-{output_stem(scene)}"))
+    from renderer.core.paths import default_output, output_stem
+    out = check_folder(args.out or default_output(f"compare-{folder}-{output_stem(scene)}"))
     names = [out / f"{stem}.png", out / f"{stem}.json"]
     check_outputs(*names)
     return names
@@ -169,7 +169,7 @@ def run(args) -> int:
     from renderer.checks.against_reference import against_reference
     from renderer.methods import method
     from renderer.core.imageio import check_folder, check_outputs, outputs
-    from renderer.core.paths import output_stem
+    from renderer.core.paths import default_output, output_stem
     from renderer.core.jsonio import to_json
     if args.out is not None:
         check_folder(args.out)
@@ -181,7 +181,7 @@ def run(args) -> int:
     if args.methods:
         return run_methods(args)
     scene = load_traced(args, method(args.method).need(args.size, ["gpu", "reference"], args.options))
-    out = check_folder(args.out or Path(f"compare-{output_stem(scene)}"))
+    out = check_folder(args.out or default_output(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]
     check_outputs(*names)
     # Median of a few frames: the first one pays for shader compilation.

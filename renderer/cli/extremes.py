@@ -3,9 +3,9 @@ shadow maps' light-elevation sweep, reported as extremes.json and extremes.md.""
 
 from __future__ import annotations
 
-from pathlib import Path
 
 from renderer.cli.options import memory_option, output_path, parse_size
+from renderer.core.paths import default_output
 
 
 def add_parser(sub) -> None:
@@ -13,8 +13,8 @@ def add_parser(sub) -> None:
     extremes = sub.add_parser("extremes", help="render the extreme scenes (assets/extreme/) through "
                                                "both pipelines and report their stability")
     extremes.add_argument("scenes", nargs="*", help="further scene files to measure alike")
-    extremes.add_argument("--out", type=output_path, default=Path("extremes"),
-                          help="folder for extremes.json and extremes.md (default: extremes)")
+    extremes.add_argument("--out", type=output_path, default=default_output("extremes"),
+                          help="folder for extremes.json and extremes.md (default: out/extremes)")
     extremes.add_argument("--size", type=parse_size, default=(320, 240), metavar="WxH",
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",

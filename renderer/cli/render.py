@@ -6,7 +6,6 @@ from __future__ import annotations
 import contextlib
 import sys
 import time
-from pathlib import Path
 
 from renderer.cli.options import (check_raytrace_options, load_traced, memory_option, output_path,
                                   raytrace_options, scene_options, spelled, warn_if_nothing_drawn)
@@ -21,7 +20,7 @@ def add_parser(sub) -> None:
     raytrace_options(render)
     render.add_argument("-o", "--output", type=output_path, metavar="OUT.png",
                         help="image to write, in the format its suffix names (.png, .jpg, .webp, "
-                             ".tif, ...; default: SCENE_NAME.png)")
+                             ".tif, ...; default: out/SCENE_NAME.png)")
     render.add_argument("--backend", choices=("gpu", "reference"), default="gpu")
     render.add_argument("--depth", type=output_path, metavar="OUT.npy|OUT.exr",
                         help="also write camera-space depth (float32, +inf where empty) as a "
@@ -65,13 +64,16 @@ OUTPUT_OPTIONS = ("transfer", "bits", "dither", "halftone", "format")     # the 
 
 
 def output_settings(args):
-    """The output stage's OutputSettings from render's options, or None when none of
-    OUTPUT_OPTIONS is given (the frame's rgba8 is written as drawn). Checked before any work:
+    """The output stage's OutputSettings from render's options (-o's suffix names the format:
+    .exr and .npy are the stage's float formats even with no option of its own), or None when
+    none of OUTPUT_OPTIONS is given and -o is an image Pillow writes (the frame's rgba8 as
+    drawn). Checked before any work:
     each refusal is one line naming the option (or -o's file) and the reason, status 2."""
     from renderer.core import output_settings as stage
     given = [f"--{key}" for key in OUTPUT_OPTIONS if getattr(args, key) is not None]
-    if not given:
-        return None
+    suffix = None if args.output is None else args.output.suffix.lower()
+    if not given and stage.format_for(suffix or ".png") not in stage.FLOAT_FORMATS:
+        return None                 # -o x.exr or x.npy alone: the stage's float format by suffix
 
     def parsed(key, parse, default=None):
         text = getattr(args, key)
@@ -83,7 +85,6 @@ def output_settings(args):
             raise UserError(f"--{key} {text}: {error}") from None
 
     bits = parsed("bits", stage.parse_bits)
-    suffix = None if args.output is None else args.output.suffix.lower()
     named = stage.format_for(".png" if suffix is None else suffix, bits)
     if named is None and args.format is None:
         raise UserError(f"{' and '.join(given)} {'writes' if len(given) == 1 else 'write'} .png "
@@ -199,7 +200,7 @@ def run(args) -> int:
     from renderer.core.imageio import check_outputs, image_format, outputs
     from renderer.methods import method
     from renderer.core.output_settings import FORMATS
-    from renderer.core.paths import output_stem
+    from renderer.core.paths import default_output, output_stem
     settings = output_settings(args)         # a bad option or name: said before any work
     if args.output is not None and settings is None:
         image_format(args.output, alpha=args.background == "transparent")
@@ -209,7 +210,7 @@ def run(args) -> int:
     chosen = method(args.method)
     scene = load_traced(args, chosen.need(args.size, [args.backend], args.options))
     suffix = ".png" if settings is None else FORMATS[settings.format]
-    output = args.output or Path(f"{output_stem(scene)}{suffix}")
+    output = args.output or default_output(f"{output_stem(scene)}{suffix}")
     check_outputs(output, args.depth, args.alpha)
     frame, staged, stage_ms = render_frame(args, scene, settings)
     warn_if_nothing_drawn(scene, frame)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 
 from renderer.cli.options import load, memory_option, output_path
 
@@ -12,7 +11,7 @@ def add_parser(sub) -> None:
     shaders = sub.add_parser("shaders", help="write the exact GLSL a scene's draws use")
     shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
     shaders.add_argument("--out", type=output_path, help="folder for VARIANT.vert/.geom/.frag "
-                                                   "(default: shaders-SCENE_NAME)")
+                                                   "(default: out/shaders-SCENE_NAME)")
     memory_option(shaders)
 
 
@@ -21,13 +20,13 @@ def run(args) -> int:
     and a line per variant naming the objects that use it."""
     from renderer.core.drawn import triangle_bound
     from renderer.core.imageio import check_folder, outputs
-    from renderer.core.paths import output_stem
+    from renderer.core.paths import default_output, output_stem
     from renderer.core.shadows import has_shadow_maps
     from renderer.gpu.shaders import ShaderVariant, program_sources
     if args.out is not None:
         check_folder(args.out)
     scene = load(args.scene)
-    out = check_folder(args.out or Path(f"shaders-{output_stem(scene)}"))
+    out = check_folder(args.out or default_output(f"shaders-{output_stem(scene)}"))
     users: dict[ShaderVariant, list[str]] = {}
     maps = has_shadow_maps(scene)
     for obj in scene.objects:

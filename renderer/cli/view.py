@@ -19,7 +19,7 @@ def add_parser(sub) -> None:
                            "statistics and exit")
     view.add_argument("--screenshot", type=output_path, metavar="OUT.png",
                       help="with --frames: what the window shows after the last frame; "
-                           "otherwise the file the S key writes (default view-SCENE-NNN.png); "
+                           "otherwise the file the S key writes (default out/view-SCENE-NNN.png); "
                            "in the format its suffix names (.png, .jpg, ...)")
     view.add_argument("--stats", type=output_path, metavar="OUT.json",
                       help="with --frames: also write the frame-time statistics as JSON")

@@ -97,6 +97,17 @@ def checked_path(path, *, file: str | None = None, key: str | None = None,
     raise error(f"{show_path(path)}: {problem}", file=file, key=key)
 
 
+# Where a command writes when not told: never the current folder itself (a checkout would
+# collect render's, compare's and shaders' outputs among its files); `out/` is git-ignored.
+DEFAULT_OUT = Path("out")
+
+
+def default_output(name: str) -> Path:
+    """The path of an output a command names itself (`SCENE.png`, `compare-SCENE`): in
+    DEFAULT_OUT, under the current folder."""
+    return DEFAULT_OUT / name
+
+
 def output_stem(scene) -> str:
     """The stem of a scene's default output names (render's SCENE.png, compare-SCENE/, the
     viewer's view-SCENE-NNN.png, the ground-truth cache's files): the stem of the file it was

@@ -44,7 +44,7 @@ from renderer.gpu.context import activate
 from renderer.core.ray_options import RayOptions
 from renderer.methods import METHODS, open_renderer
 from renderer.core.imageio import write_image
-from renderer.core.paths import output_stem
+from renderer.core.paths import default_output, output_stem
 from renderer.viewer.orbit import OrbitCamera
 from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
@@ -407,7 +407,7 @@ class Viewer:
         if path is None:
             while True:
                 self._screenshots += 1
-                path = Path(f"view-{output_stem(self.authored)}-{self._screenshots:03d}.png")
+                path = default_output(f"view-{output_stem(self.authored)}-{self._screenshots:03d}.png")
                 if not path.exists():
                     break
         write_image(path, self.window_image())

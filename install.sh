@@ -36,9 +36,35 @@ if [ -x .venv/bin/python ] && [ "$(cat "$stamp" 2>/dev/null)" = "$want" ] \
         && .venv/bin/python -c "import renderer, reference" 2>/dev/null; then
     exit 0                                   # up to date: nothing to do
 fi
+# pip takes a minute or two on a fresh .venv: what it is doing is said as it goes, a line per
+# phase (on a terminal, the count of packages collected kept up to date on one line), and
+# all of pip's own output only if it fails.
+with_progress() {
+    local started=$SECONDS collected=0 line
+    set +e
+    "$@" 2>&1 | tee "$log" | while IFS= read -r line; do
+        case "$line" in
+            Collecting*|Obtaining*|"Requirement already satisfied"*)
+                collected=$((collected + 1))
+                [ -t 1 ] && printf '\rinstall.sh: pip: %d packages looked at' "$collected" ;;
+            "Installing collected packages"*)
+                [ -t 1 ] && printf '\r\033[K'
+                echo "install.sh: pip: $collected packages looked at; installing those missing" ;;
+        esac
+    done
+    local status=${PIPESTATUS[0]}
+    set -e
+    if [ "$status" -ne 0 ]; then
+        cat "$log" >&2
+        echo "install.sh: failed: $*" >&2
+        exit 1
+    fi
+    echo "install.sh: pip: done in $((SECONDS - started)) s"
+}
+
 echo "install.sh: installing the package and its dependencies into .venv (pip)"
 [ -x .venv/bin/python ] || quietly python3 -m venv .venv
 rm -f "$stamp"
 quietly .venv/bin/python -m pip install -q --upgrade pip
-quietly .venv/bin/python -m pip install -q -e '.[test,cluster]'
+with_progress .venv/bin/python -m pip install --progress-bar off -e '.[test,cluster]'
 echo "$want" > "$stamp"

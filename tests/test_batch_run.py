@@ -5,6 +5,7 @@ resume after a lost, damaged or half-recorded item, a failed item, --compare."""
 import contextlib
 import io
 import json
+import re
 import shutil
 
 import pytest
@@ -119,6 +120,10 @@ def test_every_item_has_its_files_and_a_record_that_describes_them(finished):
     assert stderr.splitlines()[0] == ("renderer: Ray is not installed (pip install "
                                       "'checked-renderer[cluster]'); running in this process")
     assert "renderer batch: 4 items: 4 rendered, 0 already complete, 0 failed" in stderr
+    summary = next(line for line in stderr.splitlines() if "4 rendered" in line)
+    rendering, whole = map(float, re.search(r"in ([\d.]+) s .*; ([\d.]+) s in all, with reading "
+                                            r"the job and starting and stopping the workers$", summary).groups())
+    assert whole >= rendering                   # the command's whole time beside the rendering's
     header, records = manifest(out)
     assert (header["items"], header["job_file"], sorted(records)) == (4, "job.toml", KEYS)
     raster = records[KEYS[0]]

@@ -21,8 +21,8 @@ from renderer.core import transforms as tf
 from renderer.checks.compare import compare_frames, depth_tie_pixels
 from renderer.gpu.context import activate, gl_function
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.study.extremes import (RAYTRACE_DEPTHS, RAYTRACE_SAMPLING, STABILITY, extreme_scenes,
-                                     is_finite_frame, is_ray_traced, measure_ray_traced)
+from renderer.study.extremes import (RAYTRACE_DEPTHS, RAYTRACE_SAMPLING, STABILITY, case_state,
+                                     extreme_scenes, is_finite_frame, is_ray_traced, measure_ray_traced)
 from renderer.core.gl_rules import GL_NEGATIVE_ONE_TO_ONE
 from renderer.gpu import GpuRenderer
 from renderer.core.primitives import plane
@@ -360,6 +360,22 @@ def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
             assert case["passes"] or case.get("before")
     assert document["size"] == [64, 48] and math.isfinite(cases["far_from_origin"]["worst"]["rmse"])
     assert "light_elevation_sweep" not in document and "sweep" not in table
+    # a line per case as it finishes, the before-images named as such, a summary that
+    # separates them from failures
+    lines = result.stdout.splitlines()
+    assert lines[:len(cases)] == [f"{name}: {case_state(case)}" for name, case in cases.items()]
+    assert all("fail" not in line for line in lines[:len(cases)])
+    assert lines[len(cases)].startswith(f"{len(cases)} cases: ") and lines[len(cases)].endswith(", 0 FAIL")
+    assert f"{len(reversed_scenes)} documented before-images" in lines[len(cases)]
+
+
+def test_a_before_image_is_not_a_failure_in_the_summary():
+    from renderer.study.extremes import summary
+    cases = [{"passes": True}, {"passes": False, "before": True}, {"refused": "x", "passes": True},
+             {"passes": False}]
+    assert [case_state(case) for case in cases] == ["pass", "before-image", "refused", "FAIL"]
+    assert summary(cases) == ("4 cases: 1 pass, 1 refused as it should be, 1 documented "
+                              "before-images (reversed_z off: not held to the rule), 1 FAIL")
 
 
 @pytest.mark.slow

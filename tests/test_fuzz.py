@@ -509,7 +509,7 @@ def gen_output_faults(rng, seed) -> Case:
               "parent is a file": "{D}/w/plain.txt/x.png", "empty": "", "same file": "{D}/w/x.png",
               "depth is a folder": "{D}/w/x.png", "existing file": "{D}/w/old.png",
               "deep new folder": "{D}/w/n/e/w/x.png", "no suffix": "{D}/w/x",
-              "bad suffix": "{D}/w/x.npy", "jpg transparent": "{D}/w/x.jpg",
+              "bad suffix": "{D}/w/x.txt", "jpg transparent": "{D}/w/x.jpg",
               "depth parent file": "{D}/w/x.png", "out is a file": "",
               "long output name": "{D}/w/" + "o" * 300 + ".png",
               "null in output": "{D}/w/o\0.png"}[fault]
@@ -1262,12 +1262,13 @@ def _check_success(case: Case, outcome: Outcome, new, changed, root: Path) -> li
     if command == "render":
         output = _opt(argv, "-o", "--output")
         depth = _opt(argv, "--depth")
-        if output is None:
-            cwd_files = [p for p in files if str(Path(p).parent) == case.cwd
+        if output is None:                     # paths.default_output: out/ under the cwd
+            default_folder = str(Path(case.cwd, "out"))
+            cwd_files = [p for p in files if str(Path(p).parent) == default_folder
                          and not p.endswith(".npy")]
             if len(cwd_files) != 1:
-                problems.append(f"without -o: expected one image in the working folder "
-                                f"{case.cwd}, got {sorted(files)}")
+                problems.append(f"without -o: expected one image in {default_folder}, "
+                                f"got {sorted(files)}")
             images = cwd_files
         else:
             images = [os.path.relpath(os.path.abspath(os.path.join(root / case.cwd, output)), root)]

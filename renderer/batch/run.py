@@ -118,12 +118,15 @@ def _to_check(out: Path, wanted: dict[str, list[str]]):
 @dataclass
 class Summary:
     """What a run did: items in the job, skipped (already complete), done now, failed
-    (key, error), wall seconds, and per worker (host/pid) the items and busy milliseconds."""
+    (key, error), seconds rendering, and per worker (host/pid) the items and busy
+    milliseconds; `wall`: the command's whole time (the driver sets it: reading the job,
+    starting and stopping the workers included), when known."""
     items: int
     skipped: int
     done: int = 0
     failed: list[tuple[str, str]] = field(default_factory=list)
     seconds: float = 0.0
+    wall: float | None = None
     where: str = ""
     workers: dict[str, list] = field(default_factory=dict)
 
@@ -131,9 +134,11 @@ class Summary:
         if self.skipped == self.items:
             return [f"batch: {self.items} items: all already complete, nothing to render"]
         rate = self.done / self.seconds if self.seconds > 0 else 0.0
+        whole = "" if self.wall is None else \
+            f"; {self.wall:.1f} s in all, with reading the job and starting and stopping the workers"
         lines = [f"batch: {self.items} items: {self.done} rendered, {self.skipped} already "
                  f"complete, {len(self.failed)} failed, in {self.seconds:.1f} s "
-                 f"({rate:.1f} items/s; {self.where})"]
+                 f"({rate:.1f} items/s; {self.where}){whole}"]
         for label, (count, busy_ms) in sorted(self.workers.items()):
             lines.append(f"batch: worker {label}: {count} items, "
                          f"{count / (busy_ms / 1000.0) if busy_ms > 0 else 0.0:.1f} items/s busy")

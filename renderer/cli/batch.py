@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import sys
+import time
 
 from renderer.cli.options import memory_option, output_path, positive_int
 
@@ -48,6 +49,7 @@ def run(args) -> int:
     from renderer.batch.run import Interrupted, plan_job, run_plan
     from renderer.cluster.executor import InProcessExecutor, open_executor
     from renderer.errors import INTERRUPTED
+    start = time.perf_counter()                 # the summary's whole time: Ray's start too
     job = read_job(args.job)
     with locked(args.out) as out:
         plan = plan_job(job, out, compare=args.compare)
@@ -62,6 +64,7 @@ def run(args) -> int:
             print(f"renderer: {(stop if isinstance(stop, Interrupted) else done).line()}",
                   file=sys.stderr)
             return INTERRUPTED
+    summary.wall = time.perf_counter() - start
     for line in summary.lines():
         print(f"renderer {line}", file=sys.stderr)
     return 1 if summary.failed else 0

@@ -32,7 +32,8 @@ def run(args) -> int:
     """extremes.json and extremes.md in --out; status 1 when a case fails (as authored)."""
     from renderer.core.builtin import resolve_scene
     from renderer.gpu.context import make_context, release_context
-    from renderer.study.extremes import CASES, all_pass, extreme_scenes, measure_extremes, write_report
+    from renderer.study.extremes import (CASES, all_pass, case_state, extreme_scenes, measure_extremes,
+                                         summary, write_report)
     from renderer.study.shadow_sweep import measure_sweep, sweep_acne
     from renderer.core.scene_file import load_scene
     from renderer.core.imageio import check_folder, check_outputs
@@ -46,18 +47,16 @@ def run(args) -> int:
         for kind in kinds:
             contexts[kind] = make_context(kind)
         methods = tuple(CASES) if args.method == "both" else (args.method,)
-        cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods)
-        sweep = None if args.no_sweep or "raster" not in methods else measure_sweep(args.size, contexts)
+        def said(case):                   # each case as it finishes: minutes of work in all
+            print(f"{case['case']}: {case_state(case)}", flush=True)
+        cases = measure_extremes(extreme_scenes(extra), args.size, contexts, methods, on_case=said)
+        sweep = None if args.no_sweep or "raster" not in methods else measure_sweep(
+            args.size, contexts, on_row=lambda row: print(
+                f"light elevation {row['elevation']}: {sweep_acne(row)} acne pixels", flush=True))
     finally:
         for ctx in contexts.values():
             release_context(ctx)
     json_path, md_path = write_report(args.out, cases, args.size, sweep)
-    for case in cases:
-        state = "refused" if "refused" in case else ("pass" if case["passes"] else "FAIL")
-        if case.get("before"):
-            state = f"{state.lower()} (the 'before' of reversed-Z)"
-        print(f"{case['case']}: {state}")
-    for row in sweep or ():
-        print(f"light elevation {row['elevation']}: {sweep_acne(row)} acne pixels")
+    print(summary(cases))
     print(f"wrote {json_path} and {md_path}")
     return 0 if all_pass(cases, sweep or ()) else 1

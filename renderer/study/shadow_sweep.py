@@ -99,9 +99,10 @@ def _summary(figures: dict) -> dict:
             "considered_pixels": figures["considered_pixels"]}
 
 
-def measure_sweep(size: tuple[int, int], contexts: dict, elevations=ELEVATIONS) -> list[dict]:
+def measure_sweep(size: tuple[int, int], contexts: dict, elevations=ELEVATIONS,
+                  on_row=None) -> list[dict]:
     """One row per elevation: the truth's figures with v from the reference ("reference")
-    and from each context's images (its kind)."""
+    and from each context's images (its kind); `on_row(row)`, if given, as each is made."""
     rows = []
     for elevation in elevations:
         scene = elevation_scene(elevation)
@@ -109,6 +110,8 @@ def measure_sweep(size: tuple[int, int], contexts: dict, elevations=ELEVATIONS) 
         for kind, ctx in contexts.items():
             row[kind] = _summary(truth_figures(scene, size, gpu_visibility(scene, size, ctx)))
         rows.append(row)
+        if on_row is not None:
+            on_row(row)
     return rows
 
 

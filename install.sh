@@ -66,5 +66,5 @@ echo "install.sh: installing the package and its dependencies into .venv (pip)"
 [ -x .venv/bin/python ] || quietly python3 -m venv .venv
 rm -f "$stamp"
 quietly .venv/bin/python -m pip install -q --upgrade pip
-with_progress .venv/bin/python -m pip install --progress-bar off -e '.[test,cluster]'
+with_progress .venv/bin/python -m pip install --progress-bar off -e '.[test,cluster,docs]'
 echo "$want" > "$stamp"

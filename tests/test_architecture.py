@@ -257,12 +257,12 @@ def shares_list(text: str) -> str:
 
 
 def test_the_reference_and_the_readme_name_the_declared_modules():
-    """reference/__init__.py's docstring ends with the same list as the README's block between
-    the twin-shares markers. The list names exactly the modules of REFERENCE_SHARES, in backticks."""
+    """reference/__init__.py's docstring ends with the same list as docs/layout.md's block
+    between the twin-shares markers. The list names exactly the modules of REFERENCE_SHARES, in backticks."""
     docstring = ast.get_docstring(ast.parse((ROOT / "reference/__init__.py").read_text()))
-    readme = (ROOT / "README.md").read_text(encoding="utf-8")
-    block = re.search(r"<!-- twin-shares -->(.*?)<!-- /twin-shares -->", readme, re.S)
-    assert block, "README.md has no <!-- twin-shares --> ... <!-- /twin-shares --> block"
+    layout = (ROOT / "docs" / "layout.md").read_text(encoding="utf-8")
+    block = re.search(r"<!-- twin-shares -->(.*?)<!-- /twin-shares -->", layout, re.S)
+    assert block, "docs/layout.md has no <!-- twin-shares --> ... <!-- /twin-shares --> block"
     assert named_core_modules(docstring) == set(REFERENCE_SHARES)
     assert shares_list(block.group(1)) == shares_list(docstring)
 

@@ -36,8 +36,15 @@ def outputs_outside_out(lines: list[str]) -> list[str]:
     return found
 
 
+def manual() -> dict[str, str]:
+    """The README and every page of the manual (docs/), by path: what a user reads."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
+    return {page.relative_to(ROOT).as_posix(): page.read_text() for page in pages
+            if "gallery" not in page.relative_to(ROOT).parts}
+
+
 def test_readme_examples_write_under_out():
-    lines = shell_lines((ROOT / "README.md").read_text())
+    lines = [line for text in manual().values() for line in shell_lines(text)]
     assert any("renderer report" in line for line in lines)          # the examples were found
     assert outputs_outside_out(lines) == []
 
@@ -58,9 +65,10 @@ TIME_FIGURE = re.compile(r"\b\d+(?:\.\d+)?\s?(?:ms|s|min|minutes?|seconds?)\b")
 
 
 def sections_with_unsourced_times(markdown: str) -> list[str]:
-    """The '## ' sections that state a time but not 'Measured on' and 'Reproduce: `...`'."""
+    """The '# ' and '## ' sections that state a time but not 'Measured on' and 'Reproduce:
+    `...`' (a page's title opens its first section)."""
     found = []
-    for section in re.split(r"^## ", markdown, flags=re.M)[1:]:
+    for section in re.split(r"^##? ", markdown, flags=re.M)[1:]:
         title, text = section.split("\n", 1)[0], " ".join(section.split())
         claims = re.sub(r"`[^`]*`", "", text)         # an example of output is not a claim
         if TIME_FIGURE.search(claims) and not ("Measured on" in text and "Reproduce: `" in text):
@@ -69,9 +77,10 @@ def sections_with_unsourced_times(markdown: str) -> list[str]:
 
 
 def test_every_timing_names_its_machine_and_how_to_reproduce_it():
-    readme = (ROOT / "README.md").read_text()
-    assert TIME_FIGURE.search(readme)                                # there are timings
-    assert sections_with_unsourced_times(readme) == []
+    pages = {name: text for name, text in manual().items() if not name.startswith("docs/report/")}
+    assert any(TIME_FIGURE.search(text) for text in pages.values())   # there are timings
+    assert [f"{name}: {found}" for name, text in pages.items()
+            for found in sections_with_unsourced_times(text)] == []
 
 
 def test_the_timing_check_sees_an_unsourced_figure():

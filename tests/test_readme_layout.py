@@ -1,4 +1,4 @@
-"""The README's "Layout" section against the tree: it names every shader under glsl/, every
+"""The manual's "Layout" page (docs/layout.md) against the tree: it names every shader under glsl/, every
 package and module under renderer/ and reference/ (an __init__.py only where the section
 chooses to), and every file or folder it names exists.
 
@@ -22,8 +22,12 @@ NUMBERS = {word: n for n, word in enumerate(
     "fifteen sixteen seventeen eighteen nineteen twenty".split())}
 
 
-def layout_section(readme: str) -> str:
-    return readme.split("\n## Layout\n", 1)[1].split("\n## ", 1)[0]
+LAYOUT = ROOT / "docs" / "layout.md"
+
+
+def layout_section(page: str) -> str:
+    """The page after its title."""
+    return page.split("\n", 1)[1]
 
 
 def tree(root: Path) -> tuple[set[str], set[str]]:
@@ -101,7 +105,7 @@ def layout_problems(section: str, existing: set[str], required: set[str]) -> lis
 def test_the_layout_names_every_shader_and_module_and_only_what_exists():
     existing, required = tree(ROOT)
     assert {"glsl/vertex.glsl", "renderer/core/", "reference/raytrace/trace.py"} <= required
-    section = layout_section((ROOT / "README.md").read_text())
+    section = layout_section(LAYOUT.read_text())
     assert layout_problems(section, existing, required) == []
 
 
@@ -110,7 +114,7 @@ def test_the_layout_counts_the_ray_tracing_stages_right():
     assert stages == sorted(path.stem for path in (ROOT / "reference" / "raytrace").glob("*.py")
                             if path.stem not in ("__init__", "pipeline"))
     claim = re.search(r"`reference/raytrace/` hold (\w+) stages",
-                      " ".join(layout_section((ROOT / "README.md").read_text()).split()))
+                      " ".join(layout_section(LAYOUT.read_text()).split()))
     assert claim and NUMBERS.get(claim.group(1)) == len(stages)
 
 

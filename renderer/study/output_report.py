@@ -196,7 +196,7 @@ def _ms(value) -> str:
 
 
 def ranking_table(rows: list[dict], bits: int = 1) -> list[str]:
-    """The ranking at `bits` as markdown lines (the README quotes it)."""
+    """The ranking at `bits` as markdown lines (docs/colour-and-output.md quotes it)."""
     lines = ["| rank | method | low-pass PSNR (dB) | ꟻLIP (rank) | block mean \\|e\\| | p95 | max "
              "| bias | GPU ms | reference ms |",
              "| ---: | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]

@@ -79,18 +79,14 @@ def _labels(marks: list[Mark]) -> list[tuple[str, tuple]]:
 
 
 def _draw(axes, xy: np.ndarray, marks: list[Mark], extent, labelled: bool):
-    """One panel: locus, sRGB triangle, the pixels' histogram over `extent`, D65, the marks
-    (named if `labelled`). The histogram's artist (None without pixels)."""
+    """One panel: locus, sRGB triangle, the pixels' histogram over `extent`, D65, the marks,
+    the wavelengths along the locus unless `labelled` (the zoomed panel names its marks
+    instead: _name_marks). The histogram's artist (None without pixels)."""
     from matplotlib.colors import LogNorm
     wavelengths, locus = spectral_locus()
     closed = np.vstack([locus, locus[:1]])
     axes.plot(closed[:, 0], closed[:, 1], color="black", linewidth=1,
               label="spectral locus (CIE 1931 2\N{DEGREE SIGN})")
-    if not labelled:
-        for nm in LOCUS_LABELS_NM:
-            x, y = locus[np.searchsorted(wavelengths, nm)]
-            axes.annotate(f"{nm}", (x, y), fontsize=6, xytext=(4 if x > 0.2 else -14, 2),
-                          textcoords="offset points")
     triangle = np.array(SRGB_PRIMARIES_XY + SRGB_PRIMARIES_XY[:1])
     axes.plot(triangle[:, 0], triangle[:, 1], color="0.3", linestyle="--", linewidth=1,
               label="sRGB gamut")
@@ -107,21 +103,37 @@ def _draw(axes, xy: np.ndarray, marks: list[Mark], extent, labelled: bool):
         if chosen:
             axes.plot([], [], marker=marker, color="white", markeredgecolor="black",
                       linestyle="none", label=f"{kind}s")
-    for label, where in _labels(marks) if labelled else ():
-        axes.annotate(label, where, fontsize=7, xytext=(6, 4), textcoords="offset points")
     axes.set_xlim(*extent[0])
     axes.set_ylim(*extent[1])
     axes.set_aspect("equal")
     axes.set_xlabel("x")
     axes.set_ylabel("y")
     axes.grid(True, linewidth=0.3)
+    if not labelled:                         # inside the panel: 500 and 510 lie near x = 0
+        from renderer.study.plot_labels import place_labels
+        axes.figure.canvas.draw()
+        place_labels(axes, [(f"{nm}", tuple(locus[np.searchsorted(wavelengths, nm)]))
+                            for nm in LOCUS_LABELS_NM], fontsize=6)
     return counts
 
 
+def _name_marks(axes, marks: list[Mark]) -> None:
+    """The marks' names beside them, inside the panel and apart (plot_labels): near D65 the
+    lights and materials crowd, and a name at a fixed offset ran off the panel's edge."""
+    from renderer.study.plot_labels import place_labels
+    axes.figure.canvas.draw()                # the panel's final place (aspect, colour bar)
+    place_labels(axes, _labels(marks), fontsize=7)
+
+
 def chromaticity_png(xy: np.ndarray, marks: list[Mark], title: str) -> bytes:
-    """PNG bytes: on the left the whole diagram (the locus, the sRGB triangle, D65, a 2D
-    histogram of the pixels' xy (N, 2), the marks), on the right the same zoomed in on the
-    pixels and marks (zoom_range), the marks named."""
+    """PNG bytes of chromaticity_figure."""
+    return _png(chromaticity_figure(xy, marks, title))
+
+
+def chromaticity_figure(xy: np.ndarray, marks: list[Mark], title: str):
+    """On the left the whole diagram (the locus, the sRGB triangle, D65, a 2D histogram of the
+    pixels' xy (N, 2), the marks), on the right the same zoomed in on the pixels and marks
+    (zoom_range), the marks named."""
     figure = _figure((12.0, 5.8))
     whole, zoomed = figure.subplots(1, 2, gridspec_kw={"left": 0.05, "right": 0.97, "top": 0.9,
                                                         "bottom": 0.09, "wspace": 0.12})
@@ -133,7 +145,8 @@ def chromaticity_png(xy: np.ndarray, marks: list[Mark], title: str) -> bytes:
     if counts is not None:
         figure.colorbar(counts, ax=zoomed, shrink=0.8, label="pixels per bin")
     figure.suptitle(title, fontsize=10)
-    return _png(figure)
+    _name_marks(zoomed, marks)
+    return figure
 
 
 def luminance_png(luminance: np.ndarray, title: str) -> bytes:

@@ -70,11 +70,24 @@ def _colour(name: str, names: list[str]) -> str:
 
 def plot_png(rows: list[dict], title: str, error: str = "rmse",
              label: str = "RMSE against the ground truth (0..1)", linear_below: float = 0.0) -> bytes:
-    """PNG bytes: `error` (a column) against median milliseconds, log-log, a line per series,
-    the Pareto front drawn as a dashed staircase through circled points. `linear_below` > 0:
-    the error axis is linear below it (symlog), so that errors of 0 are drawn too."""
+    """PNG bytes of plot_figure (same arguments)."""
+    figure = plot_figure(rows, title, error, label, linear_below)
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", metadata={"Software": None}, bbox_inches="tight")
+    return buffer.getvalue()
+
+
+def plot_figure(rows: list[dict], title: str, error: str = "rmse",
+                label: str = "RMSE against the ground truth (0..1)", linear_below: float = 0.0):
+    """`error` (a column) against median milliseconds, log-log, a line per series, the Pareto
+    front drawn as a dashed staircase through circled points, the legend beside the axes (it
+    covered the points inside them), the points named where they fit (plot_labels).
+    `linear_below` > 0: the error axis is linear below it (symlog), so that errors of 0 are
+    drawn too. A matplotlib Figure on the Agg canvas."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
+
+    from renderer.study.plot_labels import place_labels
 
     figure = Figure(figsize=(7.5, 5.0), dpi=100)
     FigureCanvasAgg(figure)
@@ -84,6 +97,7 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
         if row[error] > 0 or linear_below:
             series[series_key(row)].append(row)
     names = list(dict.fromkeys(series_name(row) for row in rows))
+    named = []                               # (text, (x, y), colour): placed once the axes are set
     for index, (name, members) in enumerate(series.items()):
         first = members[0]
         if first["knob"] in PATTERN_KNOBS:          # along the samples; other knobs as swept
@@ -96,8 +110,7 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
         if first["knob"] not in PATTERN_KNOBS:          # few points: name each one
             for r in members:
                 acne = f" (acne {r['acne_pixels']})" if r.get("acne_pixels") else ""
-                axes.annotate(r["setting"] + acne, (r["median_ms"], r[error]), fontsize=6,
-                              xytext=(4, -8), textcoords="offset points", color=colour)
+                named.append((r["setting"] + acne, (r["median_ms"], r[error]), colour))
     points = [row for members in series.values() for row in members]
     front = [points[i] for i in pareto_front([(r["median_ms"], r[error]) for r in points])]
     if front:
@@ -106,8 +119,7 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
         axes.scatter([r["median_ms"] for r in front], [r[error] for r in front], s=90,
                      facecolors="none", edgecolors="black", label="Pareto front", zorder=3)
         for r in front if front[0]["knob"] in PATTERN_KNOBS else ():
-            axes.annotate(f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r[error]),
-                          fontsize=6, xytext=(4, 3), textcoords="offset points")
+            named.append((f"{r['setting']} ({r['backend'][:3]})", (r["median_ms"], r[error]), "black"))
     axes.set_xscale("log")
     if linear_below:                       # errors are >= 0: no negative decades, room above
         axes.set_yscale("symlog", linthresh=linear_below)
@@ -118,10 +130,13 @@ def plot_png(rows: list[dict], title: str, error: str = "rmse",
     axes.set_ylabel(label)
     axes.set_title(title)
     axes.grid(True, which="both", linewidth=0.3)
-    axes.legend(fontsize=7)
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", metadata={"Software": None})
-    return buffer.getvalue()
+    axes.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)
+    figure.subplots_adjust(right=0.68)
+    figure.canvas.draw()                     # the limits the labels are placed against
+    for colour in dict.fromkeys(c for _, _, c in named):
+        place_labels(axes, [(text, xy) for text, xy, c in named if c == colour], fontsize=6,
+                     color=colour)
+    return figure
 
 
 @dataclass

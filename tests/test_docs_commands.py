@@ -123,16 +123,21 @@ def checkout(tmp_path_factory):
     return folder
 
 
-RUN = [pytest.param(page, command, id=f"{page}: {command[:60]}")
-       for page, command, skip in commands() if skip is None]
+RUN = {}
+for _page, _command, _skip in commands():
+    if _skip is None:
+        RUN.setdefault(_page, []).append(_command)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("page, command", RUN)
-def test_each_command_runs_as_written(checkout, page, command):
+@pytest.mark.parametrize("page", sorted(RUN))
+def test_each_pages_commands_run_as_written_in_order(checkout, page):
+    """A page's commands in the order it shows them (a later one may read an earlier one's
+    output: colour of out/bn.png after the render that wrote it)."""
     env = os.environ | {"PYTHONWARNINGS": "ignore"}
-    result = subprocess.run(["bash", "-c", small(command)], cwd=checkout, capture_output=True,
-                            text=True, timeout=300, env=env)
-    assert result.returncode == 0, f"{page}: {small(command)}\n{result.stderr[-2000:]}"
-    for path in outputs(command):
-        assert (checkout / path).exists(), f"{page}: {command} did not write {path}"
+    for command in RUN[page]:
+        result = subprocess.run(["bash", "-c", small(command)], cwd=checkout, capture_output=True,
+                                text=True, timeout=300, env=env)
+        assert result.returncode == 0, f"{page}: {small(command)}\n{result.stderr[-2000:]}"
+        for path in outputs(command):
+            assert (checkout / path).exists(), f"{page}: {command} did not write {path}"

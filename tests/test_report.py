@@ -40,6 +40,16 @@ def test_ground_truth_is_cached_by_scene_content(tmp_path):
     assert len(list(tmp_path.glob("*.npy"))) == 3
 
 
+def test_each_ground_truth_is_told_as_it_is_ready(tmp_path):
+    """The report's bar moves per truth (a miss takes minutes at full size), cached ones first."""
+    from renderer.study.ground_truth import ground_truths
+    scenes = [load_scene(builtin_scenes()[name]) for name in ("point_light_plane", "flat_shading")]
+    ground_truth(scenes[1], 8, 6, tmp_path)                     # cached beforehand
+    told = []
+    ground_truths(scenes, 8, 6, tmp_path, done=lambda scene: told.append(scene.name))
+    assert told == ["flat_shading", "point_light_plane"]
+
+
 def test_metrics_on_the_zero_to_one_scale():
     truth = np.zeros((2, 2, 3))
     image = truth.copy()
@@ -79,7 +89,9 @@ def test_every_knob_runs_on_its_backends():
                           for b in ("gpu", "reference"))}
     assert {s.setting for s in plan if s.pattern == "msaa"} == {"msaa 1", "msaa 4"}
     assert {s.setting for s in plan if s.pattern == "regular" and s.knob == "antialiasing"} == \
-        {"regular 1", "regular 4", "regular 16", "regular 64"}       # the squares only
+        {"regular 1", "regular 4", "regular 16"}       # the squares only, up to 16 in --quick
+    assert {s.setting for s in settings(FULL, [1, 4]) if s.pattern == "regular"
+            and s.knob == "antialiasing"} == {"regular 1", "regular 4", "regular 16", "regular 64"}
 
 
 @pytest.mark.slow                       # the quick sweep, through the command line, on a scene
@@ -95,7 +107,7 @@ def test_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
         rows = list(reader)
     assert len(rows) == len([s for s in settings(QUICK, [1, 4]) if s.variant[0] != "texture"])
     assert {row["scene"] for row in rows} == {"shadow_plane"}
-    assert all(int(row["runs"]) >= 5 and float(row["median_ms"]) > 0 for row in rows)
+    assert all(int(row["runs"]) >= QUICK.runs and float(row["median_ms"]) > 0 for row in rows)
     image_rows = [row for row in rows if not row["knob"].startswith(("shadows-", "output"))]
     assert all(0 <= float(row["rmse"]) <= float(row["max_abs"]) <= 1 for row in image_rows)
     # More samples, smaller error: jittered 16 beats one sample on both backends.

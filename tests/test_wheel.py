@@ -20,7 +20,9 @@ import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 
-pytestmark = pytest.mark.slow          # builds a wheel and a virtual environment
+# Builds a wheel (in the checkout's build/) and a virtual environment, once: with xdist, the
+# module's tests run in one worker (two builds at once collide in build/).
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("wheel")]
 
 
 @pytest.fixture(scope="module")

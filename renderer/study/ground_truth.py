@@ -168,17 +168,23 @@ def render_ground_truth(scene: Scene, width: int, height: int, method: str = "ra
 
 
 def ground_truths(scenes: list, width: int, height: int, cache_dir, method: str = "raster",
-                  tasks=None) -> list[tuple[np.ndarray, bool]]:
+                  tasks=None, done=None) -> list[tuple[np.ndarray, bool]]:
     """ground_truth of each of `scenes`; the misses rendered through `tasks(function, args)`
     ((index, result) pairs in any order: an executor's, renderer/cluster/executor.py, which may
-    render them elsewhere, at once; default here, one after another) and stored here."""
+    render them elsewhere, at once; default here, one after another) and stored here.
+    `done(scene)`, if given, as each truth is ready (a progress bar: a miss takes minutes)."""
     paths = [cache_path(scene, width, height, cache_dir, method) for scene in scenes]
     truths = [(np.load(path), True) if path.is_file() else None for path in paths]
     missing = [index for index, truth in enumerate(truths) if truth is None]
+    for index in range(len(scenes)) if done is not None else ():
+        if truths[index] is not None:
+            done(scenes[index])
     tasks = tasks or (lambda function, args: enumerate(function(*a) for a in args))
     for k, truth in tasks(render_ground_truth, [(scenes[i], width, height, method) for i in missing]):
         write_npy(paths[missing[k]], truth)
         truths[missing[k]] = (truth, False)
+        if done is not None:
+            done(scenes[missing[k]])
     return truths
 
 

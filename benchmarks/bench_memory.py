@@ -14,6 +14,9 @@ texture, each with --max-memory set to the command's own estimate (the larger of
 step and the renderers' Need), and the 5,005,448-triangle PLY refused at 3G and 5G: the
 estimate, the limit and the whole process's measured peak (VmHWM).
 
+It writes benchmarks/results/memory.json (the figures, with machine, date, load and commit)
+and memory.md (the tables made from it: `markdown`), which docs/memory.md includes.
+
 Each case runs in a new process; the figure is its peak resident memory (ru_maxrss) above
 what the process held after importing and building the scene, so that the baseline of
 Python, NumPy and the scene is left out; the estimate is the same difference.
@@ -29,7 +32,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from common import machine, revision
+from common import machine, measured_line, revision, write_results
 
 CHILD = r"""
 import json, resource, sys, warnings
@@ -89,20 +92,45 @@ def main() -> None:
     cases += [(b, 256, segments, "raster") for b in ("gpu", "reference") for segments in (256, 1024)]
     # A large mesh ray traced (ray_scene, the BVH and its build, the GPU's float textures).
     cases += [(b, 64, 700, "raytrace") for b in ("gpu", "reference")]
+    estimates = []
     for backend, size, segments, method in cases:
         r = measure(backend, size, size, segments, method)
         name = backend if method == "raster" else f"{backend} rt"
         print(f"{name:10} {f'{size}x{size}':>11} {r['triangles']:>10,} {r['measured'] / mib:>13.0f} "
               f"{r['estimate'] / mib:>13.0f} {r['estimate'] / max(r['measured'], 1):>18.2f} "
               f"{r['seconds']:>6.1f}")
+        estimates.append({"backend": backend, "method": method, "size": [size, size]} | r)
     r = refusal(16384, 16384, "1G")
     print(f"\nrenderer render sphere --size 16384x16384 --max-memory 1G: status {r['status']} in "
           f"{r['seconds']:.1f} s, peak {r['peak'] / mib:.0f} MiB (the whole process)\n  {r['line']}")
-    under_limits()
+    figures = {"estimates": estimates, "refusal": r, "whole_commands": under_limits()}
+    print(f"wrote {write_results('memory', figures, markdown)}")
 
 
-def under_limits() -> None:
-    """Whole commands under --max-memory (module docstring)."""
+def markdown(document: dict) -> str:
+    """The tables of docs/memory.md, made from a results document (write_results)."""
+    mib = 1 << 20
+    figures = document["figures"]
+    lines = ["| path | size | triangles | measured MiB | estimate MiB |", "| --- | ---: | ---: | ---: | ---: |"]
+    for r in figures["estimates"]:
+        path = ("GPU" if r["backend"] == "gpu" else "reference") + (", ray traced" if r["method"] == "raytrace" else "")
+        lines.append(f"| {path} | {r['size'][0]}×{r['size'][1]} | {r['triangles']:,} | "
+                     f"{r['measured'] / mib:.0f} | {r['estimate'] / mib:.0f} |")
+    refusal = figures["refusal"]
+    lines += ["", f"`renderer render sphere --size 16384x16384 --max-memory 1G`: status "
+              f"{refusal['status']} in {refusal['seconds']:.1f} s, a peak of {refusal['peak'] / mib:.0f} MiB "
+              f"for the whole process.", "",
+              "Whole commands (`renderer render` at 64×48; the peak is the process's VmHWM):", "",
+              "| case | estimate MiB | limit | peak MiB | peak / limit | status | s |",
+              "| --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for r in figures["whole_commands"]:
+        lines.append(f"| {r['case']} | {r['estimate'] / mib:.0f} | {r['limit']} | {r['peak'] / mib:.0f} | "
+                     f"{r['share']:.2f} | {r['status']} | {r['seconds']:.1f} |")
+    return "\n".join(lines + ["", measured_line(document), ""])
+
+
+def under_limits() -> list[dict]:
+    """Whole commands under --max-memory (module docstring): a row each."""
     from renderer.core import memory
     from renderer.core.textures import TEXTURE_BYTES_PER_TEXEL
     from renderer.methods import METHODS
@@ -111,6 +139,7 @@ def under_limits() -> None:
     print(f"\nWhole commands, renderer render at 64x48 (peak: VmHWM of the process)\n"
           f"{'case':44} {'estimate MiB':>12} {'limit':>6} {'peak MiB':>9} {'peak/limit':>10} "
           f"{'status':>6} {'s':>6}")
+    rows = []
 
     def row(case, estimate, limit, *args):
         run = measure_command("render", *args, "--size", "64x48", "--max-memory", limit, "-q",
@@ -118,6 +147,8 @@ def under_limits() -> None:
         share = run.peak / memory.parse_size(limit)
         print(f"{case:44} {estimate / mib:>12.0f} {limit:>6} {run.peak / mib:>9.0f} {share:>10.2f} "
               f"{run.status:>6} {run.seconds:>6.1f}", flush=True)
+        rows.append({"case": case, "estimate": estimate, "limit": limit, "peak": run.peak,
+                     "share": share, "status": run.status, "seconds": run.seconds})
         if run.status:
             print(f"  {run.stderr.strip()}")
 
@@ -147,6 +178,7 @@ def under_limits() -> None:
             row(f"{triangles:,}-triangle PLY, raytrace gpu", need.bytes_for(triangles), limit,
                 scene, *method_options("raytrace"))
     print(f"\n{machine()}; {revision()}; {time.strftime('%Y-%m-%d')}")
+    return rows
 
 
 if __name__ == "__main__":

@@ -53,3 +53,39 @@ def alternating_ms(calls, frames: int) -> list[float]:
             call()
             spent.append((time.perf_counter() - start) * 1000.0)
     return [statistics.median(spent) for spent in times]
+
+
+# Results files: what a benchmark measured, with where and when, so that a page of the manual
+# quotes a file rather than a figure typed by hand (issue 31). benchmarks/results/NAME.json
+# holds the figures; NAME.md, made from it by the benchmark's own `markdown(results)`, is what
+# the page includes; tests/test_docs_figures.py makes the .md again from the .json and holds
+# the two equal.
+RESULTS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results")
+
+
+def write_results(name: str, figures, markdown) -> str:
+    """benchmarks/results/NAME.json ({"machine", "cpus", "load", "date", "commit", "command",
+    "figures"}) and NAME.md (markdown(that dict)); the .json's path."""
+    import json
+    import sys
+    document = {"machine": platform.node(), "cpus": os.cpu_count(),
+                "load": [round(x, 2) for x in os.getloadavg()],
+                "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "commit": revision(),
+                "command": " ".join([".venv/bin/python", os.path.relpath(sys.argv[0]), *sys.argv[1:]]),
+                "figures": figures}
+    os.makedirs(RESULTS, exist_ok=True)
+    path = os.path.join(RESULTS, f"{name}.json")
+    with open(path, "w") as out:
+        json.dump(document, out, indent=1)
+        out.write("\n")
+    with open(os.path.join(RESULTS, f"{name}.md"), "w") as out:
+        out.write(markdown(document))
+    return path
+
+
+def measured_line(document: dict) -> str:
+    """"Measured on vm (2 CPUs, load average 1.3), 2026-12-03 18:50 UTC, at 3c62807. Reproduce:
+    `...`." for a results document."""
+    load = ", ".join(f"{x:.2f}" for x in document["load"])
+    return (f"Measured on {document['machine']} ({document['cpus']} CPUs, load average {load}), "
+            f"{document['date']}, at {document['commit']}. Reproduce: `{document['command']}`.")

@@ -39,6 +39,7 @@ def test_the_manual_builds_without_a_warning_and_draws_its_gallery(tmp_path):
         shutil.copytree(ROOT / part, tmp_path / part,
                         ignore=shutil.ignore_patterns("gallery", "_build", "sg_execution_times.rst"))
     shutil.copy(ROOT / "README.md", tmp_path)   # docs/using.md includes its tour
+    shutil.copytree(ROOT / "benchmarks" / "results", tmp_path / "benchmarks" / "results")   # and figures
     out = tmp_path / "html"
     result = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
                              str(tmp_path / "docs"), str(out)], capture_output=True, text=True,

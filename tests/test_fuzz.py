@@ -1604,11 +1604,16 @@ def test_fuzz_default(tmp_path):
     run_seeds(range(BASE_SEED, BASE_SEED + DEFAULT_CASES), tmp_path)
 
 
+SLOW_PARTS = 3                      # the slow cases in parts, so that xdist spreads them
+
+
 @pytest.mark.slow
-def test_fuzz_slow(tmp_path):
-    """SLOW_CASES further cases."""
-    start = BASE_SEED + DEFAULT_CASES
-    run_seeds(range(start, start + SLOW_CASES), tmp_path)
+@pytest.mark.parametrize("part", range(SLOW_PARTS))
+def test_fuzz_slow(tmp_path, part):
+    """SLOW_CASES further cases, a third in each part (90 s in one test held CI's last
+    minute on one worker)."""
+    start = BASE_SEED + DEFAULT_CASES + part * SLOW_CASES // SLOW_PARTS
+    run_seeds(range(start, start + SLOW_CASES // SLOW_PARTS), tmp_path)
 
 
 @pytest.mark.skipif(not os.environ.get("FUZZ_SEEDS"), reason="FUZZ_SEEDS=SEED[,SEED...] not set")

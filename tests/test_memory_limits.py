@@ -69,9 +69,10 @@ def test_five_million_triangles_are_refused_with_the_peak_under_the_limit(tmp_pa
 @pytest.mark.parametrize("method,backend", [("raster", "gpu"), ("raster", "reference"),
                                             ("raytrace", "gpu"), ("raytrace", "reference")])
 def test_a_command_let_through_stays_under_its_limit(tmp_path, method, backend):
-    """Each method and backend on a 125,000-triangle mesh, under a limit equal to its own
-    estimate (rounded up to the MiB): it renders, and its whole peak stays under."""
-    scene, triangles = grid_scene(tmp_path, 250)
+    """Each method and backend on a 51,200-triangle mesh, under a limit equal to its own
+    estimate (rounded up to the MiB): it renders, and its whole peak stays under (a million
+    triangles: benchmarks/bench_memory.py)."""
+    scene, triangles = grid_scene(tmp_path, 160)
     need = METHODS[method].need((160, 120), [backend], METHODS[method].options())
     limit = f"{(need.bytes_for(triangles) >> 20) + 1}M"
     run = measure_command("render", scene, "--method", method, "--backend", backend,

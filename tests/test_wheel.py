@@ -10,6 +10,7 @@ environment through a .pth line, which appends them after its own site-packages 
 wheel's packages, not the checkout's, are the ones imported: the test checks), and saves
 downloading them. install.sh's pip install of the whole dependency list is CI's own set-up."""
 
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -25,13 +26,22 @@ REPO = Path(__file__).resolve().parents[1]
 pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("wheel")]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def installed(tmp_path_factory):
     """(the fresh environment's python, an empty folder outside the repository, the wheel's
-    file names)."""
+    file names). Built once per session from a copy of the tracked files: setuptools builds in
+    the source's build/, and a second build there (the fixture made again after other
+    modules' tests) failed on the first's leftovers."""
     root = tmp_path_factory.mktemp("wheel")
+    source = root / "source"
+    tracked = subprocess.run(["git", "ls-files"], cwd=REPO, capture_output=True, text=True,
+                             check=True).stdout.split("\n")
+    for name in filter(None, tracked):
+        if (REPO / name).is_file():
+            (source / name).parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(REPO / name, source / name)
     build = subprocess.run([sys.executable, "-m", "pip", "wheel", "-q", "--no-deps",
-                            "-w", str(root / "dist"), str(REPO)], capture_output=True, text=True)
+                            "-w", str(root / "dist"), str(source)], capture_output=True, text=True)
     assert build.returncode == 0, build.stderr
     wheel = next((root / "dist").glob("*.whl"))
     subprocess.run([sys.executable, "-m", "venv", "--without-pip", str(root / "venv")], check=True)

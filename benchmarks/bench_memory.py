@@ -69,15 +69,12 @@ def measure(backend: str, width: int, height: int, segments: int, method: str = 
 
 
 def refusal(width: int, height: int, limit: str) -> dict:
-    """`renderer render` at a size over the limit: its status, its one line, its peak memory."""
-    code = ("import resource, sys\nfrom renderer.cli import main\nstatus = main(sys.argv[1:])\n"
-            "print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)\nsys.exit(status)")
-    start = time.perf_counter()
-    result = subprocess.run([sys.executable, "-c", code, "render", "sphere", "--size",
-                             f"{width}x{height}", "--max-memory", limit, "-o", "/tmp/never.png"],
-                            capture_output=True, text=True)
-    return {"status": result.returncode, "line": result.stderr.strip(),
-            "peak": int(result.stdout.split()[-1]), "seconds": time.perf_counter() - start}
+    """`renderer render` at a size over the limit: its status, its one line, its peak memory
+    (the whole process's, renderer/study/peak_memory.py) and its wall time."""
+    from renderer.study.peak_memory import measure_command
+    run = measure_command("render", "sphere", "--size", f"{width}x{height}", "--max-memory", limit,
+                          "-o", "/tmp/never.png")
+    return {"status": run.status, "line": run.stderr.strip(), "peak": run.peak, "seconds": run.seconds}
 
 
 def main() -> None:

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+from test_readme import OUTPUT_OPTIONS, manual
+
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = "32x24"
 SIZED = {"render", "compare", "view", "extremes"}      # and colour of a scene
@@ -23,16 +25,11 @@ SETUP = ("./install.sh",)
 BLOCK = re.compile(r"(?:^<!-- (illustration: [^\n]*?) -->\n)?^```sh\n(.*?)^```", re.S | re.M)
 
 
-def pages() -> dict[str, str]:
-    found = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
-    return {page.relative_to(ROOT).as_posix(): page.read_text() for page in found}
-
-
 def commands(texts: dict[str, str] | None = None) -> list[tuple[str, str, str | None]]:
     """(page, command line, why it is not run or None), in reading order, of `texts` (page
     name -> Markdown; the manual's pages when None)."""
     found = []
-    for name, text in (pages() if texts is None else texts).items():
+    for name, text in (manual() if texts is None else texts).items():
         for illustration, block in BLOCK.findall(text):
             for line in block.splitlines():
                 command = line.split("  #")[0].split(" # ")[0].strip()
@@ -96,8 +93,7 @@ def test_the_checks_see_a_bare_renderer_a_missing_file_and_a_shown_block():
 
 def outputs(command: str) -> list[str]:
     words = shlex.split(command)
-    return [value for option, value in zip(words, words[1:])
-            if option in ("-o", "--out", "--depth", "--alpha", "--screenshot", "--stats")]
+    return [value for option, value in zip(words, words[1:]) if option in OUTPUT_OPTIONS]
 
 
 def test_no_command_writes_over_another_commands_output():

@@ -9,6 +9,8 @@ from pathlib import Path
 
 from renderer.core.builtin import builtin_scenes, made_for
 
+from test_readme import manual
+
 ROOT = Path(__file__).resolve().parents[1]
 WORDS = {word: n for n, word in enumerate(
     "zero one two three four five six seven eight nine ten eleven twelve thirteen fourteen "
@@ -46,10 +48,8 @@ def textured_scenes() -> list[str]:
 def pages() -> dict[str, str]:
     """The README and the manual's pages (not the committed reports: each is dated, its counts
     those of its day), their lines joined."""
-    found = [ROOT / "README.md", *sorted((ROOT / "docs").rglob("*.md"))]
-    names = {page.relative_to(ROOT).as_posix(): page for page in found}
-    return {name: " ".join(page.read_text().split()) for name, page in names.items()
-            if not name.startswith(("docs/gallery/", "docs/report/"))}
+    return {name: " ".join(text.split()) for name, text in manual().items()
+            if not name.startswith("docs/report/")}
 
 
 def wrong_counts(texts: dict[str, str], counts: dict[str, int]) -> list[str]:

@@ -16,7 +16,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
-OUTPUT_OPTIONS = {"-o", "--out", "--depth", "--screenshot", "--stats", "--goldens-results"}
+OUTPUT_OPTIONS = {"-o", "--out", "--depth", "--alpha", "--screenshot", "--stats", "--goldens-results"}
 
 
 def shell_lines(markdown: str) -> list[str]:

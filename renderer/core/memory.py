@@ -253,17 +253,6 @@ def _whole(triangles: int, *renderers: int) -> int:
     return PROCESS_BYTES + triangles * MESH_HELD_BYTES_PER_TRIANGLE + sum(renderers)
 
 
-def check_render(scene, size, backends) -> None:
-    """One line, before any rendering, when rasterising `scene` at `size` on each of
-    `backends` ("gpu", "reference") would need more than the limit."""
-    raster_need(size, backends).check(scene)
-
-
-def check_raytrace_render(scene, size, backends, samples) -> None:
-    """check_render for the ray tracer at `samples` per pixel (its triangles: meshes only)."""
-    raytrace_need(size, backends, samples).check(scene)
-
-
 _planned: tuple[Need, ...] = ()
 
 

@@ -30,26 +30,27 @@ def place_labels(axes, labels, *, fontsize: float = 7, color=None) -> list:
     """Annotate each (text, (x, y)) of `labels` at the first of OFFSETS where it lies inside
     `axes` and over no label placed before; where none does, at the first inside the axes,
     else the first. Call after the axes' limits and scales are set. The annotations."""
-    figure = axes.figure
-    renderer = figure.canvas.get_renderer()
+    renderer = axes.figure.canvas.get_renderer()
     frame = axes.get_window_extent(renderer)
     placed, made = [], []
+
+    def annotated(text, xy, offset):
+        dx, dy, ha, va = offset
+        note = axes.annotate(text, xy, xytext=(dx, dy), textcoords="offset points",
+                             fontsize=fontsize, ha=ha, va=va, color=color, bbox=BACKING)
+        return note, note.get_window_extent(renderer)
+
     for text, xy in labels:
         fallback = None
-        for dx, dy, ha, va in OFFSETS:
-            note = axes.annotate(text, xy, xytext=(dx, dy), textcoords="offset points",
-                                 fontsize=fontsize, ha=ha, va=va, color=color, bbox=BACKING)
-            box = note.get_window_extent(renderer)
+        for offset in OFFSETS:
+            note, box = annotated(text, xy, offset)
             if _inside(box, frame) and not any(box.overlaps(other) for other in placed):
                 break
             if fallback is None and _inside(box, frame):
-                fallback = (dx, dy, ha, va)
+                fallback = offset
             note.remove()
         else:
-            dx, dy, ha, va = fallback or OFFSETS[0]
-            note = axes.annotate(text, xy, xytext=(dx, dy), textcoords="offset points",
-                                 fontsize=fontsize, ha=ha, va=va, color=color, bbox=BACKING)
-            box = note.get_window_extent(renderer)
+            note, box = annotated(text, xy, fallback or OFFSETS[0])
         placed.append(box)
         made.append(note)
     return made

@@ -81,7 +81,7 @@ def test_a_tiny_output_sweep_writes_its_rows_section_and_plot(tmp_path):
     from renderer.study.report import QUICK, run_report
     sweep = replace(QUICK, output_methods=("none", "blue-noise"), output_bits=(1,),
                     output_halftone=True, output_code_value=("blue-noise",), runs=1)
-    result = run_report([load_scene("sphere")], tmp_path, quick=True, size=(32, 24),
+    result = run_report([load_scene("sphere")], tmp_path, sweep_name="quick", size=(32, 24),
                         knobs=("output",), sweep=sweep, context_kind="osmesa")
     assert [(r["setting"], r["backend"]) for r in result.rows] == [
         ("none 1-bit", "gpu"), ("none 1-bit", "reference"), ("blue-noise 1-bit", "gpu"),

@@ -18,7 +18,7 @@ from renderer.core.sampling import PATTERNS
 from renderer.study.distributed_report import (LIGHT_CARRIER_SAMPLES, distributed_sections,
                                                scene_effects)
 from renderer.core.shadow_settings import BIAS_RULES, DEFAULT_FILTER, FILTERS, named_bias
-from renderer.study.report import FULL, QUICK, RasterStudy, ReportResult, metrics, run_report, settings
+from renderer.study.report import EXHAUSTIVE, QUICK, RasterStudy, ReportResult, metrics, run_report, settings
 from renderer.study.report_settings import (CSV_COLUMNS, DISTRIBUTED_KNOBS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS,
                                             SHADOW_COLUMNS, SHADOW_TARGETS, ShadowTarget)
 from renderer.study.shadow_report import cheapest_shadow, shadow_sections, with_shadow_setting
@@ -48,6 +48,35 @@ def test_each_ground_truth_is_told_as_it_is_ready(tmp_path):
     told = []
     ground_truths(scenes, 8, 6, tmp_path, done=lambda scene: told.append(scene.name))
     assert told == ["flat_shading", "point_light_plane"]
+
+
+def test_a_ray_truth_tells_its_progress_frame_by_frame(tmp_path):
+    """Inside a ray-traced truth (16 frames of 64 samples, minutes at full size) the bar moves
+    as rows are traced, up to the whole truth, never back."""
+    from renderer.study.ground_truth import RAY_TRUTH_PASSES, ground_truths
+    scene = load_scene(builtin_scenes()["classic"])
+    shares = []
+    ground_truths([scene], 4, 3, tmp_path, method="raytrace",
+                  step=lambda scene, share: shares.append(share))
+    assert shares == sorted(shares) and shares[-1] == 1.0
+    assert len(shares) >= RAY_TRUTH_PASSES
+
+
+def test_the_default_sweep_stops_at_16_samples_and_exhaustive_is_asked_for():
+    """`renderer report` with no options must finish on the 2-core machine in under 30 minutes
+    (benchmarks/bench_report.py): the 64-sample rows and the fifth run are --exhaustive's."""
+    from renderer.cli import build_parser
+    from renderer.study.ray_report import RayStudy
+    for study in (RasterStudy(), RayStudy()):
+        standard, exhaustive = study.sweep("standard"), study.sweep("exhaustive")
+        assert max(standard.sample_counts) == 16 and standard.runs == 3
+        assert max(exhaustive.sample_counts) == 64 and exhaustive.runs == 5
+    parse = build_parser().parse_args
+    assert not parse(["report", "--out", "o"]).exhaustive
+    assert parse(["report", "--out", "o", "--exhaustive"]).exhaustive
+    from renderer.errors import UsageError
+    with pytest.raises(UsageError, match="--exhaustive: not allowed with argument --quick"):
+        parse(["report", "--out", "o", "--quick", "--exhaustive"])
 
 
 def test_metrics_on_the_zero_to_one_scale():
@@ -90,7 +119,7 @@ def test_every_knob_runs_on_its_backends():
     assert {s.setting for s in plan if s.pattern == "msaa"} == {"msaa 1", "msaa 4"}
     assert {s.setting for s in plan if s.pattern == "regular" and s.knob == "antialiasing"} == \
         {"regular 1", "regular 4", "regular 16"}       # the squares only, up to 16 in --quick
-    assert {s.setting for s in settings(FULL, [1, 4]) if s.pattern == "regular"
+    assert {s.setting for s in settings(EXHAUSTIVE, [1, 4]) if s.pattern == "regular"
             and s.knob == "antialiasing"} == {"regular 1", "regular 4", "regular 16", "regular 64"}
 
 
@@ -153,7 +182,7 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, args, reason, cli_he
 # -- the shadow knobs (renderer/study/shadow_report.py) ----------------------------------------
 
 def test_shadow_knobs_sweep_resolution_filter_and_bias_one_at_a_time():
-    plan = [s for s in settings(FULL, [1, 4]) if s.knob.startswith("shadows-")]
+    plan = [s for s in settings(EXHAUSTIVE, [1, 4]) if s.knob.startswith("shadows-")]
     by_knob = {knob: [(s.setting, s.variant) for s in plan if s.knob == knob and s.backend == "gpu"]
                for knob in ("shadows-resolution", "shadows-filter", "shadows-bias")}
     assert by_knob["shadows-resolution"] == [(str(r), ("shadow", "resolution", r))
@@ -180,7 +209,7 @@ def test_a_shadow_setting_changes_every_light_with_a_map_and_nothing_else():
 
 
 def test_a_scene_gets_the_shadow_settings_its_maps_allow():
-    plan = settings(FULL, [1])
+    plan = settings(EXHAUSTIVE, [1])
     shadowless = replace(load_scene(builtin_scenes()["shadow_plane"]),
                          objects=[replace(o, casts_shadows=False)
                                   for o in load_scene(builtin_scenes()["shadow_plane"]).objects])
@@ -227,7 +256,7 @@ def test_a_tiny_shadow_sweep_writes_its_rows_plots_and_targets(tmp_path):
     scene = load_scene(builtin_scenes()["shadow_plane"])
     sweep = replace(QUICK, shadow_resolutions=(256,), shadow_filters=("hard",),
                     shadow_biases=("auto", "none"), runs=1)
-    result = run_report([scene], tmp_path, quick=True, size=(16, 12), knobs=("shadows",),
+    result = run_report([scene], tmp_path, sweep_name="quick", size=(16, 12), knobs=("shadows",),
                         sweep=sweep, context_kind="osmesa")
     assert [(r["setting"], r["backend"]) for r in result.rows] == [
         (name, b) for name in ("256", "hard", "auto", "none") for b in ("gpu", "reference")]
@@ -411,7 +440,7 @@ def test_ray_report_markdown_has_the_slopes_in_samples_and_in_time():
             for p in ("random", "jittered") for b in ("gpu", "reference") for n in (1, 4, 16)]
     result = ReportResult(rows=rows, scenes={"s": (3, 1, 0, "yes")}, gl_renderer="llvmpipe")
     text = RayStudy().markdown(result, {("s", "antialiasing"): "plots/s-antialiasing.png"},
-                               (64, 48), RAY_QUICK, quick=True)
+                               (64, 48), RAY_QUICK, "quick")
     assert "renderer report --method raytrace --quick" in text
     assert "| s | 3 | 1 | 0 | yes |" in text
     assert "| random | gpu | -0.50 | -0.50 (-0.50 to -0.50) | -0.50 |" in text

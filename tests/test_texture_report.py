@@ -14,7 +14,7 @@ from renderer.core.scene import Camera, Material, Scene, SceneObject, Transform
 from renderer.core.scene_file import load_scene
 from renderer.core.textures import MaterialTexture, Sampler, checkerboard, resampled, texture_from_linear
 from renderer.study.ground_truth import render_truth, truth_scene
-from renderer.study.report import FULL, QUICK, RasterStudy, run_report, settings
+from renderer.study.report import EXHAUSTIVE, QUICK, RasterStudy, run_report, settings
 from renderer.study.texture_report import (FILTER_SETTINGS, TEXTURE_RESOLUTIONS, TRUTH_FILTER,
                                            TRUTH_TEXELS, with_texture_setting)
 
@@ -67,7 +67,7 @@ def test_a_texture_setting_changes_every_textured_material_and_nothing_else():
 
 
 def test_the_texture_knobs_go_to_textured_scenes_only():
-    plan = settings(FULL, [1])
+    plan = settings(EXHAUSTIVE, [1])
     texture_settings = [s for s in plan if s.variant[0] == "texture"]
     assert {(s.knob, s.setting) for s in texture_settings} == {
         *(("filter", name) for name in ("nearest", "bilinear", "mip-nearest", "trilinear", "anisotropic 2",

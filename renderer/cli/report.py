@@ -18,8 +18,12 @@ def add_parser(sub) -> None:
                              "for --method: for raytrace those with spheres, planes, k_r or k_t, "
                              "for raster the others; with --quick, two small ones, or classic)")
     report.add_argument("--out", type=output_path, required=True, help="folder for the report")
-    report.add_argument("--quick", action="store_true",
-                        help="a reduced sweep at 64x48 that takes about a minute (for CI)")
+    extent = report.add_mutually_exclusive_group()
+    extent.add_argument("--quick", action="store_true",
+                        help="a reduced sweep of two small scenes at 64x48 (for CI: under 90 s)")
+    extent.add_argument("--exhaustive", action="store_true",
+                        help="every setting, 64 samples a pixel and 5 runs each (hours for the "
+                             "built-in scenes; the default sweep takes up to 16 samples and 3 runs)")
     report.add_argument("--size", type=parse_size, metavar="WxH",
                         help="image size (default 160x120; 64x48 with --quick)")
     report.add_argument("--cache", type=Path, metavar="DIR",
@@ -60,7 +64,8 @@ def run(args) -> int:
         if not scenes:
             raise UserError(f"no built-in scene is made for --method {args.method}; name the "
                             "scenes to report", key="SCENE")
-    result = run_report(scenes, args.out, method=args.method, quick=args.quick, size=args.size,
+    sweep_name = "quick" if args.quick else "exhaustive" if args.exhaustive else "standard"
+    result = run_report(scenes, args.out, method=args.method, sweep_name=sweep_name, size=args.size,
                         cache_dir=args.cache, context_kind=args.context, knobs=args.knobs,
                         address=args.address, workers=args.workers)
     print(f"wrote {args.out / 'report.md'}, results.csv ({len(result.rows)} rows) and "

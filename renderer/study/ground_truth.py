@@ -110,8 +110,9 @@ def _ray_recipe(scene: Scene) -> str:
     return recipe
 
 
-def render_truth(scene: Scene, width: int, height: int) -> np.ndarray:
-    """(H, W, 3) float64: the truth rendered now (see the module docstring)."""
+def render_truth(scene: Scene, width: int, height: int, progress=None) -> np.ndarray:
+    """(H, W, 3) float64: the truth rendered now (see the module docstring). One frame:
+    `progress` is not told before it is done."""
     big_w, big_h = width * TRUTH_GRID, height * TRUTH_GRID
     if big_w * big_h > MAX_TRUTH_PIXELS:
         raise ValueError(f"a ground truth of {width}x{height} needs a {big_w}x{big_h} reference "
@@ -129,15 +130,18 @@ def truth_light_samples(scene: Scene) -> int:
     return RAY_TRUTH_LIGHT_SAMPLES if uses_area_lights(scene) else 1
 
 
-def render_ray_truth(scene: Scene, width: int, height: int) -> np.ndarray:
-    """(H, W, 3) float64: the ray tracer's truth rendered now (see the module docstring)."""
+def render_ray_truth(scene: Scene, width: int, height: int, progress=None) -> np.ndarray:
+    """(H, W, 3) float64: the ray tracer's truth rendered now (see the module docstring);
+    `progress(share done)`, if given, as each frame's rows are traced."""
     options = RayOptions(samples=RAY_TRUTH_SAMPLES, pattern="jittered", max_depth=RAY_TRUTH_DEPTH,
                          seed=RAY_TRUTH_SEED, light_samples=truth_light_samples(scene))
     total = np.zeros((height, width, 3))
     with open_renderer(scene, (width, height), method="raytrace", backend="reference",
                        options=options, precision="float64") as truth:      # one BVH for every pass
         for frame in range(RAY_TRUTH_PASSES):
-            total += truth.render(first_sample=frame * RAY_TRUTH_SAMPLES).linear[..., :3]
+            told = None if progress is None else (
+                lambda rows, of, frame=frame: progress((frame + rows / of) / RAY_TRUTH_PASSES))
+            total += truth.render(first_sample=frame * RAY_TRUTH_SAMPLES, progress=told).linear[..., :3]
     return clamped(total / RAY_TRUTH_PASSES)
 
 
@@ -148,7 +152,7 @@ class Truth:
     drawn: Callable[[Scene], Scene]
     suffix: str
     recipe: Callable[[Scene], str]
-    render: Callable[[Scene, int, int], np.ndarray]
+    render: Callable[..., np.ndarray]          # (scene, width, height, progress=None)
 
 
 # Each method's truth, by the name renderer/methods registers it under.
@@ -162,24 +166,31 @@ def truth_of(method: str) -> Truth:
     return TRUTHS[method]
 
 
-def render_ground_truth(scene: Scene, width: int, height: int, method: str = "raster") -> np.ndarray:
-    """The truth of `method` rendered now, uncached (a plain function: a task elsewhere)."""
-    return truth_of(method).render(scene, width, height)
+def render_ground_truth(scene: Scene, width: int, height: int, method: str = "raster",
+                        progress=None) -> np.ndarray:
+    """The truth of `method` rendered now, uncached (a plain function: a task elsewhere);
+    `progress(share done)` as the truth can tell it."""
+    return truth_of(method).render(scene, width, height, progress=progress)
 
 
 def ground_truths(scenes: list, width: int, height: int, cache_dir, method: str = "raster",
-                  tasks=None, done=None) -> list[tuple[np.ndarray, bool]]:
+                  tasks=None, done=None, step=None) -> list[tuple[np.ndarray, bool]]:
     """ground_truth of each of `scenes`; the misses rendered through `tasks(function, args)`
     ((index, result) pairs in any order: an executor's, renderer/cluster/executor.py, which may
     render them elsewhere, at once; default here, one after another) and stored here.
-    `done(scene)`, if given, as each truth is ready (a progress bar: a miss takes minutes)."""
+    `done(scene)`, if given, as each truth is ready (a progress bar: a miss takes minutes);
+    `step(scene, share done)` inside a truth rendered here (not through `tasks`)."""
     paths = [cache_path(scene, width, height, cache_dir, method) for scene in scenes]
     truths = [(np.load(path), True) if path.is_file() else None for path in paths]
     missing = [index for index, truth in enumerate(truths) if truth is None]
     for index in range(len(scenes)) if done is not None else ():
         if truths[index] is not None:
             done(scenes[index])
-    tasks = tasks or (lambda function, args: enumerate(function(*a) for a in args))
+    if tasks is None:
+        def tasks(function, args):
+            for k, a in enumerate(args):
+                yield k, function(*a, progress=None if step is None else
+                                  (lambda share, scene=a[0]: step(scene, share)))
     for k, truth in tasks(render_ground_truth, [(scenes[i], width, height, method) for i in missing]):
         write_npy(paths[missing[k]], truth)
         truths[missing[k]] = (truth, False)

@@ -222,7 +222,7 @@ def output_sections(rows: list[dict]) -> list[str]:
              "of 1/255 of luminance (8x8 blocks, shown minus computed); the low-pass PSNR is of "
              f"luminance after a Gaussian of sigma {EYE_SIGMA:.2f} pixels, the eye's at 67 pixels "
              "per degree (renderer/study/output_report.py); times are the stage's alone per frame.",
-             "", f"### Ranking at 1 bit per channel (by low-pass PSNR; ꟻLIP's own order in brackets)",
+             "", "### Ranking at 1 bit per channel (by low-pass PSNR; ꟻLIP's own order in brackets)",
              "", *ranking_table(rows, 1), "",
              "A 1-bit 8x8 block shows one of 65 means per channel (steps of 1/64, 4/255), so no "
              "method holds every block within 0.5/255 at 1 bit: the distribution above (mean, 95th "

@@ -60,9 +60,11 @@ class RaySweep:
     runs: int = 5                                    # as the rasteriser's: GPU times are noisy
 
 
-RAY_FULL = RaySweep()
+RAY_EXHAUSTIVE = RaySweep()
+RAY_STANDARD = RaySweep(sample_counts=(1, 4, 16), light_counts=(1, 4, 16), runs=3)   # the default
 RAY_QUICK = RaySweep(sample_counts=(1, 4, 16), thresholds=(4,), depths=(0, 1, 4, RAY_TRUTH_DEPTH),
                      light_counts=(1, 4, 16))
+RAY_SWEEPS = {"quick": RAY_QUICK, "standard": RAY_STANDARD, "exhaustive": RAY_EXHAUSTIVE}
 
 
 @dataclass(frozen=True)
@@ -144,11 +146,12 @@ class RayStudy:
     columns = RAY_CSV_COLUMNS
     knobs = ("antialiasing", "max_depth", "precision", "light_samples", "lens", "time", "glossy")
 
-    def sweep(self, quick: bool) -> RaySweep:
-        return RAY_QUICK if quick else RAY_FULL
+    def sweep(self, name: str) -> RaySweep:
+        """The sweep called `name` (report_settings.SWEEP_NAMES)."""
+        return RAY_SWEEPS[name]
 
-    def size(self, quick: bool) -> tuple[int, int]:
-        return RAY_QUICK_SIZE if quick else RAY_DEFAULT_SIZE
+    def size(self, name: str) -> tuple[int, int]:
+        return RAY_QUICK_SIZE if name == "quick" else RAY_DEFAULT_SIZE
 
     def check(self, scenes: list, width: int, height: int) -> None:
         """A UserError, before any work: an image over RAY_MAX_SIZE, or a ground truth frame
@@ -187,6 +190,6 @@ class RayStudy:
     def scene_run(self, scene, width: int, height: int, ctx) -> RaySceneRun:
         return RaySceneRun(scene, width, height, ctx)
 
-    def markdown(self, result, plots: dict, size, sweep: RaySweep, quick: bool) -> str:
+    def markdown(self, result, plots: dict, size, sweep: RaySweep, name: str) -> str:
         from renderer.study.ray_report_output import ray_report_markdown
-        return ray_report_markdown(result, plots, size, sweep, quick)
+        return ray_report_markdown(result, plots, size, sweep, name)

@@ -9,7 +9,7 @@ from renderer.study.ground_truth import (RAY_TRUTH_DEPTH, RAY_TRUTH_PASSES, RAY_
 from renderer.study.distributed_report import distributed_sections
 from renderer.study.report_output import (cheapest_sections, convergence_slopes, errors_bullet,
                                           generated_line, plots_section, series_name, spread)
-from renderer.study.report_settings import RAY_BASE_SAMPLES, RAY_TEXTBOOK_SLOPES
+from renderer.study.report_settings import RAY_BASE_SAMPLES, RAY_TEXTBOOK_SLOPES, SWEEP_FLAGS
 
 
 def _slope_lines(rows: list[dict]) -> list[str]:
@@ -29,14 +29,14 @@ def _slope_lines(rows: list[dict]) -> list[str]:
     return lines
 
 
-def ray_report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
+def ray_report_markdown(result, plots: dict, size, sweep, name: str) -> str:
     rows = result.rows
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     lines = [
         "# Error against run time: the ray tracer",
         "",
         generated_line(result, size, sweep.runs,
-                       f"renderer report --method raytrace{' --quick' if quick else ''}"
+                       f"renderer report --method raytrace{SWEEP_FLAGS[name]}"
                        + (f" --knobs {','.join(result.knobs)}" if result.knobs else "")),
         "",
         "## Scenes",

@@ -50,13 +50,13 @@ from renderer.core import sampling
 from renderer.core.drawn import triangle_bound
 from renderer.core.shadow_settings import BIAS_RULES, FILTERS
 from renderer.study.report_output import csv_text, plot_png, report_markdown
-from renderer.study.ground_truth import (MAX_TRUTH_PIXELS, TRUTH_GRID, default_cache_dir,
-                                         ground_truths, truth_scene)
+from renderer.study.ground_truth import (MAX_TRUTH_PIXELS, TRUTH_GRID, cache_path,
+                                         default_cache_dir, ground_truths, truth_scene)
 from renderer.core.imageio import outputs
 from renderer.study.supersample import (adaptive_supersample, gpu_pass, msaa_image, reference_pass,
                                   supersample)
 from renderer.study.metrics import metrics
-from renderer.study.report_units import SceneWork, gl_facts, run_units
+from renderer.study.report_units import SceneWork, gl_facts, run_units, truth_cost, unit_cost
 from renderer.study import output_report
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, DEFAULT_SIZE, QUICK_SIZE,
                                             SHADOW_RESOLUTIONS)
@@ -85,15 +85,20 @@ class Sweep:
     runs: int = 5
 
 
-FULL = Sweep()
-# --quick (CI's sweep, under 90 s): up to 16 samples, 3 runs a setting. The reference's 64
-# samples a pixel at 5 runs were 78 of its 97 s at 32x24.
+EXHAUSTIVE = Sweep()
+# The default: every knob's settings but 64 samples a pixel, 3 runs a setting. The reference's
+# 64-sample rows at 5 runs were most of the exhaustive sweep's time: its passes at the truth's
+# tessellation take 1.8 s for the 20 built-in raster scenes at 160x120, and the antialiasing
+# knob draws 380 of them a run (about 57 minutes in all) where this sweep's draws 92 at 3 runs.
+STANDARD = Sweep(sample_counts=(1, 4, 16), adaptive=((4, 16, 0.05),), runs=3)
+# --quick (CI's sweep, under 90 s): fewer settings of every knob, two small scenes at 64x48.
 QUICK = Sweep(sample_counts=(1, 4, 16), runs=3,
               adaptive=((4, 16, 0.05),), levels=(0.25, 1.0, FINEST), shadow_resolutions=(256, 1024),
               shadow_filters=("hard", "pcf2x2"), shadow_biases=("auto", "none"),
               texture_filters=(("nearest", 1), ("trilinear", 1), ("anisotropic", 16)),
               texture_resolutions=(64, 256),
               output_methods=("none", "bayer4", "blue-noise", "floyd-steinberg"), output_bits=(1, 8))
+SWEEPS = {"quick": QUICK, "standard": STANDARD, "exhaustive": EXHAUSTIVE}
 KNOB_FAMILIES = ("antialiasing", "tessellation", "shading", "precision", "shadows", "filter",
                  "texture_resolution", output_report.KNOB)
 
@@ -244,11 +249,12 @@ class RasterStudy:
     columns = CSV_COLUMNS
     knobs = KNOB_FAMILIES
 
-    def sweep(self, quick: bool) -> Sweep:
-        return QUICK if quick else FULL
+    def sweep(self, name: str) -> Sweep:
+        """The sweep called `name` (report_settings.SWEEP_NAMES)."""
+        return SWEEPS[name]
 
-    def size(self, quick: bool) -> tuple[int, int]:
-        return QUICK_SIZE if quick else DEFAULT_SIZE
+    def size(self, name: str) -> tuple[int, int]:
+        return QUICK_SIZE if name == "quick" else DEFAULT_SIZE
 
     def check(self, scenes: list, width: int, height: int) -> None:
         """A UserError, before any work, for what the sweep cannot do."""
@@ -282,8 +288,8 @@ class RasterStudy:
     def scene_run(self, scene, width: int, height: int, ctx) -> SceneRun:
         return SceneRun(scene, width, height, ctx)
 
-    def markdown(self, result, plots: dict, size, sweep: Sweep, quick: bool) -> str:
-        return report_markdown(result, plots, size, sweep, quick)
+    def markdown(self, result, plots: dict, size, sweep: Sweep, name: str) -> str:
+        return report_markdown(result, plots, size, sweep, name)
 
 
 def _ray_study():
@@ -314,11 +320,13 @@ class ReportResult:
     where: str = "in this process"                    # the executor's describe()
 
 
-def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool = False,
+def run_report(scenes: list, out: Path, *, method: str = "raster", sweep_name: str = "standard",
                size=None, cache_dir=None, context_kind: str = "auto", sweep=None,
                knobs=None, address: str | None = None, workers: int | None = None) -> ReportResult:
     """Sweep `scenes` (Scene objects) with `method`'s study (study()), write results.csv,
-    plots/ and report.md under `out`. `knobs`: the knob families to sweep (default all of the
+    plots/ and report.md under `out`. `sweep_name`: quick, standard or exhaustive
+    (report_settings.SWEEP_NAMES; `sweep`, if given, replaces its settings but not its
+    size). `knobs`: the knob families to sweep (default all of the
     study's `knobs`; a setting's family is its knob up to a "-"). `address`, `workers`: the
     settings and the ground truths missing from the cache run on Ray (renderer/cluster/
     executor.py open_executor; report_units.py), else in this process; the cache is here."""
@@ -334,9 +342,9 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
     if unknown:
         raise UserError(f"{', '.join(unknown)}: no such knob for --method {method} (one of "
                         f"{', '.join(runner.knobs)})", key="--knobs")
-    width, height = size or runner.size(quick)
+    width, height = size or runner.size(sweep_name)
     runner.check(scenes, width, height)
-    sweep = sweep or runner.sweep(quick)
+    sweep = sweep or runner.sweep(sweep_name)
     cache_dir = Path(cache_dir) if cache_dir else default_cache_dir()
     start = time.perf_counter()
     # An --address nobody answers is one line before any work (open_executor checks it).
@@ -354,32 +362,47 @@ def run_report(scenes: list, out: Path, *, method: str = "raster", quick: bool =
         result.scenes = {scene.name: runner.describe(scene) for scene in scenes}
         traced = [i for i, scene_plan in enumerate(plans) if runner.needs_truth(scene_plan)]
         truths = [None] * len(scenes)
-        with tqdm(total=sum(len(p) + 1 for p in plans), unit="setting", file=sys.stderr,
-                  mininterval=0.5, dynamic_ncols=True) as bar:
-            bar.set_description(f"ground truths (0 of {len(traced)})")
-            made = []
+        # The bar moves by estimated cost (report_units.py unit_cost, truth_cost), not by rows,
+        # whose costs differ a thousandfold: its remaining time is then an estimate worth
+        # reading. A truth already in the cache costs nothing.
+        truth_costs = {scenes[i].name: truth_cost(runner.method, scenes[i]) for i in traced
+                       if not cache_path(scenes[i], width, height, cache_dir, runner.method).is_file()}
+        total = (sum(truth_costs.values())
+                 + sweep.runs * sum(unit_cost(s) for plan in plans for s in plan))
+        with tqdm(total=total, file=sys.stderr, mininterval=0.5, dynamic_ncols=True,
+                  bar_format="{desc}{percentage:3.0f}%|{bar}| {elapsed} elapsed, about "
+                             "{remaining} left") as bar:
+            bar.set_description(f"ground truths (0 of {len(traced)} made)")
+            made, shares = [], {}
 
-            def truth_done(scene):               # each truth as it is ready: minutes apiece
+            def truth_step(scene, share):        # inside a truth made here: minutes apiece
+                cost = truth_costs.get(scene.name, 0.0)
+                bar.update(cost * (share - shares.get(scene.name, 0.0)))
+                shares[scene.name] = share
+                bar.set_description(f"ground truths ({len(made)} of {len(traced)} made; "
+                                    f"{scene.name} {share:.0%})")
+
+            def truth_done(scene):
+                truth_step(scene, 1.0)
                 made.append(scene.name)
-                bar.set_description(f"ground truths ({len(made)} of {len(traced)}: {scene.name})")
-                bar.update(1)
+                bar.set_description(f"ground truths ({len(made)} of {len(traced)} made: {scene.name})")
             for i, (truth, hit) in zip(traced, ground_truths(
                     [scenes[i] for i in traced], width, height, cache_dir, runner.method,
-                    tasks=executor.tasks, done=truth_done)):
+                    tasks=None if executor.kind == "in-process" else executor.tasks, done=truth_done,
+                    step=truth_step)):
                 truths[i] = truth
                 result.truth_hits += hit
-            bar.update(len(scenes) - len(traced))    # the scenes that need no truth
             work = [SceneWork(i, scene, tuple(plans[i]), truths[i]) for i, scene in enumerate(scenes)]
             result.rows = run_units(executor, runner, work, sweep.runs, facts, (width, height),
                                     context_kind, bar)
     result.seconds = time.perf_counter() - start
-    write_outputs(result, Path(out), runner, (width, height), sweep, quick)
+    write_outputs(result, Path(out), runner, (width, height), sweep, sweep_name)
     return result
 
 
 # ------------------------------------------------------------------------------- outputs
 
-def write_outputs(result: ReportResult, out: Path, runner, size, sweep, quick: bool) -> None:
+def write_outputs(result: ReportResult, out: Path, runner, size, sweep, sweep_name: str) -> None:
     plots = {}
     with outputs() as written:               # the whole report or none of it
         for scene in dict.fromkeys(row["scene"] for row in result.rows):
@@ -391,5 +414,5 @@ def write_outputs(result: ReportResult, out: Path, runner, size, sweep, quick: b
                        plot_png(rows, f"{scene}: {knob}", **plot_axis(knob)))
                 written.bytes(out / plots[(scene, knob)], png)
         written.text(out / "results.csv", csv_text(result.rows, runner.columns))
-        written.text(out / "report.md", runner.markdown(result, plots, size, sweep, quick))
+        written.text(out / "report.md", runner.markdown(result, plots, size, sweep, sweep_name))
     result.files = ["report.md", "results.csv", *plots.values()]

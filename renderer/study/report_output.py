@@ -17,7 +17,8 @@ import numpy as np
 from renderer.core import sampling
 from renderer.study.ground_truth import TRUTH_GRID
 from renderer.study.report_settings import (BASE_SAMPLES, CSV_COLUMNS, MISMATCH_LEVELS,
-                                            PATTERN_KNOBS, TARGETS_RMSE, TEXTBOOK_SLOPES)
+                                            PATTERN_KNOBS, SWEEP_FLAGS, TARGETS_RMSE,
+                                            TEXTBOOK_SLOPES)
 from renderer.study import output_report, texture_report
 from renderer.study.shadow_report import method_bullet, shadow_sections
 
@@ -286,7 +287,7 @@ def truth_bullets(result, sweep, families: set) -> list[str]:
     ]
 
 
-def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
+def report_markdown(result, plots: dict, size, sweep, name: str) -> str:
     """report.md: the Method bullets and the sections of the knob families in the rows."""
     rows = result.rows
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
@@ -294,7 +295,7 @@ def report_markdown(result, plots: dict, size, sweep, quick: bool) -> str:
     lines = [
         "# Error against run time",
         "",
-        generated_line(result, size, sweep.runs, f"renderer report{' --quick' if quick else ''}"
+        generated_line(result, size, sweep.runs, f"renderer report{SWEEP_FLAGS[name]}"
                        + (f" --knobs {','.join(result.knobs)}" if result.knobs else "")),
         "",
         "## Scenes",

@@ -5,6 +5,11 @@ convergence rates, read by the sweep (report.py, shadow_report.py) and by its ou
 from dataclasses import dataclass
 
 DEFAULT_SIZE = (160, 120)
+# The sweeps a report can run, by name: `--quick` (CI's: a minute or two), the default (the
+# built-in scenes in under 30 minutes on the project's 2-core machine:
+# benchmarks/results/report.md) and `--exhaustive` (every sample count, 5 runs: hours).
+SWEEP_NAMES = ("quick", "standard", "exhaustive")
+SWEEP_FLAGS = {"quick": " --quick", "standard": "", "exhaustive": " --exhaustive"}
 QUICK_SIZE = (64, 48)
 QUICK_SCENES = ("flat_shading", "gouraud_vs_phong")
 # The errors the "cheapest setting" must reach: about 2.6/255, where one sample often does,

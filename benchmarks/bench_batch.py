@@ -21,6 +21,9 @@ Printed per run kind (medians of the repeats):
 Then the scaling efficiency rate(2) / (2 x rate(1)), the local Ray's start, a call's round
 trip on an actor (alone, and with IN_FLIGHT queued), and whether all runs' manifests hold
 the same SHA-256 for every file.
+
+It writes benchmarks/results/batch.json (the figures, with machine, date, load and commit)
+and batch.md (the table made from it: `markdown`), which docs/cluster.md includes.
 """
 
 from __future__ import annotations
@@ -34,7 +37,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from common import machine, parser
+from common import machine, measured_line, parser, write_results
 
 from renderer.batch import run as batch_run
 from renderer.batch.items import expand
@@ -206,14 +209,19 @@ def main() -> None:
             alone, queued = call_overhead_ms()
         finally:
             local.stop()
-        report(runs, job, ray_start, alone, queued)
+        figures = report(runs, job, ray_start, alone, queued)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
     print(f"after: {machine()}")
+    figures["job"] = {"scenes": len(SCENES), "views": args.views, "size": [width, height],
+                      "repeats": args.repeats}
+    print(f"wrote {write_results('batch', figures, markdown)}")
 
 
-def report(runs: dict, job, ray_start: float, alone: float, queued: float) -> None:
+def report(runs: dict, job, ray_start: float, alone: float, queued: float) -> dict:
+    """Prints the table and the lines below it; the figures, for the results file."""
     items = runs["in-process"][0]["items"]
+    rows = []
     print(f"{'run':15s} {'wall s':>6s} {'items/s':>7s} {'1st item s':>10s} {'steady/s':>8s} "
           f"{'batch':>5s} {'worker ms/item':>14s} {'CPU ms/item':>11s} {'driver ms/item':>14s} "
           f"{'machine busy':>12s}")
@@ -228,6 +236,12 @@ def report(runs: dict, job, ray_start: float, alone: float, queued: float) -> No
         print(f"{kind:15s} {median['seconds']:6.2f} {rates[kind]:7.1f} {median['first_s']:10.2f} "
               f"{steady[kind]:8.1f} {size:5d} {median['item_ms']:14.1f} {median['cpu_ms']:11.1f} "
               f"{median['driver_ms']:14.1f} {median['busy_cores']:7.2f} cores")
+        rows.append({"run": kind, "workers": workers, "seconds": round(median["seconds"], 2),
+                     "items_per_s": round(rates[kind], 1), "first_item_s": round(median["first_s"], 2),
+                     "steady_items_per_s": round(steady[kind], 1), "batch": size,
+                     "worker_ms": round(median["item_ms"], 1), "cpu_ms": round(median["cpu_ms"], 1),
+                     "driver_ms": round(median["driver_ms"], 2),
+                     "busy_cores": round(median["busy_cores"], 2)})
     one, two = "ray, 1 worker", "ray, 2 workers"
     print(f"scaling efficiency rate(2) / (2 x rate(1)) = {rates[two] / (2 * rates[one]):.2f} "
           f"(steady: {steady[two] / (2 * steady[one]):.2f}); "
@@ -239,6 +253,46 @@ def report(runs: dict, job, ray_start: float, alone: float, queued: float) -> No
     same = all(hashes == every[0] for hashes in every)
     print(f"manifests: {len(every)} runs, {items} items each: "
           f"{'the same SHA-256 for every file' if same else 'HASHES DIFFER'}")
+    return {"items": items, "runs": rows,
+            "efficiency": round(rates[two] / (2 * rates[one]), 2),
+            "steady_efficiency": round(steady[two] / (2 * steady[one]), 2),
+            "ray_1_over_in_process": round(rates[one] / rates["in-process"], 2),
+            "ray_start_s": round(ray_start, 1), "call_ms": round(alone, 2),
+            "call_queued_ms": round(queued, 2), "in_flight": IN_FLIGHT,
+            "runs_compared": len(every), "same_bytes": same}
+
+
+def markdown(document: dict) -> str:
+    """The table of docs/cluster.md ("How it scales"), made from a results document."""
+    f = document["figures"]
+    job = f["job"]
+    lines = [f"{job['scenes']} scenes × {job['views']} orbit views = {f['items']} items at "
+             f"{job['size'][0]}×{job['size'][1]}, an sRGB png8 each; the runs take turns, "
+             f"{job['repeats']} of each kind (medians):", "",
+             "| run | wall s | items/s | 1st item s | steady items/s | batch | worker ms/item "
+             "| CPU ms/item | driver ms/item | machine busy, cores |",
+             "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for r in f["runs"]:
+        lines.append(f"| {r['run']} | {r['seconds']:.2f} | {r['items_per_s']:.1f} | "
+                     f"{r['first_item_s']:.2f} | {r['steady_items_per_s']:.1f} | {r['batch']} | "
+                     f"{r['worker_ms']:.1f} | {r['cpu_ms']:.1f} | {r['driver_ms']:.2f} | "
+                     f"{r['busy_cores']:.2f} |")
+    ray = [r for r in f["runs"] if r["run"] != "in-process"]
+    driver_ms = max(r["driver_ms"] for r in ray)
+    cpu_ms = max(r["cpu_ms"] for r in ray)
+    lines += ["",
+              f"Scaling efficiency rate(2 workers) / (2 × rate(1 worker)): {f['efficiency']:.2f} "
+              f"with the start, {f['steady_efficiency']:.2f} steady; 1 Ray worker against one "
+              f"process: {f['ray_1_over_in_process']:.2f} of its rate. A local Ray's start: "
+              f"{f['ray_start_s']:.1f} s. A call's round trip (an empty batch, on one actor): "
+              f"{f['call_ms']:.2f} ms alone, {f['call_queued_ms']:.2f} ms with {f['in_flight']} "
+              f"in flight. The driver's writing (the one serial part, up to {driver_ms:.2f} ms "
+              f"an item) caps a cluster at about {1000 / driver_ms:,.0f} items/s at this item "
+              f"size, some {cpu_ms / driver_ms:.0f} workers of {cpu_ms:.1f} CPU-ms an item. "
+              f"{f['runs_compared']} runs' manifests: "
+              + ("the same SHA-256 for every file." if f["same_bytes"] else "the files' SHA-256 DIFFER."),
+              "", measured_line(document), ""]
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -17,7 +17,9 @@ samples:
 - samples per second: pixels x spp / time (camera samples, each carrying one lens point, one
   time and one glossy direction per hit); for soft_shadows also light samples per second
   (pixels x spp x M per area light).
-Not a test: this machine is shared and noisy; the load average is printed.
+Not a test: this machine is shared and noisy; the load average is printed. The figures go to
+benchmarks/results/distributed.json and .md (benchmarks/common.py write_results; `markdown`
+makes the .md), which docs/ray-tracing.md includes.
 """
 
 from __future__ import annotations
@@ -33,7 +35,7 @@ from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
 
-from common import alternating_ms, machine, parser       # benchmarks/common.py
+from common import alternating_ms, machine, measured_line, parser, write_results       # benchmarks/common.py
 
 EFFECTS = {"soft_shadows": "area lights", "depth_of_field": "thin lens",
            "motion_blur": "motion blur", "glossy": "glossy reflection"}
@@ -67,6 +69,9 @@ def main() -> None:
     print("| scene | effect | GPU ms | GPU Msamples/s | without ms | effect / without | "
           "reference s | reference ksamples/s | without s | effect / without | light Msamples/s (GPU) |")
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+    figures = {"size": list(args.size), "reference_size": [rw, rh], "spp": args.spp,
+               "light_samples": args.light_samples, "frames": args.frames, "context": args.context,
+               "renderer": ctx.info["GL_RENDERER"], "rows": []}
     for name, effect in EFFECTS.items():
         scene = load_scene(builtin_scenes()[name])
         plain = without_effect(scene)
@@ -89,6 +94,34 @@ def main() -> None:
         print(f"| {name} | {effect} | {ms:.1f} | {samples / ms / 1e3:.2f} | {bare_ms:.1f} | "
               f"{ms / bare_ms:.2f} | {seconds[0]:.2f} | {rw * rh * args.spp / seconds[0] / 1e3:.1f} | "
               f"{seconds[1]:.2f} | {seconds[0] / seconds[1]:.2f} | {light} |")
+        figures["rows"].append({"scene": name, "effect": effect, "light_samples": m,
+                                "gpu_ms": round(ms, 2), "gpu_without_ms": round(bare_ms, 2),
+                                "reference_s": round(seconds[0], 4), "reference_without_s": round(seconds[1], 4)})
+    ctx.release()
+    print(f"wrote {write_results('distributed', figures, markdown)}")
+
+
+def markdown(document: dict) -> str:
+    """The table of docs/ray-tracing.md, "Distributed ray tracing", "Speed", made from a results
+    document (write_results)."""
+    figures = document["figures"]
+    (width, height), (rw, rh) = figures["size"], figures["reference_size"]
+    spp = figures["spp"]
+    lines = [f"GPU path ({figures['renderer']} on {figures['context']}) at {width}×{height}, the median of "
+             f"{figures['frames']} frames alternating with the scene without its effect; reference at "
+             f"{rw}×{rh}, one frame each; {spp} jittered samples per pixel (soft_shadows: "
+             f"{figures['light_samples']} light samples per hit).", "",
+             "| scene | GPU Msamples/s | effect / without (GPU) | reference ksamples/s | effect / without (reference) |",
+             "| --- | ---: | ---: | ---: | ---: |"]
+    for row in figures["rows"]:
+        samples = width * height * spp
+        rate = f"{samples / row['gpu_ms'] / 1e3:.2f}"
+        if row["scene"] == "soft_shadows":
+            rate += f" ({samples * row['light_samples'] / row['gpu_ms'] / 1e3:.1f} M light samples/s)"
+        lines.append(f"| {row['scene']} ({row['effect']}) | {rate} | {row['gpu_ms'] / row['gpu_without_ms']:.2f} | "
+                     f"{rw * rh * spp / row['reference_s'] / 1e3:.0f} | "
+                     f"{row['reference_s'] / row['reference_without_s']:.2f} |")
+    return "\n".join(lines + ["", measured_line(document), ""])
 
 
 if __name__ == "__main__":

@@ -5,6 +5,9 @@ renderer against a bare moderngl program doing the same GL work.
 
 Not a test: this machine is shared and noisy, so figures are medians measured side by side
 in one run (the renderer and the bare program alternate frame by frame).
+
+It writes benchmarks/results/pipeline.json (the figures, with machine, date, load and commit)
+and pipeline.md (the tables made from it: `markdown`), which docs/benchmarks.md includes.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from renderer.core.scene_file import load_scene
 from renderer.gpu.shaders import program_source
 from renderer.methods import open_renderer
 
-from common import arguments          # benchmarks/common.py
+from common import arguments, measured_line, write_results          # benchmarks/common.py
 
 
 def sphere_scene() -> Scene:
@@ -86,7 +89,8 @@ def timed(fn) -> float:
     return (time.perf_counter() - start) * 1000.0
 
 
-def bench_scenes(ctx, size, frames):
+def bench_scenes(ctx, size, frames) -> list[dict]:
+    rows = []
     print(f"\nBuilt-in scenes at {size[0]}x{size[1]} (median ms per frame; GPU path = llvmpipe here)")
     print(f"{'scene':<20} {'triangles':>9} {'gpu_ms':>8} {'reference_ms':>13} {'ratio':>7}")
     for name, path in builtin_scenes().items():
@@ -98,9 +102,12 @@ def bench_scenes(ctx, size, frames):
         twin = open_renderer(scene, size, backend="reference")
         ref_ms = statistics.median(timed(twin.render) for _ in range(3))
         print(f"{name:<20} {triangles:>9} {gpu_ms:>8.2f} {ref_ms:>13.1f} {ref_ms / gpu_ms:>6.1f}x")
+        rows.append({"scene": name, "triangles": triangles, "gpu_ms": round(gpu_ms, 3),
+                     "reference_ms": round(ref_ms, 2)})
+    return rows
 
 
-def bench_overhead(ctx, size, frames):
+def bench_overhead(ctx, size, frames) -> dict:
     scene = sphere_scene()
     bare = BareProgram(ctx, scene, *size)
     with open_renderer(scene, size, context=ctx) as gpu:
@@ -122,14 +129,45 @@ def bench_overhead(ctx, size, frames):
     print(f"  ratio renderer (new arrays) / bare    {fresh_ms / bare_ms:8.3f}")
     print(f"  reference (float64)                   {ref_ms:8.1f} ms/frame, "
           f"{ref_ms / fresh_ms:.1f}x the GPU path (target <= 100)")
+    return {"reused_ms": round(ours_ms, 3), "fresh_ms": round(fresh_ms, 3), "bare_ms": round(bare_ms, 3),
+            "reference_ms": round(ref_ms, 2)}
 
 
 def main():
     args = arguments(__doc__, "frames", 30)
     ctx = make_context(args.context)
     print(f"GL: {ctx.info['GL_RENDERER']} | {ctx.info['GL_VERSION']} | context {args.context}")
-    bench_overhead(ctx, args.size, args.frames)
-    bench_scenes(ctx, args.size, max(5, args.frames // 3))
+    scene_frames = max(5, args.frames // 3)
+    overhead = bench_overhead(ctx, args.size, args.frames)
+    scenes = bench_scenes(ctx, args.size, scene_frames)
+    figures = {"gl_renderer": ctx.info["GL_RENDERER"], "context": args.context, "size": list(args.size),
+               "frames": args.frames, "scene_frames": scene_frames, "reference_frames": 3,
+               "overhead": overhead, "scenes": scenes}
+    print(f"wrote {write_results('pipeline', figures, markdown)}")
+
+
+def markdown(document: dict) -> str:
+    """docs/benchmarks.md's tables of frame times, made from a results document (write_results)."""
+    f = document["figures"]
+    o = f["overhead"]
+    width, height = f["size"]
+    lines = [f"| 20,480-triangle sphere at {width}×{height}, colour + depth read back "
+             f"| ms/frame (median of {f['frames']}) |", "| --- | --- |",
+             f"| `GpuRenderer.render(out=frame)` (arrays reused) | {o['reused_ms']:.2f} "
+             f"({o['reused_ms'] / o['bare_ms']:.2f}× the bare program) |",
+             f"| `GpuRenderer.render()` (new arrays each frame) | {o['fresh_ms']:.2f} "
+             f"({o['fresh_ms'] / o['bare_ms']:.2f}×) |",
+             f"| a bare moderngl program doing the same GL work | {o['bare_ms']:.2f} |",
+             f"| NumPy reference, float64 (median of {f['reference_frames']}) | {o['reference_ms']:.1f} "
+             f"({o['reference_ms'] / o['fresh_ms']:.1f}× the GPU path) |",
+             "", f"Each built-in scene at {width}×{height} (medians: the GPU path of {f['scene_frames']} "
+             f"frames, the reference of {f['reference_frames']}):", "",
+             "| scene | triangles | GPU ms | reference ms | reference / GPU |",
+             "| --- | ---: | ---: | ---: | ---: |"]
+    for r in f["scenes"]:
+        lines.append(f"| {r['scene']} | {r['triangles']} | {r['gpu_ms']:.2f} | {r['reference_ms']:.1f} "
+                     f"| {r['reference_ms'] / r['gpu_ms']:.1f}× |")
+    return "\n".join(lines + ["", f"GL: {f['gl_renderer']}, context {f['context']}.", measured_line(document), ""])
 
 
 if __name__ == "__main__":

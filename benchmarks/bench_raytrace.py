@@ -21,7 +21,9 @@ Then, at 1 spp, the GPU specialised (the default: only what the scene uses compi
 all features compiled in (RayTracer(..., specialise=False)), frames alternating; the images
 must be identical; and the rasteriser (renderer.gpu.GpuRenderer) against the ray tracer at
 1 spp, frames alternating. The BVH's speed-up over brute force: benchmarks/bench_bvh.py.
-Not a test: this machine is shared and noisy; the load average is printed.
+Not a test: this machine is shared and noisy; the load average is printed. The figures go to
+benchmarks/results/raytrace.json and .md (benchmarks/common.py write_results; `markdown`
+makes the .md), which docs/ray-tracing.md includes.
 """
 
 from __future__ import annotations
@@ -40,10 +42,12 @@ from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
 
-from common import alternating_ms, machine       # benchmarks/common.py
+from common import alternating_ms, machine, measured_line, write_results       # benchmarks/common.py
 
 RAYTRACE_SCENES = ("classic", "cornell_box", "mesh_shadow", "tir_bubble")
 ICOSPHERE = "icosphere (20,480 tri)"
+TARGET_MS = 100          # issue 14: `classic` at 640x480, 1 spp, within 100 ms a frame on the GPU path
+REFERENCE_LIMIT = 50     # issue 14: the reference within 50 times the GPU path's time
 
 
 def icosphere_scene():
@@ -116,6 +120,9 @@ def main() -> None:
     print(header)
     print("-" * len(header))
     counts = {}
+    figures = {"size": [W, H], "frames": args.frames, "context": args.context,
+               "renderer": ctx.info["GL_RENDERER"], "target_ms": TARGET_MS,
+               "reference_limit": REFERENCE_LIMIT, "rows": [], "specialisation": [], "raster": []}
     for name, scene in scenes.items():
         rs = ray_scene(scene)
         for spp in args.spp:
@@ -136,6 +143,8 @@ def main() -> None:
                     counts[name] = rays
             ref = (f"{r:10.0f} {rays / r / 1000:11.2f} {r / g:7.1f}x" if r is not None
                    else f"{'-':>10} {'-':>11} {'-':>8}")
+            figures["rows"].append({"scene": name, "spp": spp, "rays": rays, "estimated": mark == "~",
+                                    "gpu_ms": round(g, 1), "reference_ms": None if r is None else round(r, 1)})
             print(f"{name:24} {spp:3d} {mark}{rays:11,d} {g:9.1f} {rays / g / 1000:11.2f} {ref}",
                   flush=True)
     print(f"\nspecialisation, GPU, 1 spp (frames alternate; median of {args.frames}):")
@@ -149,6 +158,8 @@ def main() -> None:
             left_out = [k for k in ("SPECULAR", "SHADOWS", "MESHES", "SECONDARY") if every.defines[k] and not fast.defines[k]]
             print(f"  {name:24} specialised {f:7.1f} ms, all features {e:7.1f} ms: {e / f:.2f}x "
                   f"(left out: {', '.join(left_out) or 'nothing'}; identical images: {same})")
+            figures["specialisation"].append({"scene": name, "specialised_ms": round(f, 1), "all_ms": round(e, 1),
+                                              "left_out": left_out, "identical": bool(same)})
     print(f"\nthe rasteriser against the ray tracer, GPU, 1 spp (frames alternate after a warm-up; "
           f"median of {args.frames}; colour and depth read back):")
     for name, scene in scenes.items():
@@ -158,8 +169,54 @@ def main() -> None:
             tracer.render()
             r, t = alternating_ms((raster.render, tracer.render), args.frames)
             print(f"  {name:24} rasteriser {r:7.1f} ms, ray tracer {t:7.1f} ms: {t / r:.0f}x")
+            figures["raster"].append({"scene": name, "raster_ms": round(r, 2), "raytrace_ms": round(t, 1)})
     print(f"\n{machine()}")
     ctx.release()
+    print(f"wrote {write_results('raytrace', figures, markdown)}")
+
+
+def scene_label(name: str) -> str:
+    """`classic`, `sphere` (3,968 tri), icosphere (20,480 tri): a built-in scene's name as code."""
+    first, _, rest = name.partition(" ")
+    label = first if name == ICOSPHERE else f"`{first}`"
+    return f"{label} {rest}".strip()
+
+
+def markdown(document: dict) -> str:
+    """The tables of docs/ray-tracing.md, "How fast", made from a results document (write_results)."""
+    figures = document["figures"]
+    (W, H), frames = figures["size"], figures["frames"]
+
+    def ms(x: float) -> str:
+        return f"{x:,.0f}" if x >= 100 else f"{x:.1f}"
+    lines = [f"{W}×{H}, max depth 4, regular samples. GPU path: {figures['renderer']} "
+             f"on {figures['context']}, the median of {frames} frames after a warm-up; reference: one frame. "
+             "Rays per frame are counted in the reference (\"~\": spp times the 1-spp count, "
+             "where the reference's frame was left out).", "",
+             "| scene | spp | rays/frame | GPU ms | GPU Mrays/s | reference ms | reference Mrays/s | reference/GPU |",
+             "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for row in figures["rows"]:
+        g, r, rays = row["gpu_ms"], row["reference_ms"], row["rays"]
+        ref = (f"{ms(r)} | {rays / r / 1000:.2f} | {r / g:.1f}x" if r is not None else " | | ")
+        lines.append(f"| {scene_label(row['scene'])} | {row['spp']} | {'~' if row['estimated'] else ''}{rays:,} | "
+                     f"{ms(g)} | {rays / g / 1000:.1f} | {ref} |")
+    lines += ["", f"Issue 14's targets: `classic` at 640×480, 1 spp, within {figures['target_ms']} ms a frame "
+              f"on the GPU path; the reference within {figures['reference_limit']} times the GPU path's time.",
+              "", "Specialised (only what the scene uses compiled in, the default) against every feature "
+              f"compiled in (`specialise=False`), GPU, 1 spp, frames alternating, median of {frames}:", "",
+              "| scene | left out | specialised ms | all features ms | all / specialised | identical images |",
+              "| --- | --- | ---: | ---: | ---: | --- |"]
+    for row in figures["specialisation"]:
+        lines.append(f"| {scene_label(row['scene'])} | {', '.join(row['left_out']) or 'nothing'} | "
+                     f"{row['specialised_ms']:,.1f} | {row['all_ms']:,.1f} | "
+                     f"{row['all_ms'] / row['specialised_ms']:.2f}x | {'yes' if row['identical'] else 'no'} |")
+    lines += ["", "The rasteriser against the ray tracer, GPU, 1 spp, frames alternating after a warm-up, "
+              f"median of {frames}, colour and depth read back:", "",
+              "| scene | rasteriser ms | ray tracer ms | ray tracer / rasteriser |", "| --- | ---: | ---: | ---: |"]
+    for row in figures["raster"]:
+        lines.append(f"| {scene_label(row['scene'])} | {row['raster_ms']:,.1f} | {row['raytrace_ms']:,.1f} | "
+                     f"{row['raytrace_ms'] / row['raster_ms']:.1f}x |")
+    return "\n".join(lines + ["", measured_line(document), ""])
 
 
 if __name__ == "__main__":

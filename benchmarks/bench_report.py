@@ -87,6 +87,10 @@ def findings(rows: list[dict]) -> dict:
     return {"slopes": slopes, "targets": targets}
 
 
+def _ms(value: float) -> str:
+    return f"{value:.3g}" if value < 1000 else f"{value:,.0f}"
+
+
 def markdown(document: dict) -> str:
     """docs/error-against-run-time.md's figures, from a results document (write_results)."""
     figures = document["figures"]
@@ -102,13 +106,13 @@ def markdown(document: dict) -> str:
                      f"{slope['points']} | {slope['samples'][0]}–{slope['samples'][1]} |")
     lines += ["", "The cheapest setting per scene reaching each RMSE target (report.md's "
               "tables, counted): over every knob, which knob it was; among the anti-aliasing "
-              "settings alone, the commonest:", "",
+              "settings alone, the commonest (in brackets, for how many scenes):", "",
               "| RMSE at most | backend | scenes reaching it | cheapest, ms | by knob | anti-aliasing alone |",
               "| ---: | --- | ---: | ---: | --- | --- |"]
     for t in figures["targets"]:
-        ms = "" if t["ms"] is None else f"{t['ms'][0]:.3g} to {t['ms'][1]:.3g}"
-        knobs = ", ".join(f"{knob} {count}" for knob, count in t["knobs"].items())
-        settings = ", ".join(f"{name} {count}" for name, count in t["antialiasing"].items())
+        ms = "" if t["ms"] is None else f"{_ms(t['ms'][0])} to {_ms(t['ms'][1])}"
+        knobs = ", ".join(f"{knob} ({count})" for knob, count in t["knobs"].items())
+        settings = ", ".join(f"{name} ({count})" for name, count in t["antialiasing"].items())
         lines.append(f"| {t['rmse']:g} | {t['backend']} | {t['reached']} of {t['scenes']} | "
                      f"{ms} | {knobs} | {settings} |")
     return "\n".join(lines + ["", measured_line(document), ""])

@@ -17,6 +17,10 @@ directional map is fitted to every caster, so that image may differ; the frame's
 what is compared. Programs whose object receives no shadow compile no lookup at all (the
 scene-level counterpart: benchmarks/bench_shadows.py, with shadows against without).
 Not a test: this machine is shared and noisy.
+
+Run on every built-in scene (no --scenes), it writes benchmarks/results/shadow_pruning.json
+(the figures, with machine, date, load and commit) and shadow_pruning.md (the table made from
+it: `markdown`), which docs/benchmarks.md includes; a run on other scenes only prints.
 """
 
 from __future__ import annotations
@@ -28,7 +32,7 @@ from renderer.core.raster_options import RasterOptions
 from renderer.gpu.pipeline import GpuRenderer
 from renderer.methods import open_renderer
 
-from common import alternating_ms, machine, parser       # benchmarks/common.py
+from common import alternating_ms, machine, measured_line, parser, write_results   # benchmarks/common.py
 
 SCENES = ",".join(sorted(builtin_scenes()))
 
@@ -54,6 +58,7 @@ def main() -> None:
     print(f"{machine()}; {ctx.info['GL_RENDERER']} ({args.context})")
     print(f"{'scene':<16} {'passes, draws (pruned)':>23} {'(all)':>9} {'pruned ms':>10} "
           f"{'all ms':>8} {'saved':>7}")
+    rows = []
     try:
         for name in args.scenes.split(","):
             scene = load_scene(name)
@@ -66,10 +71,37 @@ def main() -> None:
                 drawn = work(pruned), work(full)
             print(f"{name:<16} {drawn[0]:>23} {drawn[1]:>9} {ms_pruned:>10.1f} "
                   f"{ms_full:>8.1f} {1 - ms_pruned / ms_full:>7.0%}")
+            rows.append({"scene": name, "pruned": drawn[0], "all": drawn[1],
+                         "pruned_ms": round(ms_pruned, 3), "all_ms": round(ms_full, 3)})
+        gl = ctx.info["GL_RENDERER"]
     finally:
         release_context(ctx)
+    if args.scenes == SCENES:                         # docs/benchmarks.md's table: every scene
+        figures = {"gl_renderer": gl, "context": args.context, "size": [width, height],
+                   "rounds": args.rounds, "scenes": rows}
+        print(f"wrote {write_results('shadow_pruning', figures, markdown)}")
     print(f"Reproduce: .venv/bin/python benchmarks/bench_shadow_pruning.py --size {width}x{height} "
           f"--rounds {args.rounds}")
+
+
+def markdown(document: dict) -> str:
+    """docs/benchmarks.md's table of shadow pruning, made from a results document
+    (write_results): the scenes where the pruned plan's passes and draws differ from drawing
+    everything, then those where they are the same."""
+    f = document["figures"]
+    width, height = f["size"]
+    differ = [r for r in f["scenes"] if r["pruned"] != r["all"]]
+    same = [f"{r['scene']} ({r['pruned']})" for r in f["scenes"] if r["pruned"] == r["all"]]
+    lines = [f"{width}×{height}, medians of {f['rounds']} frames each, the two renderers in turn; "
+             f"GL: {f['gl_renderer']}, context {f['context']}.", "",
+             "| scene | pruned: passes, draws | all: passes, draws | pruned ms | all ms |",
+             "| --- | --- | --- | ---: | ---: |"]
+    lines += [f"| {r['scene']} | {r['pruned']} | {r['all']} | {r['pruned_ms']:.1f} | {r['all_ms']:.1f} |"
+              for r in differ]
+    if same:
+        lines += ["", "The same in both (passes, draws; none: no light of the scene gets a map either "
+                  "way): " + ", ".join(same) + "."]
+    return "\n".join(lines + ["", measured_line(document), ""])
 
 
 if __name__ == "__main__":

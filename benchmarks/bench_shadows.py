@@ -24,6 +24,10 @@ plan: run when the camera, lights or objects move, not per frame) is timed the s
 with and without. The renderer also turns GL's bottom-up rows into row-0-on-top arrays and
 window depth into camera distance, which the bare program does not (about 0.2 ms at 640x480:
 benchmarks/bench_pipeline.py). Not a test: this machine is shared and noisy.
+
+Run on the default scenes (no --scenes), it writes benchmarks/results/shadows.json (the
+figures, with machine, date, load and commit) and shadows.md (the table made from it:
+`markdown`), which docs/benchmarks.md includes; a run on other scenes only prints.
 """
 
 from __future__ import annotations
@@ -50,7 +54,7 @@ from renderer.gpu.shadow_maps import ShadowMaps
 from renderer.gpu.uniforms import frame_uniform_values, object_uniform_values, set_shadow_sampler_units
 from renderer.methods import open_renderer
 
-from common import alternating_ms, machine, parser       # benchmarks/common.py
+from common import alternating_ms, machine, measured_line, parser, write_results   # benchmarks/common.py
 
 # sphere, the default scene: one convex ball, which nothing can shadow, so it has no maps at
 # all and its frame with shadows on must cost what it costs with them off (issue 28: within
@@ -192,6 +196,17 @@ def maps_label(renderer: GpuRenderer) -> str:
     return f"{sizes} ({stacks}), {len(plan.passes)} passes, {draws} draws"
 
 
+def maps_figures(renderer: GpuRenderer) -> dict | None:
+    """maps_label's figures, for a results file: each map's kind and resolution, the layer
+    stacks (layers, side) and the current plan's passes and caster draws; None: no maps."""
+    if renderer.shadow_maps is None:
+        return None
+    layout, plan = renderer.shadow_maps.layout, renderer.shadow_maps.plan
+    return {"maps": [[m.kind, m.resolution] for m in layout.maps],
+            "stacks": [[s.layers, s.side] for s in layout.stacks if s.layers],
+            "passes": len(plan.passes), "draws": sum(len(p.casters) for p in plan.passes)}
+
+
 def measure(ctx, scene: Scene, size, rounds: int) -> dict:
     plain_scene = without_shadows(scene)
     # A scene without maps has no shadow passes for a bare program to draw: with = without.
@@ -208,10 +223,10 @@ def measure(ctx, scene: Scene, size, rounds: int) -> dict:
             calls.append(bare.frame)
         plain_ms, shadowed_ms, *bare_ms = alternating_ms(calls, rounds)
         update_plain, update_shadowed = alternating_ms((plain.update, shadowed.update), rounds)
-        label = maps_label(shadowed)
+        label, maps = maps_label(shadowed), maps_figures(shadowed)
     if bare is not None:
         bare.release()
-    return {"scene": scene.name, "maps": label, "without": plain_ms, "with": shadowed_ms,
+    return {"scene": scene.name, "maps": label, "map figures": maps, "without": plain_ms, "with": shadowed_ms,
             "bare": bare_ms[0] if bare_ms else None, "update without": update_plain,
             "update with": update_shadowed, "bare differs": differ, "same image": same}
 
@@ -254,11 +269,66 @@ def main() -> None:
                       if r["bare differs"] is not None)
           + " of the pixels (its fixed bias). Same image: with shadows on and off, every pixel.")
     print(f"{machine()}")
+    if args.scenes == list(SCENES):                   # docs/benchmarks.md's table: every scene
+        figures = {"gl_renderer": ctx.info["GL_RENDERER"], "context": args.context,
+                   "size": [width, height], "rounds": rounds, "scenes": [results_row(r) for r in rows]}
+        print(f"wrote {write_results('shadows', figures, markdown)}")
     scenes = "" if args.scenes == list(SCENES) else f" --scenes {','.join(args.scenes)}"
     quick = " --quick" if args.quick else f" --rounds {args.rounds}"
     print(f"Reproduce: .venv/bin/python benchmarks/bench_shadows.py --size {width}x{height}"
           f"{quick}{scenes} --context {args.context}")
     ctx.release()
+
+
+def results_row(row: dict) -> dict:
+    """A measure() row for the results file: ms rounded, the maps as figures."""
+    def rounded(value):
+        return None if value is None else round(value, 3)
+    return {"scene": row["scene"], "maps": row["map figures"], "without_ms": rounded(row["without"]),
+            "with_ms": rounded(row["with"]), "bare_ms": rounded(row["bare"]),
+            "update_without_ms": rounded(row["update without"]), "update_with_ms": rounded(row["update with"]),
+            "bare_differs": None if row["bare differs"] is None else round(row["bare differs"], 5),
+            "same_image": row["same image"]}
+
+
+def markdown(document: dict) -> str:
+    """docs/benchmarks.md's table of shadow maps' cost, made from a results document
+    (write_results). A ratio that misses its target is in bold."""
+    f = document["figures"]
+    width, height = f["size"]
+    lines = [f"{width}×{height}, medians of {f['rounds']} rounds, the three frames of a round in turn, "
+             f"colour and depth read back; GL: {f['gl_renderer']}, context {f['context']}.", "",
+             "| scene | maps (texels on a side; layers) | passes, caster draws | without ms | with ms "
+             f"| bare ms | with / without | with / bare (target ≤ {TARGET}) | update ms, without / with "
+             "| same image as without |",
+             "| --- | --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
+
+    def ratio(value: float, target: float) -> str:
+        return f"**{value:.2f}×**" if value > target else f"{value:.2f}×"
+
+    for r in f["scenes"]:
+        maps = r["maps"]
+        name = r["scene"] + (" (the default)" if r["scene"] == SCENES[0] else "")
+        if maps is None:
+            drawn, work = "none: nothing in it can shadow", "0, 0"
+        else:
+            sizes = " + ".join(str(size) if kind != "point" else f"point 6 × {size}" for kind, size in maps["maps"])
+            stacks = " + ".join(f"{layers} layer{'s' if layers > 1 else ''} of {side}²"
+                                for layers, side in maps["stacks"])
+            drawn, work = f"{sizes} ({stacks})", f"{maps['passes']}, {maps['draws']}"
+        with_without = r["with_ms"] / r["without_ms"]
+        if r["bare_ms"] is None:
+            first, bare, second = f"{ratio(with_without, DEFAULT_TARGET)} (target ≤ {DEFAULT_TARGET})", "", ""
+        else:
+            first, bare, second = f"{with_without:.2f}×", f"{r['bare_ms']:.2f}", ratio(r["with_ms"] / r["bare_ms"], TARGET)
+        lines.append(f"| {name} | {drawn} | {work} | {r['without_ms']:.2f} | {r['with_ms']:.2f} | {bare} "
+                     f"| {first} | {second} | {r['update_without_ms']:.2f} / {r['update_with_ms']:.2f} "
+                     f"| {'yes' if r['same_image'] else 'no'} |")
+    differs = [f"{r['scene']} {100 * r['bare_differs']:.2f} %" for r in f["scenes"] if r["bare_differs"] is not None]
+    if differs:
+        lines += ["", "The bare program's image differs from the renderer's (by more than 8/255 in a "
+                  "channel, its fixed bias) in " + ", ".join(differs) + " of the pixels."]
+    return "\n".join(lines + ["", measured_line(document), ""])
 
 
 if __name__ == "__main__":

@@ -12,6 +12,10 @@ camera sees a few), the same scene is drawn by two GpuRenderers on one context:
 It prints the median frame time of each (frames alternate between the two, so both see the
 same machine load), their ratio, and whether the two images are bit-identical; then the
 geometric mean of the ratios. Not a test: this machine is shared and noisy.
+
+It writes benchmarks/results/specialisation.json (the figures, with machine, date, load and
+commit) and specialisation.md (the table made from it: `markdown`), which
+docs/specialisation.md includes.
 """
 
 from __future__ import annotations
@@ -29,7 +33,7 @@ from renderer.core.primitives import icosphere
 from renderer.core.scene import Camera, DirectionalLight, Material, PointLight, Scene, SceneObject, Transform
 from renderer.core.scene_file import load_scene
 
-from common import arguments          # benchmarks/common.py
+from common import arguments, measured_line, write_results          # benchmarks/common.py
 
 
 def crowd_scene() -> Scene:
@@ -75,16 +79,46 @@ def main() -> None:
           f"medians of {args.rounds} frames each, alternating")
     print(f"{'scene':<18} {'objects drawn':>14} {'specialised ms':>15} {'all-features ms':>16} "
           f"{'ratio':>6}  images")
-    ratios = []
+    ratios, rows = [], []
     for scene in scenes():
         row = measure(ctx, scene, args.size, args.rounds)
         ratios.append(row["ratio"])
+        rows.append({"scene": row["scene"], "drawn": row["drawn"][0], "objects": row["objects"],
+                     "specialised_ms": round(row["specialised"], 3),
+                     "all_features_ms": round(row["all-features"], 3), "identical": row["identical"]})
         drawn = f"{row['drawn'][0]}/{row['drawn'][1]}"
         print(f"{row['scene']:<18} {drawn:>14} {row['specialised']:>15.2f} "
               f"{row['all-features']:>16.2f} {row['ratio']:>6.2f}  "
               f"{'identical' if row['identical'] else 'DIFFERENT'}")
     print(f"geometric mean of the ratios: {math.exp(statistics.fmean(map(math.log, ratios))):.2f}")
+    figures = {"gl_renderer": info["GL_RENDERER"], "context": args.context, "size": list(args.size),
+               "rounds": args.rounds, "scenes": rows}
     ctx.release()
+    print(f"wrote {write_results('specialisation', figures, markdown)}")
+
+
+def markdown(document: dict) -> str:
+    """docs/specialisation.md's table, made from a results document (write_results): per scene
+    the objects drawn, both medians, their ratio and whether the images are identical; then the
+    geometric mean and the range of the ratios."""
+    f = document["figures"]
+    width, height = f["size"]
+    lines = [f"{width}×{height}, medians of {f['rounds']} frames each, the two builds alternating "
+             f"frame by frame; GL: {f['gl_renderer']}, context {f['context']}.", "",
+             "| scene | objects drawn | specialised ms | all-features ms | speed-up | images |",
+             "| --- | ---: | ---: | ---: | ---: | --- |"]
+    ratios = []
+    for r in f["scenes"]:
+        ratio = r["all_features_ms"] / r["specialised_ms"]
+        ratios.append(ratio)
+        lines.append(f"| {r['scene']} | {r['drawn']}/{r['objects']} | {r['specialised_ms']:.2f} | "
+                     f"{r['all_features_ms']:.2f} | {ratio:.2f}× | "
+                     f"{'identical' if r['identical'] else '**different**'} |")
+    mean = math.exp(statistics.fmean(map(math.log, ratios)))
+    lines += ["", f"Speed-up of the specialised build, geometric mean over the {len(ratios)} scenes: "
+              f"**{mean:.2f}×** (from {min(ratios):.2f}× to {max(ratios):.2f}×).",
+              "", measured_line(document), ""]
+    return "\n".join(lines)
 
 
 if __name__ == "__main__":

@@ -17,10 +17,15 @@ over the textured surface's pixels whose view depth is beyond the median (the fa
 the texture is minified); and the same for the scene untextured, the edges' share of it. The
 jittered truth is itself within about RMSE(16) sqrt(16/truth) of the limit. Not a test:
 tests/test_raytrace_textures.py holds the trend.
+
+It writes benchmarks/results/texture_aliasing.json (the figures, with machine, date, load and
+commit) and texture_aliasing.md (the table made from it: `markdown`), which docs/textures.md
+includes.
 """
 
 from __future__ import annotations
 
+import os
 from dataclasses import replace
 from pathlib import Path
 
@@ -32,13 +37,14 @@ from renderer.core.ray_options import RayOptions
 from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
 
-from common import machine, parser       # benchmarks/common.py
+from common import machine, measured_line, parser, write_results       # benchmarks/common.py
 
 # The analytic shapes' textured scenes, and the built-in textured scenes where they exist.
 SCENES = [str(Path(__file__).resolve().parents[1] / "tests" / "scenes" / f"{name}.toml")
           for name in ("rt_checker_horizon", "rt_globe")] \
     + [name for name in ("checker_horizon", "globe", "textured_mesh") if name in builtin_scenes()]
 SETTINGS = ((1, "regular"), (4, "jittered"), (16, "jittered"))
+ROOT = Path(__file__).resolve().parents[1]
 
 
 def rmse(a, b, where=None) -> float:
@@ -79,15 +85,42 @@ def main() -> None:
     print(machine())
     print(f"{width}x{height}, truth {args.truth} jittered samples, {args.context}; RMSE of rgba8 RGB (0-255)")
     print(f"{'scene':<22} {'samples':<12} {'all pixels':>10} {'far half':>9}   untextured: all, far half")
+    figures = {"size": [width, height], "truth": args.truth, "context": args.context,
+               "gl_renderer": ctx.info["GL_RENDERER"], "scenes": []}
     for name in args.scenes:
         scene = load_scene(name)
         textured = aliasing(scene, width, height, args.truth, ctx)
         plain = aliasing(untextured(scene), width, height, args.truth, ctx)
+        rows = []
         for setting, (whole, far) in textured.items():
             samples, pattern = setting
             print(f"{scene.name:<22} {f'{samples} {pattern}':<12} {whole:>10.2f} {far:>9.2f}"
                   f"   {plain[setting][0]:.2f}, {plain[setting][1]:.2f}")
+            rows.append({"samples": samples, "pattern": pattern, "all": round(whole, 3),
+                         "far": round(far, 3), "untextured_all": round(plain[setting][0], 3),
+                         "untextured_far": round(plain[setting][1], 3)})
+        source = os.path.relpath(name, ROOT) if os.path.exists(name) else "built-in"
+        figures["scenes"].append({"scene": scene.name, "source": source, "settings": rows})
     ctx.release()
+    print(f"wrote {write_results('texture_aliasing', figures, markdown)}")
+
+
+def markdown(document: dict) -> str:
+    """The table docs/textures.md includes, made from a results document (write_results)."""
+    f = document["figures"]
+    width, height = f["size"]
+    first = f["scenes"][0]["settings"] if f["scenes"] else []
+    header = ", ".join(f"{r['samples']}" + (" (centre)" if r["pattern"] == "regular" else f" {r['pattern']}")
+                       for r in first)
+    lines = [f"RMSE (rgba8 RGB, 0–255) against {f['truth']} jittered samples per pixel at {width}×{height}, "
+             f"the GPU ray tracer, {f['context']} ({f['gl_renderer']}); samples per pixel {header}; "
+             "the far half: the pixels beyond the median view depth, where the texture is minified.", "",
+             "| scene | textured | far half | the same scene untextured |", "| --- | --- | --- | --- |"]
+    for s in f["scenes"]:
+        def joined(key):
+            return " / ".join(f"{r[key]:.1f}" for r in s["settings"])
+        lines.append(f"| `{s['scene']}` ({s['source']}) | {joined('all')} | {joined('far')} | {joined('untextured_all')} |")
+    return "\n".join(lines + ["", measured_line(document), ""])
 
 
 if __name__ == "__main__":

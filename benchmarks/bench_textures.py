@@ -20,6 +20,9 @@ reference, and what the texture code costs programs without textures, printed.
    paired ratio, and whether the images are identical.
 `--quick`: 5 GPU frames, the reference at the default filter only, 5 rounds.
 Not a test: this machine is shared and noisy; the load average is printed.
+
+It writes benchmarks/results/textures.json (the figures, with machine, date, load and commit)
+and textures.md (the two tables made from it: `markdown`), which docs/textures.md includes.
 """
 
 from __future__ import annotations
@@ -43,7 +46,7 @@ from renderer.methods import open_renderer
 from renderer.study.texture_report import filter_name, with_texture_setting, with_textures
 
 import ab_raytrace                                        # benchmarks/ab_raytrace.py
-from common import alternating_ms, machine, parser         # benchmarks/common.py
+from common import alternating_ms, machine, measured_line, parser, write_results   # benchmarks/common.py
 
 TEXTURED_SCENES = ("textured_mesh", "checker_horizon", "globe")
 FILTERS = (("nearest", 1), ("bilinear", 1), ("mip-nearest", 1), ("trilinear", 1), ("anisotropic", 16))
@@ -61,7 +64,7 @@ def reference_ms(scenes, width: int, height: int, frames: int) -> list[float]:
     return alternating_ms([r.render for r in renderers], frames)
 
 
-def textured_against_untextured(args, ctx) -> None:
+def textured_against_untextured(args, ctx) -> list[dict]:
     width, height = args.size
     print(f"## Textured against untextured, {width}x{height}: GPU median of {args.frames} frames, "
           f"reference of {args.reference_frames}, alternating")
@@ -69,6 +72,7 @@ def textured_against_untextured(args, ctx) -> None:
     print("| scene | filter | GPU ms | untextured GPU ms | GPU ratio | reference ms | untextured "
           "reference ms | reference ratio |")
     print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+    rows = []
     for name in TEXTURED_SCENES:
         scene = load_scene(builtin_scenes()[name])
         plain = untextured(scene)
@@ -81,13 +85,19 @@ def textured_against_untextured(args, ctx) -> None:
                 bare.render()                                          # compiled, uploaded
                 ms, bare_ms = alternating_ms([gpu.render, bare.render], args.frames)
             cells = [f"{ms:.2f}", f"{bare_ms:.2f}", f"{ms / bare_ms:.2f}"]
+            row = {"scene": name, "filter": filter_name(setting),
+                   "as_authored": setting[0] == authored.filter,
+                   "gpu_ms": round(ms, 3), "untextured_gpu_ms": round(bare_ms, 3)}
             if not args.quick or setting[0] == authored.filter:
                 ref, ref_bare = reference_ms([drawn, plain], width, height, args.reference_frames)
                 cells += [f"{ref:.0f}", f"{ref_bare:.0f}", f"{ref / ref_bare:.2f}"]
+                row |= {"reference_ms": round(ref, 1), "untextured_reference_ms": round(ref_bare, 1)}
             else:
                 cells += ["", "", ""]
             mark = " (as authored)" if setting[0] == authored.filter else ""
             print(f"| {name} | {filter_name(setting)}{mark} | " + " | ".join(cells) + " |", flush=True)
+            rows.append(row)
+    return rows
 
 
 def preprocessed_programs(tree: Path, scene: str, out: Path) -> dict[str, str]:
@@ -108,7 +118,7 @@ def preprocessed_programs(tree: Path, scene: str, out: Path) -> dict[str, str]:
     return programs
 
 
-def untextured_programs(args) -> None:
+def untextured_programs(args) -> list[dict]:
     width, height = args.size
     print()
     print(f"## Untextured scenes: {args.base} (before issue 17) against this tree, {width}x{height}, "
@@ -119,6 +129,7 @@ def untextured_programs(args) -> None:
     print("| scene | programs | identical after the preprocessor | base ms | this ms | base / this "
           "(medians) | paired | identical images |")
     print("| --- | ---: | --- | ---: | ---: | ---: | ---: | --- |")
+    rows = []
     with tempfile.TemporaryDirectory() as temp:
         base = ab_raytrace.export(args.base, Path(temp) / "base")
         here = ab_raytrace.ROOT
@@ -143,6 +154,11 @@ def untextured_programs(args) -> None:
             print(f"| {name} | {len(programs[1])} | {same} | "
                   f"{a:.2f} | {b:.2f} | {a / b:.3f} | {paired:.3f} | "
                   f"{'yes' if infos[0]['rgba8'] == infos[1]['rgba8'] else '**no**'} |", flush=True)
+            identical = sum(programs[0].get(n) == h for n, h in programs[1].items())
+            rows.append({"scene": name, "programs": len(programs[1]), "identical": identical, "differ": differ,
+                         "base_ms": round(a, 3), "this_ms": round(b, 3), "paired": round(paired, 4),
+                         "identical_images": infos[0]["rgba8"] == infos[1]["rgba8"]})
+    return rows
 
 
 def main() -> None:
@@ -158,10 +174,37 @@ def main() -> None:
     print(f"{machine()}; {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}")
     print(f"GL_RENDERER: {ctx.info['GL_RENDERER']}; numpy {np.__version__}")
     print()
-    textured_against_untextured(args, ctx)
-    untextured_programs(args)
+    figures = {"size": list(args.size), "context": args.context, "gl_renderer": ctx.info["GL_RENDERER"],
+               "frames": args.frames, "reference_frames": args.reference_frames, "base": args.base,
+               "rounds": args.rounds}
+    figures["textured"] = textured_against_untextured(args, ctx)
+    figures["untextured_programs"] = untextured_programs(args)
     print()
     print(machine())
+    print(f"wrote {write_results('textures', figures, markdown)}")
+
+
+def markdown(document: dict) -> str:
+    """The table docs/textures.md includes, made from a results document (write_results). The
+    second part's comparison with an old commit is printed, not tabulated: later issues have
+    changed those programs for their own reasons, so it no longer measures issue 17 alone."""
+    f = document["figures"]
+    width, height = f["size"]
+    lines = [f"Textured against untextured at {width}×{height}, {f['context']} ({f['gl_renderer']}): "
+             f"GPU frames the median of {f['frames']}, the reference's of {f['reference_frames']}, "
+             "the textured and the untextured renderer's frames alternating.", "",
+             "| scene | filter | GPU ms | untextured | textured / untextured | reference ms | untextured "
+             "| textured / untextured |", "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
+    for r in f["textured"]:
+        cells = [f"{r['gpu_ms']:.2f}", f"{r['untextured_gpu_ms']:.2f}", f"{r['gpu_ms'] / r['untextured_gpu_ms']:.2f}"]
+        if "reference_ms" in r:
+            cells += [f"{r['reference_ms']:,.0f}", f"{r['untextured_reference_ms']:,.0f}",
+                      f"{r['reference_ms'] / r['untextured_reference_ms']:.2f}"]
+        else:
+            cells += ["", "", ""]
+        mark = " (as authored)" if r["as_authored"] else ""
+        lines.append(f"| `{r['scene']}` | {r['filter']}{mark} | " + " | ".join(cells) + " |")
+    return "\n".join(lines + ["", measured_line(document), ""])
 
 
 if __name__ == "__main__":

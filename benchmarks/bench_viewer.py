@@ -12,8 +12,12 @@ also does). Medians over the frames of all rounds; the rounds alternate so that 
 see the same machine.
 
 Viewer frame time is from swap to swap: events, the update, drawing, the copy to the back
-buffer and the swap (on Xvfb a copy of the image into the X server). Not a test: this
+buffer and the swap (on Xvfb a copy of the image into the X server); the viewer's drawing
+(draw() and glFinish, as its --stats report it) is printed beside it. Not a test: this
 machine is shared and noisy.
+
+It writes benchmarks/results/viewer.json (the figures, with machine, date, load and commit)
+and viewer.md (the table made from it: `markdown`), which docs/benchmarks.md includes.
 """
 
 from __future__ import annotations
@@ -37,6 +41,8 @@ from renderer.methods import open_renderer
 from renderer.viewer.orbit import OrbitCamera
 from renderer.core.scene_file import load_scene
 from renderer.viewer.virtual_display import virtual_display
+
+from common import measured_line, write_results          # benchmarks/common.py
 
 SCENES = ("sphere", "coloured_lights", "hierarchy", "point_light_plane")
 
@@ -91,7 +97,7 @@ def main() -> None:
         else virtual_display()
     with display_context as display:
         results = {name: {"double": [], "triple": [], "latency_double": [], "latency_triple": [],
-                          "render": [], "draw": []} for name in SCENES}
+                          "viewer_draw": [], "render": [], "draw": []} for name in SCENES}
         renderers = {}
         for name in SCENES:
             authored = load_scene(resolve_scene(name))
@@ -104,6 +110,8 @@ def main() -> None:
                     # Per-frame times stay in the subprocess; its median stands for the round.
                     results[name][buffering].append(stats["frame_ms_median"])
                     results[name][f"latency_{buffering}"].append(stats["latency_ms_median"])
+                    if buffering == "double":
+                        results[name]["viewer_draw"].append(stats["draw_ms_median"])
                 gpu, authored = renderers[name]
                 render_ms, draw_ms = headless_run(gpu, authored, args.frames)
                 results[name]["render"].append(statistics.median(render_ms))
@@ -115,13 +123,46 @@ def main() -> None:
 
     print(f"\n{width}x{height}, {args.frames} frames x {args.rounds} rounds, camera turning 1 degree "
           f"a frame, v-sync off; {gl}; medians of the rounds' medians (ms)\n")
-    print("| scene | headless render (draw + read-back) | headless draw | viewer, double buffering "
-          "| viewer, triple buffering | viewer / headless render | latency double / triple |")
-    print("| --- | ---: | ---: | ---: | ---: | ---: | --- |")
-    for name in SCENES:
-        r = {key: statistics.median(values) for key, values in results[name].items()}
-        print(f"| {name} | {r['render']:.2f} | {r['draw']:.2f} | {r['double']:.2f} | {r['triple']:.2f} "
-              f"| {r['double'] / r['render']:.2f}x | {r['latency_double']:.2f} / {r['latency_triple']:.2f} |")
+    rows = [{"scene": name} | {key: median(values) for key, values in results[name].items()}
+            for name in SCENES]
+    figures = {"gl_renderer": gl, "display": "DISPLAY" if os.environ.get("DISPLAY") else "Xvfb",
+               "size": [width, height], "frames": args.frames, "rounds": args.rounds, "scenes": rows}
+    print(table(figures))
+    print(f"wrote {write_results('viewer', figures, markdown)}")
+
+
+def median(values: list) -> float | None:
+    """The median of the values there are, rounded (None: none, as a run too short for a latency)."""
+    values = [v for v in values if v is not None]
+    return round(statistics.median(values), 3) if values else None
+
+
+def ms(value: float | None) -> str:
+    return "–" if value is None else f"{value:.2f}"
+
+
+def table(figures: dict) -> str:
+    """The table of medians (ms), one row per scene."""
+    lines = ["| scene | headless `render()` ms (draw + colour read-back) | headless `draw()` ms "
+             "| viewer ms, double buffering | viewer ms, triple | viewer / headless "
+             "| viewer's drawing ms | latency ms, double / triple |",
+             "| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |"]
+    for r in figures["scenes"]:
+        lines.append(f"| {r['scene']} | {r['render']:.2f} | {r['draw']:.2f} | {r['double']:.2f} "
+                     f"| {r['triple']:.2f} | {r['double'] / r['render']:.2f}× | {r['viewer_draw']:.2f} "
+                     f"| {ms(r['latency_double'])} / {ms(r['latency_triple'])} |")
+    return "\n".join(lines)
+
+
+def markdown(document: dict) -> str:
+    """docs/benchmarks.md's table of the viewer against the headless path, made from a results
+    document (write_results)."""
+    f = document["figures"]
+    window = "on Xvfb" if f["display"] == "Xvfb" else "on the display in DISPLAY"
+    head = (f"{f['size'][0]}×{f['size'][1]}, v-sync off, {f['frames']} frames × {f['rounds']} rounds, "
+            f"the camera turning 1° a frame; medians of the rounds' medians; the window {window}; "
+            f"GL: {f['gl_renderer']}.")
+    return "\n".join([head, "", table(f), "", measured_line(document), ""])
 
 
 if __name__ == "__main__":

@@ -61,34 +61,6 @@ def test_the_check_sees_a_loose_output():
         "renderer compare sphere --out cmp/: cmp/"]
 
 
-TIME_FIGURE = re.compile(r"\b\d+(?:\.\d+)?\s?(?:ms|s|min|minutes?|seconds?)\b")
-
-
-def sections_with_unsourced_times(markdown: str) -> list[str]:
-    """The '# ' and '## ' sections that state a time but not 'Measured on' and 'Reproduce:
-    `...`' (a page's title opens its first section)."""
-    found = []
-    for section in re.split(r"^##? ", markdown, flags=re.M)[1:]:
-        title, text = section.split("\n", 1)[0], " ".join(section.split())
-        claims = re.sub(r"`[^`]*`", "", text)         # an example of output is not a claim
-        if TIME_FIGURE.search(claims) and not ("Measured on" in text and "Reproduce: `" in text):
-            found.append(f"{title}: {TIME_FIGURE.search(claims).group(0)}")
-    return found
-
-
-def test_every_timing_names_its_machine_and_how_to_reproduce_it():
-    pages = {name: text for name, text in manual().items() if not name.startswith("docs/report/")}
-    assert any(TIME_FIGURE.search(text) for text in pages.values())   # there are timings
-    assert [f"{name}: {found}" for name, text in pages.items()
-            for found in sections_with_unsourced_times(text)] == []
-
-
-def test_the_timing_check_sees_an_unsourced_figure():
-    assert sections_with_unsourced_times(
-        "## Tests\nThe suite runs in about 90 s.\n## Benchmarks\nMeasured on the 2-core "
-        "machine: 5.2 ms. Reproduce: `python bench.py`.\n## Using it\nIt prints `wrote x.png (3 ms)`.\n") == ["Tests: 90 s"]
-
-
 # What the example leaves behind, checked after it has run.
 CHECKS = """
 assert scene.name == "sphere", scene.name

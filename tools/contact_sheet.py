@@ -1,5 +1,6 @@
 """The README figures' contact sheet: labelled panels in rows, pixels 1:1, written as PNG
-(tools/make_texture_figure.py, tools/make_output_figure.py import it from beside them)."""
+(tools/make_texture_figure.py, tools/make_output_figure.py, tools/make_docs_images.py import it
+from beside them)."""
 
 from __future__ import annotations
 
@@ -31,6 +32,20 @@ def contact_sheet(panels: list[tuple[str, np.ndarray]], columns: int, label_heig
 
 
 def write_figure(out: Path, data: bytes, root: Path) -> None:
+    """Write `data` to `out` (its folder made) and say so, the path relative to `root` when
+    it lies under it."""
+    out = Path(out)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_bytes(data)
-    print(f"{out.relative_to(root)}: {len(data):,} bytes")
+    shown = out.resolve().relative_to(root) if out.resolve().is_relative_to(root) else out
+    print(f"{shown}: {len(data):,} bytes")
+
+
+def out_option(default: Path, argv: list[str] | None, description: str) -> Path:
+    """The path a figure script writes: its --out PATH, else `default` (tests make the
+    figure again elsewhere: tests/test_docs_images.py)."""
+    import argparse
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--out", type=Path, default=default, metavar="PATH.png",
+                        help=f"the file to write (default: {default.name} in docs/images/)")
+    return parser.parse_args(argv).out

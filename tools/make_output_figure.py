@@ -9,7 +9,7 @@ labelled with the report's measures of it (renderer/study/output_report.py): the
 luminance after the eye's low-pass and the bias of its 8 x 8 blocks' mean luminance, in levels
 of 1/255. Pixels are shown 1:1 (a scaled view averages the pattern away). Deterministic.
 
-    PYTHONPATH=. .venv/bin/python tools/make_output_figure.py
+    PYTHONPATH=. .venv/bin/python tools/make_output_figure.py [--out PATH.png]
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_sheet import contact_sheet, write_figure
+from contact_sheet import contact_sheet, out_option, write_figure
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "images" / "output-methods.png"
@@ -63,8 +63,9 @@ def panels() -> list[tuple[str, np.ndarray]]:
     return out
 
 
-def main() -> None:
-    write_figure(OUT, contact_sheet(panels(), COLUMNS, LABEL_HEIGHT, font_size=12), ROOT)
+def main(argv: list[str] | None = None) -> None:
+    out = out_option(OUT, argv, "Write docs/images/output-methods.png.")
+    write_figure(out, contact_sheet(panels(), COLUMNS, LABEL_HEIGHT, font_size=12), ROOT)
 
 
 if __name__ == "__main__":

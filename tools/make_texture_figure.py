@@ -8,7 +8,7 @@ anisotropic filter's degree 2 to 16 draws the same image on llvmpipe (its level 
 footprint's minor axis whatever the degree): one panel. Deterministic output (the truth takes
 about a minute).
 
-    PYTHONPATH=. .venv/bin/python tools/make_texture_figure.py
+    PYTHONPATH=. .venv/bin/python tools/make_texture_figure.py [--out PATH.png]
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from contact_sheet import contact_sheet, write_figure
+from contact_sheet import contact_sheet, out_option, write_figure
 
 ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "docs" / "images" / "texture-filters.png"
@@ -50,10 +50,11 @@ def panels() -> list[tuple[str, np.ndarray]]:
     return out
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    out = out_option(OUT, argv, "Write docs/images/texture-filters.png.")
     from renderer.core.gl_rules import to_unorm8
     sheet = [(label, to_unorm8(image)) for label, image in panels()]
-    write_figure(OUT, contact_sheet(sheet, columns=3, label_height=LABEL_HEIGHT, font_size=14), ROOT)
+    write_figure(out, contact_sheet(sheet, columns=3, label_height=LABEL_HEIGHT, font_size=14), ROOT)
 
 
 if __name__ == "__main__":

@@ -36,12 +36,14 @@ def machine() -> str:
 
 def revision() -> str:
     """The repository's commit (short hash), with "+ uncommitted changes" when the work tree
-    differs from it: what the figures were measured with."""
+    differs from it (the results files, which benchmarks write, aside): what the figures were
+    measured with."""
     def git(*args) -> str:
         return subprocess.run(["git", *args], capture_output=True, text=True,
                               cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip()
     commit = git("rev-parse", "--short", "HEAD") or "unknown"
-    return commit + (" + uncommitted changes" if git("status", "--porcelain", "--untracked-files=no") else "")
+    return commit + (" + uncommitted changes" if git("status", "--porcelain", "--untracked-files=no", "--", ":(top)",
+                                                    ":(exclude,top)benchmarks/results") else "")
 
 
 def alternating_ms(calls, frames: int) -> list[float]:

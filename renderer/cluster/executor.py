@@ -40,7 +40,7 @@ RAY_EXTRA = "pip install 'checked-renderer[cluster]'"
 
 def batch_size(item_seconds: float, items: int, workers: int) -> int:
     """Units per batch: TARGET_BATCH_SECONDS of work per call, so a call's fixed overhead
-    (1-2.4 ms on Ray here: docs/cluster.md) stays under 1 %,
+    (a round trip on Ray: benchmarks/results/batch.md) stays under 1 %,
     at most MAX_BATCH, and at most items / (BATCHES_PER_WORKER x workers) so that every worker
     gets several batches and none idles long at the end of the job."""
     by_time = round(TARGET_BATCH_SECONDS / item_seconds) if item_seconds > 0 else MAX_BATCH

@@ -28,7 +28,7 @@ devices are numbered as Ray numbers the GPUs (CUDA's order; EGL_NV_device_cuda c
 them where they are not).
 
 Scheduling. A ray.wait loop with IN_FLIGHT calls queued on each actor, so that an actor
-finishing a batch finds the next one waiting (a call's round trip, ~1 ms here, is hidden
+finishing a batch finds the next one waiting (a call's round trip, benchmarks/results/batch.md, is hidden
 this way). Faults: actors restart without limit (max_restarts=-1) and retry their calls
 (max_task_retries=3); a batch whose call still fails is queued again here, and a batch
 failing MAX_ATTEMPTS times raises BatchFailed (a batch that kills its process every time

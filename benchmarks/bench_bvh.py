@@ -1,6 +1,14 @@
 """The BVH's build time and its speed-up over brute force on the 20,480-triangle icosphere, printed.
 
     .venv/bin/python benchmarks/bench_bvh.py [--rays 4096] [--brute-rays 256] [--context egl]
+    .venv/bin/python benchmarks/bench_bvh.py --builds [--recursive]
+
+--builds: the build alone (issue 32) on generated meshes of about 5k, 131k and 1M triangles
+(the torus knot of tools/make_meshes.py at three resolutions, an icosphere, a randomly
+perturbed grid): median seconds of 3 builds (1 above 500k triangles), nodes, depth and the
+tree's SAH cost (traversal and intersection cost 1: the sum over nodes of their area over the
+root's, a leaf's times its triangles); --recursive times the node-at-a-time build it replaced
+(tests/bvh_recursive.py) beside it, up to 131k triangles, and says whether the trees agree.
 
 Builds the BVH of icosphere(subdivisions=5) (renderer/core/bvh.py) and times the closest hit of
 seeded random rays (a third from inside the sphere, a third aimed at it, a third anywhere):
@@ -82,12 +90,67 @@ def gpu_pass(ctx, fragment: str, O, D, bvh, width: int):
     return run, release
 
 
+def sah_cost(bvh) -> float:
+    """The tree's SAH cost (the module docstring)."""
+    d = bvh.bounds_max.astype(np.float64) - bvh.bounds_min
+    area = d[:, 0] * d[:, 1] + d[:, 1] * d[:, 2] + d[:, 2] * d[:, 0]
+    weight = np.where(bvh.is_leaf, bvh.nodes[:, 1, 3], 1.0)
+    return float((area * weight).sum() / area[0])
+
+
+def build_meshes():
+    """(name, (T, 3, 3) float32) of the generated meshes --builds times."""
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tools"))
+    from make_meshes import torus_knot
+    out = []
+    for segments, sides in ((160, 16), (512, 128), (2048, 256)):
+        positions, _, faces = torus_knot(segments=segments, sides=sides)
+        out.append((f"torus knot {segments}x{sides}", mesh_vertices(positions, faces)))
+    for level in (3, 5, 8):
+        mesh = icosphere(subdivisions=level)
+        out.append((f"icosphere({level})", mesh_vertices(mesh.positions, mesh.faces)))
+    n = 724                                     # 2 n^2 = 1,048,352 triangles
+    rng = np.random.default_rng(32)
+    x, y = np.meshgrid(np.arange(n + 1, dtype=float), np.arange(n + 1, dtype=float))
+    z = rng.normal(scale=0.3, size=x.shape)
+    points = np.stack([x + rng.uniform(-0.3, 0.3, x.shape), y + rng.uniform(-0.3, 0.3, x.shape), z], -1)
+    a, b, c, d = points[:-1, :-1], points[:-1, 1:], points[1:, :-1], points[1:, 1:]
+    grid = np.concatenate([np.stack([a, b, c], -2), np.stack([b, d, c], -2)]).reshape(-1, 3, 3)
+    out.append(("perturbed grid", grid.astype(F32)))
+    return out
+
+
+def builds(recursive: bool) -> None:
+    if recursive:
+        import sys
+        sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+        from bvh_recursive import build_bvh_recursive
+    print(f"{'mesh':24} {'triangles':>10} {'build s':>8} {'nodes':>8} {'depth':>5} {'SAH cost':>9}"
+          + (f" {'recursive s':>11} {'same tree':>9}" if recursive else ""))
+    for name, V in build_meshes():
+        seconds, bvh = timed(lambda: build_bvh(V), 1 if len(V) > 500_000 else 3)
+        line = (f"{name:24} {len(V):>10,} {seconds:>8.2f} {len(bvh.nodes):>8,} {bvh.depth:>5} "
+                f"{sah_cost(bvh):>9.1f}")
+        if recursive and len(V) <= 140_000:
+            old_seconds, old = timed(lambda: build_bvh_recursive(V), 1)
+            same = ((old.nodes + 0.0).tobytes() == (bvh.nodes + 0.0).tobytes()
+                    and old.triangles.tobytes() == bvh.triangles.tobytes())
+            line += f" {old_seconds:>11.2f} {str(same):>9}"
+        print(line, flush=True)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rays", type=int, default=4096)
     parser.add_argument("--brute-rays", type=int, default=256)
     parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
+    parser.add_argument("--builds", action="store_true", help="the build alone, on 5k to 1M triangles")
+    parser.add_argument("--recursive", action="store_true", help="with --builds: the old build beside it")
     args = parser.parse_args()
+    if args.builds:
+        builds(args.recursive)
+        return
 
     mesh = icosphere(subdivisions=5)
     V = mesh_vertices(mesh.positions, mesh.faces)

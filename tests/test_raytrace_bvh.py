@@ -16,7 +16,9 @@ import pytest
 
 from reference.raytrace.bvh import any_hit, closest_hit, closest_hit_brute_force, inverse_direction, ray_box
 from reference.raytrace.intersect import ray_triangle
-from renderer.core.bvh import MAX_DEPTH, Bvh, build_bvh, forest, mesh_vertices, refit, roots, texels
+from renderer.core.bvh import MAX_DEPTH, MAX_LEAF_SIZE, Bvh, build_bvh, forest, mesh_vertices, refit, roots, texels
+from renderer.core.builtin import builtin_scenes
+from renderer.core.scene_file import load_scene
 from renderer.core.primitives import icosphere
 
 GLSL = Path(__file__).parent / "glsl"
@@ -111,7 +113,8 @@ SPHERE_TRIANGLES = {4: 5120, 5: 20480}
                 ids=["5120-triangle sphere", "20480-triangle sphere"])
 def sphere(request):
     """The icosphere at 5,120 triangles in the default run; the full run (--all) adds the
-    20,480-triangle one (its build takes about 2 s here; benchmarks/bench_bvh.py times it)."""
+    20,480-triangle one (its traversal tests are the slow part; benchmarks/bench_bvh.py times
+    the build)."""
     mesh = icosphere(subdivisions=request.param)
     vertices = mesh_vertices(mesh.positions, mesh.faces)
     assert len(vertices) == SPHERE_TRIANGLES[request.param]
@@ -154,6 +157,54 @@ def test_builder_invariants_soup_sphere_and_degenerate(sphere):
     assert build_bvh(vertices[:2000]).nodes.tobytes() == build_bvh(vertices[:2000]).nodes.tobytes()
     with pytest.raises(ValueError):
         build_bvh(np.zeros((0, 3, 3)))
+
+
+def same_tree(a: Bvh, b: Bvh) -> bool:
+    """The same nodes (to the sign of a zero in a box: min(0.0, -0.0) may give either), the same
+    triangles in the same leaf order, the same depth."""
+    return ((a.nodes + 0.0).tobytes() == (b.nodes + 0.0).tobytes()
+            and a.triangles.tobytes() == b.triangles.tobytes() and a.depth == b.depth)
+
+
+def grid_triangles(n: int) -> np.ndarray:
+    """2n^2 right triangles tiling an n x n square: centroids in rows, ties on every axis."""
+    corner = np.stack(np.meshgrid(np.arange(n), np.arange(n)), -1).reshape(-1, 2).astype(F32)
+    out = np.zeros((2 * len(corner), 3, 3), F32)
+    for k, offsets in enumerate((((0, 0), (1, 0), (0, 1)), ((1, 0), (1, 1), (0, 1)))):
+        for v, offset in enumerate(offsets):
+            out[k::2, v, :2] = corner + offset
+    return out
+
+
+def chain(count: int) -> np.ndarray:
+    """Small triangles at x = 2^k: the SAH peels a few off at a time, a lopsided tree of many
+    levels (28 for 120), each with nodes of very different sizes."""
+    out = np.zeros((count, 3, 3), F32)
+    out[:, :, 0] = np.exp2(np.arange(count, dtype=F32))[:, None]
+    out[:, 1, 1] = out[:, 2, 2] = 1.0
+    return out
+
+
+@pytest.mark.parametrize("case", ["soup", "copies", "near copies", "grid", "flat", "chain",
+                                  "mesh_file", "shadow_knot_floor"])
+def test_the_level_by_level_build_makes_the_recursive_builds_tree(case):
+    """Split for split (issue 32): SAH costs in the same float64 arithmetic, ties to the lower axis
+    and bin, the object median where no split is found, stable partitions; for leaves of 4 and of 1."""
+    from bvh_recursive import build_bvh_recursive
+    if case in ("mesh_file", "shadow_knot_floor"):
+        scene = load_scene(builtin_scenes()[case])
+        meshes = [o.mesh for o in scene.objects if o.mesh is not None and o.mesh.triangle_count > 100]
+        vertices = np.concatenate([mesh_vertices(m.positions, m.faces) for m in meshes])
+    else:
+        rng = np.random.default_rng(7)
+        vertices = {"soup": soup(3000, 8), "copies": np.repeat(soup(1, 4), 50, axis=0),
+                    "near copies": np.repeat(soup(1, 4), 40, axis=0)
+                    + rng.normal(scale=1e-6, size=(40, 1, 1)).astype(F32),
+                    "grid": grid_triangles(30), "flat": grid_triangles(12) * F32([1, 1, 0]),
+                    "chain": chain(120)}[case]
+    for leaf in (MAX_LEAF_SIZE, 1):
+        assert same_tree(build_bvh(vertices, max_leaf_size=leaf),
+                         build_bvh_recursive(vertices, max_leaf_size=leaf)), (case, leaf)
 
 
 # -- a refit: the tree kept, the boxes made again -----------------------------------------------

@@ -31,6 +31,15 @@ grow deeper than MAX_DEPTH - 24, the triangles are halved in centroid order alon
 axis (the object median). Deterministic: the same triangles give the same bytes. The depth
 never exceeds MAX_DEPTH (the build refuses otherwise), so a traversal stack of MAX_DEPTH
 entries suffices.
+
+The build runs level by level (issue 32): every node of a level is binned, costed and split
+at once, with no Python call per node (a recursive build made 40,101 calls for the
+131,072-triangle torus knot and took 8 s). Each node's triangles are a contiguous run of one
+permutation; a split partitions its run stably, left side first, so that the leaves tile the
+permutation left to right, which is then the triangles' leaf order. The pre-order numbering
+is worked out afterwards from the subtrees' sizes. Split for split it is the recursive build
+(tests/test_raytrace_bvh.py holds the two equal, tests/bvh_recursive.py), to the sign of a
+zero in a box.
 """
 
 from __future__ import annotations
@@ -43,12 +52,9 @@ BINS = 16
 MAX_LEAF_SIZE = 4
 MAX_DEPTH = 64                  # the GLSL's BVH_STACK_SIZE (renderer/gpu/shaders.py defines it)
 TEXTURE_WIDTH = 1024
-# Triangles binned at once by a SAH split: the (chunk, 3, BINS, 3) float64 temporaries of a
-# node's bin bounds take 1152 bytes a triangle, 38 MiB a chunk, where a 5-million-triangle
-# root once asked for 5.4 GiB at once (issue 30). Bin bounds are minima and maxima: the
-# same in any grouping, so the tree is the same.
-SAH_CHUNK = 1 << 15
 MAX_EXACT_INDEX = 1 << 24       # float32 holds every integer below it
+GROUP_TRIANGLES = 1 << 14       # a level's nodes split together: at most this many triangles
+GROUP_NODES = 1 << 10           # and nodes (but one node of more triangles goes alone)
 
 
 @dataclass(frozen=True)
@@ -84,52 +90,73 @@ def _half_area(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
     return d[..., 0] * d[..., 1] + d[..., 1] * d[..., 2] + d[..., 2] * d[..., 0]
 
 
-def _sah_split(centroids, tri_min, tri_max, bins):
-    """(axis, mask of the left side, cost) of the best binned SAH split, or None."""
-    cmin, cmax = centroids.min(0), centroids.max(0)
+def _runs(starts: np.ndarray, lengths: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(positions, run of each position, each run's offset among the positions) of the
+    runs [start, start + length), concatenated in order."""
+    run = np.repeat(np.arange(len(starts)), lengths)
+    offsets = np.cumsum(lengths) - lengths
+    return np.arange(len(run)) - offsets[run] + starts[run], run, offsets
+
+
+def _sah_splits(ids, run, offsets, counts, centroids, tri_min, tri_max, bins):
+    """Every node's best binned SAH split at once (the module docstring): (the nodes that have
+    one, the side of each of `ids`: True on the left). `ids` are the nodes' triangles, node by
+    node (`run`: the node of each; `offsets`: where each node's begin)."""
+    m, c = len(counts), centroids[ids]
+    cmin, cmax = np.minimum.reduceat(c, offsets), np.maximum.reduceat(c, offsets)
     extent = cmax - cmin
-    n = len(centroids)
-    if not (extent > 0).any():
-        return None
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         scale = np.where(extent > 0, bins / np.where(extent > 0, extent, 1.0), 0.0)
-        index = np.minimum(((centroids - cmin) * scale).astype(np.int64), bins - 1)   # (n, 3)
-    counts = np.zeros((3, bins), np.int64)
-    lo, hi = np.full((3, bins, 3), np.inf), np.full((3, bins, 3), -np.inf)            # (3, B, 3)
-    for start in range(0, n, SAH_CHUNK):        # the (chunk, 3, B, 3) temporaries stay bounded
-        part = slice(start, start + SAH_CHUNK)
-        onehot = index[part, :, None] == np.arange(bins)                              # (c, 3, B)
-        counts += onehot.sum(0)
-        np.minimum(lo, np.where(onehot[..., None], tri_min[part, None, None, :], np.inf).min(0), out=lo)
-        np.maximum(hi, np.where(onehot[..., None], tri_max[part, None, None, :], -np.inf).max(0), out=hi)
-    left_n = np.cumsum(counts, axis=1)[:, :-1]                                         # (3, B-1)
-    right_n = n - left_n
-    left_lo = np.minimum.accumulate(lo, axis=1)[:, :-1]
-    left_hi = np.maximum.accumulate(hi, axis=1)[:, :-1]
-    right_lo = np.minimum.accumulate(lo[:, ::-1], axis=1)[:, ::-1][:, 1:]
-    right_hi = np.maximum.accumulate(hi[:, ::-1], axis=1)[:, ::-1][:, 1:]
+        index = np.minimum(((c - cmin[run]) * scale[run]).astype(np.int64), bins - 1)    # (e, 3)
+    counted = np.empty((m, 3, bins), np.int64)
+    bounds = np.full((m * 3 * bins, 6), np.inf)      # per (node, axis, bin): min, then -max
+    low_high = np.concatenate([tri_min[ids], -tri_max[ids]], axis=1)   # one reduction for both
+    for axis in range(3):
+        # Each (bin, node)'s triangles together: a stable sort by bin (a radix sort, the bins
+        # fitting a byte) keeps each bin's triangles in node order, so the runs of equal
+        # (bin, node) are contiguous and reduceat gives their bounds.
+        order = np.argsort(index[:, axis].astype(np.uint8), kind="stable")
+        key = index[order, axis] * m + run[order]
+        first = np.flatnonzero(np.diff(key, prepend=-1))
+        which = key[first]
+        bounds[(which % m * 3 + axis) * bins + which // m] = np.minimum.reduceat(low_high[order], first)
+        counted[:, axis] = np.bincount(run * bins + index[:, axis], minlength=m * bins).reshape(m, bins)
+    bounds = bounds.reshape(m, 3, bins, 6)
+    lo, hi = bounds[..., :3], -bounds[..., 3:]
+    left_n = np.cumsum(counted, axis=2)[:, :, :-1]                                   # (m, 3, B-1)
+    right_n = counts[:, None, None] - left_n
+    left_lo = np.minimum.accumulate(lo, axis=2)[:, :, :-1]
+    left_hi = np.maximum.accumulate(hi, axis=2)[:, :, :-1]
+    right_lo = np.minimum.accumulate(lo[:, :, ::-1], axis=2)[:, :, ::-1][:, :, 1:]
+    right_hi = np.maximum.accumulate(hi[:, :, ::-1], axis=2)[:, :, ::-1][:, :, 1:]
     with np.errstate(invalid="ignore", over="ignore"):
         cost = _half_area(left_lo, left_hi) * left_n + _half_area(right_lo, right_hi) * right_n
-    valid = (left_n > 0) & (right_n > 0) & (extent > 0)[:, None]
-    cost = np.where(valid, cost, np.inf)
-    flat = int(np.argmin(cost))                 # ties: the lower axis, then the lower bin
-    axis, k = divmod(flat, bins - 1)
-    if not np.isfinite(cost[axis, k]):
-        return None
-    return axis, index[:, axis] <= k, float(cost[axis, k])
+    valid = (left_n > 0) & (right_n > 0) & (extent > 0)[:, :, None]
+    cost = np.where(valid, cost, np.inf).reshape(m, -1)
+    best = np.argmin(cost, axis=1)              # ties: the lower axis, then the lower bin
+    axis, k = np.divmod(best, bins - 1)
+    found = np.isfinite(cost[np.arange(m), best])
+    return found, index[np.arange(len(ids)), axis[run]] <= k[run]
 
 
-def _median_split(centroids):
-    axis = int(np.argmax(centroids.max(0) - centroids.min(0)))
-    order = np.argsort(centroids[:, axis], kind="stable")
-    left = np.zeros(len(centroids), bool)
-    left[order[: len(centroids) // 2]] = True
+def _median_splits(ids, run, offsets, counts, centroids, nodes):
+    """The sides of the triangles of `nodes` (a mask over the nodes) halved in centroid order
+    along each node's widest axis (the object median; stable: ties keep their order), as a
+    mask over all of `ids`: True for the first half."""
+    left = np.zeros(len(ids), bool)
+    c = centroids[ids]
+    widest = np.argmax(np.maximum.reduceat(c, offsets) - np.minimum.reduceat(c, offsets), axis=1)
+    chosen = np.flatnonzero(nodes[run])
+    order = chosen[np.lexsort((c[chosen, widest[run[chosen]]], run[chosen]))]
+    node = run[order]
+    rank = np.arange(len(order)) - np.searchsorted(node, node, "left")
+    left[order] = rank < counts[node] // 2
     return left
 
 
-def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) -> Bvh:
-    """The BVH of triangles `vertices` (T, 3, 3) (A, B, C of each; any float dtype; the layout
-    holds them as float32), T >= 1; or of a Mesh-like (positions, faces) via `mesh_vertices`."""
+def build_inputs(vertices, max_leaf_size: int):
+    """(vertices as float32, each triangle's float64 min and max corner, its centroid) of a
+    build's checked input: a ValueError for what no tree can hold."""
     vertices = np.asarray(vertices, dtype=np.float32)
     if vertices.ndim != 3 or vertices.shape[1:] != (3, 3) or len(vertices) == 0:
         raise ValueError(f"triangles must be (T, 3, 3) with T >= 1, not {vertices.shape}")
@@ -137,52 +164,106 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) ->
         raise ValueError("triangle vertices must be finite")
     if max_leaf_size < 1:
         raise ValueError("max_leaf_size must be at least 1")
-    T = len(vertices)
-    if 2 * T >= MAX_EXACT_INDEX:
-        raise ValueError(f"{T} triangles: the float32 layout indexes at most {MAX_EXACT_INDEX // 2 - 1}")
+    if 2 * len(vertices) >= MAX_EXACT_INDEX:
+        raise ValueError(f"{len(vertices)} triangles: the float32 layout indexes at most "
+                         f"{MAX_EXACT_INDEX // 2 - 1}")
     v64 = vertices.astype(np.float64)
     tri_min, tri_max = v64.min(1), v64.max(1)
-    centroids = (tri_min + tri_max) / 2
+    return vertices, tri_min, tri_max, (tri_min + tri_max) / 2
 
-    nodes = []                  # [min(3), a, max(3), count] per node, pre-order
-    order = []                  # original indices in leaf order
-    placed = 0
-    depth_seen = 0
 
-    def emit(ids: np.ndarray, depth: int) -> None:
-        nonlocal placed, depth_seen
-        depth_seen = max(depth_seen, depth)
-        lo, hi = tri_min[ids].min(0), tri_max[ids].max(0)
-        index = len(nodes)
-        nodes.append([lo, 0, hi, 0])
-        n = len(ids)
-        split = None
-        if n > max_leaf_size:
-            if depth < MAX_DEPTH - 24:
-                split = _sah_split(centroids[ids], tri_min[ids], tri_max[ids], bins)
-            if split is None:
-                split = (None, _median_split(centroids[ids]), None)
-        if not split:
-            nodes[index][1], nodes[index][3] = placed, n
-            order.append(ids)
-            placed += n
-            return
-        left = split[1]
-        emit(ids[left], depth + 1)
-        nodes[index][1] = len(nodes)
-        emit(ids[~left], depth + 1)
+def _groups(counts: np.ndarray) -> list[slice]:
+    """A level's nodes in consecutive groups of at most GROUP_TRIANGLES triangles and
+    GROUP_NODES nodes (a bigger node alone): the temporaries of a split, some 300 bytes a
+    triangle and 6 KiB a node, stay bounded however large the mesh (issue 30's limits)."""
+    groups, begin, triangles = [], 0, 0
+    for end, count in enumerate(counts.tolist()):
+        if end > begin and (triangles + count > GROUP_TRIANGLES or end - begin >= GROUP_NODES):
+            groups.append(slice(begin, end))
+            begin, triangles = end, 0
+        triangles += count
+    return groups + [slice(begin, len(counts))]
 
-    emit(np.arange(T), 0)
-    if depth_seen >= MAX_DEPTH:
-        raise ValueError(f"BVH depth {depth_seen} exceeds the traversal stack ({MAX_DEPTH})")
-    flat = np.zeros((len(nodes), 2, 4), np.float32)
-    for i, (lo, a, hi, count) in enumerate(nodes):
-        flat[i, 0, :3], flat[i, 0, 3], flat[i, 1, :3], flat[i, 1, 3] = lo, a, hi, count
-    order = np.concatenate(order)
-    triangles = np.zeros((T, 3, 4), np.float32)
-    triangles[:, :, :3] = vertices[order]
-    triangles[:, 0, 3] = order
-    return Bvh(flat, triangles, depth_seen)
+
+def _split_nodes(perm, starts, counts, depth, centroids, tri_min, tri_max, bins) -> np.ndarray:
+    """Split the nodes whose triangles are perm[start:start + count] (the module docstring):
+    each run partitioned in place, stably, its left side first; the left sides' sizes."""
+    positions, run, offsets = _runs(starts, counts)
+    ids = perm[positions]
+    sah = np.zeros(len(counts), bool)
+    left = np.zeros(len(ids), bool)
+    if depth < MAX_DEPTH - 24:
+        sah, left = _sah_splits(ids, run, offsets, counts, centroids, tri_min, tri_max, bins)
+    if not sah.all():
+        left = np.where(sah[run], left, _median_splits(ids, run, offsets, counts, centroids, ~sah))
+    n_left = np.bincount(run, weights=left, minlength=len(counts)).astype(np.int64)
+    before_left = np.cumsum(left) - left - (np.cumsum(n_left) - n_left)[run]
+    before_right = np.cumsum(~left) - ~left - (np.cumsum(counts - n_left) - (counts - n_left))[run]
+    perm[np.where(left, starts[run] + before_left, starts[run] + n_left[run] + before_right)] = ids
+    return n_left
+
+
+def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) -> Bvh:
+    """The BVH of triangles `vertices` (T, 3, 3) (A, B, C of each; any float dtype; the layout
+    holds them as float32), T >= 1; or of a Mesh-like (positions, faces) via `mesh_vertices`."""
+    vertices, tri_min, tri_max, centroids = build_inputs(vertices, max_leaf_size)
+    T = len(vertices)
+    perm = np.arange(T)                         # each node's triangles: a run of it
+    start, count = [np.zeros(1, np.int64)], [np.full(1, T, np.int64)]     # per level
+    left_of = []                                # per level: each node's left child, or -1
+    depth = 0
+    while True:
+        starts, counts = start[-1], count[-1]
+        split = counts > max_leaf_size
+        left_child = np.full(len(starts), -1, np.int64)
+        left_of.append(left_child)
+        if not split.any():
+            break
+        starts, counts = starts[split], counts[split]
+        n_left = np.concatenate([_split_nodes(perm, starts[group], counts[group], depth, centroids,
+                                              tri_min, tri_max, bins)
+                                 for group in _groups(counts)])
+        first = sum(len(level) for level in start)
+        left_child[split] = first + 2 * np.arange(len(counts))    # and the right child after it
+        start.append(np.stack([starts, starts + n_left], axis=1).ravel())
+        count.append(np.stack([n_left, counts - n_left], axis=1).ravel())
+        depth += 1
+    if depth >= MAX_DEPTH:
+        raise ValueError(f"BVH depth {depth} exceeds the traversal stack ({MAX_DEPTH})")
+    return Bvh(*_layout(perm, np.concatenate(start), np.concatenate(count), left_of,
+                        vertices, tri_min, tri_max), depth)
+
+
+def _layout(perm, start, count, left_of, vertices, tri_min, tri_max):
+    """(nodes, triangles) in the module docstring's layout, from the nodes in the order they were
+    made (level by level; `left_of[d]`: level d's left children, -1 for a leaf)."""
+    left = np.concatenate(left_of)
+    level = np.repeat(np.arange(len(left_of)), [len(d) for d in left_of])
+    leaf, N = left < 0, len(left)
+    lo, hi = np.empty((N, 3)), np.empty((N, 3))
+    leaves = np.flatnonzero(leaf)
+    leaves = leaves[np.argsort(start[leaves], kind="stable")]     # they tile the permutation
+    lo[leaves] = np.minimum.reduceat(tri_min[perm], start[leaves])
+    hi[leaves] = np.maximum.reduceat(tri_max[perm], start[leaves])
+    size = np.ones(N, np.int64)                 # nodes in each subtree
+    for d in range(len(left_of) - 2, -1, -1):   # children before their parents
+        inner = np.flatnonzero((level == d) & ~leaf)
+        l, r = left[inner], left[inner] + 1
+        lo[inner], hi[inner] = np.minimum(lo[l], lo[r]), np.maximum(hi[l], hi[r])
+        size[inner] = 1 + size[l] + size[r]
+    pre = np.zeros(N, np.int64)                 # pre-order: a node, its left subtree, its right
+    for d in range(len(left_of) - 1):
+        inner = np.flatnonzero((level == d) & ~leaf)
+        pre[left[inner]] = pre[inner] + 1
+        pre[left[inner] + 1] = pre[inner] + 1 + size[left[inner]]
+    nodes = np.zeros((N, 2, 4), np.float32)
+    nodes[pre, 0, :3], nodes[pre, 1, :3] = lo, hi
+    nodes[pre, 0, 3] = np.where(leaf, start, pre[np.where(leaf, 0, left + 1)])
+    nodes[pre, 1, 3] = np.where(leaf, count, 0)
+    triangles = np.zeros((len(perm), 3, 4), np.float32)
+    triangles[:, :, :3] = vertices[perm]
+    triangles[:, 0, 3] = perm
+    return nodes, triangles
 
 
 def refit(bvh: Bvh, vertices) -> Bvh:

@@ -144,7 +144,7 @@ def reference_bytes(width: int, height: int, triangles: int, *, linear: bool = F
 # about 55 MiB over a chunk of 65,536 camera rays, doubled for scenes of many triangles):
 RAYTRACE_FIXED = 128 * MIB
 RAYTRACE_BYTES_PER_PIXEL = 64                   # float colour and depth targets, read-back, rgba8
-# Per triangle: ray_scene (float64), the BVH and its build (its SAH bins in bounded chunks:
+# Per triangle: ray_scene (float64), the BVH and its build (a level's nodes split in bounded groups:
 # renderer/core/bvh.py), and on the GPU the float textures and their upload. Measured on a
 # 488,600-triangle uv_sphere at 64x48 (peak RSS over the scene's, 2026-12-03): GPU 1,069 and
 # reference 641 bytes a triangle; but after loading a 999,698-triangle PLY (merged and

@@ -98,10 +98,11 @@ def _runs(starts: np.ndarray, lengths: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return np.arange(len(run)) - offsets[run] + starts[run], run, offsets
 
 
-def _sah_splits(ids, run, offsets, counts, centroids, tri_min, tri_max, bins):
+def _sah_splits(ids, run, offsets, counts, centroids, low_high, bins):
     """Every node's best binned SAH split at once (the module docstring): (the nodes that have
     one, the side of each of `ids`: True on the left). `ids` are the nodes' triangles, node by
-    node (`run`: the node of each; `offsets`: where each node's begin)."""
+    node (`run`: the node of each; `offsets`: where each node's begin); `low_high` (T, 6) each
+    triangle's min corner and its max corner negated, so that one reduction takes both."""
     m, c = len(counts), centroids[ids]
     cmin, cmax = np.minimum.reduceat(c, offsets), np.maximum.reduceat(c, offsets)
     extent = cmax - cmin
@@ -110,7 +111,6 @@ def _sah_splits(ids, run, offsets, counts, centroids, tri_min, tri_max, bins):
         index = np.minimum(((c - cmin[run]) * scale[run]).astype(np.int64), bins - 1)    # (e, 3)
     counted = np.empty((m, 3, bins), np.int64)
     bounds = np.full((m * 3 * bins, 6), np.inf)      # per (node, axis, bin): min, then -max
-    low_high = np.concatenate([tri_min[ids], -tri_max[ids]], axis=1)   # one reduction for both
     for axis in range(3):
         # Each (bin, node)'s triangles together: a stable sort by bin (a radix sort, the bins
         # fitting a byte) keeps each bin's triangles in node order, so the runs of equal
@@ -119,7 +119,7 @@ def _sah_splits(ids, run, offsets, counts, centroids, tri_min, tri_max, bins):
         key = index[order, axis] * m + run[order]
         first = np.flatnonzero(np.diff(key, prepend=-1))
         which = key[first]
-        bounds[(which % m * 3 + axis) * bins + which // m] = np.minimum.reduceat(low_high[order], first)
+        bounds[(which % m * 3 + axis) * bins + which // m] = np.minimum.reduceat(low_high[ids[order]], first)
         counted[:, axis] = np.bincount(run * bins + index[:, axis], minlength=m * bins).reshape(m, bins)
     bounds = bounds.reshape(m, 3, bins, 6)
     lo, hi = bounds[..., :3], -bounds[..., 3:]
@@ -185,7 +185,7 @@ def _groups(counts: np.ndarray) -> list[slice]:
     return groups + [slice(begin, len(counts))]
 
 
-def _split_nodes(perm, starts, counts, depth, centroids, tri_min, tri_max, bins) -> np.ndarray:
+def _split_nodes(perm, starts, counts, depth, centroids, low_high, bins) -> np.ndarray:
     """Split the nodes whose triangles are perm[start:start + count] (the module docstring):
     each run partitioned in place, stably, its left side first; the left sides' sizes."""
     positions, run, offsets = _runs(starts, counts)
@@ -193,7 +193,7 @@ def _split_nodes(perm, starts, counts, depth, centroids, tri_min, tri_max, bins)
     sah = np.zeros(len(counts), bool)
     left = np.zeros(len(ids), bool)
     if depth < MAX_DEPTH - 24:
-        sah, left = _sah_splits(ids, run, offsets, counts, centroids, tri_min, tri_max, bins)
+        sah, left = _sah_splits(ids, run, offsets, counts, centroids, low_high, bins)
     if not sah.all():
         left = np.where(sah[run], left, _median_splits(ids, run, offsets, counts, centroids, ~sah))
     n_left = np.bincount(run, weights=left, minlength=len(counts)).astype(np.int64)
@@ -209,6 +209,7 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) ->
     vertices, tri_min, tri_max, centroids = build_inputs(vertices, max_leaf_size)
     T = len(vertices)
     perm = np.arange(T)                         # each node's triangles: a run of it
+    low_high = np.concatenate([tri_min, -tri_max], axis=1)
     start, count = [np.zeros(1, np.int64)], [np.full(1, T, np.int64)]     # per level
     left_of = []                                # per level: each node's left child, or -1
     depth = 0
@@ -221,7 +222,7 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) ->
             break
         starts, counts = starts[split], counts[split]
         n_left = np.concatenate([_split_nodes(perm, starts[group], counts[group], depth, centroids,
-                                              tri_min, tri_max, bins)
+                                              low_high, bins)
                                  for group in _groups(counts)])
         first = sum(len(level) for level in start)
         left_child[split] = first + 2 * np.arange(len(counts))    # and the right child after it

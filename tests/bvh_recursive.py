@@ -8,9 +8,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from renderer.core.bvh import BINS, MAX_DEPTH, MAX_LEAF_SIZE, Bvh, _half_area, build_inputs
+from renderer.core.bvh import BINS, MAX_DEPTH, MAX_LEAF_SIZE, Bvh, build_inputs
 
 SAH_CHUNK = 1 << 15             # triangles binned at once: bounded temporaries
+
+
+def _half_area(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    d = hi - lo
+    return d[..., 0] * d[..., 1] + d[..., 1] * d[..., 2] + d[..., 2] * d[..., 0]
 
 
 def _sah_split(centroids, tri_min, tri_max, bins):

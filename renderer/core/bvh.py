@@ -85,9 +85,20 @@ class Bvh:
         return self.triangles[:, :, :3]
 
 
-def _half_area(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    d = hi - lo
-    return d[..., 0] * d[..., 1] + d[..., 1] * d[..., 2] + d[..., 2] * d[..., 0]
+def _half_extent_area(d: np.ndarray, axis: int) -> np.ndarray:
+    """Half the surface area of boxes of extent d (x, y and z along `axis`), or of -d: the
+    products are the same."""
+    x, y, z = (np.take(d, i, axis=axis) for i in range(3))
+    return x * y + y * z + z * x
+
+
+def _running_min(a: np.ndarray) -> np.ndarray:
+    """np.minimum.accumulate(a, axis=0), the same values, a plane at a time: numpy's
+    accumulate runs along the axis for each element of a plane, several times slower."""
+    a = a.copy()
+    for i in range(1, len(a)):
+        np.minimum(a[i], a[i - 1], out=a[i])
+    return a
 
 
 def _runs(starts: np.ndarray, lengths: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -103,36 +114,40 @@ def _sah_splits(ids, run, offsets, counts, centroids, low_high, bins):
     one, the side of each of `ids`: True on the left). `ids` are the nodes' triangles, node by
     node (`run`: the node of each; `offsets`: where each node's begin); `low_high` (T, 6) each
     triangle's min corner and its max corner negated, so that one reduction takes both."""
-    m, c = len(counts), centroids[ids]
+    m, c = len(counts), np.take(centroids, ids, axis=0)     # take: faster than [ids] for rows
     cmin, cmax = np.minimum.reduceat(c, offsets), np.maximum.reduceat(c, offsets)
     extent = cmax - cmin
     with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
         scale = np.where(extent > 0, bins / np.where(extent > 0, extent, 1.0), 0.0)
-        index = np.minimum(((c - cmin[run]) * scale[run]).astype(np.int64), bins - 1)    # (e, 3)
-    counted = np.empty((m, 3, bins), np.int64)
-    bounds = np.full((m * 3 * bins, 6), np.inf)      # per (node, axis, bin): min, then -max
-    for axis in range(3):
-        # Each (bin, node)'s triangles together: a stable sort by bin (a radix sort, the bins
-        # fitting a byte) keeps each bin's triangles in node order, so the runs of equal
-        # (bin, node) are contiguous and reduceat gives their bounds.
-        order = np.argsort(index[:, axis].astype(np.uint8), kind="stable")
-        key = index[order, axis] * m + run[order]
-        first = np.flatnonzero(np.diff(key, prepend=-1))
-        which = key[first]
-        bounds[(which % m * 3 + axis) * bins + which // m] = np.minimum.reduceat(low_high[ids[order]], first)
-        counted[:, axis] = np.bincount(run * bins + index[:, axis], minlength=m * bins).reshape(m, bins)
-    bounds = bounds.reshape(m, 3, bins, 6)
-    lo, hi = bounds[..., :3], -bounds[..., 3:]
-    left_n = np.cumsum(counted, axis=2)[:, :, :-1]                                   # (m, 3, B-1)
-    right_n = counts[:, None, None] - left_n
-    left_lo = np.minimum.accumulate(lo, axis=2)[:, :, :-1]
-    left_hi = np.maximum.accumulate(hi, axis=2)[:, :, :-1]
-    right_lo = np.minimum.accumulate(lo[:, :, ::-1], axis=2)[:, :, ::-1][:, :, 1:]
-    right_hi = np.maximum.accumulate(hi[:, :, ::-1], axis=2)[:, :, ::-1][:, :, 1:]
+        index = ((c - np.repeat(cmin, counts, axis=0)) * np.repeat(scale, counts, axis=0)).astype(np.int64)
+        np.minimum(index, bins - 1, out=index)                                          # (e, 3)
+    # Each (bin, node, axis)'s triangles: how many, and their bounds (min, then -max), by
+    # np.minimum.at on flat indices (numpy >= 1.25 runs it as a plain loop: on the deep levels'
+    # bins of a triangle or two, some 2.5 times a sort by bin and a reduceat). The bins are
+    # the outer axis and the six bounds the next, so that the scans over bins and the areas
+    # below work on whole contiguous planes.
+    cells = m * 3
+    at = index * cells
+    at += run[:, None] * 3 + np.arange(3)                       # (e, 3): (bin, node, axis)
+    counted = np.bincount(at.ravel(), minlength=bins * cells).reshape(bins, m, 3)
+    at += index * (5 * cells)                                   # (bin, column 0, node, axis)
+    bounds = np.full(bins * 6 * cells, np.inf)
+    values = np.take(low_high, ids, axis=0)                                          # (e, 6)
+    for column in range(6):
+        np.minimum.at(bounds, at.ravel(), np.repeat(values[:, column], 3))
+        at += cells
+    bounds = bounds.reshape(bins, 6, m, 3)
+    left_n = np.cumsum(counted, axis=0)[:-1]                                         # (B-1, m, 3)
+    right_n = counts[:, None] - left_n
+    # The bins' bounds to the left of each split and to its right, min and -max in one scan
+    # each way; a box's extent is then -(min + -max), exactly, and its products the same.
+    left = _running_min(bounds)[:-1]
+    right = _running_min(bounds[::-1])[-2::-1]
     with np.errstate(invalid="ignore", over="ignore"):
-        cost = _half_area(left_lo, left_hi) * left_n + _half_area(right_lo, right_hi) * right_n
-    valid = (left_n > 0) & (right_n > 0) & (extent > 0)[:, :, None]
-    cost = np.where(valid, cost, np.inf).reshape(m, -1)
+        cost = (_half_extent_area(left[:, :3] + left[:, 3:], axis=1) * left_n
+                + _half_extent_area(right[:, :3] + right[:, 3:], axis=1) * right_n)
+    valid = (left_n > 0) & (right_n > 0) & (extent > 0)
+    cost = np.where(valid, cost, np.inf).transpose(1, 2, 0).reshape(m, -1)         # (m, 3 (B-1))
     best = np.argmin(cost, axis=1)              # ties: the lower axis, then the lower bin
     axis, k = np.divmod(best, bins - 1)
     found = np.isfinite(cost[np.arange(m), best])
@@ -144,7 +159,7 @@ def _median_splits(ids, run, offsets, counts, centroids, nodes):
     along each node's widest axis (the object median; stable: ties keep their order), as a
     mask over all of `ids`: True for the first half."""
     left = np.zeros(len(ids), bool)
-    c = centroids[ids]
+    c = np.take(centroids, ids, axis=0)
     widest = np.argmax(np.maximum.reduceat(c, offsets) - np.minimum.reduceat(c, offsets), axis=1)
     chosen = np.flatnonzero(nodes[run])
     order = chosen[np.lexsort((c[chosen, widest[run[chosen]]], run[chosen]))]
@@ -244,8 +259,8 @@ def _layout(perm, start, count, left_of, vertices, tri_min, tri_max):
     lo, hi = np.empty((N, 3)), np.empty((N, 3))
     leaves = np.flatnonzero(leaf)
     leaves = leaves[np.argsort(start[leaves], kind="stable")]     # they tile the permutation
-    lo[leaves] = np.minimum.reduceat(tri_min[perm], start[leaves])
-    hi[leaves] = np.maximum.reduceat(tri_max[perm], start[leaves])
+    lo[leaves] = np.minimum.reduceat(np.take(tri_min, perm, axis=0), start[leaves])
+    hi[leaves] = np.maximum.reduceat(np.take(tri_max, perm, axis=0), start[leaves])
     size = np.ones(N, np.int64)                 # nodes in each subtree
     for d in range(len(left_of) - 2, -1, -1):   # children before their parents
         inner = np.flatnonzero((level == d) & ~leaf)
@@ -262,7 +277,7 @@ def _layout(perm, start, count, left_of, vertices, tri_min, tri_max):
     nodes[pre, 0, 3] = np.where(leaf, start, pre[np.where(leaf, 0, left + 1)])
     nodes[pre, 1, 3] = np.where(leaf, count, 0)
     triangles = np.zeros((len(perm), 3, 4), np.float32)
-    triangles[:, :, :3] = vertices[perm]
+    triangles[:, :, :3] = np.take(vertices, perm, axis=0)
     triangles[:, 0, 3] = perm
     return nodes, triangles
 

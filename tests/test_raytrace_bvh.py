@@ -368,7 +368,7 @@ def gpu_closest_hits(ctx, bvh, O, D, s_min=0.0, s_max=1e30, any_hit=False, root=
             program[name].value = unit
         program["u_s_min"].value = s_min
         program["u_s_max"].value = s_max
-        program["u_root"].value = root
+        program["u_root"].value = int(np.flatnonzero(roots(bvh) == root)[0])   # the tree's entry
         framebuffer.use()
         vao.render(vertices=3)
         ctx.finish()

@@ -2,12 +2,14 @@
 // The closest hit of a ray P = O + s D against the triangles of a BVH (docs/conventions.md,
 // "Rays"), traversed depth first with a fixed stack, the nearer child first; and whether any
 // triangle is hit (shadow rays), which stops at the first hit it finds. Both walk the tree whose
-// root node is `root`: 0, or one of the trees of a forest (renderer/core/bvh.py, motion blur). The BVH is two
-// RGBA32F textures in the layout of renderer/core/bvh.py (texel k at (k % width, k / width),
-// the width a power of two):
-//   nodes:     texel 2i = [min.xyz, a], texel 2i + 1 = [max.xyz, count]; count > 0: a leaf of
-//              triangles a .. a + count - 1; count == 0: left child i + 1, right child a
-//   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, 0], [C.xyz, 0]
+// root is `root`: 0, or tree `root` of a forest (renderer/core/bvh.py, motion blur). The BVH is
+// two RGBA32F textures in the layout of renderer/core/bvh.py's Walk (texel k at (k % width,
+// k / width), the width a power of two):
+//   entries:   tree r's root: texel 4r = [min.xyz, ref], 4r + 1 = [max.xyz, 0]; an interior
+//              node's entry e: texels 4e, 4e + 1 = its left child's [min.xyz, ref], [max.xyz, 0],
+//              4e + 2, 4e + 3 = its right child's; ref >= 0: that child's entry (an interior
+//              node), ref < 0: a leaf of the triangles from -ref - 1 to the first flagged last
+//   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, last], [C.xyz, 0]
 // The builder keeps the depth below BVH_STACK_SIZE: renderer/core/bvh.py's MAX_DEPTH, defined
 // before this file (renderer/gpu/shaders.py, FILE_CONSTANTS).
 // Needs raytrace/intersect.glsl (ray_triangle).
@@ -46,30 +48,28 @@ bool bvh_ray_box(vec3 O, vec3 inv_D, vec3 bmin, vec3 bmax, float s_min, float s_
     return near <= far;
 }
 
-// Node i: its count (> 0: a leaf of `count` triangles from a; 0: an interior node whose right
-// child is a).
-int bvh_node(sampler2D nodes, int node, out int a) {
-    a = int(bvh_texel(nodes, 2 * node).w);
-    return int(bvh_texel(nodes, 2 * node + 1).w);
-}
-
-// Whether the ray meets the root's box in [s_min, s_max].
-bool bvh_meets_root(sampler2D nodes, int root, vec3 O, vec3 inv_D, float s_min, float s_max) {
-    float near;
-    return bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * root).xyz, bvh_texel(nodes, 2 * root + 1).xyz,
-                       s_min, s_max, near);
+// Whether the ray meets in [s_min, s_max] the box at texels k, k + 1 of the entries (a root's,
+// or an interior node's child's): near is where it enters, ref that node's ref.
+bool bvh_box_at(sampler2D entries, int k, vec3 O, vec3 inv_D, float s_min, float s_max,
+                out float near, out int ref) {
+    vec4 lo = bvh_texel(entries, k);
+    ref = int(lo.w);
+    return bvh_ray_box(O, inv_D, lo.xyz, bvh_texel(entries, k + 1).xyz, s_min, s_max, near);
 }
 
 // Whether the ray hits triangle j of the triangles texture (vertices A, B, C, original index)
 // with s_min < s' < s, nearer than the hit so far: (s, uv, triangle) then become that hit's
-// parameter, barycentric (u, v) and original index. Both walks test a leaf's triangles so.
+// parameter, barycentric (u, v) and original index. `last`: whether j ends its leaf. Both
+// walks test a leaf's triangles so.
 bool bvh_nearer_triangle(sampler2D triangles, int j, vec3 O, vec3 D, float s_min,
-                         inout float s, inout vec2 uv, inout int triangle) {
+                         inout float s, inout vec2 uv, inout int triangle, out bool last) {
     vec4 a = bvh_texel(triangles, 3 * j);
+    vec4 b = bvh_texel(triangles, 3 * j + 1);
+    last = b.w > 0.0;
     float hit_s;
     vec2 hit_uv;
-    bool hit = ray_triangle(O, D, a.xyz, bvh_texel(triangles, 3 * j + 1).xyz,
-                            bvh_texel(triangles, 3 * j + 2).xyz, s_min, s, hit_s, hit_uv);
+    bool hit = ray_triangle(O, D, a.xyz, b.xyz, bvh_texel(triangles, 3 * j + 2).xyz, s_min, s,
+                            hit_s, hit_uv);
     if (hit) {
         s = hit_s;
         uv = hit_uv;
@@ -78,22 +78,9 @@ bool bvh_nearer_triangle(sampler2D triangles, int j, vec3 O, vec3 D, float s_min
     return hit;
 }
 
-// The children left (node + 1) and right (a) of an interior node, and whether the ray meets
-// each one's box in [s_min, s_max] (near: where it enters).
-void bvh_children(sampler2D nodes, int node, int a, vec3 O, vec3 inv_D, float s_min,
-                  float s_max, out int left, out int right, out bool hit_left,
-                  out bool hit_right, out float near_left, out float near_right) {
-    left = node + 1;
-    right = a;
-    hit_left = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * left).xyz,
-                           bvh_texel(nodes, 2 * left + 1).xyz, s_min, s_max, near_left);
-    hit_right = bvh_ray_box(O, inv_D, bvh_texel(nodes, 2 * right).xyz,
-                            bvh_texel(nodes, 2 * right + 1).xyz, s_min, s_max, near_right);
-}
-
 // Whether a triangle is hit with s_min < s < s_max; s the nearest hit's parameter (s_max on a
 // miss), uv its barycentric (u, v), triangle its original index (-1 on a miss).
-bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec3 D,
+bool bvh_closest_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, vec3 D,
                      float s_min, float s_max, out float s, out vec2 uv, out int triangle) {
     vec3 inv_D = 1.0 / D;
     s = s_max;
@@ -102,31 +89,29 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec
     int stack[BVH_STACK_SIZE];
     float stack_near[BVH_STACK_SIZE];
     int top = 0;
-    if (!bvh_meets_root(nodes, root, O, inv_D, s_min, s)) return false;
-    int node = root;
+    float near;
+    int ref;
+    if (!bvh_box_at(entries, 4 * root, O, inv_D, s_min, s, near, ref)) return false;
     while (true) {
-        int a;
-        int count = bvh_node(nodes, node, a);
         bool descend = false;
-        if (count > 0) {
+        if (ref < 0) {
             // the leaf's triangles; the test at the end of the body, as a do-while, since
             // llvmpipe runs a body with lanes masked off until every lane of its SIMD group has
             // left: a test at the top ran one whole body more (a triangle, three fetches)
-            int j = a;
-            int end = a + count;
+            int j = -ref - 1;
+            bool last;
             do {
-                bvh_nearer_triangle(triangles, j, O, D, s_min, s, uv, triangle);
+                bvh_nearer_triangle(triangles, j, O, D, s_min, s, uv, triangle, last);
                 ++j;
-            } while (j < end);
+            } while (!last);
         } else {
             int left, right;
-            bool hit_left, hit_right;
             float near_left, near_right;
-            bvh_children(nodes, node, a, O, inv_D, s_min, s, left, right, hit_left, hit_right,
-                         near_left, near_right);
+            bool hit_left = bvh_box_at(entries, 4 * ref, O, inv_D, s_min, s, near_left, left);
+            bool hit_right = bvh_box_at(entries, 4 * ref + 2, O, inv_D, s_min, s, near_right, right);
             if (hit_left && hit_right) {
                 bool right_first = near_right < near_left;
-                node = right_first ? right : left;
+                ref = right_first ? right : left;
                 if (top < BVH_STACK_SIZE) {
                     stack[top] = right_first ? left : right;
                     stack_near[top] = right_first ? near_left : near_right;
@@ -134,7 +119,7 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec
                 }
                 descend = true;
             } else if (hit_left || hit_right) {
-                node = hit_left ? left : right;
+                ref = hit_left ? left : right;
                 descend = true;
             }
         }
@@ -144,7 +129,7 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec
         while (top > 0 && !found) {
             --top;
             if (stack_near[top] <= s) {
-                node = stack[top];
+                ref = stack[top];
                 found = true;
             }
         }
@@ -156,43 +141,42 @@ bool bvh_closest_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec
 // Whether any triangle is hit with s_min < s < s_max (a shadow ray): the same walk, but it stops
 // at the first hit it finds and takes the children in stored order (no nearest-first ordering,
 // no distances on the stack, s_max fixed), so it answers as bvh_closest_hit's return value.
-bool bvh_any_hit(sampler2D nodes, sampler2D triangles, int root, vec3 O, vec3 D, float s_min,
+bool bvh_any_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, vec3 D, float s_min,
                  float s_max) {
     vec3 inv_D = 1.0 / D;
     int stack[BVH_STACK_SIZE];
     int top = 0;
-    if (!bvh_meets_root(nodes, root, O, inv_D, s_min, s_max)) return false;
-    int node = root;
+    float near;
+    int ref;
+    if (!bvh_box_at(entries, 4 * root, O, inv_D, s_min, s_max, near, ref)) return false;
     bool hit = false;
     while (true) {
-        int a;
-        int count = bvh_node(nodes, node, a);
         bool descend = false;
-        if (count > 0) {
+        if (ref < 0) {
             float s = s_max;                        // stays: the first hit ends the walk
             vec2 uv;
             int triangle;
-            int j = a;
+            int j = -ref - 1;
+            bool last;
             do {                                    // the test at the end: see bvh_closest_hit
-                hit = bvh_nearer_triangle(triangles, j, O, D, s_min, s, uv, triangle);
+                hit = bvh_nearer_triangle(triangles, j, O, D, s_min, s, uv, triangle, last);
                 ++j;
-            } while (j < a + count && !hit);
+            } while (!last && !hit);
         } else {
             int left, right;
-            bool hit_left, hit_right;
             float near_left, near_right;
-            bvh_children(nodes, node, a, O, inv_D, s_min, s_max, left, right, hit_left,
-                         hit_right, near_left, near_right);
+            bool hit_left = bvh_box_at(entries, 4 * ref, O, inv_D, s_min, s_max, near_left, left);
+            bool hit_right = bvh_box_at(entries, 4 * ref + 2, O, inv_D, s_min, s_max, near_right, right);
             if (hit_left && hit_right && top < BVH_STACK_SIZE) {
                 stack[top] = right;
                 ++top;
             }
-            node = hit_left ? left : right;
+            ref = hit_left ? left : right;
             descend = hit_left || hit_right;
         }
         if (!descend && top > 0) {
             --top;
-            node = stack[top];
+            ref = stack[top];
             descend = true;
         }
         if (hit || !descend) break;

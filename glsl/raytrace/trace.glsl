@@ -17,7 +17,7 @@
 #include "raytrace/sampling.glsl"     // distributed_2d: the numbers a hit draws
 #include "raytrace/warp.glsl"
 #ifdef MESHES
-uniform sampler2D u_nodes;           // renderer/core/bvh.py's layout
+uniform sampler2D u_nodes;           // renderer/core/bvh.py's Walk layout
 uniform sampler2D u_triangles;
 uniform sampler2D u_triangle_data;   // per original triangle: A, B, C, (nA, object), nB, nC
 #endif
@@ -51,7 +51,7 @@ uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, io
 // the spheres and planes where they are at the camera sample's time (g_spheres, g_planes) and
 // takes each moving mesh's motion at that time (g_mesh_motion), once per camera sample: its
 // reflected, transmitted and shadow rays see the scene at the same time. A moving mesh has its
-// own tree in u_nodes (root u_mesh_root), walked with the ray moved into its time-0 frame.
+// own tree in u_nodes (tree u_mesh_root), walked with the ray moved into its time-0 frame.
 #include "raytrace/motion.glsl"
 uniform vec2 u_shutter;
 #if NUM_SPHERES > 0

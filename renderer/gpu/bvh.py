@@ -1,12 +1,13 @@
 """Arrays as the RGBA32F textures the ray tracer's GLSL reads (`texel_texture`: texel k at
 (k % width, k // width), the width a power of two, `renderer.core.bvh.texels`); a BVH
-(renderer/core/bvh.py) as its two, nodes and triangles, as glsl/raytrace/bvh.glsl reads them."""
+(renderer/core/bvh.py) as its two, entries and triangles, in the layout glsl/raytrace/bvh.glsl
+walks (renderer/core/bvh.py's Walk)."""
 
 from __future__ import annotations
 
 import moderngl
 
-from renderer.core.bvh import Bvh, texels
+from renderer.core.bvh import Bvh, texels, walk_layout
 
 
 def texel_texture(ctx: moderngl.Context, array) -> moderngl.Texture:
@@ -19,5 +20,6 @@ def texel_texture(ctx: moderngl.Context, array) -> moderngl.Texture:
 
 
 def bvh_textures(ctx: moderngl.Context, bvh: Bvh) -> tuple[moderngl.Texture, moderngl.Texture]:
-    """(nodes, triangles) textures; the caller releases them."""
-    return texel_texture(ctx, bvh.nodes), texel_texture(ctx, bvh.triangles)
+    """(entries, triangles) textures of `bvh` (a BVH or a forest); the caller releases them."""
+    walk = walk_layout(bvh)
+    return texel_texture(ctx, walk.entries), texel_texture(ctx, walk.triangles)

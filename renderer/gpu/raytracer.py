@@ -43,7 +43,7 @@ import time
 import moderngl
 import numpy as np
 
-from renderer.core.bvh import build_bvh, forest, roots, texels
+from renderer.core.bvh import build_bvh, forest, roots, texels, walk_layout
 from renderer.core.camera_rays import camera_ray_uniforms, lens_uniforms
 from renderer.core.frame import Frame, image_size
 from renderer.core.motion import declares_motion, moves, scene_motion
@@ -209,7 +209,8 @@ class RayTracer(ContextRenderer):
             bvh = self._bvh(rs)
             if rs.bvh is None:                        # all features, no triangles: a placeholder
                 triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
-            arrays["u_nodes"], arrays["u_triangles"] = bvh.nodes, bvh.triangles
+            walk = walk_layout(bvh)
+            arrays["u_nodes"], arrays["u_triangles"] = walk.entries, walk.triangles
             data = np.zeros((len(triangles), 6, 4))
             data[:, :3, :3] = triangles
             data[:, 3:, :3] = normals
@@ -274,7 +275,7 @@ class RayTracer(ContextRenderer):
 
     def _motion_uniforms(self, rs) -> dict:
         """The shutter and every sphere's, plane's and moving mesh's motion rows (renderer/
-        core/motion.py), the moving meshes' roots in u_nodes and their objects."""
+        core/motion.py), the moving meshes' trees in u_nodes (walk_layout's) and their objects."""
         if "MOTION" not in self.defines:
             return {}
         motion = rs.motion if rs.motion is not None else scene_motion(self.scene)
@@ -284,7 +285,8 @@ class RayTracer(ContextRenderer):
         values = {name: np.asarray(value, np.float32).tobytes() for name, value in rows.items()
                   if np.size(value)}
         if len(moving):                   # the moving meshes' trees are the last ones
-            values["u_mesh_root"] = roots(self._bvh(rs))[-len(moving):].astype(np.int32).tobytes()
+            trees = len(roots(self._bvh(rs)))
+            values["u_mesh_root"] = np.arange(trees - len(moving), trees, dtype=np.int32).tobytes()
             values["u_mesh_object"] = moving.astype(np.int32).tobytes()
         return values
 

@@ -16,7 +16,8 @@ import pytest
 
 from reference.raytrace.bvh import any_hit, closest_hit, closest_hit_brute_force, inverse_direction, ray_box
 from reference.raytrace.intersect import ray_triangle
-from renderer.core.bvh import MAX_DEPTH, MAX_LEAF_SIZE, Bvh, build_bvh, forest, mesh_vertices, refit, roots, texels
+from renderer.core.bvh import (EMPTY, MAX_DEPTH, MAX_LEAF_SIZE, Bvh, build_bvh, forest, mesh_vertices,
+                                node_depths, refit, roots, texels, walk_layout)
 from renderer.core.builtin import builtin_scenes
 from renderer.core.scene_file import load_scene
 from renderer.core.primitives import icosphere
@@ -55,6 +56,69 @@ def test_the_builder_makes_the_hand_written_layout():
     assert texels(HAND.nodes, width=4).shape == (2, 4, 4)
     assert texels(HAND.nodes, width=4)[1, 1].tolist() == HAND.nodes[2, 1].tolist()
     assert texels(HAND.nodes, width=4)[1, 2:].tolist() == [[0] * 4] * 2
+
+
+def decoded_walk(walk):
+    """The Walk's entries read back as the GLSL reads them (bvh_children, bvh_meets_root): each
+    entry's four children's decoded boxes (float32) and refs; each entry read as a root's
+    (min, max, ref)."""
+    e = walk.entries
+    words = e.view(np.int32)
+    byte = lambda w, c: ((w.astype(np.int64) >> (8 * c)) & 0xFF).astype(F32)
+    origin = e[:, 0, :3].view(F32)
+    lo_words = e[:, 1, :3]
+    hi_words = np.stack([e[:, 1, 3], e[:, 2, 0], e[:, 2, 1]], 1)
+    with np.errstate(over="ignore", invalid="ignore"):      # the roots' rows are not quantised
+        step = np.ldexp(F32(1), ((e[:, 0, 3:4].astype(np.int64) >> np.array([0, 8, 16])) & 0xFF) - 127).astype(F32)
+        lo = np.stack([origin + byte(lo_words, c) * step for c in range(4)], 1).astype(F32)
+        hi = np.stack([origin + byte(hi_words, c) * step for c in range(4)], 1).astype(F32)
+    refs = np.concatenate([words[:, 2, 2:], words[:, 3, :2]], 1)
+    return lo, hi, refs, origin, e[:, 1, :3].view(F32), words[:, 0, 3]
+
+
+def test_the_walk_layout_holds_the_tree_four_children_a_step():
+    """walk_layout (the GLSL's layout, renderer/core/bvh.py Walk): the root first, unquantised;
+    then each even-depth interior node with its children, or an interior child's two children,
+    in the tree's order; every leaf of the tree is one child of one entry, and each decoded box
+    holds its node's box (quantised outwards) and is no more than a step wider on each side."""
+    for vertices in (soup(500, 3), grid_triangles(12), TWO):
+        bvh = build_bvh(vertices)
+        walk = walk_layout(bvh)
+        lo, hi, refs, root_min, root_max, root_ref = decoded_walk(walk)
+        assert walk.entries.dtype == np.uint32 and walk.entries.shape[1:] == (4, 4)
+        assert root_min[0].tolist() == bvh.bounds_min[0].tolist() and root_max[0].tolist() == bvh.bounds_max[0].tolist()
+        leaf = bvh.is_leaf
+        first, count = bvh.nodes[:, 0, 3].astype(int), bvh.nodes[:, 1, 3].astype(int)
+        # walk the entries from the root, recording the binary nodes each child stands for
+        seen_leaves = []
+        depth = node_depths(bvh)
+        node_of_entry = {1 + k: n for k, n in enumerate(np.flatnonzero(~leaf & (depth % 2 == 0)))}
+        if leaf[0]:
+            assert root_ref[0] == -1 and len(walk.entries) == 1
+            seen_leaves.append(0)
+        for entry, n in node_of_entry.items():
+            children = []
+            for child in (n + 1, first[n]):
+                children += [child + 1, first[child]] if not leaf[child] else [child, None]
+            for c, node in enumerate(children):
+                if node is None:
+                    assert refs[entry, c] == EMPTY
+                    continue
+                assert np.all(lo[entry, c] <= bvh.bounds_min[node]) and np.all(hi[entry, c] >= bvh.bounds_max[node])
+                step = np.ldexp(1.0, ((walk.entries[entry, 0, 3].astype(np.int64) >> np.array([0, 8, 16])) & 0xFF) - 127)
+                assert np.all(bvh.bounds_min[node] - lo[entry, c] <= 2 * step)
+                assert np.all(hi[entry, c] - bvh.bounds_max[node] <= 2 * step)
+                if leaf[node]:
+                    assert refs[entry, c] == -first[node] - 1
+                    seen_leaves.append(node)
+                else:
+                    assert node_of_entry[refs[entry, c]] == node
+        assert sorted(seen_leaves) == np.flatnonzero(leaf).tolist()
+        # each leaf's last triangle flagged, and only those
+        last = np.zeros(len(bvh.triangles), bool)
+        last[first[leaf] + count[leaf] - 1] = True
+        assert (walk.triangles[:, 1, 3] == 1).tolist() == last.tolist()
+        assert np.array_equal(np.delete(walk.triangles, 1, axis=1), np.delete(bvh.triangles, 1, axis=1))
 
 
 def test_texture_rows_are_a_power_of_two_wide():

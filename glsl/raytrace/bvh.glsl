@@ -1,15 +1,17 @@
 // Twin: reference/raytrace/bvh.py
 // The closest hit of a ray P = O + s D against the triangles of a BVH (docs/conventions.md,
-// "Rays"), traversed depth first with a fixed stack, the nearer child first; and whether any
-// triangle is hit (shadow rays), which stops at the first hit it finds. Both walk the tree whose
-// root is `root`: 0, or tree `root` of a forest (renderer/core/bvh.py, motion blur). The BVH is
-// two RGBA32F textures in the layout of renderer/core/bvh.py's Walk (texel k at (k % width,
-// k / width), the width a power of two):
-//   entries:   tree r's root: texel 4r = [min.xyz, ref], 4r + 1 = [max.xyz, 0]; an interior
-//              node's entry e: texels 4e, 4e + 1 = its left child's [min.xyz, ref], [max.xyz, 0],
-//              4e + 2, 4e + 3 = its right child's; ref >= 0: that child's entry (an interior
-//              node), ref < 0: a leaf of the triangles from -ref - 1 to the first flagged last
-//   triangles: texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, last], [C.xyz, 0]
+// "Rays"), traversed depth first with a fixed stack, four boxes a step, the nearest child
+// first; and whether any triangle is hit (shadow rays), which stops at the first hit it finds.
+// Both walk tree `root`: 0, or one of the trees of a forest (renderer/core/bvh.py, motion
+// blur). The BVH is two textures in the layout of renderer/core/bvh.py's Walk (texel k at
+// (k % width, k / width), the width a power of two):
+//   entries:   RGBA32UI, four texels an entry. Tree r's root: [min.xyz, ref], [max.xyz, 0]
+//              (float bits); an interior node's: its up to four children's boxes, quantised
+//              (origin + q 2^e, bvh_children), and their refs: >= 0 a child's entry (an
+//              interior node), BVH_EMPTY none, another < 0 a leaf of the triangles from
+//              -ref - 1 to the first flagged last
+//   triangles: RGBA32F, texels 3j, 3j + 1, 3j + 2 = [A.xyz, original index], [B.xyz, last],
+//              [C.xyz, 0]
 // The builder keeps the depth below BVH_STACK_SIZE: renderer/core/bvh.py's MAX_DEPTH, defined
 // before this file (renderer/gpu/shaders.py, FILE_CONSTANTS).
 // Needs raytrace/intersect.glsl (ray_triangle).
@@ -48,13 +50,74 @@ bool bvh_ray_box(vec3 O, vec3 inv_D, vec3 bmin, vec3 bmax, float s_min, float s_
     return near <= far;
 }
 
-// Whether the ray meets in [s_min, s_max] the box at texels k, k + 1 of the entries (a root's,
-// or an interior node's child's): near is where it enters, ref that node's ref.
-bool bvh_box_at(sampler2D entries, int k, vec3 O, vec3 inv_D, float s_min, float s_max,
-                out float near, out int ref) {
-    vec4 lo = bvh_texel(entries, k);
+// An unused child's ref (renderer/core/bvh.py EMPTY): below every leaf's.
+const int BVH_EMPTY = int(0x80000000u);
+// The walk's stack: a step pushes up to three children, and a 4-wide tree is half as deep.
+#define BVH_WALK_STACK (3 * (BVH_STACK_SIZE / 2) + 3)
+
+// Texel k of the entries (RGBA32UI: bvh_texel's addressing).
+uvec4 bvh_entry(usampler2D entries, int k) {
+    int width = textureSize(entries, 0).x;
+    int log2_width = (floatBitsToInt(float(width)) >> 23) - 127;
+    return texelFetch(entries, ivec2(k & (width - 1), k >> log2_width), 0);
+}
+
+// The four bytes of a word, as floats (child c's in component c).
+vec4 bvh_bytes(uint word) {
+    return vec4(uvec4(word, word >> 8u, word >> 16u, word >> 24u) & 0xFFu);
+}
+
+// The slab of one axis for four boxes at once (bvh_ray_box's, component by component).
+void bvh_slabs(float o, float inv_d, vec4 bmin, vec4 bmax, out vec4 tn, out vec4 tf) {
+    float inf = uintBitsToFloat(0x7F800000u);
+    vec4 lo = (bmin - o) * inv_d;
+    vec4 hi = (bmax - o) * inv_d;
+    tn = min(lo, hi);
+    tf = max(lo, hi);
+    if (isinf(inv_d)) {
+        bvec4 inside = bvec4(step(bmin, vec4(o)) * step(vec4(o), bmax));
+        tn = mix(vec4(inf), vec4(-inf), inside);
+        tf = mix(vec4(-inf), vec4(inf), inside);
+    }
+}
+
+// The children of entry e (up to four): whether the ray meets each one's box in
+// [s_min, s_max] (hit), where it enters it (near), and each one's ref (bvh_ray_box's test,
+// four boxes at once, on the boxes decoded as origin + q 2^e; an unused child never hit).
+void bvh_children(usampler2D entries, int e, vec3 O, vec3 inv_D, float s_min, float s_max,
+                  out bvec4 hit, out vec4 near, out ivec4 ref) {
+    int k = 4 * e;
+    uvec4 t0 = bvh_entry(entries, k);
+    uvec4 t1 = bvh_entry(entries, k + 1);
+    uvec4 t2 = bvh_entry(entries, k + 2);
+    uvec4 t3 = bvh_entry(entries, k + 3);
+    vec3 origin = uintBitsToFloat(t0.xyz);
+    // 2^e from its biased byte (renderer/core/bvh.py QUANT_BIAS = 127: the byte is the
+    // exponent field of 2^e)
+    vec3 scale = uintBitsToFloat((uvec3(t0.w, t0.w >> 8u, t0.w >> 16u) & 0xFFu) << 23u);
+    vec4 tn_x, tf_x, tn_y, tf_y, tn_z, tf_z;
+    bvh_slabs(O.x, inv_D.x, origin.x + bvh_bytes(t1.x) * scale.x,
+              origin.x + bvh_bytes(t1.w) * scale.x, tn_x, tf_x);
+    bvh_slabs(O.y, inv_D.y, origin.y + bvh_bytes(t1.y) * scale.y,
+              origin.y + bvh_bytes(t2.x) * scale.y, tn_y, tf_y);
+    bvh_slabs(O.z, inv_D.z, origin.z + bvh_bytes(t1.z) * scale.z,
+              origin.z + bvh_bytes(t2.y) * scale.z, tn_z, tf_z);
+    ref = ivec4(t2.zw, t3.xy);
+    near = max(max(tn_x, tn_y), max(tn_z, vec4(s_min)));
+    vec4 far = min(min(min(tf_x, tf_y), tf_z) * BVH_BOX_FAR_SCALE, vec4(s_max));
+    hit = bvec4(vec4(lessThanEqual(near, far)) * vec4(notEqual(ref, ivec4(BVH_EMPTY))));
+}
+
+// Whether the ray meets tree `root`'s root box in [s_min, s_max] (two texels: the root's entry
+// holds it unquantised as [min.xyz, ref], [max.xyz, 0], so that a ray missing it costs two
+// fetches); ref: the root's ref.
+bool bvh_meets_root(usampler2D entries, int root, vec3 O, vec3 inv_D, float s_min, float s_max,
+                    out int ref) {
+    uvec4 lo = bvh_entry(entries, 4 * root);
     ref = int(lo.w);
-    return bvh_ray_box(O, inv_D, lo.xyz, bvh_texel(entries, k + 1).xyz, s_min, s_max, near);
+    float near;
+    return bvh_ray_box(O, inv_D, uintBitsToFloat(lo.xyz),
+                       uintBitsToFloat(bvh_entry(entries, 4 * root + 1).xyz), s_min, s_max, near);
 }
 
 // Whether the ray hits triangle j of the triangles texture (vertices A, B, C, original index)
@@ -78,20 +141,31 @@ bool bvh_nearer_triangle(sampler2D triangles, int j, vec3 O, vec3 D, float s_min
     return hit;
 }
 
+// Sort two children by near (a compare-exchange of a sorting network; a tie keeps the order).
+void bvh_order(inout float near_a, inout int ref_a, inout float near_b, inout int ref_b) {
+    bool swap = near_b < near_a;
+    float n = near_a;
+    int r = ref_a;
+    near_a = swap ? near_b : near_a;
+    ref_a = swap ? ref_b : ref_a;
+    near_b = swap ? n : near_b;
+    ref_b = swap ? r : ref_b;
+}
+
 // Whether a triangle is hit with s_min < s < s_max; s the nearest hit's parameter (s_max on a
 // miss), uv its barycentric (u, v), triangle its original index (-1 on a miss).
-bool bvh_closest_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, vec3 D,
+bool bvh_closest_hit(usampler2D entries, sampler2D triangles, int root, vec3 O, vec3 D,
                      float s_min, float s_max, out float s, out vec2 uv, out int triangle) {
     vec3 inv_D = 1.0 / D;
     s = s_max;
     uv = vec2(0.0);
     triangle = -1;
-    int stack[BVH_STACK_SIZE];
-    float stack_near[BVH_STACK_SIZE];
+    float inf = uintBitsToFloat(0x7F800000u);
+    int stack[BVH_WALK_STACK];
+    float stack_near[BVH_WALK_STACK];
     int top = 0;
-    float near;
     int ref;
-    if (!bvh_box_at(entries, 4 * root, O, inv_D, s_min, s, near, ref)) return false;
+    if (!bvh_meets_root(entries, root, O, inv_D, s_min, s_max, ref)) return false;
     while (true) {
         bool descend = false;
         if (ref < 0) {
@@ -105,23 +179,24 @@ bool bvh_closest_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, v
                 ++j;
             } while (!last);
         } else {
-            int left, right;
-            float near_left, near_right;
-            bool hit_left = bvh_box_at(entries, 4 * ref, O, inv_D, s_min, s, near_left, left);
-            bool hit_right = bvh_box_at(entries, 4 * ref + 2, O, inv_D, s_min, s, near_right, right);
-            if (hit_left && hit_right) {
-                bool right_first = near_right < near_left;
-                ref = right_first ? right : left;
-                if (top < BVH_STACK_SIZE) {
-                    stack[top] = right_first ? left : right;
-                    stack_near[top] = right_first ? near_left : near_right;
-                    ++top;
-                }
-                descend = true;
-            } else if (hit_left || hit_right) {
-                ref = hit_left ? left : right;
-                descend = true;
-            }
+            bvec4 hit;
+            vec4 near;
+            ivec4 child;
+            bvh_children(entries, ref, O, inv_D, s_min, s, hit, near, child);
+            near = mix(vec4(inf), near, hit);       // the boxes missed sort last
+            // the children met, nearest first: a sorting network of five compare-exchanges
+            bvh_order(near.x, child.x, near.y, child.y);
+            bvh_order(near.z, child.z, near.w, child.w);
+            bvh_order(near.x, child.x, near.z, child.z);
+            bvh_order(near.y, child.y, near.w, child.w);
+            bvh_order(near.y, child.y, near.z, child.z);
+            int met = int(hit.x) + int(hit.y) + int(hit.z) + int(hit.w);
+            // the farther ones on the stack, the farthest first; the nearest next
+            if (met > 3) { stack[top] = child.w; stack_near[top] = near.w; ++top; }
+            if (met > 2) { stack[top] = child.z; stack_near[top] = near.z; ++top; }
+            if (met > 1) { stack[top] = child.y; stack_near[top] = near.y; ++top; }
+            ref = child.x;
+            descend = met > 0;
         }
         if (descend) continue;
         // pop the next node still nearer than the closest hit so far
@@ -141,14 +216,13 @@ bool bvh_closest_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, v
 // Whether any triangle is hit with s_min < s < s_max (a shadow ray): the same walk, but it stops
 // at the first hit it finds and takes the children in stored order (no nearest-first ordering,
 // no distances on the stack, s_max fixed), so it answers as bvh_closest_hit's return value.
-bool bvh_any_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, vec3 D, float s_min,
+bool bvh_any_hit(usampler2D entries, sampler2D triangles, int root, vec3 O, vec3 D, float s_min,
                  float s_max) {
     vec3 inv_D = 1.0 / D;
-    int stack[BVH_STACK_SIZE];
+    int stack[BVH_WALK_STACK];
     int top = 0;
-    float near;
     int ref;
-    if (!bvh_box_at(entries, 4 * root, O, inv_D, s_min, s_max, near, ref)) return false;
+    if (!bvh_meets_root(entries, root, O, inv_D, s_min, s_max, ref)) return false;
     bool hit = false;
     while (true) {
         bool descend = false;
@@ -163,23 +237,21 @@ bool bvh_any_hit(sampler2D entries, sampler2D triangles, int root, vec3 O, vec3 
                 ++j;
             } while (!last && !hit);
         } else {
-            int left, right;
-            float near_left, near_right;
-            bool hit_left = bvh_box_at(entries, 4 * ref, O, inv_D, s_min, s_max, near_left, left);
-            bool hit_right = bvh_box_at(entries, 4 * ref + 2, O, inv_D, s_min, s_max, near_right, right);
-            if (hit_left && hit_right && top < BVH_STACK_SIZE) {
-                stack[top] = right;
-                ++top;
-            }
-            ref = hit_left ? left : right;
-            descend = hit_left || hit_right;
+            bvec4 met;
+            vec4 near;
+            ivec4 child;
+            bvh_children(entries, ref, O, inv_D, s_min, s_max, met, near, child);
+            // the first child met next, the others on the stack (popped in stored order)
+            if (met.w) { stack[top] = child.w; ++top; }
+            if (met.z) { stack[top] = child.z; ++top; }
+            if (met.y) { stack[top] = child.y; ++top; }
+            if (met.x) { stack[top] = child.x; ++top; }
+            descend = top > 0;
         }
-        if (!descend && top > 0) {
-            --top;
-            ref = stack[top];
-            descend = true;
-        }
-        if (hit || !descend) break;
+        if (hit) break;
+        if (top == 0) break;
+        --top;
+        ref = stack[top];
     }
     return hit;
 }

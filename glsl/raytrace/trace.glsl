@@ -17,7 +17,7 @@
 #include "raytrace/sampling.glsl"     // distributed_2d: the numbers a hit draws
 #include "raytrace/warp.glsl"
 #ifdef MESHES
-uniform sampler2D u_nodes;           // renderer/core/bvh.py's Walk layout
+uniform usampler2D u_nodes;          // renderer/core/bvh.py's Walk layout
 uniform sampler2D u_triangles;
 uniform sampler2D u_triangle_data;   // per original triangle: A, B, C, (nA, object), nB, nC
 #endif

@@ -303,10 +303,7 @@ def refit(bvh: Bvh, vertices) -> Bvh:
     nodes[leaf, 1, :3] = np.maximum.reduceat(placed.max(1), first)
     inner = np.flatnonzero(~leaf)
     left, right = inner + 1, nodes[inner, 0, 3].astype(np.int64)
-    depth = np.zeros(len(nodes), np.int64)                  # pre-order: a parent precedes
-    for _ in range(bvh.depth):                              # its children, so one pass per
-        depth[left] = depth[inner] + 1                      # level settles every depth
-        depth[right] = depth[inner] + 1
+    depth = node_depths(bvh)
     for level in range(bvh.depth - 1, -1, -1):
         at = depth[inner] == level
         i, l, r = inner[at], left[at], right[at]
@@ -348,46 +345,127 @@ def roots(bvh: Bvh) -> np.ndarray:
     return np.flatnonzero(~child)
 
 
+WALK_WIDTH = 4                  # children a step of the GLSL's walk tests together
+
+
 @dataclass(frozen=True)
 class Walk:
     """A BVH (or forest) laid out for the GLSL's walk (glsl/raytrace/bvh.glsl): the same tree,
-    each interior node's two children's boxes stored together in it, so that a step of the
-    walk reads the four texels of the boxes it tests and nothing else (the node's own two texels
-    told only what its children were: a third of a step's fetches; issue 32).
+    each step testing up to four boxes at once: an interior node at an even depth (the root's
+    0) holds its children, or, where a child is interior, that child's two children, skipping
+    its box (a binary tree collapsed to a 4-wide one); the four boxes quantised to 8 bits an
+    axis in the node's own box, rounded outwards (issue 32: a step reads four texels, where the
+    build's layout took twelve for the same boxes, and texel fetches are most of the walk's time
+    on llvmpipe).
 
-      entries    (R + I, 4, 4) float32. Entry r < R: tree r's root (the trees of a `forest`
-                 in order; a single BVH: R = 1): texel 4r = [min.xyz, ref], 4r + 1 =
-                 [max.xyz, 0], the rest zero. Entry R + k: the k-th interior node in pre-order:
-                 texels [left min.xyz, left ref], [left max.xyz, 0], [right min.xyz, right
-                 ref], [right max.xyz, 0]. A ref >= 0 is an interior node's entry; a ref < 0 is
-                 a leaf whose triangles begin at -ref - 1 and run to the first flagged last.
+      entries    (R + W, 4, 4) uint32 (an RGBA32UI texture; floats as their bits). Entry
+                 r < R: tree r's root (the trees of a `forest` in order; a single BVH: R = 1),
+                 unquantised: texels [min.xyz, ref], [max.xyz, 0], then zeros. Entry R + k:
+                 the k-th even-depth interior node in pre-order, its up to four children in
+                 the tree's left-to-right order:
+                   texel 0  [origin.xyz, exponents]: the children's boxes are origin +
+                            q 2^e on each axis, e - QUANT_BIAS the byte (x, y, z: bits 0, 8, 16)
+                   texel 1  [lo.x, lo.y, lo.z, hi.x]  each four bytes: child c's q in byte c
+                   texel 2  [hi.y, hi.z, ref 0, ref 1]
+                   texel 3  [ref 2, ref 3, 0, 0]
+                 A ref (as int32) >= 0 is an interior node's entry; EMPTY an unused child
+                 (never hit); another < 0 a leaf whose triangles begin at -ref - 1 and run to
+                 the first flagged last. Every decoded box (float32: origin + q 2^e, the
+                 product exact) holds its child's float32 box.
       triangles  Bvh.triangles with texel 3j + 1's w = 1 on the last triangle of each leaf.
     """
     entries: np.ndarray
     triangles: np.ndarray
 
 
+EMPTY = -(1 << 31)              # an unused child's ref: below every leaf's
+QUANT_BIAS = 127                # exponent e is stored as the byte e + QUANT_BIAS
+QUANT_MIN_EXPONENT = -100       # a flat axis's step: normal, and far below any box's size
+
+
+def node_depths(bvh: Bvh) -> np.ndarray:
+    """Each node's depth in its tree (a root's 0), parents before children in pre-order."""
+    inner = np.flatnonzero(~bvh.is_leaf)
+    left, right = inner + 1, bvh.nodes[inner, 0, 3].astype(np.int64)
+    depth = np.zeros(len(bvh.nodes), np.int64)
+    for _ in range(bvh.depth):          # each pass settles one more level, whole-array
+        depth[left] = depth[inner] + 1
+        depth[right] = depth[inner] + 1
+    return depth
+
+
+def _quantise(lo, hi, used):
+    """(origin (W, 3) float32, exponent (W, 3), q_lo, q_hi (W, 4, 3) uint8) of the children's
+    boxes lo, hi (W, 4, 3) float32 (`used` (W, 4): the children there are): origin the used
+    boxes' min corner, 2^e the smallest power of two with 254 steps spanning them, q rounded
+    outwards and checked in the GLSL's float32 arithmetic (origin + q 2^e, the product exact)."""
+    f32 = np.float32
+    origin = np.where(used[..., None], lo, np.inf).min(1)
+    top = np.where(used[..., None], hi, -np.inf).max(1)
+    tiny = np.abs(origin) < np.finfo(f32).tiny          # a subnormal origin: llvmpipe flushes it
+    origin = np.where(tiny, -np.finfo(f32).tiny, origin).astype(f32)
+    span = top.astype(np.float64) - origin
+    with np.errstate(divide="ignore"):
+        e = np.ceil(np.log2(np.maximum(span, 0.0) / 254.0))
+    e = np.maximum(np.where(span > 0, e, QUANT_MIN_EXPONENT), QUANT_MIN_EXPONENT).astype(np.int64)
+    while True:                                         # a step too small by rounding: widen
+        step = np.ldexp(f32(1), e).astype(f32)
+        q_lo = np.floor((lo - origin[:, None]) / step[:, None].astype(np.float64))
+        q_hi = np.ceil((hi - origin[:, None]) / step[:, None].astype(np.float64))
+        q_lo, q_hi = np.clip(q_lo, 0, 255), np.clip(q_hi, 0, 255)
+        for _ in range(2):                              # outwards where float32 rounded inwards
+            low = (origin[:, None] + (q_lo * step[:, None]).astype(f32)).astype(f32)
+            high = (origin[:, None] + (q_hi * step[:, None]).astype(f32)).astype(f32)
+            q_lo = np.where(low > lo, np.maximum(q_lo - 1, 0), q_lo)
+            q_hi = np.where(high < hi, np.minimum(q_hi + 1, 255), q_hi)
+        low = (origin[:, None] + (q_lo * step[:, None]).astype(f32)).astype(f32)
+        high = (origin[:, None] + (q_hi * step[:, None]).astype(f32)).astype(f32)
+        bad = ((low > lo) | (high < hi)) & used[..., None]
+        if not bad.any():
+            return origin, e, q_lo.astype(np.uint8), q_hi.astype(np.uint8)
+        e = e + bad.any(1)
+
+
 def walk_layout(bvh: Bvh) -> Walk:
     """`bvh` (a BVH or a forest) in the layout of `Walk`."""
     leaf, N = bvh.is_leaf, len(bvh.nodes)
     tree_roots = roots(bvh)
-    inner = np.flatnonzero(~leaf)
+    R = len(tree_roots)
+    first = bvh.nodes[:, 0, 3].astype(np.int64)           # a leaf's first triangle, or the right child
+    inner = ~leaf
+    depth = node_depths(bvh)
+    wide = np.flatnonzero(inner & (depth % 2 == 0))
     entry = np.full(N, -1, np.int64)
-    entry[inner] = len(tree_roots) + np.arange(len(inner))
-    first = bvh.nodes[:, 0, 3].astype(np.int64)
-    ref = np.where(leaf, -first - 1, entry).astype(np.float32)          # each node's, as a child
-    entries = np.zeros((len(tree_roots) + len(inner), 4, 4), np.float32)
-    for rows, nodes in (((slice(0, len(tree_roots)), slice(0, 2)), tree_roots),
-                        ((slice(len(tree_roots), None), slice(0, 2)), inner + 1),
-                        ((slice(len(tree_roots), None), slice(2, 4)), first[inner])):
-        part = entries[rows]
-        part[:, 0, :3], part[:, 1, :3] = bvh.bounds_min[nodes], bvh.bounds_max[nodes]
-        part[:, 0, 3] = ref[nodes]
-        entries[rows] = part
+    entry[wide] = R + np.arange(len(wide))
+    ref = np.where(leaf, -first - 1, entry)
+    # each wide node's four children: per binary child, its two children if it is interior,
+    # else itself and an unused slot
+    slots = np.full((len(wide), 4), -1, np.int64)
+    for half, child in ((0, wide + 1), (2, first[wide])):
+        collapsed = inner[child]
+        slots[:, half] = np.where(collapsed, child + 1, child)
+        slots[:, half + 1] = np.where(collapsed, first[child], -1)
+    used = slots >= 0
+    node = np.where(used, slots, 0)
+    origin, e, q_lo, q_hi = _quantise(bvh.bounds_min[node], bvh.bounds_max[node], used)
+    words = np.zeros((len(wide), 4, 4), np.uint32)
+    words[:, 0, :3] = origin.view(np.uint32)
+    words[:, 0, 3] = ((e + QUANT_BIAS) << np.array([0, 8, 16])).sum(1)
+    shifts = np.array([0, 8, 16, 24], np.uint32)[None, :, None]
+    lo_words = (q_lo.astype(np.uint32) << shifts).sum(1, dtype=np.uint32)      # (W, 3)
+    hi_words = (q_hi.astype(np.uint32) << shifts).sum(1, dtype=np.uint32)
+    words[:, 1, :3], words[:, 1, 3] = lo_words, hi_words[:, 0]
+    words[:, 2, :2] = hi_words[:, 1:]
+    refs = np.where(used, ref[node], EMPTY).astype(np.int32).view(np.uint32)
+    words[:, 2, 2:], words[:, 3, :2] = refs[:, :2], refs[:, 2:]
+    head = np.zeros((R, 4, 4), np.uint32)
+    head[:, 0, :3] = bvh.bounds_min[tree_roots].astype(np.float32).view(np.uint32)
+    head[:, 1, :3] = bvh.bounds_max[tree_roots].astype(np.float32).view(np.uint32)
+    head[:, 0, 3] = ref[tree_roots].astype(np.int32).view(np.uint32)
     triangles = bvh.triangles.copy()
     count = bvh.nodes[leaf, 1, 3].astype(np.int64)
     triangles[first[leaf] + count - 1, 1, 3] = 1.0
-    return Walk(entries, triangles)
+    return Walk(np.concatenate([head, words]), triangles)
 
 
 def mesh_vertices(positions, faces) -> np.ndarray:
@@ -396,14 +474,15 @@ def mesh_vertices(positions, faces) -> np.ndarray:
 
 
 def texels(array: np.ndarray, width: int = TEXTURE_WIDTH) -> np.ndarray:
-    """(rows, width, 4) float32: the RGBA texels of `array` (..., 4) in order, row by row, the
-    last row padded with zeros; `width` (a power of two) to a row, or the smallest power of two
-    that holds them all if that is narrower."""
+    """(rows, width, 4): the RGBA texels of `array` (..., 4) in order, row by row, the last row
+    padded with zeros; `width` (a power of two) to a row, or the smallest power of two that
+    holds them all if that is narrower. float32, or uint32 for a uint32 array."""
     if width < 1 or width & (width - 1):
         raise ValueError(f"the texture width must be a power of two, got {width}")
-    flat = np.asarray(array, np.float32).reshape(-1, 4)
+    dtype = np.uint32 if np.asarray(array).dtype == np.uint32 else np.float32
+    flat = np.asarray(array, dtype).reshape(-1, 4)
     width = min(width, 1 << max(len(flat) - 1, 0).bit_length())
     rows = -(-len(flat) // width)
-    out = np.zeros((rows * width, 4), np.float32)
+    out = np.zeros((rows * width, 4), dtype)
     out[: len(flat)] = flat
     return out.reshape(rows, width, 4)

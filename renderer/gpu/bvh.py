@@ -6,14 +6,17 @@ walks (renderer/core/bvh.py's Walk)."""
 from __future__ import annotations
 
 import moderngl
+import numpy as np
 
 from renderer.core.bvh import Bvh, texels, walk_layout
 
 
 def texel_texture(ctx: moderngl.Context, array) -> moderngl.Texture:
-    """`array`'s rows of 4 floats (texels) as a nearest-filtered, unrepeated RGBA32F texture."""
+    """`array`'s rows of 4 floats (texels) as a nearest-filtered, unrepeated RGBA32F texture
+    (RGBA32UI for a uint32 array)."""
     data = texels(array)
-    texture = ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(), dtype="f4")
+    texture = ctx.texture((data.shape[1], data.shape[0]), 4, data.tobytes(),
+                          dtype="u4" if data.dtype == np.uint32 else "f4")
     texture.filter = (ctx.NEAREST, ctx.NEAREST)
     texture.repeat_x = texture.repeat_y = False
     return texture

@@ -6,7 +6,7 @@
 #include "raytrace/bvh.glsl"
 uniform sampler2D u_origins;
 uniform sampler2D u_directions;
-uniform sampler2D u_nodes;
+uniform usampler2D u_nodes;
 uniform sampler2D u_triangles;
 uniform float u_s_min;
 uniform float u_s_max;

@@ -396,3 +396,40 @@ def test_error_names_the_scene_file_and_key_when_given(tmp_path):
         load_mesh(path, source="room.toml", key="objects[3].mesh.file")
     assert info.value.line() == (f"room.toml: objects[3].mesh.file: {path}: vertex 2 is not "
                                  f"finite (0, nan, 0); 1 of 3 vertices are NaN or Inf")
+
+
+# --------------------------------------------------------------------------- trimesh's import
+# renderer/core/trimesh_import.py imports trimesh with scipy hidden (a fifth of a command's
+# start); what trimesh reads for us must not change, and scipy must still import after.
+
+TRIMESH_PROBE = r"""
+import hashlib, sys
+import numpy as np
+if sys.argv[1] == "scipy first":
+    import scipy.spatial
+from renderer.core.builtin import assets_dir
+from renderer.core.meshio import load_mesh
+from renderer.core.primitives import icosphere
+print("scipy" in sys.modules)
+digest = hashlib.sha256()
+for path in sorted((assets_dir() / "meshes").iterdir()):
+    if path.suffix in (".obj", ".ply", ".stl"):
+        mesh = load_mesh(path)
+        for array in (mesh.positions, mesh.normals, mesh.faces):
+            digest.update(np.ascontiguousarray(array).tobytes())
+ball = icosphere(subdivisions=3)
+digest.update(ball.positions.tobytes() + ball.faces.tobytes())
+import scipy.spatial
+print(scipy.spatial.cKDTree(np.zeros((2, 3))).n, digest.hexdigest())
+"""
+
+
+def test_trimesh_imports_without_scipy_and_reads_the_same():
+    import subprocess
+    import sys
+    runs = {order: subprocess.run([sys.executable, "-c", TRIMESH_PROBE, order], capture_output=True,
+                                  text=True, check=True).stdout.split()
+            for order in ("scipy first", "trimesh first")}
+    assert runs["trimesh first"][0] == "False"          # loading meshes did not import scipy
+    assert runs["scipy first"][0] == "True"
+    assert runs["trimesh first"][1:] == runs["scipy first"][1:] and runs["scipy first"][1] == "2"

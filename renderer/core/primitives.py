@@ -13,9 +13,9 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-import trimesh
 
 from renderer.core.scene import Mesh
+from renderer.core.trimesh_import import trimesh
 from renderer.core.uv_rules import plane_uv, sphere_uv, weld_corners
 
 

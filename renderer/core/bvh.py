@@ -182,8 +182,8 @@ def build_inputs(vertices, max_leaf_size: int):
     if 2 * len(vertices) >= MAX_EXACT_INDEX:
         raise ValueError(f"{len(vertices)} triangles: the float32 layout indexes at most "
                          f"{MAX_EXACT_INDEX // 2 - 1}")
-    v64 = vertices.astype(np.float64)
-    tri_min, tri_max = v64.min(1), v64.max(1)
+    # min and max in float32 and then widened: the same values as in float64 (both exact)
+    tri_min, tri_max = vertices.min(1).astype(np.float64), vertices.max(1).astype(np.float64)
     return vertices, tri_min, tri_max, (tri_min + tri_max) / 2
 
 

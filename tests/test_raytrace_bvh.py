@@ -285,6 +285,19 @@ def test_a_refit_moves_the_hand_written_boxes_with_the_triangles():
         refit(HAND, TWO[:1])
 
 
+def test_a_build_laid_out_on_other_positions_is_its_refit():
+    """build_bvh(v, layout=w): the tree built on v, its boxes and triangles w's, as
+    refit(build_bvh(v), w) (a scene's tree built in world space, traced relative to the eye)."""
+    v = soup(2000, 30)
+    w = (v * F32(1.5) + F32([40, -3, 7])).astype(F32)
+    laid, refitted = build_bvh(v, layout=w), refit(build_bvh(v), w)
+    assert laid.nodes.tolist() == refitted.nodes.tolist() and laid.depth == refitted.depth
+    assert laid.triangles.tolist() == refitted.triangles.tolist()
+    assert laid.nodes[:, :, 3].tolist() == build_bvh(v).nodes[:, :, 3].tolist()     # the same tree
+    with pytest.raises(ValueError, match="layout"):
+        build_bvh(v, layout=w[:10])
+
+
 def check_tight(bvh):
     """Every leaf's box is its triangles' bounds, every interior node's its children's union."""
     lo, hi, a, count = bvh.bounds_min, bvh.bounds_max, bvh.nodes[:, 0, 3], bvh.nodes[:, 1, 3]

@@ -218,10 +218,19 @@ def _split_nodes(perm, starts, counts, depth, centroids, low_high, bins) -> np.n
     return n_left
 
 
-def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) -> Bvh:
+def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS, *,
+              layout=None) -> Bvh:
     """The BVH of triangles `vertices` (T, 3, 3) (A, B, C of each; any float dtype; the layout
-    holds them as float32), T >= 1; or of a Mesh-like (positions, faces) via `mesh_vertices`."""
+    holds them as float32), T >= 1; or of a Mesh-like (positions, faces) via `mesh_vertices`.
+    `layout`: other positions of the same triangles (T, 3, 3) that the layout holds, its boxes
+    fitted to them: the tree built on `vertices`, laid out as refit(build_bvh(vertices), layout)
+    would give it, without building the boxes twice (a scene's tree is built in world space and
+    traced relative to the eye: renderer/core/raytrace_scene.py)."""
     vertices, tri_min, tri_max, centroids = build_inputs(vertices, max_leaf_size)
+    if layout is not None:
+        placed = np.asarray(layout, dtype=np.float32)
+        if placed.shape != vertices.shape or not np.isfinite(placed).all():
+            raise ValueError(f"layout must be finite and ({len(vertices)}, 3, 3), not {placed.shape}")
     T = len(vertices)
     perm = np.arange(T)                         # each node's triangles: a run of it
     low_high = np.concatenate([tri_min, -tri_max], axis=1)
@@ -246,6 +255,9 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS) ->
         depth += 1
     if depth >= MAX_DEPTH:
         raise ValueError(f"BVH depth {depth} exceeds the traversal stack ({MAX_DEPTH})")
+    if layout is not None:
+        vertices = placed
+        tri_min, tri_max = placed.min(1).astype(np.float64), placed.max(1).astype(np.float64)
     return Bvh(*_layout(perm, np.concatenate(start), np.concatenate(count), left_of,
                         vertices, tri_min, tri_max), depth)
 

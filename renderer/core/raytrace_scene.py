@@ -119,8 +119,10 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
     triangles = np.concatenate(tris) if tris else np.zeros((0, 3, 3))
     owners = np.concatenate(owner) if owner else np.zeros(0, np.int64)
     mesh_object = _tree_objects(scene, owners, motion)
-    if len(triangles) and tree is None:
-        tree = _build_trees(np.concatenate(world_tris), owners, mesh_object)
+    bvh = None
+    if len(triangles):
+        bvh = (refit(tree, triangles) if tree is not None
+               else _build_trees(np.concatenate(world_tris), triangles, owners, mesh_object))
     mats = [obj.material for obj in scene.objects]
 
     def rows(name, width=3):
@@ -137,7 +139,7 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         triangles=triangles,
         triangle_normals=np.concatenate(normals) if normals else np.zeros((0, 3, 3)),
         triangle_object=np.concatenate(owner) if owner else np.zeros(0, np.int64),
-        bvh=refit(tree, triangles) if len(triangles) else None,
+        bvh=bvh,
         ka=rows("ka"), kd=rows("kd"), ks=rows("ks"), n=rows("n", 1), kr=rows("kr"), kt=rows("kt"),
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
         gloss=np.array([m.gloss_exponent for m in mats], np.float64),
@@ -157,15 +159,17 @@ def _tree_objects(scene: Scene, owners: np.ndarray, motion: bool) -> np.ndarray:
     return np.array(static + moving, np.int64)
 
 
-def _build_trees(absolute: np.ndarray, owners: np.ndarray, mesh_object: np.ndarray) -> Bvh:
+def _build_trees(absolute: np.ndarray, placed: np.ndarray, owners: np.ndarray,
+                 mesh_object: np.ndarray) -> Bvh:
     """The BVH (a `forest` where some mesh moves) over world-space triangles, each tree built
-    relative to its triangles' bounds' centre (independent of the eye; refitted after)."""
+    relative to its triangles' bounds' centre (independent of the eye) and laid out over the
+    camera-relative triangles `placed` (the refit of that tree to them, in one go)."""
     trees = []
     for k in mesh_object:
         ids = np.flatnonzero(~np.isin(owners, mesh_object[mesh_object >= 0]) if k < 0 else owners == k)
         group = absolute[ids]
         centre = (group.min((0, 1)) + group.max((0, 1))) / 2
-        built = build_bvh(group - centre)
+        built = build_bvh(group - centre, layout=placed[ids])
         triangles = built.triangles.copy()
         triangles[:, 0, 3] = ids[built.original_index]           # the scene's numbering
         trees.append(Bvh(built.nodes, triangles, built.depth))

@@ -356,8 +356,11 @@ def image_format(path, alpha: bool = False) -> str:
     if not suffix:
         raise UserError(f"no suffix to say the image format; name the file e.g. {path.name}.png "
                         f"or {path.name}.jpg", file=str(path))
-    Image.init()
-    found = Image.registered_extensions().get(suffix)
+    Image.preinit()             # the common formats (PNG, JPEG, BMP, GIF, PPM): no more is
+    found = Image.EXTENSION.get(suffix)         # loaded for them (init() imports every plugin)
+    if found is None:
+        Image.init()
+        found = Image.registered_extensions().get(suffix)
     if found is None or not _pillow_writes(found, alpha=False):
         raise UserError(f"cannot write {suffix} images; use {SUGGESTED_SUFFIXES} or another suffix "
                         f"Pillow writes", file=str(path))

@@ -150,16 +150,25 @@ def main() -> None:
         return
     if args.base is None:
         parser.error("give the revision to compare against, e.g. HEAD~1")
-    args.scene = scene_path(args.scene)
+    compare(args, echo=True)
+
+
+def compare(args, echo: bool = False) -> dict:
+    """Frames of args.base and args.head (the options of `main`) interleaved: {"wall", "cpu":
+    {"a", "b", "a_min", "b_min", "ratio" (of the medians), "paired" (median of the rounds'
+    ratios)}, "identical", "renderer", "load"}; printed as it goes with `echo`."""
+    scene = scene_path(args.scene)
+    args = argparse.Namespace(**{**vars(args), "scene": scene})
     with tempfile.TemporaryDirectory() as a_dir, tempfile.TemporaryDirectory() as b_dir:
         names = (args.base, args.head)
         processes, infos = zip(*(start(export(r, Path(d)), args) for r, d in zip(names, (a_dir, b_dir))))
-        print(f"{platform.node()}: {os.cpu_count()} CPUs; {infos[0]['renderer']}; "
-              f"{time.strftime('%Y-%m-%d %H:%M')}; load average {load()}")
         what = (f"{args.spp} spp, max depth {args.max_depth}" if args.method == "raytrace"
                 else "rasterised")
-        print(f"{Path(args.scene).name} {args.size[0]}x{args.size[1]}, {what}, {args.context}; "
-              f"{args.rounds} rounds, frames interleaved")
+        if echo:
+            print(f"{platform.node()}: {os.cpu_count()} CPUs; {infos[0]['renderer']}; "
+                  f"{time.strftime('%Y-%m-%d %H:%M')}; load average {load()}")
+            print(f"{Path(args.scene).name} {args.size[0]}x{args.size[1]}, {what}, {args.context}; "
+                  f"{args.rounds} rounds, frames interleaved")
         times = ([], [])
         for k in range(args.rounds):
             for i in ((0, 1) if k % 2 == 0 else (1, 0)):
@@ -167,14 +176,21 @@ def main() -> None:
         for process in processes:
             process.stdin.close()
             process.wait()
+    result = {"identical": infos[0]["rgba8"] == infos[1]["rgba8"], "renderer": infos[0]["renderer"],
+              "load": load()}
     for column, what in enumerate(("wall", "CPU")):
         t_a, t_b = ([t[column] for t in ts] for ts in times)
         a, b = statistics.median(t_a), statistics.median(t_b)
         paired = statistics.median(x / y for x, y in zip(t_a, t_b))
-        print(f"  {what:4} A {a:7.1f} ms (min {min(t_a):6.1f})  B {b:7.1f} ms (min {min(t_b):6.1f})  "
-              f"A/B {a / b:.3f} (medians), {paired:.3f} (paired rounds)")
-    print(f"  A = {names[0]}, B = {names[1]}; identical rgba8: {infos[0]['rgba8'] == infos[1]['rgba8']}; "
-          f"load average {load()}")
+        result[what.lower()] = {"a": round(a, 2), "b": round(b, 2), "a_min": round(min(t_a), 2),
+                                "b_min": round(min(t_b), 2), "ratio": round(a / b, 3), "paired": round(paired, 3)}
+        if echo:
+            print(f"  {what:4} A {a:7.1f} ms (min {min(t_a):6.1f})  B {b:7.1f} ms (min {min(t_b):6.1f})  "
+                  f"A/B {a / b:.3f} (medians), {paired:.3f} (paired rounds)")
+    if echo:
+        print(f"  A = {names[0]}, B = {names[1]}; identical rgba8: {result['identical']}; "
+              f"load average {result['load']}")
+    return result
 
 
 if __name__ == "__main__":

@@ -5,10 +5,11 @@
 
 --builds: the build alone (issue 32) on generated meshes of about 5k, 131k and 1M triangles
 (the torus knot of tools/make_meshes.py at three resolutions, an icosphere, a randomly
-perturbed grid): median seconds of 3 builds (1 above 500k triangles), nodes, depth and the
+perturbed grid): median seconds of 3 builds (5 above 500k triangles), nodes, depth and the
 tree's SAH cost (traversal and intersection cost 1: the sum over nodes of their area over the
 root's, a leaf's times its triangles); --recursive times the node-at-a-time build it replaced
-(tests/bvh_recursive.py) beside it, up to 131k triangles, and says whether the trees agree.
+(tests/bvh_recursive.py) beside it, once (a minute or more at a million triangles), with its
+SAH cost and whether the trees agree. Written to benchmarks/results/bvh.json and .md.
 
 Builds the BVH of icosphere(subdivisions=5) (renderer/core/bvh.py) and times the closest hit of
 seeded random rays (a third from inside the sphere, a third aimed at it, a third anywhere):
@@ -35,6 +36,8 @@ from renderer.core.primitives import icosphere
 from renderer.gpu.bvh import bvh_textures
 from renderer.gpu.context import make_context
 from renderer.gpu.shaders import shader_source
+
+from common import machine, write_results                         # benchmarks/common.py
 
 GLSL = Path(__file__).resolve().parent.parent / "tests" / "glsl"
 F32 = np.float32
@@ -122,22 +125,52 @@ def build_meshes():
 
 
 def builds(recursive: bool) -> None:
+    """The builds' table, printed; written to benchmarks/results/bvh.json and .md."""
     if recursive:
         import sys
         sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
         from bvh_recursive import build_bvh_recursive
+    print(machine())
     print(f"{'mesh':24} {'triangles':>10} {'build s':>8} {'nodes':>8} {'depth':>5} {'SAH cost':>9}"
-          + (f" {'recursive s':>11} {'same tree':>9}" if recursive else ""))
+          + (f" {'recursive s':>11} {'its SAH':>8} {'same tree':>9}" if recursive else ""))
+    rows = []
     for name, V in build_meshes():
-        seconds, bvh = timed(lambda: build_bvh(V), 1 if len(V) > 500_000 else 3)
+        repeats = 3 if len(V) < 500_000 else 5
+        seconds, bvh = timed(lambda: build_bvh(V), repeats)
+        row = {"mesh": name, "triangles": len(V), "build_s": round(seconds, 3), "repeats": repeats,
+               "nodes": len(bvh.nodes), "depth": bvh.depth, "sah": round(sah_cost(bvh), 2)}
         line = (f"{name:24} {len(V):>10,} {seconds:>8.2f} {len(bvh.nodes):>8,} {bvh.depth:>5} "
                 f"{sah_cost(bvh):>9.1f}")
-        if recursive and len(V) <= 140_000:
+        if recursive:
             old_seconds, old = timed(lambda: build_bvh_recursive(V), 1)
             same = ((old.nodes + 0.0).tobytes() == (bvh.nodes + 0.0).tobytes()
                     and old.triangles.tobytes() == bvh.triangles.tobytes())
-            line += f" {old_seconds:>11.2f} {str(same):>9}"
+            row.update(recursive_s=round(old_seconds, 2), recursive_sah=round(sah_cost(old), 2), same_tree=same)
+            line += f" {old_seconds:>11.2f} {sah_cost(old):>8.1f} {str(same):>9}"
+        rows.append(row)
         print(line, flush=True)
+    print(f"wrote {write_results('bvh', {'rows': rows, 'recursive': recursive}, markdown)}")
+
+
+def markdown(document: dict) -> str:
+    """docs/ray-tracing.md's table of BVH builds, from a results document (write_results)."""
+    figures = document["figures"]
+    recursive = figures["recursive"]
+    lines = ["The build alone (renderer/core/bvh.py `build_bvh`), median of the runs shown; SAH cost: the "
+             "sum over nodes of their surface area over the root's, a leaf's times its triangles"
+             + ("; beside it the node-at-a-time build it replaced (tests/bvh_recursive.py), one run." if recursive
+                else "."), "",
+             "| mesh | triangles | build | runs | nodes | depth | SAH cost |"
+             + (" node at a time | its SAH cost | same tree |" if recursive else ""),
+             "| --- | ---: | ---: | ---: | ---: | ---: | ---: |" + (" ---: | ---: | --- |" if recursive else "")]
+    for row in figures["rows"]:
+        line = (f"| {row['mesh']} | {row['triangles']:,} | {row['build_s']:.2f} s | {row['repeats']} | "
+                f"{row['nodes']:,} | {row['depth']} | {row['sah']:.1f} |")
+        if recursive:
+            line += (f" {row['recursive_s']:.1f} s | {row['recursive_sah']:.1f} | "
+                     f"{'yes' if row['same_tree'] else 'no'} |")
+        lines.append(line)
+    return "\n".join(lines) + "\n"
 
 
 def main() -> None:

@@ -7,7 +7,8 @@ Scenes: the built-in scenes made for the ray tracer (classic: a floor plane, a d
 mirror and a glass sphere, two lights; cornell_box: five planes, a mirror and a glass sphere,
 a point light; mesh_shadow: the 5,040-triangle torus knot over a plane; tir_bubble: a glass
 sphere and an air bubble before a 256-triangle checkerboard), the built-in `sphere` (3,968
-triangles) and a 20,480-triangle icosphere (subdivisions 5) lit as `sphere`, built here.
+triangles), a 20,480-triangle icosphere (subdivisions 5) lit as `sphere`, built here, and
+issue 32's knot: mesh_shadow with a 131,072-triangle knot (benchmarks/knot_scene.py).
 For each at 1 and 16 samples per pixel (--spp; regular pattern, max depth 4):
 - GPU (renderer/gpu/raytracer.py): the median of --frames frames after a warm-up frame,
   RayTracer.render() (the draw and the read-back);
@@ -30,6 +31,7 @@ from __future__ import annotations
 
 import argparse
 import statistics
+import tempfile
 import time
 
 import numpy as np
@@ -43,9 +45,11 @@ from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
 
 from common import alternating_ms, machine, measured_line, write_results       # benchmarks/common.py
+from knot_scene import knot_toml                                                 # benchmarks/knot_scene.py
 
 RAYTRACE_SCENES = ("classic", "cornell_box", "mesh_shadow", "tir_bubble")
 ICOSPHERE = "icosphere (20,480 tri)"
+KNOT = "knot (131,072 tri)"
 TARGET_MS = 100          # issue 14: `classic` at 640x480, 1 spp, within 100 ms a frame on the GPU path
 REFERENCE_LIMIT = 50     # issue 14: the reference within 50 times the GPU path's time
 
@@ -102,7 +106,7 @@ def main() -> None:
     parser.add_argument("--spp", type=lambda text: [int(n) for n in text.split(",")], default=[1, 16],
                         help="sample counts, comma-separated (each a perfect square)")
     parser.add_argument("--scenes", type=lambda text: text.split(","), default=None,
-                        help=f"comma-separated names among {', '.join(RAYTRACE_SCENES)}, sphere, icosphere")
+                        help=f"comma-separated names among {', '.join(RAYTRACE_SCENES)}, sphere, icosphere, knot")
     parser.add_argument("--context", choices=("egl", "osmesa"), default="egl")
     args = parser.parse_args()
     W, H = args.size
@@ -111,6 +115,8 @@ def main() -> None:
     scenes = {name: load_scene(name) for name in RAYTRACE_SCENES}
     scenes["sphere (3,968 tri)"] = load_scene("sphere")
     scenes[ICOSPHERE] = icosphere_scene()
+    knot_folder = tempfile.TemporaryDirectory()
+    scenes[KNOT] = load_scene(knot_toml(knot_folder.name))
     if args.scenes:
         scenes = {name: scene for name, scene in scenes.items() if name.split()[0] in args.scenes}
     print(f"{W}x{H}, max depth 4, regular samples; GPU: median of {args.frames} frames after a "
@@ -172,13 +178,14 @@ def main() -> None:
             figures["raster"].append({"scene": name, "raster_ms": round(r, 2), "raytrace_ms": round(t, 1)})
     print(f"\n{machine()}")
     ctx.release()
+    knot_folder.cleanup()
     print(f"wrote {write_results('raytrace', figures, markdown)}")
 
 
 def scene_label(name: str) -> str:
     """`classic`, `sphere` (3,968 tri), icosphere (20,480 tri): a built-in scene's name as code."""
     first, _, rest = name.partition(" ")
-    label = first if name == ICOSPHERE else f"`{first}`"
+    label = first if name in (ICOSPHERE, KNOT) else f"`{first}`"
     return f"{label} {rest}".strip()
 
 

@@ -85,6 +85,30 @@ def write_results(name: str, figures, markdown) -> str:
     return path
 
 
+README = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "README.md")
+
+
+def readme_block(text: str, name: str) -> tuple[int, int]:
+    """(start, end) of the README's block for results file `name`: the text between the lines
+    `<!-- results: NAME -->` and `<!-- /results -->` (the README is read on GitHub, which
+    includes no file: the block is the results file's .md, copied in by `fill_readme_block`;
+    tests/test_docs_figures.py holds the two equal)."""
+    opening = f"<!-- results: {name} -->\n"
+    start = text.index(opening) + len(opening)
+    return start, text.index("<!-- /results -->", start)
+
+
+def fill_readme_block(name: str) -> None:
+    """Copy benchmarks/results/NAME.md into the README's block for it (readme_block)."""
+    with open(README) as source:
+        text = source.read()
+    with open(os.path.join(RESULTS, f"{name}.md")) as source:
+        made = source.read()
+    start, end = readme_block(text, name)
+    with open(README, "w") as out:
+        out.write(text[:start] + made + text[end:])
+
+
 def measured_line(document: dict) -> str:
     """"Measured on vm (2 CPUs, load average 1.3), 2026-12-03 18:50 UTC, at 3c62807. Reproduce:
     `...`." for a results document."""

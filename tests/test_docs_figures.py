@@ -48,6 +48,18 @@ def test_each_page_fragment_is_made_from_its_results_file(path):
     assert path.with_suffix(".md").read_text() == made, f"{path.with_suffix('.md').name} was edited by hand"
 
 
+README_BLOCK = re.compile(r"<!-- results: (\S+) -->\n(.*?)<!-- /results -->", re.S)
+
+
+def test_each_readme_block_is_its_results_file():
+    """The README (read on GitHub, which includes no file) holds a results file's .md between
+    `<!-- results: NAME -->` and `<!-- /results -->`, copied in by the benchmark
+    (benchmarks/common.py fill_readme_block): the two must be equal."""
+    blocks = README_BLOCK.findall((ROOT / "README.md").read_text())
+    assert blocks
+    assert [name for name, text in blocks if text != (RESULTS / f"{name}.md").read_text()] == []
+
+
 def test_every_results_file_a_page_includes_exists():
     included = []
     for page in (ROOT / "docs").rglob("*.md"):
@@ -88,11 +100,12 @@ NOT_MEASURED = {
 
 def prose(markdown: str) -> str:
     """What a page states in its own words: without code blocks, code spans (commands, output
-    shown), HTML comments and included files (a results file's fragment is measured). Lines
-    keep their numbers."""
+    shown), HTML comments, included files and the README's copies of them (a results file's
+    fragment is measured). Lines keep their numbers."""
     def blank(match):
         return "\n" * match.group(0).count("\n")
     markdown = re.sub(r"^```.*?^```", blank, markdown, flags=re.S | re.M)
+    markdown = README_BLOCK.sub(blank, markdown)
     markdown = re.sub(r"<!--.*?-->", blank, markdown, flags=re.S)
     return re.sub(r"`[^`\n]*`", "", markdown)
 
@@ -129,6 +142,7 @@ def test_the_check_sees_a_typed_figure():
             "times a Bayer pass, and the run 1–2.4 s and 630 MiB.\n"
             "At 320×240 with 16 samples, `renderer render --size 32x24` prints `wrote x (3 ms)`.\n"
             "```{include} ../benchmarks/results/memory.md\n```\n<!-- 5 ms -->\n"
-            "```sh\ntime renderer report  # 29 s\n```\n")
+            "```sh\ntime renderer report  # 29 s\n```\n"
+            "<!-- results: knot -->\n| the frame | 7.5 ms |\n<!-- /results -->\n")
     assert typed_figures(page) == [(1, "12.4 ms"), (1, "3.2×"), (1, "25 to 40 times a"),
                                    (1, "1–2.4 s"), (1, "630 MiB")]

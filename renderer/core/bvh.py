@@ -1,6 +1,7 @@
 """A bounding volume hierarchy over a triangle list, built once per scene on the CPU (binned
-surface area heuristic, NumPy) and laid out flat, so that the GLSL (glsl/raytrace/bvh.glsl) and
-its NumPy twin (reference/raytrace/bvh.py) traverse the very same arrays.
+surface area heuristic, NumPy) and laid out flat: the NumPy twin (reference/raytrace/bvh.py)
+traverses these arrays, and the GLSL (glsl/raytrace/bvh.glsl) the very same tree laid out four
+boxes a step (`walk_layout`, `Walk`).
 
 The layout (every number float32; the integers in it are exact, being below 2^24):
 
@@ -357,9 +358,6 @@ def roots(bvh: Bvh) -> np.ndarray:
     return np.flatnonzero(~child)
 
 
-WALK_WIDTH = 4                  # children a step of the GLSL's walk tests together
-
-
 @dataclass(frozen=True)
 class Walk:
     """A BVH (or forest) laid out for the GLSL's walk (glsl/raytrace/bvh.glsl): the same tree,
@@ -376,7 +374,7 @@ class Walk:
                  the k-th even-depth interior node in pre-order, its up to four children in
                  the tree's left-to-right order:
                    texel 0  [origin.xyz, exponents]: the children's boxes are origin +
-                            q 2^e on each axis, e - QUANT_BIAS the byte (x, y, z: bits 0, 8, 16)
+                            q 2^e on each axis, the byte e + QUANT_BIAS (x, y, z: bits 0, 8, 16)
                    texel 1  [lo.x, lo.y, lo.z, hi.x]  each four bytes: child c's q in byte c
                    texel 2  [hi.y, hi.z, ref 0, ref 1]
                    texel 3  [ref 2, ref 3, 0, 0]

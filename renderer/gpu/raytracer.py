@@ -211,7 +211,7 @@ class RayTracer(ContextRenderer):
                 triangles, normals, owner = np.zeros((1, 3, 3)), np.zeros((1, 3, 3)), np.zeros(1)
             walk = walk_layout(bvh)
             arrays["u_nodes"], arrays["u_triangles"] = walk.entries, walk.triangles
-            data = np.zeros((len(triangles), 6, 4))
+            data = np.zeros((len(triangles), 6, 4), np.float32)     # the texture's type: no copy
             data[:, :3, :3] = triangles
             data[:, 3:, :3] = normals
             data[:, 3, 3] = owner

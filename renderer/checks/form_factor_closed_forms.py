@@ -9,6 +9,9 @@ its length. Reciprocity: A_i F_ij = A_j F_ji. The two closed forms are configura
 C-14 of J. R. Howell, "A Catalog of Radiation Heat Transfer Configuration Factors" (3rd ed.,
 the catalogue behind Siegel and Howell's "Thermal Radiation Heat Transfer"):
 
+    element_to_rectangle(a, b, c)        B-3: from a differential element to a parallel a × b
+                                         rectangle c away, one corner on the element's normal
+                                         (what one hemicube measures)
     parallel_rectangles(a, b, c)         C-11: two directly opposed parallel a × b rectangles
                                          a distance c apart
     perpendicular_rectangles(l, w, h)    C-14: from an l × w rectangle to an l × h one at right
@@ -25,6 +28,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
+
+
+def element_to_rectangle(a: float, b: float, c: float) -> float:
+    """B-3: F from a differential element to a parallel a × b rectangle c away whose corner is
+    on the element's normal. With A = a / c, B = b / c:
+    F = 1 / (2π) [A / √(1 + A²) atan(B / √(1 + A²)) + B / √(1 + B²) atan(A / √(1 + B²))]."""
+    if not (a > 0 and b > 0 and c > 0):
+        raise ValueError(f"the sides and the distance must be positive, got {a}, {b}, {c}")
+    A, B = a / c, b / c
+    a1, b1 = math.sqrt(1 + A * A), math.sqrt(1 + B * B)
+    return (A / a1 * math.atan(B / a1) + B / b1 * math.atan(A / b1)) / (2 * math.pi)
 
 
 def parallel_rectangles(a: float, b: float, c: float) -> float:

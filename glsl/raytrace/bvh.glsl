@@ -21,14 +21,18 @@
 // Traversal", JCGT 2013) so that rounding does not lose a triangle on a box's face.
 const float BVH_BOX_FAR_SCALE = 1.00000036;
 
-// Texel k (>= 0) of a texture in that layout. The width is a power of two, so k % width and
+// Where texel k (>= 0) of a texture in that layout is, and the texel (bvh_texel; bvh_entry
+// for the integer texture of entries). The width is a power of two, so k % width and
 // k / width are a mask and a shift (llvmpipe has no vector integer division: it would divide
 // lane by lane, twice per fetch); log2(width) is the exponent of float(width), exact for a
 // power of two (GLSL 3.30 has no findLSB).
-vec4 bvh_texel(sampler2D texture_, int k) {
-    int width = textureSize(texture_, 0).x;
+ivec2 bvh_address(int width, int k) {
     int log2_width = (floatBitsToInt(float(width)) >> 23) - 127;
-    return texelFetch(texture_, ivec2(k & (width - 1), k >> log2_width), 0);
+    return ivec2(k & (width - 1), k >> log2_width);
+}
+
+vec4 bvh_texel(sampler2D texture_, int k) {
+    return texelFetch(texture_, bvh_address(textureSize(texture_, 0).x, k), 0);
 }
 
 // Slab test with inv_D = 1 / D (IEEE: +-inf where D's component is 0). An axis with infinite
@@ -55,11 +59,9 @@ const int BVH_EMPTY = int(0x80000000u);
 // The walk's stack: a step pushes up to three children, and a 4-wide tree is half as deep.
 #define BVH_WALK_STACK (3 * (BVH_STACK_SIZE / 2) + 3)
 
-// Texel k of the entries (RGBA32UI: bvh_texel's addressing).
+// Texel k of the entries (RGBA32UI, addressed as bvh_texel).
 uvec4 bvh_entry(usampler2D entries, int k) {
-    int width = textureSize(entries, 0).x;
-    int log2_width = (floatBitsToInt(float(width)) >> 23) - 127;
-    return texelFetch(entries, ivec2(k & (width - 1), k >> log2_width), 0);
+    return texelFetch(entries, bvh_address(textureSize(entries, 0).x, k), 0);
 }
 
 // The four bytes of a word, as floats (child c's in component c).
@@ -225,7 +227,6 @@ bool bvh_any_hit(usampler2D entries, sampler2D triangles, int root, vec3 O, vec3
     if (!bvh_meets_root(entries, root, O, inv_D, s_min, s_max, ref)) return false;
     bool hit = false;
     while (true) {
-        bool descend = false;
         if (ref < 0) {
             float s = s_max;                        // stays: the first hit ends the walk
             vec2 uv;
@@ -246,7 +247,6 @@ bool bvh_any_hit(usampler2D entries, sampler2D triangles, int root, vec3 O, vec3
             if (met.z) { stack[top] = child.z; ++top; }
             if (met.y) { stack[top] = child.y; ++top; }
             if (met.x) { stack[top] = child.x; ++top; }
-            descend = top > 0;
         }
         if (hit) break;
         if (top == 0) break;

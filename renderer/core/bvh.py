@@ -183,9 +183,14 @@ def build_inputs(vertices, max_leaf_size: int):
     if 2 * len(vertices) >= MAX_EXACT_INDEX:
         raise ValueError(f"{len(vertices)} triangles: the float32 layout indexes at most "
                          f"{MAX_EXACT_INDEX // 2 - 1}")
-    # min and max in float32 and then widened: the same values as in float64 (both exact)
-    tri_min, tri_max = vertices.min(1).astype(np.float64), vertices.max(1).astype(np.float64)
+    tri_min, tri_max = _corners(vertices)
     return vertices, tri_min, tri_max, (tri_min + tri_max) / 2
+
+
+def _corners(vertices: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each float32 triangle's min and max corner as float64: taken in float32 and then
+    widened, the same values as in float64 (both exact), a third of the conversion."""
+    return vertices.min(1).astype(np.float64), vertices.max(1).astype(np.float64)
 
 
 def _groups(counts: np.ndarray) -> list[slice]:
@@ -258,7 +263,7 @@ def build_bvh(vertices, max_leaf_size: int = MAX_LEAF_SIZE, bins: int = BINS, *,
         raise ValueError(f"BVH depth {depth} exceeds the traversal stack ({MAX_DEPTH})")
     if layout is not None:
         vertices = placed
-        tri_min, tri_max = placed.min(1).astype(np.float64), placed.max(1).astype(np.float64)
+        tri_min, tri_max = _corners(placed)
     return Bvh(*_layout(perm, np.concatenate(start), np.concatenate(count), left_of,
                         vertices, tri_min, tri_max), depth)
 

@@ -15,7 +15,8 @@ says why the module is shared, or which check that does not share it catches its
 - computations held against a check that does not share them: `shadows.py`,
   `shadow_settings.py` and `facets.py` (ray-cast shadow truth), `visibility.py` (the frame
   without culling), `drawn.py` (depth against ray casts), `camera_rays.py` and
-  `raytrace_scene.py` (the rasteriser against the ray tracer).
+  `raytrace_scene.py` (the rasteriser against the ray tracer) and `hemicube.py` (Howell's
+  closed forms).
 """
 
 from reference.pipeline import render

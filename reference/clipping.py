@@ -67,13 +67,16 @@ def is_inside_plane(distance: np.ndarray) -> np.ndarray:
 
 
 def intersect_edge(inside_vertex, outside_vertex, d_inside, d_outside):
-    """The point where an edge crosses the plane, interpolated from its inside end.
+    """The point where an edge crosses the plane, interpolated from its outside end as
+    llvmpipe's clipper does it (draw_pipe_clip.c: t = d_out / (d_out - d_in), then
+    out + t (in - out), each operation rounded in the vertices' dtype), so that in float32
+    the new vertex is GL's bit for bit.
 
-    Always starting from the inside vertex makes the new vertex the same whichever
-    triangle of a shared edge is clipped, so neighbours stay watertight.
+    Always starting from the same end makes the new vertex the same whichever triangle of a
+    shared edge is clipped, so neighbours stay watertight.
     """
-    t = (d_inside / (d_inside - d_outside))[..., None]
-    return inside_vertex + t * (outside_vertex - inside_vertex)
+    t = (d_outside / (d_outside - d_inside))[..., None]
+    return outside_vertex + t * (inside_vertex - outside_vertex)
 
 
 def clip_polygons_against_plane(vertices: np.ndarray, count: np.ndarray, plane: tuple):

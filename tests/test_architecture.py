@@ -92,6 +92,8 @@ REFERENCE_SHARES = {
              "plane, renderer/checks/depth_truth.py (tests/test_depth_truth.py)",
     "camera_rays": "the ray tracer's primary rays from P V; the rasteriser, which does not read them, "
                    "against the ray tracer in tests/test_raytrace_trace.py and renderer/checks/methods.py",
+    "hemicube": "radiosity's hemicube faces, their matrices and delta form factors; by hand and against "
+                "Howell's closed forms (renderer/checks/form_factor_closed_forms.py) in tests/test_hemicube.py",
     "raytrace_scene": "the ray tracer's scene and BVH; the BVH against brute force in tests/test_raytrace_bvh.py, "
                       "the rasteriser against the ray tracer in tests/test_raytrace_trace.py",
 }

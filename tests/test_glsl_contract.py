@@ -893,11 +893,58 @@ def test_a_renamed_output_uniform_is_caught():
                                         "reference/output/"))
 
 
+# -- radiosity's item buffers: glsl/radiosity/ against renderer/gpu/item_buffers.py, reference/radiosity/
+
+RADIOSITY_FILES = tuple(sorted(path.relative_to(glsl_dir()).as_posix()
+                               for path in (glsl_dir() / "radiosity").iterdir()))
+# What the twin (reference/radiosity/) reads for each uniform.
+RADIOSITY_TWIN_NAMES = {"u_clip_from_world": ("clip_from_world",), "u_horizon": ("horizon",)}
+
+
+def radiosity_uploads(ctx) -> set[str]:
+    """Every uniform name ItemBuffers sets on its program while drawing a hemicube."""
+    from renderer.core.radiosity_elements import Elements
+    from renderer.gpu.item_buffers import ItemBuffers
+    names = set()
+    getitem = moderngl.Program.__getitem__
+
+    def recording_getitem(self, key):
+        names.add(key)
+        return getitem(self, key)
+
+    corners = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1], [0, 1, 1], [1, 0, 1]]], float)
+    elements = Elements(corners, np.zeros(2, np.int64), np.full((2, 3), 0.5), np.zeros((2, 3)))
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(moderngl.Program, "__getitem__", recording_getitem)
+        buffers = ItemBuffers(ctx, elements, 4)
+        try:
+            buffers.draw([0])
+        finally:
+            buffers.release()
+    return names
+
+
+def test_every_item_buffer_uniform_is_uploaded_and_every_upload_declared(gl_contexts):
+    parsed = parse(read_glsl(RADIOSITY_FILES))
+    uploaded = radiosity_uploads(gl_contexts["egl"])
+    problems = uniforms_not_uploaded(parsed, uploaded, "renderer/gpu/item_buffers.py", "it sets")
+    problems += uploads_not_declared(parsed, uploaded, "renderer/gpu/item_buffers.py", "glsl/radiosity/")
+    assert not problems, report(problems)
+
+
+def test_the_item_buffer_uniforms_are_names_its_twin_reads():
+    problems = uniforms_the_twin_does_not_read(parse(read_glsl(RADIOSITY_FILES)), set(),
+                                               RADIOSITY_TWIN_NAMES, twin_text("radiosity"),
+                                               "reference/radiosity/")
+    assert not problems, report(problems)
+
+
 # -- coverage ------------------------------------------------------------------------------------
 
 def test_every_twinned_glsl_file_is_held_here():
     """Each file of glsl/ whose first line names its twin is one this test reads."""
-    read = {*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *RAYTRACE_FILES, *OUTPUT_FILES}
+    read = {*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *RAYTRACE_FILES, *OUTPUT_FILES,
+            *RADIOSITY_FILES}
     twinned = {path.relative_to(glsl_dir()).as_posix() for path in glsl_dir().rglob("*")
                if path.is_file() and path.read_text(encoding="utf-8").startswith("// Twin:")}
     assert twinned <= read, f"not read by tests/test_glsl_contract.py: {sorted(twinned - read)}"

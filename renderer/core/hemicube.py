@@ -30,6 +30,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.core.gl_rules import REVERSED_Z_DEPTH
+from renderer.core.transforms import perspective
+
+
+# An item buffer's pixel: 0 where nothing is seen, else the element's index + 1, with this bit
+# set where the hemicube sees the element's back (glsl/radiosity/item_buffer.frag).
+ITEM_BACK_SHIFT = 31
+ITEM_BACK_BIT = 1 << ITEM_BACK_SHIFT
+ITEM_INDEX_MASK = ITEM_BACK_BIT - 1
+
 
 @dataclass(frozen=True)
 class Face:
@@ -77,3 +87,62 @@ def delta_form_factors(face: Face, resolution: int) -> np.ndarray:
     r2 = (p * p).sum(-1)                            # x² + y² + 1 on top, 1 + y² + z² on a side
     return p[..., 2] * area / (np.pi * r2 * r2)     # cos at the element (z / r) × cos at the
                                                     # pixel (1 / r) / (π r²): z / (π r⁴)
+
+
+def weights(resolution: int) -> np.ndarray:
+    """(5, N, N) float64: the delta form factors of the five faces in FACES' order, each drawn
+    as a full N x N image (a side face's image is the whole 90-degree view; its upper N / 2 rows
+    are the face, the lower half, below the element's plane, weighs 0), scaled so that the
+    whole hemicube sums to exactly 1. The scale (1 / (1 + ~0.542 / N^2)) is within the
+    midpoint rule's own error; it makes a closed room's rows of form factors sum to 1, so that
+    energy is conserved exactly and a white furnace gives E / (1 - rho) to rounding."""
+    n = _check(resolution)
+    table = np.zeros((len(FACES), n, n))
+    for k, face in enumerate(FACES):
+        rows, _ = face_shape(face, n)
+        table[k, :rows] = delta_form_factors(face, n)
+    return table / table.sum()
+
+
+def face_views(frames: np.ndarray, centres: np.ndarray, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """(E, 5, 4, 4) float64: for each element (its frame's rows u, v, n in world coordinates and
+    its centre) the view matrix of each face of FACES: the camera at the centre looking along
+    the face's forward with its up at the top (transforms.look_at's convention: forward to -z,
+    up to +y), of points given relative to `origin` (as the GPU's float32 positions are)."""
+    frames = np.asarray(frames, np.float64)
+    forward = np.array([f.forward for f in FACES], np.float64) @ frames          # (E, 5, 3)
+    up = np.array([f.up for f in FACES], np.float64) @ frames
+    right = np.cross(forward, up)
+    rotation = np.stack([right, up, -forward], axis=-2)                          # (E, 5, 3, 3)
+    eye = np.asarray(centres, np.float64) - np.asarray(origin, np.float64)
+    views = np.zeros(rotation.shape[:2] + (4, 4))
+    views[..., :3, :3] = rotation
+    views[..., :3, 3] = -np.einsum("efij,ej->efi", rotation, eye)
+    views[..., 3, 3] = 1.0
+    return views
+
+
+def projection(near: float, far: float) -> np.ndarray:
+    """(4, 4): every face's projection, a 90-degree square frustum (transforms.perspective):
+    the face's N x N image spans [-1, 1]^2 at distance 1. Depth is reversed-Z (DEPTH_MAPPING),
+    whose float32 window depth keeps about 1e-7 of relative precision at every distance, so
+    that `near` can be a small fraction of the smallest element (`depth_range`)."""
+    return perspective(np.pi / 2, 1.0, near, far, reversed_z=True)
+
+
+DEPTH_MAPPING = REVERSED_Z_DEPTH
+# The near plane as a fraction of the shortest element edge: what lies nearer the hemicube's
+# centre than that is not seen (a neighbour's sliver, about this fraction of its form factor).
+NEAR_FRACTION = 1e-3
+
+
+def depth_range(shortest_edge: float, diameter: float) -> tuple[float, float]:
+    """(near, far) of every hemicube of elements whose shortest edge and whose bounding box's
+    diagonal are given: near NEAR_FRACTION of that edge, far beyond every element."""
+    return NEAR_FRACTION * shortest_edge, 2.0 * diameter + shortest_edge
+
+
+def clip_from_world(frames, centres, origin, near: float, far: float) -> np.ndarray:
+    """(E, 5, 4, 4) float64: projection @ face_views, each face's matrix from positions
+    relative to `origin` to its clip coordinates."""
+    return projection(near, far) @ face_views(frames, centres, origin)

@@ -31,6 +31,7 @@ import numpy as np
 
 from renderer.core.bvh import MAX_DEPTH as BVH_MAX_DEPTH
 from renderer.core.facets import CREASE_CAP, FACES_PER_ROW
+from renderer.core.hemicube import ITEM_BACK_SHIFT
 from renderer.core.resources import glsl_dir
 from renderer.core.shadow_settings import MAX_SLOPE, SQRT2, shared_kernel
 from renderer.core.textures import MODULATED
@@ -53,6 +54,7 @@ FILE_CONSTANTS: dict[str, dict[str, object]] = {
     "shadow/lookup.glsl": {"SHADOW_MAX_SLOPE": MAX_SLOPE, "SHADOW_SQRT2": SQRT2,
                            "SHADOW_CREASE_CAP": CREASE_CAP},
     "raytrace/bvh.glsl": {"BVH_STACK_SIZE": BVH_MAX_DEPTH},    # the builder keeps the depth below
+    "radiosity/item_buffer.frag": {"ITEM_BACK_SHIFT": ITEM_BACK_SHIFT},   # a back face's bit
 }
 
 

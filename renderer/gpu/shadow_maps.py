@@ -26,7 +26,6 @@ matrix, composed in float64 once per set_plan(), so that a frame only uploads by
 
 from __future__ import annotations
 
-import ctypes
 
 import moderngl
 import numpy as np
@@ -34,17 +33,12 @@ import numpy as np
 from renderer.core.gl_rules import STANDARD_DEPTH
 from renderer.core.shadows import SHADOW_KINDS, ShadowLayout, ShadowPlan
 from renderer.core.transforms import to_glsl
-from renderer.errors import ContextError
-from renderer.gpu.context import gl_function
+from renderer.gpu.array_textures import (ArrayTextureGL, delete_framebuffers, layer_framebuffers,
+                                         make_depth_layers)
 from renderer.gpu.polygon_buffers import PolygonBuffers
 from renderer.gpu.shaders import shader_source
 from renderer.gpu.uniforms import SHADOW_MAPS_UNITS
 
-GL_TEXTURE_2D_ARRAY = 0x8C1A
-GL_DEPTH_COMPONENT = 0x1902
-GL_DEPTH_COMPONENT32F = 0x8CAC
-GL_FLOAT = 0x1406
-GL_TEXTURE_INTERNAL_FORMAT = 0x1003
 GL_TEXTURE_PARAMETERS = {               # name -> value, as the lookup needs them
     0x2801: 0x2601,                     # MIN_FILTER: LINEAR (one level, no mipmaps)
     0x2800: 0x2601,                     # MAG_FILTER: LINEAR
@@ -54,79 +48,6 @@ GL_TEXTURE_PARAMETERS = {               # name -> value, as the lookup needs the
     0x884C: 0x884E,                     # COMPARE_MODE: COMPARE_REF_TO_TEXTURE
     0x884D: 0x0203,                     # COMPARE_FUNC: LEQUAL
 }
-GL_FRAMEBUFFER = 0x8D40
-GL_FRAMEBUFFER_BINDING = 0x8CA6
-GL_DEPTH_ATTACHMENT = 0x8D00
-GL_FRAMEBUFFER_COMPLETE = 0x8CD5
-GL_NONE = 0
-
-
-class _GL:
-    """The GL entry points moderngl does not wrap for depth array textures."""
-
-    def __init__(self, ctx: moderngl.Context):
-        u, i, p = ctypes.c_uint, ctypes.c_int, ctypes.POINTER
-        signatures = {
-            "glBindTexture": (None, u, u),
-            "glTexImage3D": (None, u, i, i, i, i, i, i, u, u, ctypes.c_void_p),
-            "glTexParameteri": (None, u, u, i),
-            "glGetTexLevelParameteriv": (None, u, i, u, p(i)),
-            "glGetIntegerv": (None, u, p(i)),
-            "glGenFramebuffers": (None, i, p(u)),
-            "glDeleteFramebuffers": (None, i, p(u)),
-            "glBindFramebuffer": (None, u, u),
-            "glFramebufferTextureLayer": (None, u, u, u, i, i),
-            "glCheckFramebufferStatus": (u, u),
-            "glDrawBuffer": (None, u),
-            "glReadBuffer": (None, u),
-        }
-        for name, (restype, *argtypes) in signatures.items():
-            function = gl_function(ctx, name, restype, *argtypes)
-            if function is None:
-                raise ContextError(f"shadow maps need {name}, which this GL does not have")
-            setattr(self, name[2:], function)
-
-
-def make_depth_layers(ctx: moderngl.Context, gl: _GL, side: int, layers: int) -> moderngl.TextureArray:
-    """A side x side x layers array texture re-specified as DEPTH_COMPONENT32F with the
-    lookup's sampling state (a ContextError where GL cannot make it)."""
-    texture = ctx.texture_array((side, side, layers), 1, dtype="f4")
-    value = ctypes.c_int(0)
-    gl.BindTexture(GL_TEXTURE_2D_ARRAY, texture.glo)
-    gl.TexImage3D(GL_TEXTURE_2D_ARRAY, 0, GL_DEPTH_COMPONENT32F, side, side, layers, 0,
-                  GL_DEPTH_COMPONENT, GL_FLOAT, None)
-    ctx.error                                               # clear any error it raised
-    gl.GetTexLevelParameteriv(GL_TEXTURE_2D_ARRAY, 0, GL_TEXTURE_INTERNAL_FORMAT, ctypes.byref(value))
-    for name, setting in GL_TEXTURE_PARAMETERS.items():
-        gl.TexParameteri(GL_TEXTURE_2D_ARRAY, name, setting)
-    gl.BindTexture(GL_TEXTURE_2D_ARRAY, 0)
-    if value.value != GL_DEPTH_COMPONENT32F:
-        texture.release()
-        raise ContextError(f"this GL made the shadow maps {hex(value.value)}, not "
-                           f"DEPTH_COMPONENT32F ({side}x{side}, {layers} layers)")
-    return texture
-
-
-def _layer_framebuffers(ctx: moderngl.Context, gl: _GL, texture, layers: int) -> list:
-    """A depth-only framebuffer on each layer of `texture`: (GL name, moderngl's view of it);
-    GL's framebuffer binding is left as it was."""
-    bound = ctypes.c_int(0)
-    gl.GetIntegerv(GL_FRAMEBUFFER_BINDING, ctypes.byref(bound))
-    names = (ctypes.c_uint * layers)()
-    gl.GenFramebuffers(layers, names)
-    try:
-        for layer, name in enumerate(names):
-            gl.BindFramebuffer(GL_FRAMEBUFFER, name)
-            gl.FramebufferTextureLayer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, texture.glo, 0, layer)
-            gl.DrawBuffer(GL_NONE)
-            gl.ReadBuffer(GL_NONE)
-            status = gl.CheckFramebufferStatus(GL_FRAMEBUFFER)
-            if status != GL_FRAMEBUFFER_COMPLETE:
-                gl.DeleteFramebuffers(layers, names)
-                raise ContextError(f"a shadow map's framebuffer is not complete ({hex(status)})")
-        return [(name, ctx.detect_framebuffer(name)) for name in names]
-    finally:
-        gl.BindFramebuffer(GL_FRAMEBUFFER, bound.value)
 
 
 class ShadowMaps:
@@ -135,7 +56,7 @@ class ShadowMaps:
 
     def __init__(self, ctx: moderngl.Context, layout: ShadowLayout):
         self.ctx = ctx
-        self._gl = _GL(ctx)
+        self._gl = ArrayTextureGL(ctx, "shadow maps")
         self.layout: ShadowLayout | None = None
         # kind -> (array texture, per layer (GL name, moderngl view)) for the kinds with maps
         self._stacks: dict[str, tuple[moderngl.TextureArray, list]] = {}
@@ -157,8 +78,9 @@ class ShadowMaps:
                 continue
             self._release_stack(kind)
             if stack.layers:
-                texture = make_depth_layers(self.ctx, self._gl, stack.side, stack.layers)
-                self._stacks[kind] = (texture, _layer_framebuffers(self.ctx, self._gl, texture, stack.layers))
+                texture = make_depth_layers(self.ctx, self._gl, stack.side, stack.layers,
+                                            GL_TEXTURE_PARAMETERS, "the shadow maps")
+                self._stacks[kind] = (texture, layer_framebuffers(self.ctx, self._gl, texture, stack.layers))
         self.layout = layout
         self.plan, self._passes = None, []
 
@@ -255,8 +177,7 @@ class ShadowMaps:
     def _release_stack(self, kind: str) -> None:
         texture, framebuffers = self._stacks.pop(kind, (None, []))
         if framebuffers:
-            names = (ctypes.c_uint * len(framebuffers))(*(n for n, _ in framebuffers))
-            self._gl.DeleteFramebuffers(len(names), names)
+            delete_framebuffers(self._gl, (n for n, _ in framebuffers))
         if texture is not None:
             texture.release()
 

@@ -1,0 +1,135 @@
+"""Radiosity's elements (notes 2, indirect illumination; issue 33): the scene's surfaces cut into
+small flat triangles, each of which is given one radiosity B_i. One definition for the GPU
+path and its twin: both draw these triangles into their item buffers and place a hemicube on
+each (renderer/core/hemicube.py).
+
+An element is a triangle in world coordinates (float64) with
+  - its front: the side the mesh's normals point to (the average of its source triangle's
+    vertex normals through the normal matrix). Its corners are ordered counter-clockwise seen
+    from the front (swapped where the winding disagrees), so that GL's gl_FrontFacing (and the
+    twin's signed area) says which side of it a hemicube sees: only the front reflects and
+    emits; a back face seen is an occluder that passes nothing on;
+  - its centre (the centroid, where its hemicube sits), unit normal and area;
+  - the object it belongs to, its reflectance rho (per channel, <= 1) and its emitted
+    radiosity E (exitance, per channel).
+
+Meshing: each source triangle is cut into k x k similar triangles (k = the smallest integer
+with longest edge / k <= `size`), the regular split whose pieces keep the triangle's shape.
+Pieces of neighbouring triangles need not share vertices (T-junctions); the hemicube does
+not mind, and the display interpolates per vertex of each piece.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from renderer.core.transforms import normal_matrix
+
+
+@dataclass(frozen=True)
+class Elements:
+    corners: np.ndarray          # (E, 3, 3) float64 world, counter-clockwise seen from the front
+    obj: np.ndarray              # (E,) int64 index of the scene object
+    reflectance: np.ndarray      # (E, 3) float64 rho per channel
+    emission: np.ndarray         # (E, 3) float64 emitted radiosity per channel
+
+    def __len__(self) -> int:
+        return len(self.corners)
+
+    @property
+    def centres(self) -> np.ndarray:
+        return self.corners.mean(axis=1)
+
+    @property
+    def _cross(self) -> np.ndarray:
+        a, b, c = self.corners[:, 0], self.corners[:, 1], self.corners[:, 2]
+        return np.cross(b - a, c - a)
+
+    @property
+    def areas(self) -> np.ndarray:
+        return 0.5 * np.linalg.norm(self._cross, axis=1)
+
+    @property
+    def normals(self) -> np.ndarray:
+        cross = self._cross
+        return cross / np.linalg.norm(cross, axis=1, keepdims=True)
+
+    def frames(self) -> np.ndarray:
+        """(E, 3, 3): each element's hemicube frame, rows u, v, n in world coordinates (u along
+        its first edge, n its front normal, v = n x u): the element's frame of hemicube.py."""
+        n = self.normals
+        u = self.corners[:, 1] - self.corners[:, 0]
+        u = u / np.linalg.norm(u, axis=1, keepdims=True)
+        return np.stack([u, np.cross(n, u), n], axis=1)
+
+    def shortest_edge(self) -> float:
+        return float(np.linalg.norm(self.corners - np.roll(self.corners, 1, axis=1), axis=2).min())
+
+    def extent(self) -> tuple[np.ndarray, float]:
+        """(centre, diameter) of the elements' bounding box."""
+        lo, hi = self.corners.min(axis=(0, 1)), self.corners.max(axis=(0, 1))
+        return (lo + hi) / 2, float(np.linalg.norm(hi - lo))
+
+
+def split_triangle(corners: np.ndarray, k: int) -> np.ndarray:
+    """(T, 3, 3) triangles, each split into k x k similar ones: (T * k * k, 3, 3), each piece
+    wound as its source, the pieces of one source together."""
+    i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    up = (i + j) < k                                     # (i, j), (i+1, j), (i, j+1)
+    down = (i + j) < k - 1                               # (i+1, j), (i+1, j+1), (i, j+1)
+    lattice = [np.stack([i[up], j[up]], -1)[:, None] + np.array([[0, 0], [1, 0], [0, 1]]),
+               np.stack([i[down], j[down]], -1)[:, None] + np.array([[1, 0], [1, 1], [0, 1]])]
+    steps = np.concatenate(lattice) / k                  # (k*k, 3, 2): (s, t) along b - a, c - a
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    return (a[:, None, None] + steps[None, ..., :1] * (b - a)[:, None, None]
+            + steps[None, ..., 1:] * (c - a)[:, None, None]).reshape(-1, 3, 3)
+
+
+def mesh_triangles(positions, faces, normals, model) -> tuple[np.ndarray, np.ndarray]:
+    """(T, 3, 3) world triangles of a mesh through `model`, each counter-clockwise seen from the
+    side its vertex normals point to, and (T, 3) that side's unit normal (the winding's)."""
+    positions = np.asarray(positions, np.float64)
+    faces = np.asarray(faces, np.int64)
+    world = positions @ model[:3, :3].T + model[:3, 3]
+    corners = world[faces]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    front = (np.asarray(normals, np.float64) @ normal_matrix(model).T)[faces].sum(axis=1)
+    flip = (cross * front).sum(axis=1) < 0
+    corners[flip] = corners[flip][:, [0, 2, 1]]
+    cross[flip] = -cross[flip]
+    keep = np.linalg.norm(cross, axis=1) > 0
+    return corners[keep], cross[keep] / np.linalg.norm(cross[keep], axis=1, keepdims=True)
+
+
+def mesh_elements(triangles: np.ndarray, obj: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
+    """The triangles (T, 3, 3) cut into elements no longer than `size` on any edge: (corners,
+    object index of each)."""
+    edges = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(axis=1)
+    splits = np.maximum(1, np.ceil(edges / size - 1e-9)).astype(np.int64)
+    pieces, source = [], []
+    for k in np.unique(splits):
+        these = np.flatnonzero(splits == k)
+        pieces.append(split_triangle(triangles[these], int(k)))
+        source.append(np.repeat(these, k * k))
+    source = np.concatenate(source)
+    order = np.argsort(source, kind="stable")            # back into the sources' order
+    return np.concatenate(pieces)[order], np.asarray(obj)[source[order]]
+
+
+def scene_elements(scene, size: float, reflectance=None, emission=None) -> Elements:
+    """The scene's objects (their meshes through their world matrices) cut into elements of at
+    most `size` scene units. `reflectance` and `emission`: per object (O, 3), default each
+    material's k_d and nothing."""
+    matrices = scene.world_matrices()
+    triangles, owner = [], []
+    for index, (obj, model) in enumerate(zip(scene.objects, matrices)):
+        corners, _ = mesh_triangles(obj.mesh.positions, obj.mesh.faces, obj.mesh.normals, model)
+        triangles.append(corners)
+        owner.append(np.full(len(corners), index, np.int64))
+    corners, obj = mesh_elements(np.concatenate(triangles), np.concatenate(owner), size)
+    rho = np.array([o.material.kd for o in scene.objects], np.float64) if reflectance is None \
+        else np.asarray(reflectance, np.float64)
+    emitted = np.zeros((len(scene.objects), 3)) if emission is None else np.asarray(emission, np.float64)
+    return Elements(corners, obj, rho[obj], emitted[obj])

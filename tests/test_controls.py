@@ -189,6 +189,8 @@ def test_c_cycles_the_reference_view():
 
 
 def test_m_toggles_the_ray_tracer_and_changes_the_picture():
+    """M steps between the methods it steps to (radiosity, whose form factors may take
+    seconds, opens only by name)."""
     viewer = Viewer()
     viewer.press(glfw.KEY_M)
     assert viewer.state.method == "raytrace" and viewer.state.scene_changed
@@ -199,6 +201,13 @@ def test_m_toggles_the_ray_tracer_and_changes_the_picture():
     assert viewer.state.method == "raster" and viewer.state.scene_changed
     assert viewer.messages[-1] == "method: rasteriser"
     assert "  M     rasteriser / ray tracer (refines while the view is still)" in help_lines()
+
+
+def test_m_from_radiosity_steps_on_to_the_rasteriser():
+    viewer = Viewer()
+    viewer.state.method = "radiosity"
+    viewer.press(glfw.KEY_M)
+    assert viewer.state.method == "raster"
 
 
 def test_o_toggles_shadows():

@@ -29,10 +29,14 @@ def goldens() -> list[str]:
 def tree_counts() -> dict[str, int]:
     """Each claim's pattern (NUMBER where the count stands) and the count the tree gives."""
     ray_traced = [name for name in builtin_scenes() if made_for(name) == "raytrace"]
+    radiated = [name for name in builtin_scenes() if made_for(name) == "radiosity"]
     return {
         rf"\b{NUMBER} scenes made for the ray tracer": len(ray_traced),
-        rf"\b{NUMBER} goldens at 256×256": len([g for g in goldens() if not g.endswith("-raytrace")]),
+        rf"\b{NUMBER} scenes made for radiosity": len(radiated),
+        rf"\b{NUMBER} goldens at 256×256": len([g for g in goldens()
+                                                 if not g.endswith(("-raytrace", "-radiosity"))]),
         rf"\b{NUMBER} ray-traced ones": len([g for g in goldens() if g.endswith("-raytrace")]),
+        rf"\b{NUMBER} radiosity ones": len([g for g in goldens() if g.endswith("-radiosity")]),
         rf"\b{NUMBER} more, {NUMBER} in all": None,            # read by its own rule below
         rf"\b{NUMBER} built-in scenes are made for the ray tracer": len(ray_traced),
         rf"\b{NUMBER} built-in scenes are textured": len(textured_scenes()),
@@ -69,11 +73,12 @@ def test_the_manual_counts_what_the_tree_holds():
 
 
 def test_the_goldens_add_up():
+    """"N more, M in all": the ray-traced and radiosity goldens beside the 256×256 ones."""
     in_all = len(goldens())
-    raytraced = len([g for g in goldens() if g.endswith("-raytrace")])
+    beside = len([g for g in goldens() if g.endswith(("-raytrace", "-radiosity"))])
     for name, text in pages().items():
         for more, total in re.findall(rf"\b{NUMBER} more, {NUMBER} in all", text):
-            assert (value(more), value(total)) == (raytraced, in_all), name
+            assert (value(more), value(total)) == (beside, in_all), name
 
 
 def test_the_check_sees_a_stale_count():

@@ -898,13 +898,19 @@ def test_a_renamed_output_uniform_is_caught():
 RADIOSITY_FILES = tuple(sorted(path.relative_to(glsl_dir()).as_posix()
                                for path in (glsl_dir() / "radiosity").iterdir()))
 # What the twin (reference/radiosity/) reads for each uniform.
-RADIOSITY_TWIN_NAMES = {"u_clip_from_world": ("clip_from_world",), "u_horizon": ("horizon",)}
+RADIOSITY_TWIN_NAMES = {"u_clip_from_world": ("clip_from_world",), "u_horizon": ("horizon",),
+                        "u_view": ("view",), "u_projection": ("projection",)}
 
 
 def radiosity_uploads(ctx) -> set[str]:
-    """Every uniform name ItemBuffers sets on its program while drawing a hemicube."""
+    """Every uniform name ItemBuffers sets on its program while drawing a hemicube, and the
+    radiosity renderer on its display's while drawing a frame."""
+    from renderer.core.builtin import builtin_scenes
     from renderer.core.radiosity_elements import Elements
+    from renderer.core.radiosity_options import RadiosityOptions
+    from renderer.core.scene_file import load_scene
     from renderer.gpu.item_buffers import ItemBuffers
+    from renderer.gpu.radiosity import RadiosityRenderer
     names = set()
     getitem = moderngl.Program.__getitem__
 
@@ -921,18 +927,21 @@ def radiosity_uploads(ctx) -> set[str]:
             buffers.draw([0])
         finally:
             buffers.release()
+        scene = load_scene(builtin_scenes()["radiosity_plates"])
+        with RadiosityRenderer(scene, 8, 6, RadiosityOptions(element_size=1.0, hemicube=4), context=ctx) as r:
+            r.render()
     return names
 
 
-def test_every_item_buffer_uniform_is_uploaded_and_every_upload_declared(gl_contexts):
+def test_every_radiosity_uniform_is_uploaded_and_every_upload_declared(gl_contexts):
     parsed = parse(read_glsl(RADIOSITY_FILES))
     uploaded = radiosity_uploads(gl_contexts["egl"])
-    problems = uniforms_not_uploaded(parsed, uploaded, "renderer/gpu/item_buffers.py", "it sets")
-    problems += uploads_not_declared(parsed, uploaded, "renderer/gpu/item_buffers.py", "glsl/radiosity/")
+    problems = uniforms_not_uploaded(parsed, uploaded, "renderer/gpu/item_buffers.py or radiosity.py", "they set")
+    problems += uploads_not_declared(parsed, uploaded, "renderer/gpu/item_buffers.py or radiosity.py", "glsl/radiosity/")
     assert not problems, report(problems)
 
 
-def test_the_item_buffer_uniforms_are_names_its_twin_reads():
+def test_the_radiosity_uniforms_are_names_its_twin_reads():
     problems = uniforms_the_twin_does_not_read(parse(read_glsl(RADIOSITY_FILES)), set(),
                                                RADIOSITY_TWIN_NAMES, twin_text("radiosity"),
                                                "reference/radiosity/")

@@ -904,5 +904,5 @@ def test_check_scene_ray_traces_with_the_tracer_options(spec):
     assert json.loads((spec.goldens / "test_traced.json").read_text())["scene"] == "classic"
     assert failure(result, "test_raster_with_samples").strip() == "samples: is for method raytrace, not raster"
     assert failure(result, "test_unknown_method").strip() == \
-        "method: unknown method 'pathtrace'; one of raster, raytrace"
+        "method: unknown method 'pathtrace'; one of raster, raytrace, radiosity"
     assert outcomes(spec.run("-k", "traced")) == {"test_traced": "passed"}

@@ -1,5 +1,6 @@
 """This project's golden images: every built-in scene in each shading mode, at 256x256, and
-each scene made for the ray tracer ray traced, at 160x120.
+each scene made for the ray tracer ray traced, and each made for radiosity solved and drawn,
+at 160x120.
 
 Each golden is held two ways. The GPU's frame is held against it on EGL and on OSMesa (the
 `golden` fixture from renderer/checks/pytest_plugin.py, default policy "threshold"). The golden is
@@ -26,13 +27,15 @@ from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.scene import SHADING_MODES
 from renderer.core.scene_file import load_scene
 
-from conftest import RAYTRACE_SCENES, SHADOW_SCENES, raster_scene_params
+from conftest import RADIOSITY_SCENES, RAYTRACE_SCENES, SHADOW_SCENES, raster_scene_params
 
 SIZE = (256, 256)
 RAYTRACE_SIZE = (160, 120)
 GOLDENS = Path(__file__).parent / "goldens"
 AS_AUTHORED = "as-authored"
 RAYTRACE = "raytrace"
+RADIOSITY = "radiosity"
+RADIOSITY_SIZE = (160, 120)
 
 
 @functools.lru_cache(maxsize=None)
@@ -163,17 +166,45 @@ def test_ray_traced_golden_matches_reference(name, traced_references):
                                                           **TRACE_OPTIONS.get(name, {})).rgba8)
 
 
+# Radiosity's goldens (its default options: the scene's diagonal / 12 elements, hemicubes of
+# 64, Gauss-Seidel), each held to the GPU's frame on EGL (OSMesa in the full run) and to the
+# twin (reference/radiosity/) in the full run; the default run holds the GPU against the twin
+# on smaller settings (tests/test_radiosity_method.py).
+RADIATED = sorted(RADIOSITY_SCENES)
+RADIATED_IDS = [f"{name}-{RADIOSITY}" for name in RADIATED]
+
+
+@pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
+@pytest.mark.parametrize("name", RADIATED, ids=RADIATED_IDS)
+def test_radiosity_matches_golden(name, context_kind, gl_contexts, golden):
+    frame = golden.check_scene(scene_variant(name, AS_AUTHORED), f"{name}-{RADIOSITY}",
+                               size=RADIOSITY_SIZE, context=gl_contexts[context_kind], method=RADIOSITY)
+    assert (frame.rgba8[..., 3] == 255).mean() > 0.02
+    assert_exact_where_made(f"{name}-{RADIOSITY}", frame)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", RADIATED, ids=RADIATED_IDS)
+def test_radiosity_golden_matches_reference(name):
+    from renderer.methods import open_renderer
+    with open_renderer(scene_variant(name, AS_AUTHORED), RADIOSITY_SIZE, method=RADIOSITY,
+                       backend="reference") as twin:
+        expected = twin.render()
+    assert_matches_reference(golden_png(f"{name}-{RADIOSITY}"), expected.rgba8, expected.rgba8_tie)
+
+
 def test_every_golden_belongs_to_a_scene_and_mode():
     """No golden is left behind by a removed scene, and each has its sidecar."""
     on_disk = {path.stem for path in GOLDENS.glob("*.png")}
-    assert on_disk == set(IDS) | set(TRACED_IDS)
+    assert on_disk == set(IDS) | set(TRACED_IDS) | set(RADIATED_IDS)
     assert {path.stem for path in GOLDENS.glob("*.json")} == on_disk
 
 
 @pytest.mark.parametrize("name, mode, size",
                          [(name, mode, SIZE) for name, mode in VARIANTS]
-                         + [(name, RAYTRACE, RAYTRACE_SIZE) for name in TRACED],
-                         ids=IDS + TRACED_IDS)
+                         + [(name, RAYTRACE, RAYTRACE_SIZE) for name in TRACED]
+                         + [(name, RADIOSITY, RADIOSITY_SIZE) for name in RADIATED],
+                         ids=IDS + TRACED_IDS + RADIATED_IDS)
 def test_sidecar_describes_its_golden(name, mode, size):
     sidecar = json.loads((GOLDENS / f"{name}-{mode}.json").read_text())
     assert sidecar["name"] == f"{name}-{mode}"

@@ -9,6 +9,7 @@ import pytest
 
 from reference.radiosity.item_buffer import _clip_coordinates, draw
 from renderer.core.hemicube import FACES, ITEM_BACK_BIT
+from renderer.gpu.context import activate
 from renderer.gpu.item_buffers import ItemBuffers, batch_size
 from renderer.gpu.shaders import shader_source
 from tests.radiosity_scenes import elements_of, furnished_room, quad
@@ -59,6 +60,7 @@ def test_the_twins_vertex_product_is_llvmpipes_bit_for_bit(gl_contexts):
     """item_buffer.vert's M * vec4(p, 1) captured by transform feedback equals the twin's
     _clip_coordinates in every bit (sums in column order, no fused multiply-add)."""
     ctx = gl_contexts["egl"]
+    activate(ctx)
     rng = np.random.default_rng(7)
     positions = (rng.normal(size=(4096, 3)) * 3).astype(np.float32)
     matrices = rng.normal(size=(2, 4, 4))

@@ -111,7 +111,7 @@ def test_options_of_another_method_are_refused_by_name():
     with pytest.raises(OptionError) as refused:
         method_options("raster", {"samples": 4})
     assert (refused.value.fields, refused.value.reason) == (("samples",), "is for method raytrace, not raster")
-    with pytest.raises(OptionError, match="unknown method 'pathtrace'; one of raster, raytrace"):
+    with pytest.raises(OptionError, match="unknown method 'pathtrace'; one of raster, raytrace, radiosity"):
         method_options("pathtrace")
     with pytest.raises(TypeError, match="method raytrace takes RayOptions, not RasterOptions"):
         open_renderer(None, (8, 8), method="raytrace", options=RasterOptions())
@@ -139,6 +139,13 @@ def test_a_new_method_is_one_registration(monkeypatch, sphere_scene):
 
 @pytest.fixture
 def sphere_scene():
+    """The built-in sphere scene with a coarser sphere (16 x 8, 224 triangles): radiosity draws
+    a hemicube per element over every element (its twin's 3,968 would take a minute)."""
+    import dataclasses
+
     from renderer.core.builtin import resolve_scene
+    from renderer.core.primitives import uv_sphere
     from renderer.core.scene_file import load_scene
-    return load_scene(resolve_scene("sphere"))
+    scene = load_scene(resolve_scene("sphere"))
+    scene.objects[0] = dataclasses.replace(scene.objects[0], mesh=uv_sphere(1.0, 16, 8))
+    return scene

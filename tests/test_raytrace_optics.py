@@ -258,6 +258,8 @@ def optics_inputs():
 
 
 def gpu_run(ctx, uniforms, offset, inputs):
+    from renderer.gpu.context import activate
+    activate(ctx)                   # another test's renderer may have left its own context current
     program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
                           fragment_shader=shader_source("raytrace_optics.frag", directory=GLSL).text)
     textures = [ctx.texture((WIDTH, HEIGHT), a.shape[-1], np.ascontiguousarray(a).tobytes(), dtype="f4")

@@ -29,7 +29,7 @@ BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_p
                  "shadow_plane", "shadow_room", "shadow_curved", "depth_of_field", "soft_shadows",
                  "glossy", "motion_blur", "textured_mesh", "checker_horizon", "globe",
                  "shadow_boxes", "shadow_thin_contact", "shadow_big_floor", "shadow_lowpoly_sphere",
-                 "shadow_knot_floor"}
+                 "shadow_knot_floor", "radiosity_furnace", "radiosity_plates", "cornell_box_radiosity"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera, a ground under it), or a backdrop (tir_bubble's checkerboard) filling
 # the view.
@@ -66,7 +66,9 @@ def test_builtin_scene_loads(name):
     scene = load_scene(builtin_scenes()[name])
     assert scene.name == name
     assert scene.source == str(builtin_scenes()[name])
-    assert scene.objects and (scene.directional_lights or scene.point_lights)
+    # lit: by lights, or (radiosity's scenes) by surfaces that emit
+    emits = any(any(obj.material.emission) for obj in scene.objects)
+    assert scene.objects and (scene.directional_lights or scene.point_lights or emits)
     description = scene_descriptions()[name]
     assert description and "\n" not in description
     for obj in scene.objects:
@@ -771,7 +773,7 @@ BAD_SCENES = [
      "objects[0].angular_speed: unknown key; did you mean 'angular_velocity'?"),
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
-     "two_sided, shading, kr, kt, ior, gloss, texture"),
+     "two_sided, shading, kr, kt, ior, gloss, texture, emission"),
     # textures (docs/scene-format.md, "Textures")
     ("texture without a source", OBJECT + "material = { texture = { wrap = \"clamp\" } }\n",
      'objects[0].material.texture: needs image = "FILE" or checker = { ... }'),

@@ -74,8 +74,8 @@ def draw_hemicube(positions32: np.ndarray, matrices: np.ndarray, resolution: int
         t_parts.append(t)
     items = np.zeros(faces * n * n, np.uint32)
     tied = np.zeros(faces * n * n, bool)
-    if pixel_parts:
-        pixel, z, t = (np.concatenate(p) for p in (pixel_parts, z_parts, t_parts))
+    pixel, z, t = (np.concatenate(p) if p else np.zeros(0) for p in (pixel_parts, z_parts, t_parts))
+    if len(pixel):
         order = np.lexsort((t, -z, pixel))                 # nearest (largest z_w) first, then drawn first
         pixel, z, t = pixel[order], z[order], t[order]
         first = np.flatnonzero(np.r_[True, pixel[1:] != pixel[:-1]])

@@ -64,14 +64,14 @@ def against_reference(scene, size, gpu_frame: Frame, *, method: str = "raster",
                             reference_tie=tie, reference_tie_depth=tie_depth)
     heat = heat_map(gpu_frame.rgba8, expected, tolerance.threshold, tolerance.deviation,
                     reference_tie=tie)
-    raster = method == "raster"
+    traced = method == "raytrace"     # the rasteriser and radiosity's display have depth ties
     figures = {"scene": scene.name, "size": list(size), "method": method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
-               "depth_tie_pixels": depth_tie_pixels(ref_frame) if raster else 0,
-               "shadow_tie_pixels": shadow_tie_pixels(ref_frame) if raster else 0,
+               "depth_tie_pixels": 0 if traced else depth_tie_pixels(ref_frame),
+               "shadow_tie_pixels": 0 if traced else shadow_tie_pixels(ref_frame),
                "grazing_ray_pixels": grazing, "anisotropic_envelope_renders": envelope_renders,
                "reference_ms": reference_ms}
-    if not raster:     # adaptive: the samples traced, and where the twins chose differently
+    if traced:         # adaptive: the samples traced, and where the twins chose differently
         figures |= {"gpu_samples_per_pixel": float(gpu_frame.samples.mean()),
                     "reference_samples_per_pixel": float(ref_frame.samples.mean()),
                     "refined_differently_pixels": int((gpu_frame.samples != ref_frame.samples).sum()),

@@ -11,6 +11,7 @@ from pathlib import Path
 
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
+from renderer.core.radiosity_options import DEFAULT_ELEMENTS_ACROSS, MAX_HEMICUBE, SOLVERS
 from renderer.errors import OptionError, UsageError, UserError
 
 DEFAULT_SIZE = (640, 480)
@@ -87,9 +88,10 @@ def scene_options(p) -> None:
 
 def raytrace_options(p) -> None:
     """--method and the ray tracer's options, the lens's among them (render, compare)."""
-    p.add_argument("--method", choices=("raster", "raytrace"),
+    p.add_argument("--method", choices=("raster", "raytrace", "radiosity"),
                    help="raster (default): the rasteriser; raytrace: the ray tracer (shadows, "
-                        "reflection, refraction; docs/conventions.md, \"Rays\")")
+                        "reflection, refraction; docs/conventions.md, \"Rays\"); radiosity: "
+                        "light from emitting surfaces, bounced between diffuse ones (docs/radiosity.md)")
     p.add_argument("--spp", type=int, default=None, metavar="N",
                    help="ray tracer: samples per pixel (default 1)")
     p.add_argument("--pattern", default=None, metavar="|".join(RAY_PATTERNS),
@@ -107,6 +109,14 @@ def raytrace_options(p) -> None:
                    help=f"ray tracer: points sampled on each area light per hit, 1 to "
                         f"{MAX_LIGHT_SAMPLES} (default 1; docs/conventions.md, \"Area lights\")")
     lens_options(p)
+    p.add_argument("--element-size", type=float, default=None, metavar="S",
+                   help="radiosity: the longest edge of an element, scene units (default: the "
+                        f"scene's diagonal / {DEFAULT_ELEMENTS_ACROSS})")
+    p.add_argument("--hemicube", type=int, default=None, metavar="N",
+                   help="radiosity: pixels across a hemicube's top face, a power of two from 4 to "
+                        f"{MAX_HEMICUBE} (default 64)")
+    p.add_argument("--solver", default=None, metavar="|".join(SOLVERS),
+                   help="radiosity: how the equation is solved (default gauss-seidel)")
 
 
 def lens_options(p) -> None:
@@ -153,10 +163,12 @@ def load(scene_arg, *needs):
     return scene
 
 
-# RayOptions' fields -> the command line's options (renderer/core/ray_options.py holds the rules).
+# RayOptions' and RadiosityOptions' fields -> the command line's options (renderer/core/ray_options.py
+# and radiosity_options.py hold the rules).
 RAY_FLAGS = {"samples": "--spp", "pattern": "--pattern", "max_depth": "--max-depth", "seed": "--seed",
              "adaptive_threshold": "--adaptive-threshold", "light_samples": "--light-samples",
-             "aperture": "--aperture", "focus_distance": "--focus-distance"}
+             "aperture": "--aperture", "focus_distance": "--focus-distance",
+             "element_size": "--element-size", "hemicube": "--hemicube", "solver": "--solver"}
 
 
 def _dest(flag: str) -> str:
@@ -178,7 +190,8 @@ def show_option(value) -> str:
 
 
 def ray_options_given(args) -> dict:
-    """The RayOptions fields the command line gave (the others keep RayOptions' defaults)."""
+    """The method options' fields the command line gave (the others keep their defaults; one
+    of another method's is refused by name, renderer/methods method_options)."""
     return {field: getattr(args, _dest(flag)) for field, flag in RAY_FLAGS.items()
             if getattr(args, _dest(flag), None) is not None}
 

@@ -27,6 +27,8 @@ DEFAULT_SCENE = "sphere"
 # are no mark: the shadow scenes use them so that the ray tracer's shadows, their truth, come
 # from exact spheres and planes, and they are made for the rasteriser.
 RAYTRACE_MARK = "--method raytrace"
+# And of one made for radiosity: lit by surfaces that emit, which only radiosity reads.
+RADIOSITY_MARK = "--method radiosity"
 
 
 def assets_dir() -> Path:
@@ -102,8 +104,11 @@ def scene_descriptions() -> dict[str, str]:
 
 def made_for(scene: str) -> str:
     """The method (renderer/methods' name) the built-in scene or scene file is made for:
-    "raytrace" where its description says RAYTRACE_MARK, else "raster"."""
-    return "raytrace" if made_for_raytracing(scene) else "raster"
+    "raytrace" where its description says RAYTRACE_MARK, "radiosity" where RADIOSITY_MARK,
+    else "raster"."""
+    if made_for_raytracing(scene):
+        return "raytrace"
+    return "radiosity" if RADIOSITY_MARK in describe(scene) else "raster"
 
 
 def made_for_raytracing(scene: str) -> bool:

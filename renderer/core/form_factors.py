@@ -21,6 +21,9 @@ import numpy as np
 
 from renderer.core.hemicube import ITEM_BACK_BIT, ITEM_INDEX_MASK, weights
 
+# rows_from_items sums a batch's pixels by (row, element) key in a dense array when there are at
+# most this many keys (16 MiB of float64), else by sorting them.
+DENSE_KEYS = 1 << 21
 
 @dataclass(frozen=True)
 class FormFactors:
@@ -82,8 +85,13 @@ def rows_from_items(items: np.ndarray, resolution: int, elements: int):
     backs = np.where((index > 0) & ~front, weight, 0.0).sum(axis=1)
     row = np.broadcast_to(np.arange(h)[:, None], flat.shape)[front]
     key = row * (elements + 1) + index[front]
-    unique, inverse = np.unique(key, return_inverse=True)
-    values = np.bincount(inverse, weights=weight[front])
+    if h * (elements + 1) <= DENSE_KEYS:         # a dense count is faster than sorting the keys
+        sums = np.bincount(key, weights=weight[front], minlength=h * (elements + 1))
+        unique = np.flatnonzero(np.bincount(key, minlength=h * (elements + 1)))
+        values = sums[unique]
+    else:
+        unique, inverse = np.unique(key, return_inverse=True)
+        values = np.bincount(inverse, weights=weight[front])
     return unique // (elements + 1), unique % (elements + 1) - 1, values, unseen, backs
 
 

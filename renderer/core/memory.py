@@ -173,6 +173,34 @@ def raytrace_reference_bytes(width: int, height: int, triangles: int, *, samples
             + triangles * RAYTRACE_BYTES_PER_TRIANGLE)
 
 
+# Radiosity (renderer/core/form_factors.py): a row holds at most one value per element and per
+# pixel of its hemicube (N^2 on top, N^2 / 2 on each side: 3 N^2), 16 bytes each (column and
+# value) and as much again while a batch's rows are summed; a batch's item buffers, their keys
+# and weights, 48 bytes a hemicube pixel, at most RADIOSITY_BATCH_BYTES of GL storage beside
+# them on the GPU (renderer/gpu/item_buffers.py BATCH_BYTES); the twin's fragments of one
+# hemicube, 160 bytes a pixel (several fragments a pixel, each with its keys); elements, 512 bytes each.
+RADIOSITY_BATCH_BYTES = 64 * MIB
+RADIOSITY_BYTES_PER_ELEMENT = 512
+
+
+def radiosity_bytes(elements: int, resolution: int, backend: str) -> int:
+    """The form factors of `elements` elements at hemicube resolution `resolution`: the
+    matrix at its largest and drawing it, on `backend` ("gpu" or "reference")."""
+    pixels = 5 * resolution * resolution
+    per_row = min(elements, 3 * resolution * resolution)
+    batch = max(1, RADIOSITY_BATCH_BYTES // (8 * pixels))
+    drawing = (min(batch, elements) * pixels * 48 + RADIOSITY_BATCH_BYTES if backend == "gpu"
+               else pixels * 160)
+    return elements * per_row * 32 + drawing + elements * RADIOSITY_BYTES_PER_ELEMENT
+
+
+def check_radiosity(elements: int, resolution: int, backend: str, name: str) -> None:
+    """One line (a UserError) before any hemicube is drawn when the form factors of
+    `elements` elements would need more than the limit."""
+    check(radiosity_bytes(elements, resolution, backend),
+          f"radiosity of {name} ({elements:,} elements, hemicubes of {resolution}) on {backend}")
+
+
 def over_limit(needed: int, *, loading: bool = False) -> str | None:
     """None when `needed` bytes fit under the limit, else the end of a refusal:
     "needs about 19.1 GiB of memory, over the limit of 12.0 GiB (...)". `loading`: `needed`

@@ -97,6 +97,10 @@ class Material:
     # A texture (renderer/core/textures.py): its texel multiplies the coefficients it names
     # (texture.modulate) before lighting; None: untextured. The object's mesh needs UVs.
     texture: MaterialTexture | None = None
+    # Emitted radiosity E (exitance, linear RGB, >= 0): the light a surface gives off itself.
+    # Only radiosity reads it (renderer/core/radiosity.py); the rasteriser and the ray tracer
+    # light with their lights (docs/scene-format.md).
+    emission: tuple = (0.0, 0.0, 0.0)
 
     @property
     def textured(self) -> bool:

@@ -57,7 +57,7 @@ LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
                *LENS_KEYS, "shutter")
 MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss",
-                 "texture")
+                 "texture", "emission")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 AREA_KEYS = ("area", "size", "radius", "normal")   # a point light's area (LightArea), `area` first
 AREA_SHAPE_KEYS = {"rectangle": ("size", "normal"), "disc": ("radius", "normal"),
@@ -594,7 +594,7 @@ class _Reader(TableReader):
         if "shading" in raw:
             mat.shading = self.choice(raw["shading"], _join(path, "shading"), "shading",
                                       SHADING_MODES)
-        for coefficient in ("kr", "kt"):
+        for coefficient in ("kr", "kt", "emission"):
             if coefficient in raw:
                 setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
         if "ior" in raw:

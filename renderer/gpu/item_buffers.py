@@ -11,8 +11,9 @@ to the face's layer of an R32UI array texture (and of a DEPTH_COMPONENT32F one),
 N x N drawn from texel (0, 0) as the twin draws it (llvmpipe evaluates depth from the window
 origin). Reversed-Z (glClipControl ZERO_TO_ONE, cleared to 0, GL_GREATER: hemicube.DEPTH_MAPPING),
 no culling (a back face seen hides what is behind it), the items cleared to 0 with
-glClearBufferuiv (glClear's float colour is undefined on an integer buffer). GL's clip control
-is left at its default after every draw, as GpuRenderer expects it.
+glClearBufferuiv (glClear's float colour is undefined on an integer buffer). GL's clip control,
+depth function and depth test are left at their defaults after every draw (a context shared
+with other renderers, as GpuRenderer expects it).
 
 Twin: reference/radiosity/item_buffer.py.
 """
@@ -29,7 +30,7 @@ from renderer.core.hemicube import DEPTH_MAPPING, FACES, clip_from_world, depth_
 from renderer.core.radiosity_elements import Elements
 from renderer.gpu.array_textures import (ArrayTextureGL, delete_framebuffers, layered_framebuffer,
                                          make_depth_layers)
-from renderer.gpu.context import gl_function
+from renderer.gpu.context import activate, gl_function
 from renderer.gpu.shaders import shader_source
 from renderer.errors import ContextError
 
@@ -52,6 +53,7 @@ class ItemBuffers:
     """The GL objects that draw `elements`' hemicubes at `resolution` (even) on `ctx`."""
 
     def __init__(self, ctx: moderngl.Context, elements: Elements, resolution: int):
+        activate(ctx)
         self.ctx, self.elements, self.resolution = ctx, elements, int(resolution)
         self.origin, diameter = elements.extent()
         self.near, self.far = depth_range(elements.shortest_edge(), diameter)
@@ -96,6 +98,7 @@ class ItemBuffers:
         count, n, ctx = len(indices), self.resolution, self.ctx
         if not 0 < count <= self.batch:
             raise ValueError(f"draw takes 1 to {self.batch} hemicubes, got {count}")
+        activate(ctx)
         faces = len(FACES) * count
         columns = np.swapaxes(self.matrices_of(indices), -1, -2)        # each matrix by columns
         self.matrices.write(columns.astype(np.float32).tobytes(), viewport=(0, 0, 4 * faces, 1))
@@ -110,8 +113,10 @@ class ItemBuffers:
         self._clip_control(GL_LOWER_LEFT, DEPTH_MAPPING.clip_control)
         try:
             self.vao.render(moderngl.TRIANGLES, instances=faces)
-        finally:
+        finally:                                      # GL's defaults back for whoever draws next
             self._clip_control(GL_LOWER_LEFT, STANDARD_DEPTH.clip_control)
+            ctx.depth_func = STANDARD_DEPTH.depth_func
+            ctx.disable(moderngl.DEPTH_TEST)
         data = np.frombuffer(self.items.read(), np.uint32)
         layers = data.reshape(-1, n, n)[:faces]
         return layers[:, ::-1].reshape(count, len(FACES), n, n).copy()     # GL rows to row 0 top
@@ -122,6 +127,7 @@ class ItemBuffers:
                 for start in range(0, len(self.elements), self.batch)]
 
     def release(self) -> None:
+        activate(self.ctx)
         if getattr(self, "_framebuffer_name", None):
             delete_framebuffers(self._gl, [self._framebuffer_name])
             self._framebuffer_name = None

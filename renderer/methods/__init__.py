@@ -1,4 +1,4 @@
-"""Every way of making an image, behind one call: a method ("raster", "raytrace") on a backend
+"""Every way of making an image, behind one call: a method ("raster", "raytrace", "radiosity") on a backend
 ("gpu": GLSL through moderngl; "reference": the NumPy twin), opened as a Renderer
 (renderer/gpu/base.py: render, update, resize, release, a context manager, gl_info).
 
@@ -16,10 +16,10 @@ from __future__ import annotations
 
 from renderer.core.scene import Scene
 from renderer.errors import OptionError
-from renderer.methods import raster, raytrace
+from renderer.methods import radiosity, raster, raytrace
 from renderer.methods.registry import BACKENDS, Method
 
-METHODS: dict[str, Method] = {m.name: m for m in (raster.METHOD, raytrace.METHOD)}
+METHODS: dict[str, Method] = {m.name: m for m in (raster.METHOD, raytrace.METHOD, radiosity.METHOD)}
 
 
 def method(name: str) -> Method:

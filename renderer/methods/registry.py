@@ -27,7 +27,8 @@ memory estimates and a batch's costs). `progressive`: successive frames bring ne
     samples (render(first_sample=k)), so a viewer refines while the view is still; `seeded`:
     the frames depend on a seed (reseed(seed), a batch item's own); `shutter`: objects move
 during the camera's shutter (motion blur; a method without it draws time 0), so an
-animation's frames differ."""
+animation's frames differ; `stepped_to`: the viewer's M key steps to it (not to a method whose
+first frame may take seconds, as radiosity's form factors)."""
     name: str
     title: str
     options: type
@@ -39,6 +40,7 @@ animation's frames differ."""
     progressive: bool = False
     seeded: bool = False
     shutter: bool = False
+    stepped_to: bool = True
 
     def check_memory(self, scene, size, backends, options) -> None:
         """One line (a UserError) when drawing `scene` would need more than the memory limit."""

@@ -349,7 +349,8 @@ class Controls:
         self._say(f"reference view: {self.state.reference}")
 
     def _method(self) -> None:
-        names = list(METHODS)                    # M steps through them in registration order
+        names = [n for n, m in METHODS.items() if m.stepped_to or n == self.state.method]
+        # M steps through them in registration order
         self._set("method", names[(names.index(self.state.method) + 1) % len(names)])
         shown = METHODS[self.state.method]
         self._say(f"method: {shown.title}" + ("; it refines while the view is still (the title "

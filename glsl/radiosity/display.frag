@@ -1,0 +1,14 @@
+// Twin: reference/radiosity/display.py
+#version 330 core
+// The interpolated radiosity is the pixel's linear colour, opaque; the view depth beside it.
+
+in vec3 v_radiosity;
+in float v_view_depth;
+
+layout(location = 0) out vec4 out_color;
+layout(location = 1) out float out_view_depth;
+
+void main() {
+    out_color = vec4(v_radiosity, 1.0);
+    out_view_depth = v_view_depth;
+}

@@ -1,0 +1,62 @@
+"""Radiosity's options (issue 33; renderer/methods/radiosity.py): how finely the surfaces are cut,
+how finely each hemicube sees, and how the equation is solved. Every range is checked here, once,
+as an OptionError naming the field."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass, fields
+from typing import ClassVar
+
+from renderer.errors import OptionError
+
+SOLVERS = ("gauss-seidel", "progressive")
+MAX_HEMICUBE = 1024
+# Without an element size the scene's bounding box's diagonal is cut in this many.
+DEFAULT_ELEMENTS_ACROSS = 12
+
+
+@dataclass(frozen=True)
+class RadiosityOptions:
+    """`element_size`: the longest edge of an element, scene units (None: the scene's diagonal
+    over DEFAULT_ELEMENTS_ACROSS); `hemicube`: pixels across a hemicube's top face, a power of
+    two from 4 to MAX_HEMICUBE (so that GL's viewport scale N / 2 is exact: the twin's window
+    coordinates are GL's bit for bit); `solver`: one of SOLVERS; `tolerance`: the residual to
+    reach, relative to the largest emission (Gauss-Seidel) or the emitted power (progressive);
+    `max_iterations`: sweeps or shots (None: the solver's default)."""
+    element_size: float | None = None
+    hemicube: int = 64
+    solver: str = "gauss-seidel"
+    tolerance: float = 1e-6
+    max_iterations: int | None = None
+    SETTING_FIELDS: ClassVar[tuple[str, ...]] = ("element_size", "hemicube", "solver")
+
+    def __post_init__(self):
+        size = self.element_size
+        if size is not None and not (isinstance(size, (int, float)) and math.isfinite(size) and size > 0):
+            raise OptionError("element_size", f"must be a number > 0 (scene units), got {size!r}")
+        n = self.hemicube
+        if not (isinstance(n, int) and 4 <= n <= MAX_HEMICUBE and n & (n - 1) == 0):
+            raise OptionError("hemicube", f"must be a power of two from 4 to {MAX_HEMICUBE}, got {n!r}")
+        if self.solver not in SOLVERS:
+            raise OptionError("solver", f"unknown solver {self.solver!r}; one of {', '.join(SOLVERS)}")
+        if not (isinstance(self.tolerance, (int, float)) and 0 < self.tolerance < 1):
+            raise OptionError("tolerance", f"must be a number between 0 and 1, got {self.tolerance!r}")
+        m = self.max_iterations
+        if m is not None and not (isinstance(m, int) and m >= 1):
+            raise OptionError("max_iterations", f"must be an integer >= 1, got {m!r}")
+
+    def size_for(self, diameter: float) -> float:
+        """The element size for a scene whose bounding box's diagonal is `diameter`."""
+        return self.element_size if self.element_size is not None else diameter / DEFAULT_ELEMENTS_ACROSS
+
+    def scene_for(self, scene):
+        """The scene as radiosity draws it: as given (a pinhole camera, as the rasteriser's)."""
+        return scene
+
+    def replace(self, **changes) -> "RadiosityOptions":
+        return dataclasses.replace(self, **changes)
+
+    def as_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}

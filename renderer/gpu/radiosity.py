@@ -1,0 +1,184 @@
+"""Radiosity on the GPU (issue 33; the method "radiosity", renderer/methods/radiosity.py): the
+scene's elements, their hemicubes drawn by GL (renderer/gpu/item_buffers.py), the equation
+solved (renderer/core/radiosity.py), and each frame the elements drawn with their corners'
+radiosity interpolated (glsl/radiosity/display.vert, display.frag; Gouraud shading).
+
+The solution is kept while only the camera moves: update() compares the new scene's elements
+with the last ones and draws the hemicubes again only when the geometry changed; new
+reflectances or emissions re-solve with the same form factors (`solves`, `form_factor_draws`
+count each). Frames: RGBA32F colour and R32F view depth, read back row 0 at the top; GL's
+standard depth test (or reversed-Z's, with glClipControl, as the camera says), no culling
+(elements are seen from either side; their back is as bright as their front, as the display
+of a one-sided solution usually is).
+
+Twin: reference/radiosity/display.py (with reference/radiosity/item_buffer.py).
+"""
+
+from __future__ import annotations
+
+import ctypes
+import time
+
+import moderngl
+import numpy as np
+
+from renderer.core import memory
+from renderer.core.frame import Frame, image_size
+from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, depth_mapping, to_unorm8
+from renderer.core.radiosity import RadiositySolution, elements_for, solve, what_changed
+from renderer.core.radiosity_options import RadiosityOptions
+from renderer.core.scene import Scene
+from renderer.core.transforms import to_glsl
+from renderer.errors import ContextError
+from renderer.gpu.base import ContextRenderer
+from renderer.gpu.context import activate, gl_function
+from renderer.gpu.context import context_kind as kind_of
+from renderer.gpu.item_buffers import ItemBuffers
+from renderer.gpu.readback import flip_into
+from renderer.gpu.shaders import shader_source
+
+
+class RadiosityRenderer(ContextRenderer):
+    """The method "radiosity" on the GPU, for the Renderer protocol (renderer/gpu/base.py)."""
+
+    def __init__(self, scene: Scene, width: int, height: int, options: RadiosityOptions | None = None, *,
+                 context: moderngl.Context | None = None, context_kind: str = "auto"):
+        self.scene = scene
+        self.width, self.height = image_size(width, height)
+        self.options = options or RadiosityOptions()
+        self.solution: RadiositySolution | None = None
+        self.solves = self.form_factor_draws = 0
+        self._open_context(context, context_kind)
+        self._resources: list = []
+        self._mesh: list = []
+        try:
+            activate(self.ctx)
+            ctx = self.ctx
+            self._clip_control = gl_function(ctx, "glClipControl", None, ctypes.c_uint, ctypes.c_uint)
+            self.program = ctx.program(vertex_shader=shader_source("radiosity/display.vert").text,
+                                       fragment_shader=shader_source("radiosity/display.frag").text)
+            self._resources.append(self.program)
+            self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
+                             "GL_VERSION": ctx.info["GL_VERSION"], "context": kind_of(ctx)}
+            self._build_targets()
+            self.update()
+        except BaseException:
+            self.release()
+            raise
+
+    def _build_targets(self) -> None:
+        ctx = self.ctx
+        self._targets = [ctx.texture((self.width, self.height), 4, dtype="f4"),
+                         ctx.texture((self.width, self.height), 1, dtype="f4"),
+                         ctx.depth_renderbuffer((self.width, self.height))]
+        self._fbo = ctx.framebuffer(self._targets[:2], self._targets[2])
+
+    def _release_targets(self) -> None:
+        for thing in (self._fbo, *self._targets):
+            thing.release()
+
+    # -- the solution ----------------------------------------------------------------------------
+    def update(self, scene: Scene | None = None) -> None:
+        """Take `scene` (or the scene changed in place): the hemicubes are drawn again only if
+        its elements moved; the equation is solved again if anything but the camera changed."""
+        self._check_alive()
+        if scene is not None:
+            self.scene = scene
+        activate(self.ctx)
+        elements = elements_for(self.scene, self.options)
+        change = what_changed(self.solution, elements)
+        if change == "nothing":
+            return
+        if change == "materials":
+            self.solution = solve(elements, self.options, matrix=self.solution.form_factors)
+        else:
+            memory.check_radiosity(len(elements), self.options.hemicube, "gpu", self.scene.name)
+            buffers = ItemBuffers(self.ctx, elements, self.options.hemicube)
+            try:
+                self.solution = solve(elements, self.options, buffers.draw, buffers.batch)
+            finally:
+                buffers.release()
+            self.form_factor_draws += 1
+        self.solves += 1
+        self._upload_mesh()
+
+    def _upload_mesh(self, origin=None) -> None:
+        """The elements' corners relative to the camera's `origin` (the frame's) and their values."""
+        for thing in self._mesh:
+            thing.release()
+        self._mesh = []
+        origin = self.scene.matrices(self.width, self.height).origin if origin is None else origin
+        self._origin = np.array(origin, np.float64)
+        solution = self.solution
+        data = np.concatenate([(solution.elements.corners - origin).reshape(-1, 3),
+                               solution.corner_radiosity.reshape(-1, 3)], axis=1).astype(np.float32)
+        if len(data):
+            vbo = self.ctx.buffer(data.tobytes())
+            vao = self.ctx.vertex_array(self.program, [(vbo, "3f 3f", "in_position", "in_radiosity")])
+            self._mesh = [vao, vbo]
+
+    # -- frames ----------------------------------------------------------------------------------
+    def render(self, out: Frame | None = None, *, linear: bool = True, depth: bool = True,
+               progress=None) -> Frame:
+        """The elements drawn from the scene's camera: rgba8, linear (alpha the coverage) and
+        view depth, row 0 at the top, into `out`'s arrays when given."""
+        self._check_alive()
+        start = time.perf_counter()
+        activate(self.ctx)
+        ctx = self.ctx
+        matrices = self.scene.matrices(self.width, self.height)
+        mapping = depth_mapping(self.scene.camera.reversed_z)
+        if mapping is not STANDARD_DEPTH and self._clip_control is None:
+            raise ContextError("reversed_z needs glClipControl (OpenGL 4.5 or ARB_clip_control), "
+                               "which this GL does not have")
+        if not np.array_equal(matrices.origin, self._origin):     # the camera moved
+            self._upload_mesh(matrices.origin)
+        background = tuple(float(c) for c in self.scene.background)
+        self._fbo.use()
+        ctx.viewport = (0, 0, self.width, self.height)
+        self._fbo.clear(*background, 0.0, depth=mapping.clear_depth)
+        if self._mesh:
+            ctx.enable_only(moderngl.DEPTH_TEST)
+            ctx.depth_func = mapping.depth_func
+            ctx.wireframe = False
+            self.program["u_view"].write(to_glsl(matrices.view))
+            self.program["u_projection"].write(to_glsl(matrices.projection))
+            if mapping is not STANDARD_DEPTH:
+                self._clip_control(GL_LOWER_LEFT, mapping.clip_control)
+            try:
+                self._mesh[0].render(moderngl.TRIANGLES)
+            finally:                                  # GL's defaults back for whoever draws next
+                if mapping is not STANDARD_DEPTH:
+                    self._clip_control(GL_LOWER_LEFT, STANDARD_DEPTH.clip_control)
+                ctx.depth_func = STANDARD_DEPTH.depth_func
+                ctx.disable(moderngl.DEPTH_TEST)
+        h, w = self.height, self.width
+        colour = np.frombuffer(self._fbo.read(components=4, attachment=0, dtype="f4"), np.float32)
+        colour = flip_into(colour.reshape(h, w, 4), None if out is None else out.linear)
+        view_depth = np.frombuffer(self._fbo.read(components=1, attachment=1, dtype="f4"), np.float32)
+        view_depth = flip_into(view_depth.reshape(h, w), None if out is None else out.depth)
+        drawn = colour[..., 3] > 0
+        view_depth[~drawn] = np.inf
+        rgba8 = to_unorm8(colour)
+        if progress is not None:
+            progress(h, h)
+        return Frame(rgba8, colour if linear else None, view_depth if depth else None,
+                     (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info)
+
+    def resize(self, width: int, height: int) -> None:
+        self._check_alive()
+        activate(self.ctx)
+        self.width, self.height = image_size(width, height)
+        self._release_targets()
+        self._build_targets()
+        self._upload_mesh()                        # camera-relative to the new size's origin
+
+    def _free(self) -> None:
+        try:
+            for thing in (*self._mesh, *reversed(self._resources)):
+                thing.release()
+            if getattr(self, "_fbo", None) is not None:
+                self._release_targets()
+        finally:
+            self._resources, self._mesh, self._fbo = [], [], None
+

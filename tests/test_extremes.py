@@ -21,8 +21,9 @@ from renderer.core import transforms as tf
 from renderer.checks.compare import compare_frames, depth_tie_pixels
 from renderer.gpu.context import activate, gl_function
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.study.extremes import (RAYTRACE_DEPTHS, RAYTRACE_SAMPLING, STABILITY, case_state,
-                                     extreme_scenes, is_finite_frame, is_ray_traced, measure_ray_traced)
+from renderer.study.extremes import (RADIOSITY_OPTIONS, RAYTRACE_DEPTHS, RAYTRACE_SAMPLING, STABILITY,
+                                     case_state, extreme_scenes, is_finite_frame, is_ray_traced,
+                                     measure_radiosity, measure_ray_traced, method_of)
 from renderer.core.gl_rules import GL_NEGATIVE_ONE_TO_ONE
 from renderer.gpu import GpuRenderer
 from renderer.core.primitives import plane
@@ -35,8 +36,9 @@ from reference.sampler import sample
 
 SIZE = (160, 120)
 REFUSED = ("nan_mesh",)
-RENDERED = sorted(name for name in extreme_scenes() if name not in REFUSED and not is_ray_traced(name))
+RENDERED = sorted(name for name in extreme_scenes() if name not in REFUSED and method_of(name) == "raster")
 RAY_TRACED = sorted(name for name in extreme_scenes() if is_ray_traced(name))
+RADIATED = sorted(name for name in extreme_scenes() if method_of(name) == "radiosity")
 GL_CLIP_DEPTH_MODE = 0x935D
 
 
@@ -306,6 +308,36 @@ def test_extreme_scene_is_finite_and_matches_the_reference(name, context_kind, g
                              reference_tie=expected.rgba8_tie).as_dict()
     assert PIPELINE_TOLERANCE.passes(figures), PIPELINE_TOLERANCE.failures(figures)
     assert (frame.rgba8[..., 3] == 255).mean() > 0.005        # something was drawn
+
+
+# -- radiosity's extreme cases (issue 33) -------------------------------------------------------
+
+def test_radiosity_extreme_cases_are_the_issues():
+    """Issue 33's list: rho near 1 in a closed room (stiff), tiny elements beside huge ones, an
+    emitter inside a closed box, grazing element pairs, coincident surfaces."""
+    assert RADIATED == ["rad_coincident", "rad_emitter_in_closed_box", "rad_grazing_pair",
+                        "rad_stiff_furnace", "rad_tiny_beside_huge"]
+    assert {o.material.kd[0] for o in extreme_scene("rad_stiff_furnace").objects} == {0.999}
+
+
+@pytest.mark.parametrize("name", [n if n == "rad_stiff_furnace" else pytest.param(n, marks=pytest.mark.slow)
+                                  for n in RADIATED])
+def test_radiosity_extreme_case_is_finite_converged_and_within_tolerance(name, gl_contexts):
+    from renderer.core.radiosity_options import RadiosityOptions
+    case = measure_radiosity(extreme_scene(name), SIZE, gl_contexts,
+                             RADIOSITY_OPTIONS.get(name, RadiosityOptions()))
+    assert case["passes"], (case["finite"], case["converged"], case["worst"])
+    assert case["residual"] < 1e-5
+    if name == "rad_stiff_furnace":                     # about rho^-2 sweeps to gain each factor e
+        assert case["same_form_factors"] and case["iterations"] > 5000
+
+
+def test_the_stiff_furnace_shows_1000_e(gl_contexts):
+    from renderer.methods import open_renderer
+    with open_renderer(extreme_scene("rad_stiff_furnace"), (32, 24), method="radiosity",
+                       options=RADIOSITY_OPTIONS["rad_stiff_furnace"], context=gl_contexts["egl"]) as r:
+        frame = r.render(linear=True)
+    assert np.abs(frame.linear[..., :3] / 0.4 - 1).max() < 1e-5
 
 
 def test_the_pipeline_tolerance_at_its_limits():

@@ -2,7 +2,7 @@
 rendered on the GPU (renderer/gpu/radiosity.py) and by the twin (reference/radiosity/), held to
 what the two do not share and to each other.
 
-By hand: the white furnace's image is E / (1 - rho) = 0.5 in every pixel; the facing plates'
+By hand: the white furnace's image is E / (1 - rho) = 0.4 in every pixel; the facing plates'
 white plate has a mean radiosity of rho E F, F Howell's C-11. GPU against twin: the Cornell box
 within the pipeline tolerance with 0 mismatched pixels (at 320 x 240, every radiosity scene, on
 EGL and OSMesa, in the full run). The solution is kept while only the camera moves."""
@@ -43,9 +43,8 @@ def test_the_furnace_shows_e_over_one_minus_rho_in_every_pixel(gl_contexts, kind
     options = RadiosityOptions(element_size=0.5, hemicube=16)
     gpu, twin = both("radiosity_furnace", (64, 48), options, kind, gl_contexts)
     for frame in (gpu, twin):
-        drawn = frame.rgba8[..., 3] == 255
-        assert drawn.mean() > 0.2
-        assert np.abs(frame.linear[drawn][:, :3] - 0.5).max() < 1e-6
+        assert (frame.rgba8[..., 3] == 255).all()                    # the camera is inside the room
+        assert np.abs(frame.linear[..., :3] - 0.4).max() < 1e-6
 
 
 def test_the_white_plate_gets_rho_e_times_c11(gl_contexts):

@@ -33,9 +33,12 @@ BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_p
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera, a ground under it), or a backdrop (tir_bubble's checkerboard) filling
 # the view.
-PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room", "checker_horizon", "shadow_boxes",
+PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room", "checker_horizon", "shadow_boxes", "radiosity_furnace",
                   "shadow_big_floor"}
 IMAGE_SIZES = [(640, 480), (320, 240)]
+# Objects out of view by design: the wall behind a camera inside a closed room (the white
+# furnace: closed, so that B = E / (1 - rho) holds).
+BEHIND_THE_CAMERA = {("radiosity_furnace", "front")}
 
 OBJ_TRIANGLE = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"
 
@@ -107,6 +110,9 @@ def test_every_object_of_a_builtin_scene_is_in_view(name, size):
     shapes = {obj.name: obj.shape for obj in scene.objects}
     for obj_name, clip, vertex_count in clip_coordinates(scene, *size):
         inside = inside_clip_volume(clip)
+        if (name, obj_name) in BEHIND_THE_CAMERA:
+            assert not inside.any(), f"{name}: {obj_name} is in view"
+            continue
         assert inside.any(), f"{name}: {obj_name} is out of view"
         # A plane is infinite: its square (renderer/core/shapes.py) reaches out of view by design.
         if name not in PARTLY_OUTSIDE and not isinstance(shapes[obj_name], Plane):

@@ -5,7 +5,8 @@ it: each element's corners camera-relative through V then P (the frame's matrice
 (reference/clipping.py), rasterised with the reference's snapping and fill rule
 (reference/rasterizer.py), depth-tested with the camera's depth mapping, no culling, in element
 order (reference/depth_buffer.py); the winner's colour is its corners' radiosity interpolated
-perspective-correct, alpha 1, and its view depth -z_eye likewise; the background elsewhere
+perspective-correct where its front is seen (counter-clockwise in the window), black where its
+back is, alpha 1, and its view depth -z_eye likewise; the background elsewhere
 (reference/framebuffer.py). Where two elements are closer in depth than GL can order, the
 runner-up's colour goes beside the winner's (Frame.rgba8_tie), as the rasteriser's twin does.
 
@@ -31,6 +32,7 @@ def _colour(values, view_depth, payload, which, dtype):
     """(colour (P, 4), view depth (P,)) of the fragments recorded in `payload` at pixels `which`."""
     source, weights = payload["triangle"][which], payload["weights"][which].astype(dtype)
     rgb = np.einsum("pk,pkc->pc", weights, values[source].astype(dtype))
+    rgb = np.where(payload["front"][which][:, None], rgb, 0)       # a back seen is black
     colour = np.concatenate([rgb, np.ones((len(which), 1), dtype)], axis=1)
     return colour, np.einsum("pk,pk->p", weights, view_depth[source].astype(dtype))
 
@@ -61,7 +63,7 @@ def render(corners, values, scene, width: int, height: int, *, dtype=np.float64,
             b, cw = fragments.barycentric, clip_weights[t]
             weights = b[:, 0:1] * cw[:, 0] + b[:, 1:2] * cw[:, 1] + b[:, 2:3] * cw[:, 2]
             buffer.test_and_write(fragments.y * width + fragments.x, fragments.z_w, source[t],
-                                  triangle=source[t], weights=weights)
+                                  triangle=source[t], weights=weights, front=fragments.gl_FrontFacing)
     drawn = buffer.drawn
     colour = np.zeros((width * height, 4), dtype)
     shown_depth = np.full(width * height, np.inf, dtype)

@@ -15,8 +15,11 @@ element's plane: its fragments are discarded (no item, no depth).
 
 Output, `Items`: the items (H, 5, N, N) uint32, faces in hemicube.FACES' order, row 0 at the
 top of each face, and `tied` (H, 5, N, N) bool: pixels whose runner-up fragment is within
-DEPTH_TIE_TOLERANCE (relative, as reversed-Z keeps precision) of the winner, where GL's float32
-arithmetic may keep either (reference/depth_buffer.py).
+DEPTH_TIE_TOLERANCE (relative, as reversed-Z keeps precision) of the winner, or within the
+two fragments' plane slack: llvmpipe sets a triangle's depth plane up and evaluates it in
+float32 from the window origin, off this float64 plane by a few roundings of |z| + |dz/dx| x +
+|dz/dy| y (reference/shadow/depth.py, STORE_TIE_ROUNDINGS), much more than z's own rounding
+for a triangle seen edge on. There GL may keep either.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import numpy as np
 from reference.clipping import clip_triangles
 from reference.depth_buffer import DEPTH_TIE_TOLERANCE
 from reference.rasterizer import coverage, depth_planes, is_front_facing, setup_triangles
+from reference.shadow.depth import STORE_TIE_ROUNDINGS, UNIT_ROUNDOFF32
 from renderer.core.gl_rules import SUBPIXEL_BITS
 from renderer.core.hemicube import FACES, ITEM_BACK_BIT, clip_from_world, depth_range
 
@@ -63,28 +67,35 @@ def draw_hemicube(positions32: np.ndarray, matrices: np.ndarray, resolution: int
     window, source = window.select(keep), clipped.source[keep]
     layer, element = source // elements, source % elements
     x0, y0, z0, dzdx, dzdy = depth_planes(window)
-    pixel_parts, z_parts, t_parts = [], [], []
+    pixel_parts, z_parts, t_parts, slack_parts = [], [], [], []
     horizon = n // 2                                       # glsl's u_horizon
     for t, px, py in coverage(window, n, n):
         above = (layer[t] == 0) | (py >= horizon)          # a side face: its upper half only
         t, px, py = t[above], px[above], py[above]
-        z = z0[t] + dzdx[t] * (px + 0.5 - x0[t]) + dzdy[t] * (py + 0.5 - y0[t])
+        cx, cy = px + 0.5, py + 0.5
+        z = z0[t] + dzdx[t] * (cx - x0[t]) + dzdy[t] * (cy - y0[t])
         pixel_parts.append((layer[t] * n + py) * n + px)
         z_parts.append(np.clip(z, 0.0, 1.0))
         t_parts.append(t)
+        # how far llvmpipe's float32 plane, set up and evaluated from the window origin, may lie
+        # from this one (reference/shadow/depth.py's STORE_TIE_ROUNDINGS)
+        slack_parts.append(STORE_TIE_ROUNDINGS * UNIT_ROUNDOFF32 * (np.abs(z) + np.abs(dzdx[t]) * cx
+                                                                      + np.abs(dzdy[t]) * cy))
     items = np.zeros(faces * n * n, np.uint32)
     tied = np.zeros(faces * n * n, bool)
-    pixel, z, t = (np.concatenate(p) if p else np.zeros(0) for p in (pixel_parts, z_parts, t_parts))
+    pixel, z, t, slack = (np.concatenate(p) if p else np.zeros(0)
+                          for p in (pixel_parts, z_parts, t_parts, slack_parts))
     if len(pixel):
         order = np.lexsort((t, -z, pixel))                 # nearest (largest z_w) first, then drawn first
-        pixel, z, t = pixel[order], z[order], t[order]
+        pixel, z, t, slack = pixel[order], z[order], t[order], slack[order]
         first = np.flatnonzero(np.r_[True, pixel[1:] != pixel[:-1]])
         winner = t[first]
         items[pixel[first]] = ((element[winner] + 1).astype(np.uint32)
                                | np.where(is_front_facing(window.area2[winner]), 0, ITEM_BACK_BIT).astype(np.uint32))
         has_second = np.r_[first[1:], len(pixel)] - first > 1
         second = np.minimum(first + 1, len(pixel) - 1)
-        close = has_second & (z[first] - z[second] <= DEPTH_TIE_TOLERANCE * np.abs(z[first]))
+        close = has_second & (z[first] - z[second] <= np.maximum(DEPTH_TIE_TOLERANCE * np.abs(z[first]),
+                                                                 slack[first] + slack[second]))
         tied[pixel[first][close]] = True
     shape = (faces, n, n)
     return items.reshape(shape)[:, ::-1], tied.reshape(shape)[:, ::-1]      # GL rows to row 0 top

@@ -19,9 +19,9 @@ def add_parser(sub) -> None:
                           help="image size in pixels (default 320x240)")
     extremes.add_argument("--context", choices=("both", "egl", "osmesa"), default="both",
                           help="GL contexts to render with (default: both)")
-    extremes.add_argument("--method", choices=("both", "raster", "raytrace"), default="both",
-                          help="which cases: rasterised, ray traced (scene files named rt_*), or "
-                               "both (default)")
+    extremes.add_argument("--method", choices=("both", "raster", "raytrace", "radiosity"), default="both",
+                          help="which cases: rasterised, ray traced (scene files named rt_*), "
+                               "radiosity's (named rad_*), or every kind (both, the default)")
     extremes.add_argument("--no-sweep", action="store_true",
                           help="leave out the light-elevation sweep of shadow maps (measured "
                                "with the rasterised cases otherwise)")

@@ -183,21 +183,24 @@ RADIOSITY_BATCH_BYTES = 64 * MIB
 RADIOSITY_BYTES_PER_ELEMENT = 512
 
 
-def radiosity_bytes(elements: int, resolution: int, backend: str) -> int:
+def radiosity_bytes(elements: int, resolution: int, backend: str, direct: bool = False) -> int:
     """The form factors of `elements` elements at hemicube resolution `resolution`: the
-    matrix at its largest and drawing it, on `backend` ("gpu" or "reference")."""
+    matrix at its largest and drawing it, on `backend` ("gpu" or "reference"); with `direct`,
+    the direct solver's dense matrix and system beside it (16 bytes an element pair)."""
     pixels = 5 * resolution * resolution
     per_row = min(elements, 3 * resolution * resolution)
     batch = max(1, RADIOSITY_BATCH_BYTES // (8 * pixels))
     drawing = (min(batch, elements) * pixels * 48 + RADIOSITY_BATCH_BYTES if backend == "gpu"
                else pixels * 160)
-    return elements * per_row * 32 + drawing + elements * RADIOSITY_BYTES_PER_ELEMENT
+    dense = 16 * elements * elements if direct else 0
+    return elements * per_row * 32 + drawing + elements * RADIOSITY_BYTES_PER_ELEMENT + dense
 
 
-def check_radiosity(elements: int, resolution: int, backend: str, name: str) -> None:
+def check_radiosity(elements: int, resolution: int, backend: str, name: str, direct: bool = False) -> None:
     """One line (a UserError) before any hemicube is drawn when the form factors of
-    `elements` elements would need more than the limit."""
-    check(radiosity_bytes(elements, resolution, backend),
+    `elements` elements (and with `direct`, the direct solver's dense system) would need more
+    than the limit."""
+    check(radiosity_bytes(elements, resolution, backend, direct),
           f"radiosity of {name} ({elements:,} elements, hemicubes of {resolution}) on {backend}")
 
 

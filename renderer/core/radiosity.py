@@ -30,7 +30,7 @@ from renderer.core.form_factors import FormFactors, form_factors
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE
 from renderer.core.radiosity_elements import Elements, scene_elements
 from renderer.core.radiosity_options import RadiosityOptions
-from renderer.core.radiosity_solve import Solution, gauss_seidel, progressive
+from renderer.core.radiosity_solve import Solution, direct, gauss_seidel, progressive
 
 # Element corners closer than this fraction of the scene's diagonal are one point of the
 # display's mesh (corners of neighbouring source triangles are computed apart and may differ
@@ -93,6 +93,8 @@ def solve(elements: Elements, options: RadiosityOptions, draw: Callable[[np.ndar
     if options.solver == "gauss-seidel":
         solution = gauss_seidel(matrix, elements.reflectance, elements.emission,
                                 tolerance=options.tolerance, **limit)
+    elif options.solver == "direct":
+        solution = direct(matrix, elements.reflectance, elements.emission)
     else:
         solution = progressive(matrix, elements.areas, elements.reflectance, elements.emission,
                                tolerance=options.tolerance, **limit)

@@ -11,7 +11,7 @@ from typing import ClassVar
 
 from renderer.errors import OptionError
 
-SOLVERS = ("gauss-seidel", "progressive")
+SOLVERS = ("gauss-seidel", "progressive", "direct")
 MAX_HEMICUBE = 1024
 # Without an element size the scene's bounding box's diagonal is cut in this many.
 DEFAULT_ELEMENTS_ACROSS = 12

@@ -8,8 +8,8 @@ with the last ones and draws the hemicubes again only when the geometry changed;
 reflectances or emissions re-solve with the same form factors (`solves`, `form_factor_draws`
 count each). Frames: RGBA32F colour and R32F view depth, read back row 0 at the top; GL's
 standard depth test (or reversed-Z's, with glClipControl, as the camera says), no culling
-(elements are seen from either side; their back is as bright as their front, as the display
-of a one-sided solution usually is).
+(an element's back hides what is behind it, and shows black: elements reflect and emit from
+their front only).
 
 Twin: reference/radiosity/display.py (with reference/radiosity/item_buffer.py).
 """
@@ -92,7 +92,8 @@ class RadiosityRenderer(ContextRenderer):
         if change == "materials":
             self.solution = solve(elements, self.options, matrix=self.solution.form_factors)
         else:
-            memory.check_radiosity(len(elements), self.options.hemicube, "gpu", self.scene.name)
+            memory.check_radiosity(len(elements), self.options.hemicube, "gpu", self.scene.name,
+                                   direct=self.options.solver == "direct")
             buffers = ItemBuffers(self.ctx, elements, self.options.hemicube)
             try:
                 self.solution = solve(elements, self.options, buffers.draw, buffers.batch)

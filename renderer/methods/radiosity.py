@@ -36,7 +36,8 @@ class ReferenceRadiosity(ReferenceRenderer):
             if change == "materials":
                 self._solution = solve(elements, self.options, matrix=self._solution.form_factors)
             elif change == "geometry":
-                memory.check_radiosity(len(elements), self.options.hemicube, "reference", self.scene.name)
+                memory.check_radiosity(len(elements), self.options.hemicube, "reference", self.scene.name,
+                                       direct=self.options.solver == "direct")
                 n = self.options.hemicube
                 self._solution = solve(elements, self.options, lambda ix: draw(elements, n, ix).items, 16)
             self._stale = False

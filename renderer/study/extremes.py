@@ -18,6 +18,11 @@ ray (renderer/checks/compare.py, grazing_ray_pixels) either one's colour and dep
 accepted, as at the rasteriser's depth ties. Ray-traced cases are not rasterised: the
 rasteriser draws their spheres and planes as tessellations, whose extremes are the rasteriser
 cases' own.
+
+A scene file whose name starts with `rad_` is drawn by radiosity (RadiosityRenderer on each
+context against the twin in float64, RADIOSITY_OPTIONS or the defaults): it passes when
+nothing is NaN or Inf, the solver converged, and every frame meets the pipeline tolerance;
+its figures say whether the GPU's form factors were the twin's exactly, and its residual.
 """
 
 from __future__ import annotations
@@ -32,6 +37,8 @@ from renderer.core.builtin import assets_dir, scene_description
 from renderer.checks.compare import compare_frames, depth_tie_pixels, either_precision
 from renderer.checks.tolerance import PIPELINE_TOLERANCE as TOLERANCE
 from renderer.core.ray_depth import DEFAULT_MAX_DEPTH
+from renderer.core.radiosity_options import RadiosityOptions
+from renderer.core.radiosity_solve import residual
 from renderer.core.ray_options import RayOptions
 from renderer.errors import SceneError
 from renderer.methods import open_renderer
@@ -115,6 +122,26 @@ STABILITY = {
                 "level's size (as llvmpipe); mirror takes the float path; the mip chain's "
                 "fractional box weights are the same uploaded levels for both",
     # ray traced (docs/conventions.md, "Rays")
+    "rad_stiff_furnace": "the delta form factors are scaled to sum to exactly 1, so a closed room's "
+                         "rows sum to 1 within 1e-15 and B = E / (1 - rho) holds at rho = 0.999 "
+                         "(a sensitivity of 1e-15 / (1 - rho)); Gauss-Seidel sweeps until its "
+                         "largest change is 1e-6 of E (about 7,000 sweeps); the direct solver is "
+                         "exact in one",
+    "rad_tiny_beside_huge": "reversed-Z hemicubes (float32 depth keeps 1e-7 relative precision at "
+                            "every distance) with the near plane 1e-3 of the shortest element "
+                            "edge and the far plane beyond every element: finite, GPU = twin. "
+                            "Not accurate: the huge elements' hemicubes see the tile through no "
+                            "pixel centre (it is smaller than a pixel), so its light is lost; "
+                            "finer elements or hemicubes are the remedy",
+    "rad_emitter_in_closed_box": "an element emits and reflects from its front only: its back "
+                                 "passes nothing on in the item buffers and is drawn black",
+    "rad_grazing_pair": "a neighbour below an element's plane is clipped at the near plane or "
+                        "falls below a side face's horizon (discarded): the delta form factors "
+                        "weigh z / (pi r^4), finite at every angle",
+    "rad_coincident": "coplanar surfaces: the twin keeps the first drawn of equal depths as GL "
+                      "does and flags as ties the pixels where GL's float32 depth planes may "
+                      "order the two either way; the form factors then differ there (z-fighting "
+                      "in the hemicubes), the images stay within the tolerance",
     "rt_coplanar": "hit ties: a surface replaces the nearest hit only when nearer by more than "
                    "2^-18 relative, so the plane, found first, shows wherever the triangle lies "
                    "in it; rays leaving it start at s > 2^-18 |O| and skip it",
@@ -166,11 +193,26 @@ RAYTRACE_DEPTHS = {"rt_mirrors": (0, 64)}
 RAYTRACE_SAMPLING = {"rt_huge_aperture": (4, "jittered"), "rt_fast_motion": (4, "regular"),
                      "rt_huge_area_light": (4, "jittered"), "rt_glossy_exponents": (4, "jittered")}
 RAY_TRACED_PREFIX = "rt_"
+# A scene file whose name starts with this is drawn by radiosity (`--method radiosity`), each
+# GPU context's frame against the twin's (reference/radiosity/, float64), with the options of
+# RADIOSITY_OPTIONS or the defaults.
+RADIOSITY_PREFIX = "rad_"
+RADIOSITY_OPTIONS = {
+    # rho = 0.999 needs about 7,000 Gauss-Seidel sweeps: 48 elements keep them to seconds
+    "rad_stiff_furnace": RadiosityOptions(element_size=1.0, hemicube=16, max_iterations=20000),
+}
 
 
 def is_ray_traced(name: str) -> bool:
     """Whether the extreme scene file `name` (its stem) is ray traced (module docstring)."""
     return name.startswith(RAY_TRACED_PREFIX)
+
+
+def method_of(name: str) -> str:
+    """The method that draws the extreme scene file `name` (its stem): by its prefix."""
+    if is_ray_traced(name):
+        return "raytrace"
+    return "radiosity" if name.startswith(RADIOSITY_PREFIX) else "raster"
 
 
 def extreme_scenes(extra=()) -> dict[str, Path]:
@@ -245,20 +287,54 @@ def measure_ray_traced(scene, size: tuple[int, int], contexts: dict,
             "passes": all(finite.values()) and all(TOLERANCE.passes(c) for c in per_context.values())}
 
 
+def measure_radiosity(scene, size: tuple[int, int], contexts: dict, options: RadiosityOptions) -> dict:
+    """Figures of one radiosity scene, as measure_scene: each GPU context's frame against the
+    twin's in float64 (depth ties accepted either way), whether the GPU's form factors are the
+    twin's exactly (identical item buffers), and the solution's elements, iterations,
+    convergence and residual (the whole residual, max |E + rho F B - B|)."""
+    gpu_frames, matrices = {}, {}
+    for kind, ctx in contexts.items():
+        with open_renderer(scene, size, method="radiosity", options=options, context=ctx) as gpu:
+            gpu_frames[kind] = gpu.render(linear=True, depth=True)
+            matrices[kind] = gpu.solution.form_factors
+    with open_renderer(scene, size, method="radiosity", options=options, backend="reference",
+                       precision="float64") as twin:
+        truth = twin.render(linear=True)
+        solved = twin.solution
+    finite = {kind: is_finite_frame(frame) for kind, frame in gpu_frames.items()}
+    finite["reference"] = is_finite_frame(truth) and bool(np.isfinite(solved.solution.radiosity).all())
+    per_context = {kind: compare_frames(frame.rgba8, truth.rgba8, frame.depth, truth.depth,
+                                        reference_tie=truth.rgba8_tie).as_dict()
+                   for kind, frame in gpu_frames.items()}
+    against_truth = {kind: compare_frames(frame.rgba8, truth.rgba8).as_dict()
+                     for kind, frame in gpu_frames.items()}
+    same = all(all(np.array_equal(getattr(m, name), getattr(solved.form_factors, name))
+                   for name in ("indptr", "columns", "values")) for m in matrices.values())
+    e = solved.elements
+    whole = residual(solved.form_factors, e.reflectance, e.emission, solved.solution.radiosity)
+    return {"finite": finite, "tie_pixels": depth_tie_pixels(truth),
+            "contexts": per_context, "worst": _worst(per_context),
+            "truth": against_truth, "worst_truth": _worst(against_truth),
+            "elements": len(e), "same_form_factors": same, "iterations": solved.solution.iterations,
+            "converged": solved.solution.converged, "residual": whole,
+            "passes": (all(finite.values()) and solved.solution.converged
+                       and all(TOLERANCE.passes(c) for c in per_context.values()))}
+
+
 def _worst(comparisons: dict) -> dict:
     return max(comparisons.values(), key=lambda c: (c["mismatched_pixels"],
                                                     c["raw_mismatched_fraction"], c["rmse"]))
 
 
 def measure_extremes(scenes: dict[str, Path], size: tuple[int, int], contexts: dict,
-                     methods=("raster", "raytrace"), on_case=None) -> list[dict]:
+                     methods=("raster", "raytrace", "radiosity"), on_case=None) -> list[dict]:
     """One case per scene (two for a reversed-Z scene: as authored, and with it off; one per
     depth of RAYTRACE_DEPTHS for a ray-traced one), of the scenes whose method is in
     `methods`; `on_case(case)`, if given, as each is measured (a command's progress)."""
     cases = []
     for name, path in scenes.items():
         measured = len(cases)
-        method = "raytrace" if is_ray_traced(name) else "raster"
+        method = method_of(name)
         if method not in methods:
             continue
         base = {"case": name, "file": str(path), "method": method,
@@ -314,8 +390,14 @@ def _raster_cases(name: str, scene, base: dict, size, contexts) -> list[dict]:
     return cases
 
 
+def _radiosity_cases(name: str, scene, base: dict, size, contexts) -> list[dict]:
+    """One case, with the scene's RADIOSITY_OPTIONS or the defaults."""
+    options = RADIOSITY_OPTIONS.get(name, RadiosityOptions())
+    return [base | {"options": options.as_dict()} | measure_radiosity(scene, size, contexts, options)]
+
+
 # Each method's cases, by the name renderer/methods registers it under.
-CASES = {"raster": _raster_cases, "raytrace": _ray_cases}
+CASES = {"raster": _raster_cases, "raytrace": _ray_cases, "radiosity": _radiosity_cases}
 
 
 # -------------------------------------------------------------------------- the report

@@ -381,8 +381,8 @@ def test_renderer_extremes_writes_the_json_and_the_table(tmp_path, cli):
     table = (tmp_path / "extremes.md").read_text()
     cases = {case["case"]: case for case in document["cases"]}
     reversed_scenes = [n for n in RENDERED if extreme_scene(n).camera.reversed_z]
-    assert set(cases) == (set(extreme_scenes()) - set(RAY_TRACED)) | {f"{n} (reversed_z off)"
-                                                                      for n in reversed_scenes}
+    assert set(cases) == (set(extreme_scenes()) - set(RAY_TRACED) - set(RADIATED)) | {
+        f"{n} (reversed_z off)" for n in reversed_scenes}
     for name, case in cases.items():
         assert f"| {name} |" in table
         if name in REFUSED:
@@ -421,6 +421,19 @@ def test_renderer_extremes_ray_traces_the_rt_scenes(tmp_path, cli):
         assert case["method"] == "raytrace" and case["passes"] and all(case["finite"].values()), name
         assert f"| {name} | raytrace |" in (tmp_path / "extremes.md").read_text()
     assert cases["rt_grazing_sphere"]["grazing_pixels"] > 0 and cases["rt_tiny_sphere"]["grazing_pixels"] == 0
+
+
+@pytest.mark.slow
+def test_renderer_extremes_draws_the_rad_scenes_by_radiosity(tmp_path, cli):
+    result = cli("extremes", "--out", str(tmp_path), "--size", "64x48", "--context", "egl",
+                 "--method", "radiosity")
+    assert result.returncode == 0, result.stdout + result.stderr
+    cases = {case["case"]: case for case in json.loads((tmp_path / "extremes.json").read_text())["cases"]}
+    assert set(cases) == set(RADIATED)
+    for name, case in cases.items():
+        assert case["method"] == "radiosity" and case["passes"] and case["converged"], name
+        assert f"| {name} | radiosity |" in (tmp_path / "extremes.md").read_text()
+    assert cases["rad_stiff_furnace"]["same_form_factors"]
 
 
 # -- shadow maps ----------------------------------------------------------------------------------

@@ -139,13 +139,6 @@ def test_a_new_method_is_one_registration(monkeypatch, sphere_scene):
 
 @pytest.fixture
 def sphere_scene():
-    """The built-in sphere scene with a coarser sphere (16 x 8, 224 triangles): radiosity draws
-    a hemicube per element over every element (its twin's 3,968 would take a minute)."""
-    import dataclasses
-
     from renderer.core.builtin import resolve_scene
-    from renderer.core.primitives import uv_sphere
     from renderer.core.scene_file import load_scene
-    scene = load_scene(resolve_scene("sphere"))
-    scene.objects[0] = dataclasses.replace(scene.objects[0], mesh=uv_sphere(1.0, 16, 8))
-    return scene
+    return load_scene(resolve_scene("sphere"))

@@ -152,3 +152,29 @@ def test_the_command_line_renders_radiosity_and_refuses_in_one_line(cli, tmp_pat
     assert big.returncode == 2 and not (tmp_path / "big.png").exists()
     assert len(big.stderr.strip().splitlines()) == 1 and "radiosity of cornell_box_radiosity (" in big.stderr
     assert "over the limit of 2.0 GiB" in big.stderr
+
+
+def test_a_scene_where_light_does_not_bounce_draws_no_hemicube(gl_contexts):
+    """The rule of leaving out what a scene does not need: with nothing emitting, or nothing
+    reflecting, B = E exactly and no hemicube is drawn; once light can bounce, they are."""
+    options = RadiosityOptions(element_size=0.25, hemicube=16)
+    plates = scene("radiosity_plates")
+    plates.objects[1].material.kd = (0.0, 0.0, 0.0)               # nothing reflects
+    with open_renderer(plates, (32, 24), method="radiosity", options=options,
+                       context=gl_contexts["egl"]) as renderer:
+        frame = renderer.render(linear=True)
+        assert renderer.form_factor_draws == 0 and not renderer.solution.form_factors.drawn
+        b, e = renderer.solution.solution.radiosity, renderer.solution.elements.emission
+        assert np.array_equal(b, e)
+        assert frame.rgba8[..., 3].any()
+        plates.objects[1].material.kd = (0.8, 0.8, 0.8)           # now it does
+        renderer.update(plates)
+        assert renderer.form_factor_draws == 1 and renderer.solution.form_factors.drawn
+        white = renderer.solution.elements.obj == 1
+        assert (renderer.solution.solution.radiosity[white] > 0).all()
+    with open_renderer(scene("sphere"), (16, 12), method="radiosity", options=options,
+                       backend="reference") as twin:                 # nothing emits: black
+        frame = twin.render(linear=True)
+        assert twin.solution.form_factors.drawn is False
+        drawn = frame.rgba8[..., 3] == 255
+        assert drawn.any() and not frame.linear[drawn][:, :3].any()

@@ -32,6 +32,14 @@ class FormFactors:
     values: np.ndarray           # (nnz,) float64
     unseen: np.ndarray           # (E,) float64
     backs: np.ndarray            # (E,) float64
+    drawn: bool = True           # False: none drawn, the scene needing none (FormFactors.none)
+
+    @classmethod
+    def none(cls, elements: int) -> "FormFactors":
+        """No pair stored and no hemicube drawn: for a scene where light does not bounce
+        (renderer/core/radiosity.py interreflects), whose solution is B = E."""
+        return cls(np.zeros(elements + 1, np.int64), np.zeros(0, np.int64), np.zeros(0),
+                   np.zeros(elements), np.zeros(elements), drawn=False)
 
     def __len__(self) -> int:
         return len(self.indptr) - 1

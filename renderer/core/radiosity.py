@@ -66,6 +66,13 @@ def elements_for(scene, options: RadiosityOptions) -> Elements:
     return scene_elements(scene, options.size_for(scene_diameter(scene)), emission=emission)
 
 
+def interreflects(elements: Elements) -> bool:
+    """Whether light bounces at all: some element emits and some element reflects. When not,
+    B = E exactly (the light reaching a surface that reflects nothing, or no light at all), and
+    no hemicube is drawn (the rule of leaving out what a scene does not need)."""
+    return bool((elements.emission > 0).any() and (elements.reflectance > 0).any())
+
+
 def what_changed(old: RadiositySolution | None, elements: Elements) -> str:
     """What a new scene's `elements` need, given the solution `old` was made for: "nothing"
     (only the camera moved: the solution stands), "materials" (the same triangles with other
@@ -74,6 +81,8 @@ def what_changed(old: RadiositySolution | None, elements: Elements) -> str:
     if old is None or not (np.array_equal(old.elements.corners, elements.corners)
                            and np.array_equal(old.elements.obj, elements.obj)):
         return "geometry"
+    if not old.form_factors.drawn and interreflects(elements):
+        return "geometry"                     # light bounces now: the hemicubes are needed
     if (np.array_equal(old.elements.reflectance, elements.reflectance)
             and np.array_equal(old.elements.emission, elements.emission)):
         return "nothing"
@@ -86,7 +95,8 @@ def solve(elements: Elements, options: RadiosityOptions, draw: Callable[[np.ndar
     time; or `matrix`, those of the same elements kept from before), the options' solver, the
     corners' display values."""
     if matrix is None:
-        matrix = form_factors(len(elements), options.hemicube, draw, batch)
+        matrix = (form_factors(len(elements), options.hemicube, draw, batch) if interreflects(elements)
+                  else FormFactors.none(len(elements)))
     limit = {} if options.max_iterations is None else (
         {"max_sweeps": options.max_iterations} if options.solver == "gauss-seidel"
         else {"max_shots": options.max_iterations})

@@ -25,7 +25,7 @@ import numpy as np
 from renderer.core import memory
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, depth_mapping, to_unorm8
-from renderer.core.radiosity import RadiositySolution, elements_for, solve, what_changed
+from renderer.core.radiosity import RadiositySolution, elements_for, interreflects, solve, what_changed
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
@@ -91,6 +91,8 @@ class RadiosityRenderer(ContextRenderer):
             return
         if change == "materials":
             self.solution = solve(elements, self.options, matrix=self.solution.form_factors)
+        elif not interreflects(elements):         # B = E: no hemicube drawn
+            self.solution = solve(elements, self.options)
         else:
             memory.check_radiosity(len(elements), self.options.hemicube, "gpu", self.scene.name,
                                    direct=self.options.solver == "direct")

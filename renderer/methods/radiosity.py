@@ -9,7 +9,7 @@ from __future__ import annotations
 from renderer.core import memory
 from renderer.core.frame import Frame
 from renderer.core.memory import Need, raster_need
-from renderer.core.radiosity import elements_for, solve, what_changed
+from renderer.core.radiosity import elements_for, interreflects, solve, what_changed
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
@@ -35,6 +35,8 @@ class ReferenceRadiosity(ReferenceRenderer):
             change = what_changed(self._solution, elements)
             if change == "materials":
                 self._solution = solve(elements, self.options, matrix=self._solution.form_factors)
+            elif change == "geometry" and not interreflects(elements):
+                self._solution = solve(elements, self.options)       # B = E: no hemicube drawn
             elif change == "geometry":
                 memory.check_radiosity(len(elements), self.options.hemicube, "reference", self.scene.name,
                                        direct=self.options.solver == "direct")

@@ -779,7 +779,7 @@ BAD_SCENES = [
      "objects[0].angular_speed: unknown key; did you mean 'angular_velocity'?"),
     ("shadow key on a material", OBJECT + "material = { receives_shadows = false }\n",
      "objects[0].material.receives_shadows: unknown key; known keys here: ka, kd, ks, n, "
-     "two_sided, shading, kr, kt, ior, gloss, texture, emission"),
+     "two_sided, shading, kr, kt, ior, gloss, texture, emission, fresnel"),
     # textures (docs/scene-format.md, "Textures")
     ("texture without a source", OBJECT + "material = { texture = { wrap = \"clamp\" } }\n",
      'objects[0].material.texture: needs image = "FILE" or checker = { ... }'),

@@ -41,6 +41,20 @@ float fresnel_schlick(vec3 D, vec3 N, float eta) {
     return r0 + (1.0 - r0) * (m2 * m2 * m);
 }
 
+// The Fresnel equations for an unpolarised ray at a dielectric boundary, eta = n1 / n2:
+// r_s = (eta cos_i - cos_t) / (eta cos_i + cos_t), r_p = (cos_i - eta cos_t) / (cos_i + eta cos_t),
+// F = (r_s^2 + r_p^2) / 2, cos_t = sqrt(1 - eta^2 (1 - cos_i^2)); F = 1 under total internal
+// reflection.
+float fresnel_exact(vec3 D, vec3 N, float eta) {
+    float c = -dot(D, N);
+    float k = 1.0 - eta * eta * (1.0 - c * c);
+    if (k < 0.0) return 1.0;
+    float t = sqrt(k);
+    float rs = (eta * c - t) / (eta * c + t);
+    float rp = (c - eta * t) / (c + eta * t);
+    return 0.5 * (rs * rs + rp * rp);
+}
+
 // The self-intersection offset of Waechter and Binder, "A Fast and Robust Method for Avoiding
 // Self-Intersection", Ray Tracing Gems ch. 6 (2019): the hit point p moves along the geometric
 // normal n (unit, on the side the new ray leaves to) by int_scale * n units in the last place of

@@ -40,7 +40,7 @@ uniform int u_sphere_object[NUM_SPHERES];
 uniform vec4 u_planes[NUM_PLANES];              // (unit N, d): P.N + d = 0
 uniform int u_plane_object[NUM_PLANES];
 #endif
-uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, gloss), (kt, 0)
+uniform sampler2D u_materials;  // per object: (ka, n), (kd, two-sided), (ks, ior), (kr, gloss), (kt, Fresnel exact)
 
 #ifndef NUM_MOVING_MESHES
 #define NUM_MOVING_MESHES 0
@@ -472,11 +472,12 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
 #ifdef SECONDARY
             if (depth < MAX_DEPTH) {
                 vec3 kr = trace_texel(u_materials, 5 * obj + 3).xyz;
-                vec3 kt = trace_texel(u_materials, 5 * obj + 4).xyz;
+                vec4 m4 = trace_texel(u_materials, 5 * obj + 4);
+                vec3 kt = m4.xyz;
                 vec3 N_in = back ? -Ns : Ns;
                 vec3 Ng_in = back ? -Ng : Ng;
                 float eta = back ? m2.w : 1.0 / m2.w;
-                float F = fresnel_schlick(Du, N_in, eta);
+                float F = m4.w > 0.5 ? fresnel_exact(Du, N_in, eta) : fresnel_schlick(Du, N_in, eta);
                 vec3 w_r = w * (kr + kt * F);
                 vec3 w_t = w * (kt * (1.0 - F));
                 vec3 T;

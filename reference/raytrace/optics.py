@@ -80,6 +80,23 @@ def fresnel_schlick(D, N, eta):
     return np.where(tir, one, r0 + (one - r0) * (m2 * m2 * m)).astype(dtype)
 
 
+def fresnel_exact(D, N, eta):
+    """The Fresnel equations, unpolarised, eta = n1 / n2: (r_s^2 + r_p^2) / 2 with
+    r_s = (eta cos_i - cos_t) / (eta cos_i + cos_t), r_p = (cos_i - eta cos_t) / (cos_i + eta cos_t),
+    1 under total internal reflection."""
+    dtype = _float_dtype(D, N)
+    D, N, eta = _as(dtype, D, N, eta)
+    one, half = dtype.type(1), dtype.type(0.5)
+    c = -_dot(D, N)
+    eta = np.broadcast_to(eta, c.shape)
+    k = one - eta * eta * (one - c * c)
+    t = np.sqrt(np.where(k < 0, 0, k)).astype(dtype)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        rs = (eta * c - t) / (eta * c + t)
+        rp = (c - eta * t) / (c + eta * t)
+    return np.where(k < 0, one, half * (rs * rs + rp * rp)).astype(dtype)
+
+
 def offset_ray_origin(p, n):
     """Waechter and Binder, Ray Tracing Gems ch. 6: p moved along the unit geometric normal n (on
     the side the new ray leaves to) by int(256 n) ulps per coordinate (the float bits as

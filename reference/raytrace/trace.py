@@ -44,7 +44,7 @@ from reference.raytrace.intersect import (MISS, PLANE, SPHERE, TRIANGLE, plane_n
 from reference.raytrace.motion import (motion_at, motion_direction, motion_direction_back,
                                        motion_plane, motion_point, motion_point_back, motion_time)
 from renderer.core.ray_sampling import TIME_DIMENSION
-from reference.raytrace.optics import fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
+from reference.raytrace.optics import fresnel_exact, fresnel_schlick, offset_ray_origin, ray_reflect, ray_refract
 from reference.raytrace.area_lights import AreaDraw, area_light_terms
 from reference.raytrace.glossy import glossy_rays
 from reference.raytrace.textures import texture_modulate
@@ -419,7 +419,8 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
         Ng_in = np.where(back[:, None], -Ng, Ng)
         ior = rs.ior[obj].astype(t)
         eta = np.where(back, ior, t(1) / ior)
-        F = fresnel_schlick(Du, N_in, eta)[:, None]
+        F = np.where(rs.fresnel_exact[obj], fresnel_exact(Du, N_in, eta),
+                     fresnel_schlick(Du, N_in, eta))[:, None]
         kr, kt = rs.kr[obj].astype(t), rs.kt[obj].astype(t)
         w_r = weight * (kr + kt * F)
         w_t = weight * (kt * (t(1) - F))

@@ -55,6 +55,7 @@ class RayScene:
     ior: np.ndarray                  # (M,)
     two_sided: np.ndarray            # (M,) bool
     gloss: np.ndarray                # (M,) lobe exponent, inf: a mirror (Material.gloss_exponent)
+    fresnel_exact: np.ndarray        # (M,) bool: the exact Fresnel equations, else Schlick
     gloss_set: bool = False          # some material sets `gloss` (inf included)
     glossy: bool = False             # some material is glossy (Material.is_glossy: the GLSL's GLOSSY)
     motion: SceneMotion | None = None    # per object; None: no motion code (the still scene)
@@ -143,6 +144,7 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         ka=rows("ka"), kd=rows("kd"), ks=rows("ks"), n=rows("n", 1), kr=rows("kr"), kt=rows("kt"),
         ior=rows("ior", 1), two_sided=np.array([bool(m.two_sided) for m in mats], bool),
         gloss=np.array([m.gloss_exponent for m in mats], np.float64),
+        fresnel_exact=np.array([m.fresnel == "exact" for m in mats], bool),
         gloss_set=any(m.gloss is not None for m in mats),
         glossy=any(m.is_glossy for m in mats),
         motion=scene_motion(scene) if motion else None, mesh_object=mesh_object,

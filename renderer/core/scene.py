@@ -97,6 +97,9 @@ class Material:
     # A texture (renderer/core/textures.py): its texel multiplies the coefficients it names
     # (texture.modulate) before lighting; None: untextured. The object's mesh needs UVs.
     texture: MaterialTexture | None = None
+    # The ray tracer's Fresnel reflectance at a refracting surface: Schlick's approximation
+    # (the notes', the default) or the exact dielectric Fresnel equations (FRESNEL_MODES).
+    fresnel: str = "schlick"
     # Emitted radiosity E (exitance, linear RGB, >= 0): the light a surface gives off itself.
     # Only radiosity reads it (renderer/core/radiosity.py); the rasteriser and the ray tracer
     # light with their lights (docs/scene-format.md).
@@ -127,6 +130,7 @@ class Material:
 
 
 ENERGY_SLACK = 1e-9
+FRESNEL_MODES = ("schlick", "exact")
 
 
 def energy_excess(kr, kt) -> int | None:

@@ -43,7 +43,7 @@ from renderer.core.texture_keys import read_texture
 from renderer.core.shadow_settings import (FILTERS, MAX_BIAS_TEXELS, RESOLUTIONS, BiasRule, Shadow,
                                            auto_bias)
 from renderer.core.textures import MaterialTexture
-from renderer.core.scene import (AREA_SHAPES, SHADING_MODES, Camera, DirectionalLight, LightArea,
+from renderer.core.scene import (AREA_SHAPES, FRESNEL_MODES, SHADING_MODES, Camera, DirectionalLight, LightArea,
                             Material, Mesh, Plane, PointLight, Scene, SceneObject, Sphere,
                             Transform, energy_excess, world_shape)
 
@@ -57,7 +57,7 @@ LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
                *LENS_KEYS, "shutter")
 MATERIAL_KEYS = ("ka", "kd", "ks", "n", "two_sided", "shading", "kr", "kt", "ior", "gloss",
-                 "texture", "emission")
+                 "texture", "emission", "fresnel")
 SHADOW_KEYS = ("shadows", "shadow_resolution", "shadow_filter", "shadow_bias")
 AREA_KEYS = ("area", "size", "radius", "normal")   # a point light's area (LightArea), `area` first
 AREA_SHAPE_KEYS = {"rectangle": ("size", "normal"), "disc": ("radius", "normal"),
@@ -599,6 +599,8 @@ class _Reader(TableReader):
                 setattr(mat, coefficient, self.colour(raw[coefficient], _join(path, coefficient)))
         if "ior" in raw:
             mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
+        if "fresnel" in raw:
+            mat.fresnel = self.choice(raw["fresnel"], _join(path, "fresnel"), "Fresnel mode", FRESNEL_MODES)
         if "gloss" in raw:
             mat.gloss = self.gloss(raw["gloss"], _join(path, "gloss"))
         if "texture" in raw:

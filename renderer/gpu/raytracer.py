@@ -199,10 +199,10 @@ class RayTracer(ContextRenderer):
 
     def _texture_arrays(self, rs) -> dict:
         """The float textures' contents by sampler name (`texels` lays them out)."""
-        zero = np.zeros((len(rs.n), 1))
+        exact = rs.fresnel_exact[:, None].astype(np.float64)
         materials = np.stack([np.concatenate(part, 1) for part in (
             (rs.ka, rs.n[:, None]), (rs.kd, rs.two_sided[:, None].astype(np.float64)),
-            (rs.ks, rs.ior[:, None]), (rs.kr, rs.gloss[:, None]), (rs.kt, zero))], 1)  # (M, 5, 4)
+            (rs.ks, rs.ior[:, None]), (rs.kr, rs.gloss[:, None]), (rs.kt, exact))], 1)  # (M, 5, 4)
         arrays = {"u_materials": materials}
         if self.defines["MESHES"]:
             triangles, normals, owner = rs.triangles, rs.triangle_normals, rs.triangle_object

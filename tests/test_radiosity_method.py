@@ -82,6 +82,7 @@ def twin_frame(name, size):
 
 
 @pytest.mark.slow
+@pytest.mark.xdist_group("radiosity_twin_frames")          # one worker: each twin frame made once
 @pytest.mark.parametrize("kind", ["egl", "osmesa"])
 @pytest.mark.parametrize("name", sorted(RADIOSITY_SCENES))
 def test_every_radiosity_scene_gpu_and_twin_agree_at_320x240(gl_contexts, name, kind):

@@ -76,28 +76,36 @@ LIGHT_WAVELENGTHS = (400, 500, 600, 700)
 LIGHT_EMISSION = (0.0, 8.0, 15.6, 18.4)
 
 
-def reflectance_rgb(values) -> np.ndarray:
-    """Linear sRGB of a reflectance spectrum under D65, the 1931 observer, white = Y 1."""
+def observer():
+    """(wavelengths at 1 nm from 400 to 700, the CIE 1931 2-degree colour matching functions
+    there (W, 3), D65 there (W,)): colour-science's tables."""
     import colour
-    from renderer.core.colour import XYZ_TO_RGB
     shape = colour.SpectralShape(400, 700, 1)
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().align(shape)
-    rho = np.interp(shape.wavelengths, WAVELENGTHS, values)
-    weighted = d65.values[:, None] * cmfs.values
-    xyz = (rho[:, None] * weighted).sum(axis=0) / weighted[:, 1].sum()
-    return XYZ_TO_RGB @ xyz
+    return shape.wavelengths, cmfs.values, d65.values
+
+
+def linear_srgb(spectrum, weights) -> np.ndarray:
+    """Linear sRGB of `spectrum` (W,) seen through the observer with `weights` (W,) on each
+    wavelength, normalised so that a spectrum of 1 has Y = 1."""
+    from renderer.core.colour import XYZ_TO_RGB
+    _, cmfs, _ = observer()
+    weighted = weights[:, None] * cmfs
+    return XYZ_TO_RGB @ ((spectrum[:, None] * weighted).sum(axis=0) / weighted[:, 1].sum())
+
+
+def reflectance_rgb(values) -> np.ndarray:
+    """Linear sRGB of a reflectance spectrum under D65, the 1931 observer, white = Y 1."""
+    wavelengths, _, d65 = observer()
+    return linear_srgb(np.interp(wavelengths, WAVELENGTHS, values), d65)
 
 
 def emission_rgb() -> np.ndarray:
     """Linear sRGB of the light's spectral radiance, a flat spectrum of 1 having Y = 1."""
-    import colour
-    from renderer.core.colour import XYZ_TO_RGB
-    shape = colour.SpectralShape(400, 700, 1)
-    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"].copy().align(shape)
-    radiance = np.interp(shape.wavelengths, LIGHT_WAVELENGTHS, LIGHT_EMISSION)
-    xyz = (radiance[:, None] * cmfs.values).sum(axis=0) / cmfs.values[:, 1].sum()
-    return XYZ_TO_RGB @ xyz
+    wavelengths, _, _ = observer()
+    radiance = np.interp(wavelengths, LIGHT_WAVELENGTHS, LIGHT_EMISSION)
+    return linear_srgb(radiance, np.ones_like(radiance))
 
 
 def ceiling_around_light():

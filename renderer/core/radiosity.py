@@ -26,6 +26,7 @@ from typing import Callable
 
 import numpy as np
 
+from renderer.core import memory
 from renderer.core.form_factors import FormFactors, form_factors
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE
 from renderer.core.radiosity_elements import Elements, scene_elements
@@ -50,20 +51,10 @@ class RadiositySolution:
     corner_radiosity: np.ndarray        # (E, 3, C): each element corner's displayed value
 
 
-def scene_diameter(scene) -> float:
-    """The diagonal of the bounding box of every object's mesh in world coordinates."""
-    points = [np.asarray(o.mesh.positions, np.float64) @ m[:3, :3].T + m[:3, 3]
-              for o, m in zip(scene.objects, scene.world_matrices()) if len(o.mesh.positions)]
-    if not points:
-        return 0.0
-    points = np.concatenate(points)
-    return float(np.linalg.norm(points.max(axis=0) - points.min(axis=0)))
-
-
 def elements_for(scene, options: RadiosityOptions) -> Elements:
     """The scene's elements at the options' size, with the materials' k_d and emission."""
     emission = np.array([o.material.emission for o in scene.objects], np.float64).reshape(-1, 3)
-    return scene_elements(scene, options.size_for(scene_diameter(scene)), emission=emission)
+    return scene_elements(scene, options.size_for, emission=emission)
 
 
 def interreflects(elements: Elements) -> bool:
@@ -87,6 +78,26 @@ def what_changed(old: RadiositySolution | None, elements: Elements) -> str:
             and np.array_equal(old.elements.emission, elements.emission)):
         return "nothing"
     return "materials"
+
+
+def refreshed(old: RadiositySolution | None, elements: Elements, options: RadiosityOptions,
+              open_drawer, backend: str, name: str) -> RadiositySolution | None:
+    """The solution for a scene's new `elements`, or None where `old` stands (what_changed):
+    the same form factors for new materials; B = E without a hemicube where light cannot bounce;
+    else the memory checked (memory.check_radiosity) and the hemicubes drawn by
+    `open_drawer(elements)`, a context manager giving (draw, batch): the GPU's item buffers or
+    the twin's. One rule for both backends."""
+    change = what_changed(old, elements)
+    if change == "nothing":
+        return None
+    if change == "materials":
+        return solve(elements, options, matrix=old.form_factors)
+    if not interreflects(elements):
+        return solve(elements, options)
+    memory.check_radiosity(len(elements), options.hemicube, backend, name,
+                           direct=options.solver == "direct")
+    with open_drawer(elements) as (draw, batch):
+        return solve(elements, options, draw, batch)
 
 
 def solve(elements: Elements, options: RadiosityOptions, draw: Callable[[np.ndarray], np.ndarray] | None = None,

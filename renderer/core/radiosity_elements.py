@@ -22,6 +22,7 @@ not mind, and the display interpolates per vertex of each piece.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -30,6 +31,8 @@ from renderer.core.transforms import normal_matrix
 
 @dataclass(frozen=True)
 class Elements:
+    """The elements (module docstring); their centres, areas and normals computed once, from
+    `corners` (which stay as made)."""
     corners: np.ndarray          # (E, 3, 3) float64 world, counter-clockwise seen from the front
     obj: np.ndarray              # (E,) int64 index of the scene object
     reflectance: np.ndarray      # (E, 3) float64 rho per channel
@@ -38,20 +41,20 @@ class Elements:
     def __len__(self) -> int:
         return len(self.corners)
 
-    @property
+    @cached_property
     def centres(self) -> np.ndarray:
         return self.corners.mean(axis=1)
 
-    @property
+    @cached_property
     def _cross(self) -> np.ndarray:
         a, b, c = self.corners[:, 0], self.corners[:, 1], self.corners[:, 2]
         return np.cross(b - a, c - a)
 
-    @property
+    @cached_property
     def areas(self) -> np.ndarray:
         return 0.5 * np.linalg.norm(self._cross, axis=1)
 
-    @property
+    @cached_property
     def normals(self) -> np.ndarray:
         cross = self._cross
         return cross / np.linalg.norm(cross, axis=1, keepdims=True)
@@ -106,6 +109,8 @@ def mesh_triangles(positions, faces, normals, model) -> tuple[np.ndarray, np.nda
 def mesh_elements(triangles: np.ndarray, obj: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
     """The triangles (T, 3, 3) cut into elements no longer than `size` on any edge: (corners,
     object index of each)."""
+    if len(triangles) == 0:
+        return np.zeros((0, 3, 3)), np.zeros(0, np.int64)
     edges = np.linalg.norm(triangles - np.roll(triangles, 1, axis=1), axis=2).max(axis=1)
     splits = np.maximum(1, np.ceil(edges / size - 1e-9)).astype(np.int64)
     pieces, source = [], []
@@ -118,18 +123,22 @@ def mesh_elements(triangles: np.ndarray, obj: np.ndarray, size: float) -> tuple[
     return np.concatenate(pieces)[order], np.asarray(obj)[source[order]]
 
 
-def scene_elements(scene, size: float, reflectance=None, emission=None) -> Elements:
+def scene_elements(scene, size, reflectance=None, emission=None) -> Elements:
     """The scene's objects (their meshes through their world matrices) cut into elements of at
-    most `size` scene units. `reflectance` and `emission`: per object (O, 3), default each
+    most `size` scene units, or of size(d) with d the diagonal of the triangles' bounding box
+    where `size` is a function. `reflectance` and `emission`: per object (O, 3), default each
     material's k_d and nothing."""
-    matrices = scene.world_matrices()
-    triangles, owner = [], []
-    for index, (obj, model) in enumerate(zip(scene.objects, matrices)):
+    triangles, owner = [np.zeros((0, 3, 3))], [np.zeros(0, np.int64)]
+    for index, (obj, model) in enumerate(zip(scene.objects, scene.world_matrices())):
         corners, _ = mesh_triangles(obj.mesh.positions, obj.mesh.faces, obj.mesh.normals, model)
         triangles.append(corners)
         owner.append(np.full(len(corners), index, np.int64))
-    corners, obj = mesh_elements(np.concatenate(triangles), np.concatenate(owner), size)
-    rho = np.array([o.material.kd for o in scene.objects], np.float64) if reflectance is None \
+    triangles, owner = np.concatenate(triangles), np.concatenate(owner)
+    if callable(size):
+        points = triangles.reshape(-1, 3)
+        size = size(float(np.linalg.norm(np.ptp(points, axis=0))) if len(points) else 0.0)
+    corners, obj = mesh_elements(triangles, owner, size)
+    rho = np.array([o.material.kd for o in scene.objects], np.float64).reshape(-1, 3) if reflectance is None \
         else np.asarray(reflectance, np.float64)
     emitted = np.zeros((len(scene.objects), 3)) if emission is None else np.asarray(emission, np.float64)
     return Elements(corners, obj, rho[obj], emitted[obj])

@@ -59,7 +59,7 @@ def gauss_seidel(form_factors: FormFactors, reflectance, emission, *, tolerance:
     rho, e = np.asarray(reflectance, np.float64), np.asarray(emission, np.float64)
     b = e.copy() if initial is None else np.array(initial, np.float64)
     indptr, columns, values = form_factors.indptr, form_factors.columns, form_factors.values
-    scale = max(float(np.abs(e).max()), np.finfo(float).tiny)
+    scale = max(float(np.abs(e).max(initial=0.0)), np.finfo(float).tiny)
     solution = Solution(b)
     for sweep in range(1, max_sweeps + 1):
         largest = 0.0

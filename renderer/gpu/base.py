@@ -75,6 +75,13 @@ class ContextRenderer:
         """Free this renderer's GL objects (its context is current)."""
         raise NotImplementedError
 
+    def _context_info(self) -> dict:
+        """What every frame's gl_info starts from: GL_VENDOR, GL_RENDERER, GL_VERSION and the
+        context kind."""
+        info = self.ctx.info
+        return {key: info[key] for key in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")} | {
+            "context": context_kind(self.ctx)}
+
     def _check_alive(self) -> None:
         if self._released:
             raise RuntimeError(f"this {type(self).__name__} was released")

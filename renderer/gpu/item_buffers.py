@@ -56,6 +56,7 @@ class ItemBuffers:
         activate(ctx)
         self.ctx, self.elements, self.resolution = ctx, elements, int(resolution)
         self.origin, diameter = elements.extent()
+        self._frames, self._centres = elements.frames(), elements.centres      # once, not per batch
         self.near, self.far = depth_range(elements.shortest_edge(), diameter)
         self.batch = batch_size(self.resolution, len(elements),
                                 ctx.info["GL_MAX_ARRAY_TEXTURE_LAYERS"] // len(FACES))
@@ -88,8 +89,7 @@ class ItemBuffers:
 
     def matrices_of(self, indices: np.ndarray) -> np.ndarray:
         """(len(indices), 5, 4, 4) float64: the clip_from_world of each face of those hemicubes."""
-        e = self.elements
-        return clip_from_world(e.frames()[indices], e.centres[indices], self.origin, self.near, self.far)
+        return clip_from_world(self._frames[indices], self._centres[indices], self.origin, self.near, self.far)
 
     def draw(self, indices) -> np.ndarray:
         """The item buffers of the hemicubes on elements `indices` (at most `batch` of them):

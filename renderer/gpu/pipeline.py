@@ -77,7 +77,7 @@ import numpy as np
 
 from renderer.gpu.base import ContextRenderer
 from renderer.gpu.readback import flip_into, usable
-from renderer.gpu.context import activate, context_kind, gl_function
+from renderer.gpu.context import activate, gl_function
 from renderer.errors import ContextError, SystemFault
 from renderer.core.drawn import drawn_meshes, is_plane
 from renderer.core.facets import face_texture
@@ -605,9 +605,7 @@ class GpuRenderer(ContextRenderer):
 
     # -- information -------------------------------------------------------------------------
     def _query_gl_info(self) -> dict:
-        info = self.ctx.info
-        return {key: info[key] for key in ("GL_VENDOR", "GL_RENDERER", "GL_VERSION")} | {
-            "context": context_kind(self.ctx), "depth_format": self.depth_format}
+        return self._context_info() | {"depth_format": self.depth_format}
 
     @property
     def sample_counts(self) -> list[int]:

@@ -16,23 +16,22 @@ Twin: reference/radiosity/display.py (with reference/radiosity/item_buffer.py).
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import time
 
 import moderngl
 import numpy as np
 
-from renderer.core import memory
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, depth_mapping, to_unorm8
-from renderer.core.radiosity import RadiositySolution, elements_for, interreflects, solve, what_changed
+from renderer.core.radiosity import RadiositySolution, elements_for, refreshed
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.errors import ContextError
 from renderer.gpu.base import ContextRenderer
 from renderer.gpu.context import activate, gl_function
-from renderer.gpu.context import context_kind as kind_of
 from renderer.gpu.item_buffers import ItemBuffers
 from renderer.gpu.readback import flip_into
 from renderer.gpu.shaders import shader_source
@@ -58,8 +57,7 @@ class RadiosityRenderer(ContextRenderer):
             self.program = ctx.program(vertex_shader=shader_source("radiosity/display.vert").text,
                                        fragment_shader=shader_source("radiosity/display.frag").text)
             self._resources.append(self.program)
-            self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
-                             "GL_VERSION": ctx.info["GL_VERSION"], "context": kind_of(ctx)}
+            self._gl_info = self._context_info()
             self._build_targets()
             self.update()
         except BaseException:
@@ -85,25 +83,23 @@ class RadiosityRenderer(ContextRenderer):
         if scene is not None:
             self.scene = scene
         activate(self.ctx)
-        elements = elements_for(self.scene, self.options)
-        change = what_changed(self.solution, elements)
-        if change == "nothing":
+        solution = refreshed(self.solution, elements_for(self.scene, self.options), self.options,
+                             self._item_buffers, "gpu", self.scene.name)
+        if solution is None:                       # only the camera moved
             return
-        if change == "materials":
-            self.solution = solve(elements, self.options, matrix=self.solution.form_factors)
-        elif not interreflects(elements):         # B = E: no hemicube drawn
-            self.solution = solve(elements, self.options)
-        else:
-            memory.check_radiosity(len(elements), self.options.hemicube, "gpu", self.scene.name,
-                                   direct=self.options.solver == "direct")
-            buffers = ItemBuffers(self.ctx, elements, self.options.hemicube)
-            try:
-                self.solution = solve(elements, self.options, buffers.draw, buffers.batch)
-            finally:
-                buffers.release()
-            self.form_factor_draws += 1
+        self.solution = solution
         self.solves += 1
         self._upload_mesh()
+
+    @contextlib.contextmanager
+    def _item_buffers(self, elements):
+        """(draw, batch) of GL's item buffers for `elements`, released after (`refreshed`)."""
+        buffers = ItemBuffers(self.ctx, elements, self.options.hemicube)
+        try:
+            yield buffers.draw, buffers.batch
+        finally:
+            buffers.release()
+        self.form_factor_draws += 1
 
     def _upload_mesh(self, origin=None) -> None:
         """The elements' corners relative to the camera's `origin` (the frame's) and their values."""

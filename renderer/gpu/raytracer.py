@@ -58,7 +58,7 @@ from renderer.core.uniforms import light_uniforms
 from renderer.gpu.bvh import texel_texture
 from renderer.gpu.base import ContextRenderer
 from renderer.gpu.readback import flip_into
-from renderer.gpu.context import activate, context_kind
+from renderer.gpu.context import activate
 from renderer.gpu.declarations import program_uniforms, uniforms_to_write
 from renderer.gpu.defines import area_light_defines, sampling_defines
 from renderer.gpu.shaders import shader_source
@@ -113,9 +113,7 @@ class RayTracer(ContextRenderer):
             self._units[name] = unit
         self._write_uniforms(rs)
         self._build_targets()
-        self._gl_info = {"GL_VENDOR": ctx.info["GL_VENDOR"], "GL_RENDERER": ctx.info["GL_RENDERER"],
-                         "GL_VERSION": ctx.info["GL_VERSION"],
-                         "context": context_kind(ctx)}
+        self._gl_info = self._context_info()
 
     def _defines(self, rs) -> dict:
         scene, every = self.scene, not self.specialise

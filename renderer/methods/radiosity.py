@@ -6,13 +6,18 @@ form factors and solutions) and their own display."""
 from __future__ import annotations
 
 
-from renderer.core import memory
+import contextlib
+
 from renderer.core.frame import Frame
 from renderer.core.memory import Need, raster_need
-from renderer.core.radiosity import elements_for, interreflects, solve, what_changed
+from renderer.core.radiosity import elements_for, refreshed
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
+
+
+# Hemicubes the twin draws and sums at once (each drawn on its own: this bounds the rows summed).
+TWIN_BATCH = 16
 
 
 class ReferenceRadiosity(ReferenceRenderer):
@@ -30,20 +35,18 @@ class ReferenceRadiosity(ReferenceRenderer):
     @property
     def solution(self):
         if self._stale:
-            from reference.radiosity.item_buffer import draw
-            elements = elements_for(self.scene, self.options)
-            change = what_changed(self._solution, elements)
-            if change == "materials":
-                self._solution = solve(elements, self.options, matrix=self._solution.form_factors)
-            elif change == "geometry" and not interreflects(elements):
-                self._solution = solve(elements, self.options)       # B = E: no hemicube drawn
-            elif change == "geometry":
-                memory.check_radiosity(len(elements), self.options.hemicube, "reference", self.scene.name,
-                                       direct=self.options.solver == "direct")
-                n = self.options.hemicube
-                self._solution = solve(elements, self.options, lambda ix: draw(elements, n, ix).items, 16)
+            solution = refreshed(self._solution, elements_for(self.scene, self.options), self.options,
+                                 self._item_buffers, "reference", self.scene.name)
+            self._solution = self._solution if solution is None else solution
             self._stale = False
         return self._solution
+
+    @contextlib.contextmanager
+    def _item_buffers(self, elements):
+        """(draw, batch) of the twin's item buffers for `elements` (`refreshed`)."""
+        from reference.radiosity.item_buffer import draw
+        n = self.options.hemicube
+        yield (lambda indices: draw(elements, n, indices).items), TWIN_BATCH
 
     def _scene_changed(self) -> None:
         self._stale = True

@@ -11,7 +11,7 @@ says why the module is shared, or which check that does not share it catches its
 - data and rules the twin must reproduce bit for bit, each checked by hand or against another
   implementation: `gl_rules.py`, `uniforms.py`, `colour.py`, `quantise.py`, `blue_noise.py`,
   `error_kernels.py`, `halftone_screen.py`, `sampling.py`, `ray_sampling.py`, `ray_depth.py`,
-  `light_areas.py`;
+  `light_areas.py`, `path_options.py`;
 - computations held against a check that does not share them: `shadows.py`,
   `shadow_settings.py` and `facets.py` (ray-cast shadow truth), `visibility.py` (the frame
   without culling), `drawn.py` (depth against ray casts), `camera_rays.py` and

@@ -77,6 +77,10 @@ REFERENCE_SHARES = {
                     "the distributed points by chi-square in tests/test_sampler_statistics.py",
     "ray_depth": "RAY_WEIGHT_CUTOFF (trace.glsl's TRACE_WEIGHT_CUTOFF); its bound in "
                  "tests/test_raytrace_precision.py",
+    "path_options": "the path tracer's sample dimensions and Russian roulette's start (pathtrace.glsl's "
+                    "constants, held equal in tests/test_pathtrace.py); the diffuse bounce by chi-square in "
+                    "tests/test_sampler_statistics.py, the paths against the furnace's closed form in "
+                    "tests/test_pathtrace.py",
     "light_areas": "the area-light uniform and its shape codes; the axes by hand and the twin against "
                    "closed forms in tests/test_raytrace_area_lights.py",
     # computations with a check that does not share them

@@ -58,7 +58,7 @@ MISTAKES = {
                          "settings[0].samples: adaptive sampling needs at least 4 samples per pixel "
                          "(its first set), got 2"),
     "method": (SPHERE + '[[settings]]\nmethod = "raytrce"\n', "settings[0].method: unknown method "
-               "'raytrce'; did you mean 'raytrace'? expected one of: raster, raytrace, radiosity"),
+               "'raytrce'; did you mean 'raytrace'? expected one of: raster, raytrace, radiosity, pathtrace"),
     "shading for the ray tracer": (SPHERE + '[[settings]]\nmethod = "raytrace"\nshading = "flat"\n',
                                    "settings[0].shading: is for method raster, not raytrace"),
     "bits": (SPHERE + '[[settings]]\noutputs = [{ format = "png8", bits = 12 }]\n',

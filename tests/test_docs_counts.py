@@ -34,9 +34,10 @@ def tree_counts() -> dict[str, int]:
         rf"\b{NUMBER} scenes made for the ray tracer": len(ray_traced),
         rf"\b{NUMBER} scenes made for radiosity": len(radiated),
         rf"\b{NUMBER} goldens at 256×256": len([g for g in goldens()
-                                                 if not g.endswith(("-raytrace", "-radiosity"))]),
+                                                 if not g.endswith(("-raytrace", "-radiosity", "-pathtrace"))]),
         rf"\b{NUMBER} ray-traced ones": len([g for g in goldens() if g.endswith("-raytrace")]),
         rf"\b{NUMBER} radiosity ones": len([g for g in goldens() if g.endswith("-radiosity")]),
+        rf"\b{NUMBER} path-traced ones": len([g for g in goldens() if g.endswith("-pathtrace")]),
         rf"\b{NUMBER} more, {NUMBER} in all": None,            # read by its own rule below
         rf"\b{NUMBER} built-in scenes are made for the ray tracer": len(ray_traced),
         rf"\b{NUMBER} built-in scenes are textured": len(textured_scenes()),
@@ -73,9 +74,9 @@ def test_the_manual_counts_what_the_tree_holds():
 
 
 def test_the_goldens_add_up():
-    """"N more, M in all": the ray-traced and radiosity goldens beside the 256×256 ones."""
+    """"N more, M in all": the ray-traced, radiosity and path-traced goldens beside the 256×256 ones."""
     in_all = len(goldens())
-    beside = len([g for g in goldens() if g.endswith(("-raytrace", "-radiosity"))])
+    beside = len([g for g in goldens() if g.endswith(("-raytrace", "-radiosity", "-pathtrace"))])
     for name, text in pages().items():
         for more, total in re.findall(rf"\b{NUMBER} more, {NUMBER} in all", text):
             assert (value(more), value(total)) == (beside, in_all), name

@@ -648,20 +648,36 @@ RAYTRACE_TWIN_NAMES = {
     "u_textures": ("textures",), "u_texture_materials": ("slot", "modulate", "uv_transform"),
     "u_triangle_uvs": ("triangle_uvs",), "u_sphere_rotation": ("sphere_rotation",),
     "u_plane_uv": ("plane_map",),
+    "u_emission": ("emission",), "u_emitters": ("triangles", "cdf", "density", "owner"),
+    "u_emitter_count": ("count",), "u_sample": ("ks",),
 }
 # The tracer is made for every_ray_feature_scene with each of these: between them every #define
 # that adds a uniform (test_the_configurations_compile_every_ray_tracer_uniform_in).
+# {"path": True, ...}: the path tracer (PathTracer, its PathOptions), whose pathtrace.glsl adds
+# the emitters' uniforms.
 RAY_CONFIGURATIONS = ({"specialise": False, "pattern": "adaptive", "samples": 16},
-                      {"pattern": "poisson", "samples": 4})
+                      {"pattern": "poisson", "samples": 4}, {"path": True, "samples": 4})
+
+
+def ray_tracer(ctx, options: dict):
+    """The RayTracer, or the PathTracer for {"path": True}, of every_ray_feature_scene."""
+    from renderer.core.path_options import PathOptions
+    from renderer.gpu.pathtracer import PathTracer
+    from renderer.gpu.raytracer import RayTracer
+    options = dict(options)
+    if options.pop("path", False):
+        return PathTracer(every_ray_feature_scene(), 8, 6, PathOptions(**options), context=ctx)
+    return RayTracer(every_ray_feature_scene(), 8, 6, context=ctx, **options)
 
 
 def every_ray_feature_scene():
-    """A sphere, a plane and a mesh that move, a mesh that does not, all textured; a glossy
-    mirror; a directional light and a point light with an area; a thin lens; a shutter."""
+    """A sphere, a plane and a mesh that move, a mesh that does not (emitting), all textured; a
+    glossy mirror; a directional light and a point light with an area; a thin lens; a shutter."""
     scene = scene_from_dict({
         "camera": {"eye": [0, 1, 6], "look": [0, 0, 0], "aperture": 0.1, "shutter": [0, 1]},
         "materials": {"glossy": {"kd": [0.5, 0.5, 0.5], "ks": [0.3, 0.3, 0.3],
-                                 "kr": [0.4, 0.4, 0.4], "gloss": 50}},
+                                 "kr": [0.4, 0.4, 0.4], "gloss": 50},
+                      "lamp": {"emission": [2.0, 2.0, 2.0]}},
         "lights": [{"type": "directional", "direction": [-1, -1, -1]},
                    {"type": "point", "position": [2, 3, 2], "area": "disc", "radius": 0.5}],
         "objects": [{"name": "ball", "shape": {"type": "sphere", "radius": 1.0},
@@ -670,7 +686,8 @@ def every_ray_feature_scene():
                      "velocity": [0, 0, 1]},
                     {"name": "box", "mesh": {"primitive": "cube"}, "translate": [2, 0, 0],
                      "angular_velocity": [0, 30, 0]},
-                    {"name": "still", "mesh": {"primitive": "cube"}, "translate": [-2, 0, 0]}]})
+                    {"name": "still", "mesh": {"primitive": "cube"}, "translate": [-2, 0, 0],
+                     "material": "lamp"}]})
     texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2))
     return replace(scene, objects=[replace(obj, material=replace(obj.material, texture=texture))
                                    for obj in scene.objects])
@@ -693,7 +710,7 @@ def raytracer_uploads(ctx) -> tuple[set[str], list[str]]:
         patch.setattr(raytracer, "uniforms_to_write", recording)
         for options in RAY_CONFIGURATIONS:
             try:
-                with raytracer.RayTracer(every_ray_feature_scene(), 8, 6, context=ctx, **options):
+                with ray_tracer(ctx, options):
                     pass
             except ShaderSourceError:
                 pass                # test_the_ray_tracer_sets_the_uniforms_its_defines_declare
@@ -756,9 +773,8 @@ def ray_uploads(gl_contexts):
 def test_the_ray_tracer_sets_the_uniforms_its_defines_declare(gl_contexts):
     """RayTracer refuses a value for a uniform its GLSL declares nowhere and a uniform its
     #defines declare that gets no value (renderer/gpu/declarations.py, uniforms_to_write)."""
-    from renderer.gpu.raytracer import RayTracer
     for options in RAY_CONFIGURATIONS:
-        with RayTracer(every_ray_feature_scene(), 8, 6, context=gl_contexts["egl"], **options) as rt:
+        with ray_tracer(gl_contexts["egl"], options) as rt:
             assert {"u_spheres", "u_nodes", "u_mesh_root", "u_point_area"} <= rt._uniforms_written
 
 

@@ -896,7 +896,7 @@ def test_check_scene_ray_traces_with_the_tracer_options(spec):
             golden.check_scene("sphere", size=(8, 8), samples=4)
 
         def test_unknown_method(golden):
-            golden.check_scene("sphere", size=(8, 8), method="pathtrace")
+            golden.check_scene("sphere", size=(8, 8), method="photon_map")
     """)
     result = spec.run("--update-goldens")
     assert outcomes(result) == {"test_traced": "passed", "test_raster_with_samples": "failed",
@@ -904,5 +904,5 @@ def test_check_scene_ray_traces_with_the_tracer_options(spec):
     assert json.loads((spec.goldens / "test_traced.json").read_text())["scene"] == "classic"
     assert failure(result, "test_raster_with_samples").strip() == "samples: is for method raytrace, not raster"
     assert failure(result, "test_unknown_method").strip() == \
-        "method: unknown method 'pathtrace'; one of raster, raytrace, radiosity"
+        "method: unknown method 'photon_map'; one of raster, raytrace, radiosity, pathtrace"
     assert outcomes(spec.run("-k", "traced")) == {"test_traced": "passed"}

@@ -111,8 +111,8 @@ def test_options_of_another_method_are_refused_by_name():
     with pytest.raises(OptionError) as refused:
         method_options("raster", {"samples": 4})
     assert (refused.value.fields, refused.value.reason) == (("samples",), "is for method raytrace, not raster")
-    with pytest.raises(OptionError, match="unknown method 'pathtrace'; one of raster, raytrace, radiosity"):
-        method_options("pathtrace")
+    with pytest.raises(OptionError, match="unknown method 'photon_map'; one of raster, raytrace, radiosity, pathtrace"):
+        method_options("photon_map")
     with pytest.raises(TypeError, match="method raytrace takes RayOptions, not RasterOptions"):
         open_renderer(None, (8, 8), method="raytrace", options=RasterOptions())
     assert method_options("raytrace", {"samples": 4}) == RayOptions(samples=4)

@@ -8,6 +8,8 @@ tracer feeds them:
 
 - square_to_disc (the lens; a disc light's points are the disc scaled into its plane), in
   (phi, r^2), where its density 1/pi is 1/(2 pi);
+- square_to_cosine_hemisphere (the path tracer's diffuse bounce), in (phi, cos^2 alpha):
+  1/(2 pi);
 - square_to_sphere (a sphere light), in (phi, z): 1/(4 pi);
 - square_to_phong_lobe at exponents 1, 10, 1000 (glossy reflection), in (phi, alpha) with
   alpha's rows where the lobe's mass is: (e + 1)/(2 pi) cos^e alpha sin alpha;
@@ -34,6 +36,7 @@ from reference.raytrace.motion import motion_time
 from reference.raytrace.sampling import distributed_1d, distributed_2d
 from reference.raytrace.area_lights import area_light_point
 from renderer.core.light_areas import AREA_SHAPE_CODES
+from renderer.core.path_options import BOUNCE_DIMENSION
 from renderer.core.ray_sampling import LENS_DIMENSION, LIGHT_DIMENSION, TIME_DIMENSION, ray_sampling
 from renderer.gpu.defines import sampling_defines
 
@@ -115,6 +118,22 @@ def sphere_case():
         return warp.sphere_density(np.stack(np.broadcast_arrays(r * np.cos(phi), r * np.sin(phi), z), -1))
     return Case("square_to_sphere", sample, lambda: Grid.even((-PI, PI), (-1, 1), 64, 32), sphere,
                 tilted(sphere, lambda phi, z: z), "5 % more towards +z")
+
+
+def cosine_case():
+    """The path tracer's diffuse bounce, in (phi, cos^2 alpha), where its density
+    cos(alpha)/pi is 1/(2 pi) (d omega = d phi d(cos alpha), d(cos^2) = 2 cos d(cos))."""
+    def sample():
+        d = warp.square_to_cosine_hemisphere(points_2d("random", dimension=BOUNCE_DIMENSION, slot=2)).astype(np.float64)
+        return np.arctan2(d[:, 1], d[:, 0]), d[:, 2] ** 2
+
+    def cosine(phi, c2):
+        c = np.sqrt(c2)
+        s = np.sqrt(np.maximum(0, 1 - c2))
+        d = np.stack(np.broadcast_arrays(s * np.cos(phi), s * np.sin(phi), c), -1)
+        return warp.cosine_hemisphere_density(d) / (2 * np.maximum(c, 1e-300))
+    return Case("square_to_cosine_hemisphere", sample, lambda: Grid.even((-PI, PI), (0, 1), 64, 32),
+                cosine, tilted(cosine, lambda phi, c2: c2 - 0.5, 0.1), "10 % more towards the normal")
 
 
 def lobe_case(exponent: float):
@@ -207,7 +226,7 @@ def line_case(pattern: str):
 
 
 PATTERNS = ("random", "jittered", "regular", "adaptive")
-CASES = [disc_case(), sphere_case(), *(lobe_case(e) for e in (1.0, 10.0, 1000.0)),
+CASES = [disc_case(), cosine_case(), sphere_case(), *(lobe_case(e) for e in (1.0, 10.0, 1000.0)),
          rectangle_light_case(), time_case(),
          *(square_case(p) for p in PATTERNS), square_case("jittered", 4), square_case("poisson", 4),
          *(line_case(p) for p in (*PATTERNS, "poisson"))]
@@ -261,7 +280,8 @@ def test_glsl_warps_draw_the_twins_samples(gl_contexts):
     y, x = np.mgrid[0:height, 0:width].astype(np.uint32)
     routines = {1: warp.square_to_disc, 2: warp.square_to_sphere,
                 4: lambda u: warp.orthonormal_basis(warp.square_to_sphere(u))[0],
-                5: lambda u: warp.orthonormal_basis(warp.square_to_sphere(u))[1]}
+                5: lambda u: warp.orthonormal_basis(warp.square_to_sphere(u))[1],
+                6: lambda u: warp.square_to_cosine_hemisphere(u)[..., :2]}
     exponents = (1.0, 10.0, 1000.0, 1e6)
     worst = 0.0
     for kind, ctx in gl_contexts.items():
@@ -281,4 +301,9 @@ def test_glsl_warps_draw_the_twins_samples(gl_contexts):
                         error = np.abs(got[..., :expected.shape[-1]] - expected).max()
                         assert error <= WARP_EPS, (kind, pattern, k, routine, exponent, error / EPS32)
                         worst = max(worst, float(error))
+                    # the cosine hemisphere's z = sqrt(1 - r^2): its few-ulp x and y move r^2 by
+                    # up to 3 WARP_EPS, so z^2 (not z, steep at the rim) within that of the twin's
+                    z_gpu = shader.run(u_routine=6, **common)[..., 2].astype(np.float64)
+                    z_twin = warp.square_to_cosine_hemisphere(u)[..., 2].astype(np.float64)
+                    assert np.abs(z_gpu ** 2 - z_twin ** 2).max() <= 3 * WARP_EPS, (kind, pattern, k)
     assert worst > 0                     # sin, cos, log, exp: not bit for bit (conventions.md)

@@ -14,6 +14,7 @@ TWINS = {"vertex.glsl": "reference/vertex.py", "geometry.glsl": "reference/geome
          "fragment.glsl": "reference/fragment.py", "lighting.glsl": "reference/lighting.py"}
 # The ray tracer's stages (includes: no #version of their own).
 RAYTRACE_TWINS = {"raytrace/random.glsl": "reference/raytrace/random.py",
+                  "raytrace/pathtrace.glsl": "reference/raytrace/pathtrace.py",
                   "raytrace/intersect.glsl": "reference/raytrace/intersect.py",
                   "raytrace/camera.glsl": "reference/raytrace/camera.py",
                   "raytrace/optics.glsl": "reference/raytrace/optics.py",

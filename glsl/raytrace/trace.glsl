@@ -10,6 +10,8 @@
 // drawn from a lobe), MAX_DEPTH, MOTION and NUM_MOVING_MESHES
 // (motion blur), and lighting.glsl's light counts and SPECULAR; AREA_LIGHTS (some point light
 // has an area of size > 0: LIGHT_SAMPLES shadow rays to points of it per hit, area_light_term);
+// PATH_TRACE: the path tracer (pathtrace.glsl) asks this file's scene queries and lights, and
+// the Whitted loop (trace) is left out;
 // TEXTURES and NUM_TEXTURES (some material is textured: textures.glsl's texture_modulate).
 
 #include "raytrace/bvh.glsl"          // and intersect.glsl (an include is expanded once)
@@ -303,7 +305,7 @@ float light_visibility_directional(int i, vec3 P, vec3 N) {
     return occluded(ray_origin(P, n, g_shape), L, TRACE_INF, g_shape) ? 0.0 : 1.0;
 }
 #endif
-#if NUM_POINT_LIGHTS > 0
+#if NUM_POINT_LIGHTS > 0 || defined(PATH_TRACE)
 // 0 where the shadow ray from P to the point Q (a point light, or a point of an area light) is
 // blocked, else 1. It ends short of Q by the hit tie (s_max = d (1 - TRACE_HIT_TIE)): a surface
 // through Q itself (a light lying in a plane) ties with the light, which keeps it.
@@ -314,6 +316,8 @@ float light_visibility_at(vec3 Q, vec3 P) {
     float d = sqrt(dot(to_light, to_light));
     return (d > 0.0 && occluded(O, to_light / d, d * (1.0 - TRACE_HIT_TIE), g_shape)) ? 0.0 : 1.0;
 }
+#endif
+#if NUM_POINT_LIGHTS > 0
 
 float light_visibility_point(int i, vec3 P, vec3 N) {
     if (facet_turned_from(N, u_point_position[i] - P)) {
@@ -411,6 +415,27 @@ float trace_sample_time() {
 #include "raytrace/textures.glsl"
 #endif
 
+// The hit's material (rows m0, m1, m2 of u_materials) into lighting.glsl's variables, the viewer
+// at the ray's origin O, its texture applied; and the hit's geometric normal, shape and ray key
+// for its shadow rays and distributed numbers.
+void shade_hit(vec4 m0, vec4 m1, vec4 m2, int obj, int kind, int index, vec3 P, vec2 uv, vec3 O,
+               vec3 Ng, uint key) {
+    u_ka = m0.xyz;
+    u_kd = m1.xyz;
+#ifdef SPECULAR
+    u_ks = m2.xyz;
+    u_n = m0.w;
+    u_eye = O;
+#endif
+#ifdef TEXTURES
+    texture_modulate(obj, kind, index, P, uv);
+#endif
+    g_geometric_normal = Ng;
+    g_shape = kind == TRACE_SPHERE ? index : kind == TRACE_PLANE ? NUM_SPHERES + index : -1;
+    g_ray_key = key;
+}
+
+#ifndef PATH_TRACE             // the path tracer has its own loop (pathtrace.glsl)
 // The colour seen along the ray O + s D (s_min < s < s_max for this first ray; its children
 // from 0 to infinity); hit and s: the first ray's hit.
 vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s_hit) {
@@ -454,20 +479,8 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
             vec4 m0 = trace_texel(u_materials, 5 * obj);
             vec4 m1 = trace_texel(u_materials, 5 * obj + 1);
             vec4 m2 = trace_texel(u_materials, 5 * obj + 2);
-            u_ka = m0.xyz;
-            u_kd = m1.xyz;
-#ifdef SPECULAR
-            u_ks = m2.xyz;
-            u_n = m0.w;
-            u_eye = O;
-#endif
-#ifdef TEXTURES
-            texture_modulate(obj, kind, index, P, uv);
-#endif
+            shade_hit(m0, m1, m2, obj, kind, index, P, uv, O, Ng, key);
             vec3 N = (back && m1.w > 0.5) ? -Ns : Ns;
-            g_geometric_normal = Ng;
-            g_shape = kind == TRACE_SPHERE ? index : kind == TRACE_PLANE ? NUM_SPHERES + index : -1;
-            g_ray_key = key;
             colour += w * lighting(P, N);
 #ifdef SECONDARY
             if (depth < MAX_DEPTH) {
@@ -523,3 +536,4 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
     }
     return colour;
 }
+#endif

@@ -1,7 +1,8 @@
 // Twin: reference/raytrace/warp.py
 // Warps of a uniform point u in [0, 1)^2 (distributed_2d's, sampling.glsl) onto the domains the
 // distributed effects sample (docs/conventions.md, "Distributed sampling"): the unit disc (a
-// lens, a disc light), the unit sphere (a sphere light), a Phong lobe (glossy reflection); and
+// lens, a disc light), the cosine-weighted hemisphere (the path tracer's diffuse bounce), the
+// unit sphere (a sphere light), a Phong lobe (glossy reflection); and
 // an orthonormal basis about a direction. They use sin, cos, pow and sqrt, so the GPU and the
 // twin agree within a few ulps here, not bit for bit (their inputs are bit for bit).
 
@@ -24,6 +25,13 @@ vec2 square_to_disc(vec2 u) {
         theta = 2.0 * WARP_QUARTER_PI - WARP_QUARTER_PI * (o.x / o.y);
     }
     return r * vec2(cos(theta), sin(theta));
+}
+
+// Cosine-weighted on the hemisphere about +z (Malley's method), density cos(alpha) / pi: the
+// concentric disc point lifted to the hemisphere, z = sqrt(max(0, 1 - x^2 - y^2)).
+vec3 square_to_cosine_hemisphere(vec2 u) {
+    vec2 p = square_to_disc(u);
+    return vec3(p, sqrt(max(0.0, 1.0 - dot(p, p))));
 }
 
 // Uniform on the unit sphere, density 1/(4 pi): z = 1 - 2 u0, phi = 2 pi u1.

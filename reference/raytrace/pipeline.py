@@ -55,11 +55,13 @@ DECISION_MARGIN = 2.0 ** -12
 def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "regular",
            max_depth: int = DEFAULT_MAX_DEPTH, seed: int = DEFAULT_SEED, shadows: bool = True,
            rs=None, first_sample: int = 0, adaptive_threshold: float | None = None,
-           dtype=F32, light_samples: int = 1, progress=None) -> Frame:
+           dtype=F32, light_samples: int = 1, progress=None, tracer=trace) -> Frame:
     """The frame (module docstring) of sample indices first_sample .. first_sample + N - 1;
     `rs` a ray_scene(scene) made before, `shadows`=False traces no shadow rays; `dtype`
     float32 (the GPU's twin) or float64; `progress(share done)`, if given, after each chunk of
-    rays (an adaptive frame's first set fills half, its refinement the rest)."""
+    rays (an adaptive frame's first set fills half, its refinement the rest); `tracer`: what
+    traces the camera rays, trace.py's trace (Whitted) or, its emitters bound, pathtrace.py's
+    path_trace (the GLSL's PATH_TRACE)."""
     start = time.perf_counter()
     t = np.dtype(dtype).type
     rs = rs if rs is not None else ray_scene(scene)
@@ -99,7 +101,7 @@ def render(scene, width: int, height: int, *, samples: int = 1, pattern: str = "
         trees = np.zeros(len(O), np.uint64)
         parts = []
         for i in range(0, len(O), CHUNK_RAYS):
-            parts.append(trace(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near,
+            parts.append(tracer(rs, lights, O[i:i + CHUNK_RAYS], D[i:i + CHUNK_RAYS], cam.near,
                                cam.far, scene.background, max_depth, shadows,
                                trees[i:i + CHUNK_RAYS],
                                RaySamples(*(a[i:i + CHUNK_RAYS] for a in (owners.x, owners.y, owners.k)),

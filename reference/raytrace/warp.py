@@ -38,6 +38,20 @@ def square_to_disc(u) -> np.ndarray:
     return np.stack([r * np.cos(theta), r * np.sin(theta)], -1).astype(t)
 
 
+def square_to_cosine_hemisphere(u) -> np.ndarray:
+    """Cosine-weighted on the hemisphere about +z (Malley's method; density cos alpha / pi):
+    square_to_disc's point lifted, z = sqrt(max(0, 1 - x^2 - y^2)), as the GLSL."""
+    p = square_to_disc(u)
+    t = p.dtype.type
+    z = np.sqrt(np.maximum(t(0), t(1) - (p[..., 0] * p[..., 0] + p[..., 1] * p[..., 1])))
+    return np.concatenate([p, z[..., None]], -1)
+
+
+def cosine_hemisphere_density(d) -> np.ndarray:
+    """square_to_cosine_hemisphere's density (per steradian) at unit directions d (..., 3)."""
+    return np.maximum(np.asarray(d, np.float64)[..., 2], 0.0) / PI
+
+
 def square_to_sphere(u) -> np.ndarray:
     """Uniform on the unit sphere (density 1/(4 pi)): z = 1 - 2 u0, phi = 2 pi u1."""
     t = _t(u)

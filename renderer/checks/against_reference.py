@@ -45,8 +45,9 @@ def against_reference(scene, size, gpu_frame: Frame, *, method: str = "raster",
     ref_frame = twin.render()
     reference_ms = (time.perf_counter() - start) * 1000.0
     # What the twin accepts besides its own colour differs by method (a real difference: the
-    # ray tracer's float32 and float64 trees, the rasteriser's texture lookups' envelope).
-    if method == "raytrace":
+    # ray and path tracers' float32 and float64 trees, the rasteriser's texture lookups' envelope).
+    traced = method in ("raytrace", "pathtrace")
+    if traced:
         # Where float32 and float64 disagree on a grazing ray, either colour is accepted (and
         # elsewhere the adaptive pattern's other decision, rgba8_tie). Same BVH, other precision.
         twin.precision = "float64"
@@ -64,7 +65,6 @@ def against_reference(scene, size, gpu_frame: Frame, *, method: str = "raster",
                             reference_tie=tie, reference_tie_depth=tie_depth)
     heat = heat_map(gpu_frame.rgba8, expected, tolerance.threshold, tolerance.deviation,
                     reference_tie=tie)
-    traced = method == "raytrace"     # the rasteriser and radiosity's display have depth ties
     figures = {"scene": scene.name, "size": list(size), "method": method, **result.as_dict(),
                "psnr": finite_or_none(result.psnr),       # null for identical images (inf dB)
                "depth_tie_pixels": 0 if traced else depth_tie_pixels(ref_frame),

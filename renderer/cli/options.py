@@ -88,21 +88,23 @@ def scene_options(p) -> None:
 
 def raytrace_options(p) -> None:
     """--method and the ray tracer's options, the lens's among them (render, compare)."""
-    p.add_argument("--method", choices=("raster", "raytrace", "radiosity"),
+    p.add_argument("--method", choices=("raster", "raytrace", "radiosity", "pathtrace"),
                    help="raster (default): the rasteriser; raytrace: the ray tracer (shadows, "
                         "reflection, refraction; docs/conventions.md, \"Rays\"); radiosity: "
-                        "light from emitting surfaces, bounced between diffuse ones (docs/radiosity.md)")
+                        "light from emitting surfaces, bounced between diffuse ones (docs/radiosity.md); "
+                        "pathtrace: the path tracer, every bounce of light by Monte Carlo (docs/pathtrace.md)")
     p.add_argument("--spp", type=int, default=None, metavar="N",
-                   help="ray tracer: samples per pixel (default 1)")
+                   help="ray and path tracers: samples per pixel (default 1; the path tracer's 16)")
     p.add_argument("--pattern", default=None, metavar="|".join(RAY_PATTERNS),
-                   help="ray tracer: sample positions (default regular; docs/conventions.md, "
+                   help="ray and path tracers: sample positions (default regular; the path tracer's jittered; "
+                        "docs/conventions.md, "
                         "\"Sample positions\")")
     p.add_argument("--adaptive-threshold", type=float, default=None, metavar="T",
                    help="ray tracer, --pattern adaptive: refine a pixel whose first 4 samples' "
                         "clamped colours differ by more than T in some channel (default 2/255)")
     p.add_argument("--max-depth", type=int, default=None, metavar="D",
                    help="ray tracer: bounces of reflection and refraction, 0 to "
-                        f"{MAX_DEPTH_LIMIT} (default 4)")
+                        f"{MAX_DEPTH_LIMIT} (default 4); path tracer: bounces of a path (default 32)")
     p.add_argument("--seed", type=int, default=None, metavar="S",
                    help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
     p.add_argument("--light-samples", type=int, default=None, metavar="M",

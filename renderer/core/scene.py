@@ -101,8 +101,8 @@ class Material:
     # (the notes', the default) or the exact dielectric Fresnel equations (FRESNEL_MODES).
     fresnel: str = "schlick"
     # Emitted radiosity E (exitance, linear RGB, >= 0): the light a surface gives off itself.
-    # Only radiosity reads it (renderer/core/radiosity.py); the rasteriser and the ray tracer
-    # light with their lights (docs/scene-format.md).
+    # Radiosity (renderer/core/radiosity.py) and the path tracer (renderer/core/path_emitters.py)
+    # read it; the rasteriser and the ray tracer light with their lights (docs/scene-format.md).
     emission: tuple = (0.0, 0.0, 0.0)
 
     @property

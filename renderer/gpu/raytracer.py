@@ -182,10 +182,15 @@ class RayTracer(ContextRenderer):
             units = [unit for unit, _ in self._image_units()]
             values["u_textures"] = np.asarray(units, np.int32).tobytes()
         values["u_first_sample"] = np.uint32(0).tobytes()      # render() writes each frame's
+        values.update(self._more_uniforms(rs))
         self._uniforms_written = uniforms_to_write(self._fragment_text,
                                                    program_uniforms(self.program), values)
         for name in self._uniforms_written:
             self.program[name].write(values[name])
+
+    def _more_uniforms(self, rs) -> dict:
+        """A subclass's own uniforms as bytes (the path tracer's emitters); none here."""
+        return {}
 
     def _lens_values(self, matrices) -> dict:
         """The thin lens's uniforms (renderer/core/camera_rays.py, lens_uniforms) as float32
@@ -384,21 +389,10 @@ class RayTracer(ContextRenderer):
         before the next starts: Ctrl-C stops it after the band in flight, and
         `progress(rows done, rows)` is called after each band."""
         self._check_alive()
-        first_sample = check_first_sample(first_sample, self.sampling.samples)
         start = time.perf_counter()
-        activate(self.ctx)
-        if "u_first_sample" in self._uniforms_written:
-            self.program["u_first_sample"].value = first_sample
-        for unit, texture in self._textures:
-            texture.use(unit)
-        images = self._image_units()
-        for unit, material_texture in images:
-            self._image_textures.bind(material_texture, unit)
-        self._fbo.use()
-        self.ctx.viewport = (0, 0, self.width, self.height)
+        images = self._begin_frame(first_sample)
         self._trace_bands(progress)
-        for unit, material_texture in images:     # no sampler state of ours left on the context
-            self._image_textures.get(material_texture)[1].clear(unit)
+        self._end_frame(images)
         h, w = self.height, self.width
         reuse = (None, None) if out is None else (out.linear, out.depth)
         colour = _flip_read(self._fbo, 0, (h, w, 4), reuse[0])
@@ -413,6 +407,27 @@ class RayTracer(ContextRenderer):
         return Frame(rgba8, colour, view_depth, (time.perf_counter() - start) * 1000.0,
                      gl_info=self.gl_info, samples=samples)
 
+    def _begin_frame(self, first_sample: int) -> list:
+        """The frame's first sample index written, the textures bound, the framebuffer used:
+        ready to draw. Returns the image units bound (_end_frame's)."""
+        first_sample = check_first_sample(first_sample, self.sampling.samples)
+        activate(self.ctx)
+        if "u_first_sample" in self._uniforms_written:
+            self.program["u_first_sample"].value = first_sample
+        for unit, texture in self._textures:
+            texture.use(unit)
+        images = self._image_units()
+        for unit, material_texture in images:
+            self._image_textures.bind(material_texture, unit)
+        self._fbo.use()
+        self.ctx.viewport = (0, 0, self.width, self.height)
+        return images
+
+    def _end_frame(self, images) -> None:
+        """No sampler state of ours left on the context."""
+        for unit, material_texture in images:
+            self._image_textures.get(material_texture)[1].clear(unit)
+
     def bands(self) -> list[tuple[int, int]]:
         """(first row from the bottom, rows) of each band render() traces: whole rows, about
         BAND_SAMPLES samples (camera samples times light samples) each."""
@@ -420,20 +435,24 @@ class RayTracer(ContextRenderer):
         rows = max(1, BAND_SAMPLES // per_row)
         return [(y, min(rows, self.height - y)) for y in range(0, self.height, rows)]
 
-    def _trace_bands(self, progress) -> None:
+    def _trace_bands(self, progress, share=(0.0, 1.0)) -> None:
+        """Draw the pass band by band; `progress` told the rows done, scaled into the `share`
+        of the frame this pass is (the path tracer's passes, one a sample)."""
+        def told(rows):
+            if progress is not None:
+                progress(round(self.height * (share[0] + (share[1] - share[0]) * rows / self.height)),
+                         self.height)
         bands = self.bands()
         if len(bands) == 1:                      # the frame at once, as small frames always were
             self._vao.render(vertices=3)
-            if progress is not None:
-                progress(self.height, self.height)
+            told(self.height)
             return
         try:
             for y, rows in bands:
                 self.ctx.scissor = (0, y, self.width, rows)
                 self._vao.render(vertices=3)
                 self.ctx.finish()                # done before Python runs on (and Ctrl-C is seen)
-                if progress is not None:
-                    progress(y + rows, self.height)
+                told(y + rows)
         finally:
             self.ctx.scissor = None
 

@@ -1,5 +1,6 @@
-"""Every way of making an image, behind one call: a method ("raster", "raytrace", "radiosity") on a backend
-("gpu": GLSL through moderngl; "reference": the NumPy twin), opened as a Renderer
+"""Every way of making an image, behind one call: a method ("raster", "raytrace", "radiosity",
+"pathtrace") on a backend ("gpu": GLSL through moderngl; "reference": the NumPy twin), opened as
+a Renderer
 (renderer/gpu/base.py: render, update, resize, release, a context manager, gl_info).
 
     from renderer.methods import open_renderer
@@ -16,10 +17,11 @@ from __future__ import annotations
 
 from renderer.core.scene import Scene
 from renderer.errors import OptionError
-from renderer.methods import radiosity, raster, raytrace
+from renderer.methods import pathtrace, radiosity, raster, raytrace
 from renderer.methods.registry import BACKENDS, Method
 
-METHODS: dict[str, Method] = {m.name: m for m in (raster.METHOD, raytrace.METHOD, radiosity.METHOD)}
+METHODS: dict[str, Method] = {m.name: m for m in (raster.METHOD, raytrace.METHOD, radiosity.METHOD,
+                                                pathtrace.METHOD)}
 
 
 def method(name: str) -> Method:

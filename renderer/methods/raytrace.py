@@ -50,7 +50,12 @@ class ReferenceRayTracer(ReferenceRenderer):
         return render(self.scene, self.width, self.height, samples=o.samples, pattern=o.pattern,
                       max_depth=o.max_depth, seed=o.seed, shadows=o.shadows, rs=self.ray_scene,
                       first_sample=first_sample, adaptive_threshold=o.adaptive_threshold,
-                      dtype=self.dtype, light_samples=o.light_samples, progress=told)
+                      dtype=self.dtype, light_samples=o.light_samples, progress=told,
+                      **self._render_keywords())
+
+    def _render_keywords(self) -> dict:
+        """More of reference/raytrace/pipeline.py render's keywords (the path tracer's tracer)."""
+        return {}
 
 
 def _open_gpu(scene, width, height, options: RayOptions, context, context_kind):

@@ -13,7 +13,9 @@ pixels and 16 paths. Then, against the truth, on 8-bit levels of the clamped lin
 mean over the pixels of |difference| x 255, and its 95th percentile):
 - the path tracer at 16, 64 and 256 paths a pixel (error against time: Monte Carlo's slope -1/2);
 - radiosity (Gauss-Seidel, hemicubes of --hemicube) at each element size: its form factors,
-  solution and display timed together.
+  solution and display timed together, the display drawn at 4 times the size and each 4 x 4
+  block averaged (renderer/study/radiosity_report.py footprint_image: the pixel's mean, as the
+  truth's paths; a pixel-centre image would add its edges' aliasing to radiosity's error).
 The truth's own noise is in every row (its standard error is printed). Not a test: this
 machine is shared and noisy.
 """
@@ -32,6 +34,8 @@ from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
+from renderer.study.radiosity_report import footprint_image
+from renderer.study.report_settings import FOOTPRINT
 
 from common import measured_line, write_results          # benchmarks/common.py
 
@@ -95,8 +99,9 @@ def main() -> None:
     for element_size in (float(s) for s in args.sizes.split(",")):
         options = RadiosityOptions(element_size=element_size, hemicube=args.hemicube)
         start = time.perf_counter()
-        with open_renderer(scene, size, method="radiosity", options=options, context=ctx) as radiosity:
-            image = radiosity.render().linear[..., :3].astype(np.float64)
+        with open_renderer(scene, (FOOTPRINT * size[0], FOOTPRINT * size[1]), method="radiosity",
+                           options=options, context=ctx) as radiosity:
+            image = footprint_image(radiosity.render(linear=True), *size)
             elements = len(radiosity.solution.elements)
         seconds = time.perf_counter() - start
         mean, p95 = levels(image, truth)
@@ -127,6 +132,7 @@ def markdown(document: dict) -> str:
              f"{f['truth_paths']:,} paths a pixel ({f['truth_s']:.0f} s; standard error "
              f"{f['truth_standard_error']:.1e}). Differences from it in 8-bit levels of the clamped "
              "colour, the mean over the pixels and the 95th percentile:", "",
+             "Radiosity's display is drawn at 4 times the size and box-filtered: the pixel's mean.", "",
              "| method | setting | time | mean | 95th percentile |",
              "| --- | --- | ---: | ---: | ---: |"]
     for r in f["pathtrace"]:

@@ -19,8 +19,8 @@ from renderer.study.distributed_report import (LIGHT_CARRIER_SAMPLES, distribute
                                                scene_effects)
 from renderer.core.shadow_settings import BIAS_RULES, DEFAULT_FILTER, FILTERS, named_bias
 from renderer.study.report import EXHAUSTIVE, QUICK, RasterStudy, ReportResult, metrics, run_report, settings
-from renderer.study.report_settings import (CSV_COLUMNS, DISTRIBUTED_KNOBS, RAY_BASE_SAMPLES, RAY_CSV_COLUMNS,
-                                            SHADOW_COLUMNS, SHADOW_TARGETS, ShadowTarget)
+from renderer.study.report_settings import (CSV_COLUMNS, DISTRIBUTED_KNOBS, RADIOSITY_CSV_COLUMNS,
+                                            RAY_BASE_SAMPLES, RAY_CSV_COLUMNS, SHADOW_COLUMNS, SHADOW_TARGETS, ShadowTarget)
 from renderer.study.shadow_report import cheapest_shadow, shadow_sections, with_shadow_setting
 from renderer.study.report_output import convergence_slopes, pareto_front, series_name
 from renderer.core.scene_file import load_scene
@@ -476,3 +476,82 @@ def test_ray_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
                     "| adaptive @4/255 | reference |", "## Cheapest setting reaching RMSE <= 0.01 "):
         assert heading in report
     assert "wrote" in result.stdout
+
+
+# -- radiosity's report (renderer/study/radiosity_report.py) --------------------------------------
+
+def test_radiosity_truth_is_path_traced_and_cached(tmp_path):
+    """The Cornell box's truth at 8x6: the path tracer's, under its own name, made once."""
+    from renderer.study.ground_truth import PATH_TRUTH_PASSES, PATH_TRUTH_SAMPLES
+    scene = load_scene(builtin_scenes()["cornell_box_radiosity"])
+    truth, hit = ground_truth(scene, 8, 6, tmp_path, method="radiosity")
+    assert not hit and truth.shape == (6, 8, 3) and 0 < truth.mean() < 1
+    assert ground_truth(scene, 8, 6, tmp_path, method="radiosity")[1] is True
+    assert [p.name.split("-")[-3] for p in tmp_path.glob("*.npy")] == ["pathtrace"]
+    assert PATH_TRUTH_SAMPLES * PATH_TRUTH_PASSES == 4096
+
+
+def test_radiosity_settings_cover_each_knob():
+    from renderer.study.radiosity_report import RADIOSITY_SWEEPS, radiosity_settings
+    from renderer.study.report_settings import TWIN_ACROSS
+    plan = radiosity_settings(RADIOSITY_SWEEPS["standard"])
+    assert {s.knob for s in plan} == {"element_size", "hemicube", "iterations"}
+    assert {s.across for s in plan if s.backend == "reference"} == {3, 6} and TWIN_ACROSS == 6
+    assert [s.setting for s in plan if s.knob == "iterations"] == ["1 sweep", "2 sweeps", "4 sweeps",
+                                                                   "8 sweeps", "converged"]
+    assert all(s.options().elements_across == s.across for s in plan)
+
+
+def test_a_tiny_radiosity_sweep_gpu_and_twin(tmp_path, gl_contexts):
+    """The Cornell box at 16x12 against its path-traced truth: finer elements, less error; one
+    Gauss-Seidel sweep more error than converged; the twin's error the GPU's (the same item
+    buffers, the same solution)."""
+    from renderer.study.radiosity_report import RadiositySceneRun, RadiositySetting
+    scene = load_scene(builtin_scenes()["cornell_box_radiosity"])
+    truth, _ = ground_truth(scene, 16, 12, tmp_path, method="radiosity")
+    run = RadiositySceneRun(scene, 16, 12, gl_contexts["egl"])
+    error, elements = {}, {}
+    for setting in (RadiositySetting("element_size", "3", "gpu", across=3),
+                    RadiositySetting("element_size", "3", "reference", across=3),
+                    RadiositySetting("element_size", "8", "gpu", across=8),
+                    RadiositySetting("iterations", "1", "gpu", across=8, sweeps=1)):
+        image, elements[setting], ms = run.timed(setting, 1)
+        error[setting.setting, setting.backend] = metrics(image, truth)["rmse"]
+        assert ms > 0
+    assert error["8", "gpu"] < error["3", "gpu"]
+    assert error["1", "gpu"] > 1.5 * error["8", "gpu"]
+    assert error["3", "reference"] == pytest.approx(error["3", "gpu"], abs=1e-6)
+    assert 100 < min(elements.values()) < max(elements.values())
+
+
+def test_radiosity_report_markdown_states_the_truth_and_the_slopes():
+    from renderer.study.radiosity_report import RADIOSITY_SWEEPS, RadiosityStudy
+    rows = [{"scene": "s", "knob": "element_size", "setting": f"diagonal / {a}", "backend": "gpu",
+             "samples": float(a * a * 10), "median_ms": float(a ** 4), "rmse": a ** -1.0,
+             "mismatched_fraction": 0.5, "psnr": 20.0} for a in (3, 6, 12)]
+    result = ReportResult(rows=rows, scenes={"s": (38, 1, 1418)}, gl_renderer="llvmpipe")
+    text = RadiosityStudy().markdown(result, {("s", "element_size"): "plots/s-element_size.png"},
+                                     (64, 48), RADIOSITY_SWEEPS["quick"], "quick")
+    assert "renderer report --method radiosity --quick" in text
+    assert "| s | 38 | 1 | 1,418 |" in text
+    assert "4096 jittered paths a pixel" in text
+    assert "| s | -0.25 | -0.50 |  |" in text          # rmse ~ elements^-1/2 ~ time^-1/4
+
+
+@pytest.mark.slow                       # the quick radiosity sweep, through the command line
+def test_radiosity_report_command_writes_csv_plots_and_markdown(tmp_path, cli):
+    out = tmp_path / "report"
+    result = cli("report", "--method", "radiosity", "--quick", "--size", "16x12",
+                 "--out", out, "--cache", tmp_path / "cache", timeout=900)
+    assert result.returncode == 0, result.stderr
+    with open(out / "results.csv", newline="") as handle:
+        reader = csv.DictReader(handle)
+        assert tuple(reader.fieldnames) == RADIOSITY_CSV_COLUMNS
+        rows = list(reader)
+    assert len(rows) == 10
+    error = {(row["setting"], row["backend"]): float(row["rmse"]) for row in rows}
+    assert error[("diagonal / 12", "gpu")] < error[("diagonal / 3", "gpu")]
+    assert error[("1 sweep", "gpu")] > error[("converged", "gpu")]
+    plots = sorted(path.name for path in (out / "plots").iterdir())
+    assert plots == [f"cornell_box_radiosity-{k}.png" for k in ("element_size", "hemicube", "iterations")]
+    assert "# Error against run time: radiosity" in (out / "report.md").read_text()

@@ -30,15 +30,17 @@ def add_parser(sub) -> None:
                         help="ground-truth cache (default ~/.cache/checked-renderer/truth)")
     report.add_argument("--context", choices=("auto", "egl", "osmesa"), default="auto",
                         help="headless GL context (default: EGL, then OSMesa)")
-    report.add_argument("--method", choices=("raster", "raytrace"), default="raster",
+    report.add_argument("--method", choices=("raster", "raytrace", "radiosity"), default="raster",
                         help="raster (default): the rasteriser's knobs; raytrace: the ray "
                              "tracer's (samples per pixel by pattern, adaptive thresholds, max "
-                             "depth), against a ray-traced ground truth")
+                             "depth), against a ray-traced ground truth; radiosity: element size, "
+                             "hemicube, iterations, against a path-traced truth")
     report.add_argument("--knobs", type=lambda text: tuple(k.strip() for k in text.split(",")),
                         metavar="K,K", help="only these knob families (default all): raster: "
                         "antialiasing, tessellation, shading, precision, shadows (map resolution, "
                         "filter, bias rule against ray-cast truth), filter and texture_resolution "
-                        "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision")
+                        "(textured scenes), output (the output stage's methods at 1 to 8 bits); raytrace: antialiasing, max_depth, precision; "
+                        "radiosity: element_size, hemicube, iterations")
     report.add_argument("--address", metavar="auto|HOST:PORT",
                         help="run the settings on a running Ray cluster's workers (auto: the one "
                              "`ray start` made on this machine); default: this process. results.csv "

@@ -24,12 +24,14 @@ class RadiosityOptions:
     two from 4 to MAX_HEMICUBE (so that GL's viewport scale N / 2 is exact: the twin's window
     coordinates are GL's bit for bit); `solver`: one of SOLVERS; `tolerance`: the residual to
     reach, relative to the largest emission (Gauss-Seidel) or the emitted power (progressive);
-    `max_iterations`: sweeps or shots (None: the solver's default)."""
+    `max_iterations`: sweeps or shots (None: the solver's default); `elements_across`: without an
+    element size, the scene's diagonal over this many (the report's element-size knob)."""
     element_size: float | None = None
     hemicube: int = 64
     solver: str = "gauss-seidel"
     tolerance: float = 1e-6
     max_iterations: int | None = None
+    elements_across: int = DEFAULT_ELEMENTS_ACROSS
     SETTING_FIELDS: ClassVar[tuple[str, ...]] = ("element_size", "hemicube", "solver")
 
     def __post_init__(self):
@@ -46,10 +48,13 @@ class RadiosityOptions:
         m = self.max_iterations
         if m is not None and not (isinstance(m, int) and m >= 1):
             raise OptionError("max_iterations", f"must be an integer >= 1, got {m!r}")
+        a = self.elements_across
+        if isinstance(a, bool) or not (isinstance(a, int) and a >= 1):
+            raise OptionError("elements_across", f"must be an integer >= 1, got {a!r}")
 
     def size_for(self, diameter: float) -> float:
         """The element size for a scene whose bounding box's diagonal is `diameter`."""
-        return self.element_size if self.element_size is not None else diameter / DEFAULT_ELEMENTS_ACROSS
+        return self.element_size if self.element_size is not None else diameter / self.elements_across
 
     def scene_for(self, scene):
         """The scene as radiosity draws it: as given (a pinhole camera, as the rasteriser's)."""

@@ -8,6 +8,12 @@ at each sub-sample), and 16 x 16 supersampling per pixel. Rendering the referenc
 ((a + 0.5) / 16 - 0.5, (b + 0.5) / 16 - 0.5) (renderer/core/sampling.py regular_grid(256)) at a
 256th of the passes' cost.
 
+Radiosity's truth is the path tracer (docs/pathtrace.md), which shares nothing with radiosity
+but the scene: PATH_TRUTH_PASSES frames of PATH_TRUTH_SAMPLES jittered paths per pixel (4096),
+up to PATH_TRUTH_DEPTH bounces, the ray tracer's truth seed, each frame new paths; on the GPU
+(llvmpipe traces them about 13 times as fast as the twin: benchmarks/results/pathtrace.md), whose
+paths are the twin's (tests/test_pathtrace.py); the frames' average clamped to [0, 1].
+
 The ray tracer's truth is the reference ray tracer (reference/raytrace/pipeline.py) in float64
 at up to RAY_TRUTH_DEPTH bounces, RAY_TRUTH_PASSES frames of RAY_TRUTH_SAMPLES jittered samples per
 pixel (1024 in all), the frames' sample indices following one another (first_sample), so each
@@ -19,6 +25,7 @@ compared with. A frame at a time bounds the memory (the reference holds a frame'
     truth_scene(scene)                              the scene as the rasteriser's truth draws it
     ground_truth(scene, 160, 120, cache_dir)        ((120, 160, 3) float64 in [0, 1], cache hit?)
     ground_truth(scene, 160, 120, cache_dir, method="raytrace")     the ray tracer's
+    ground_truth(scene, 160, 120, cache_dir, method="radiosity")    radiosity's (path traced)
     ground_truths(scenes, 160, 120, cache_dir, tasks=executor.tasks)  several, the misses elsewhere
 """
 
@@ -56,6 +63,10 @@ RAY_TRUTH_VERSION = 1                  # bump when the ray truth's recipe change
 RAY_TRUTH_LIGHT_SAMPLES = 4            # per area light and hit, where the scene has area lights:
                                        # 4096 shadow rays per pixel and light, 16 times the
                                        # light_samples knob's most (renderer/study/distributed_report.py)
+PATH_TRUTH_SAMPLES = 256               # radiosity's truth: jittered paths per pixel in one frame
+PATH_TRUTH_PASSES = 16                 # frames averaged: 4096 paths per pixel
+PATH_TRUTH_DEPTH = MAX_DEPTH_LIMIT     # bounces (Russian roulette ends most paths long before)
+PATH_TRUTH_VERSION = 1                 # bump when the path truth's recipe changes
 
 
 def default_cache_dir() -> Path:
@@ -145,6 +156,26 @@ def render_ray_truth(scene: Scene, width: int, height: int, progress=None) -> np
     return clamped(total / RAY_TRUTH_PASSES)
 
 
+def _path_recipe(scene: Scene) -> str:
+    return (f"pathtrace jittered={PATH_TRUTH_SAMPLES}x{PATH_TRUTH_PASSES} depth={PATH_TRUTH_DEPTH} "
+            f"seed={RAY_TRUTH_SEED} v{PATH_TRUTH_VERSION}")
+
+
+def render_path_truth(scene: Scene, width: int, height: int, progress=None) -> np.ndarray:
+    """(H, W, 3) float64: radiosity's truth, path traced now (module docstring);
+    `progress(share done)` after each frame."""
+    from renderer.core.path_options import PathOptions
+    options = PathOptions(samples=PATH_TRUTH_SAMPLES, pattern="jittered", max_depth=PATH_TRUTH_DEPTH,
+                          seed=RAY_TRUTH_SEED)
+    total = np.zeros((height, width, 3))
+    with open_renderer(scene, (width, height), method="pathtrace", options=options) as truth:
+        for frame in range(PATH_TRUTH_PASSES):
+            total += truth.render(first_sample=frame * PATH_TRUTH_SAMPLES).linear[..., :3]
+            if progress is not None:
+                progress((frame + 1) / PATH_TRUTH_PASSES)
+    return clamped(total / PATH_TRUTH_PASSES)
+
+
 @dataclass(frozen=True)
 class Truth:
     """A method's ground truth (module docstring): the scene it draws, what its cache files'
@@ -157,7 +188,8 @@ class Truth:
 
 # Each method's truth, by the name renderer/methods registers it under.
 TRUTHS = {"raster": Truth(truth_scene, "", lambda scene: f"grid={TRUTH_GRID} v{TRUTH_VERSION}", render_truth),
-          "raytrace": Truth(lambda scene: scene, "-raytrace", _ray_recipe, render_ray_truth)}
+          "raytrace": Truth(lambda scene: scene, "-raytrace", _ray_recipe, render_ray_truth),
+          "radiosity": Truth(lambda scene: scene, "-pathtrace", _path_recipe, render_path_truth)}
 
 
 def truth_of(method: str) -> Truth:

@@ -30,8 +30,9 @@ some channel). report.md, results.csv and plots/SCENE-KNOB.png are written when 
 has finished, each atomically.
 
 run_report drives a study: RasterStudy, this sweep, or (method="raytrace") renderer/study/
-ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, with the same
-metrics, plots and tables. `knobs` (the command's --knobs) keeps only some knob families.
+ray_report.py's RayStudy, the ray tracer's knobs against its own ground truth, or
+(method="radiosity") renderer/study/radiosity_report.py's RadiosityStudy, radiosity's knobs
+against a path-traced truth, with the same metrics, plots and tables. `knobs` (the command's --knobs) keeps only some knob families.
 The rows run in this process or on Ray workers (--address, --workers: renderer/study/
 report_units.py), with the same results.csv but for the times and the `worker` that took them.
 """
@@ -297,8 +298,13 @@ def _ray_study():
     return RayStudy()
 
 
+def _radiosity_study():
+    from renderer.study.radiosity_report import RadiosityStudy
+    return RadiosityStudy()
+
+
 # Each method's sweep, by the name renderer/methods registers it under.
-STUDIES = {"raster": RasterStudy, "raytrace": _ray_study}
+STUDIES = {"raster": RasterStudy, "raytrace": _ray_study, "radiosity": _radiosity_study}
 
 
 def study(method: str):

@@ -54,6 +54,8 @@ def series_name(row: dict) -> str:
     """An anti-aliasing row's series: its pattern, an adaptive one's with its threshold when the
     row has a `threshold` column (the ray tracer's: a series per threshold)."""
     threshold = row.get("threshold")
+    if "pattern" not in row:                 # a study without patterns (radiosity's)
+        return row["backend"]
     return row["pattern"] if threshold in (None, "") else f"{row['pattern']} @{threshold * 255:g}/255"
 
 

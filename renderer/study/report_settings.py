@@ -65,7 +65,18 @@ TEXTBOOK_SLOPES = {                  # RMSE against N (Mitchell 1996; docs/repor
 RAY_DEFAULT_SIZE = (160, 120)
 RAY_QUICK_SIZE = (64, 48)
 RAY_QUICK_SCENES = ("classic",)
-QUICK_SCENES_OF = {"raster": QUICK_SCENES, "raytrace": RAY_QUICK_SCENES}     # --quick's, by method
+# Radiosity's report (renderer/study/radiosity_report.py, radiosity_report_output.py).
+RADIOSITY_DEFAULT_SIZE = (160, 120)
+RADIOSITY_QUICK_SIZE = (64, 48)
+RADIOSITY_QUICK_SCENES = ("cornell_box_radiosity",)
+RADIOSITY_MAX_SIZE = (320, 240)      # its path-traced truth: 4096 paths a pixel on the GPU
+TWIN_ACROSS = 6                      # the twin's element sizes: at most this many across
+FOOTPRINT = 4                        # the display drawn at 4x the size, each 4 x 4 block averaged
+RADIOSITY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "samples", "elements_across", "hemicube",
+                         "iterations", "runs", "median_ms", "worker", "rmse", "max_abs", "psnr",
+                         "flip_mean", "mismatched_fraction")
+QUICK_SCENES_OF = {"raster": QUICK_SCENES, "raytrace": RAY_QUICK_SCENES,      # --quick's, by method
+                   "radiosity": RADIOSITY_QUICK_SCENES}
 RAY_MAX_SIZE = (320, 240)            # its ground truth traces 1024 rays per pixel in float64
 RAY_BASE_SAMPLES = 16                # jittered, for the knobs other than antialiasing
 RAY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "pattern", "samples", "light_samples",

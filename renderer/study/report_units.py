@@ -76,12 +76,17 @@ def truth_cost(method: str, scene) -> float:
     if method == "raytrace":
         from renderer.study.ground_truth import RAY_TRUTH_PASSES, RAY_TRUTH_SAMPLES, truth_light_samples
         return REFERENCE_WEIGHT * RAY_TRUTH_SAMPLES * RAY_TRUTH_PASSES * truth_light_samples(scene)
+    if method == "radiosity":                            # paths on the GPU, a few bounces each
+        from renderer.study.ground_truth import PATH_TRUTH_PASSES, PATH_TRUTH_SAMPLES
+        return 4 * PATH_TRUTH_SAMPLES * PATH_TRUTH_PASSES
     return REFERENCE_WEIGHT * RASTER_TRUTH_PASSES
 
 
 def unit_cost(setting) -> float:
     """A setting's rough relative cost, only to cut and order batches (no figure depends on
     it): the frames it draws per run (samples, light samples), the reference's weighted."""
+    if hasattr(setting, "cost"):                                    # a radiosity setting's own
+        return setting.cost
     samples = getattr(setting, "samples", None)                     # a ray-tracing setting
     if samples is None:
         kind, *args = setting.sampling                             # see report.Setting

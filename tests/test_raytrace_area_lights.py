@@ -24,7 +24,7 @@ from reference.raytrace.trace import trace
 from reference.raytrace.warp import orthonormal_basis as warp_basis
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
-from renderer.core.light_areas import (AREA_SHAPE_CODES, AREA_UNIFORM, NO_AREA, area_axes,
+from renderer.core.light_areas import (AREA_SHAPE_CODES, AREA_UNIFORM, LAMBERTIAN, NO_AREA, area_axes,
                                        area_light_uniforms, orthonormal_basis)
 from renderer.core.ray_sampling import ray_sampling
 from renderer.core.raytrace_scene import ray_scene
@@ -70,7 +70,12 @@ def test_the_uniform_holds_each_lights_axes_and_shape():
     assert rows[::3, 3].tolist() == [AREA_SHAPE_CODES["rectangle"], 0, AREA_SHAPE_CODES["disc"],
                                      AREA_SHAPE_CODES["sphere"]]
     assert np.array_equal(rows[3:6], np.zeros((3, 4)))                   # no area
-    assert np.array_equal(rows[9:12, :3], area_axes(sphere)) and not rows[[10, 11], 3].any()
+    assert np.array_equal(rows[9:12, :3], area_axes(sphere)) and rows[11, 3] == 0
+    # a sized area is a Lambertian emitter; a planar one's third row its unit normal
+    assert rows[[1, 7, 10], 3].tolist() == [LAMBERTIAN] * 3
+    assert rows[2, :3].tolist() == [0.0, -1.0, 0.0] and rows[8, :3].tolist() == [0.0, 0.0, 1.0]
+    point = area_light_uniforms(with_areas(load_scene("soft_shadows"), LightArea("disc", radius=0.0)))
+    assert point[AREA_UNIFORM][1, 3] == 0                                # size 0: the point light
 
 
 def test_area_lights_are_compiled_in_only_where_some_area_has_a_size():
@@ -174,9 +179,9 @@ def test_the_visible_share_of_a_rectangle_light_beside_a_blockers_edge():
     """A 2 x 1 rectangle light 4 up (x across, z along), a blocker filling y = 2 for x < 0. From
     the floor point (x_p, 0, 0) the ray to the light's point (q_x, 4, q_z) passes y = 2 at
     x = (x_p + q_x) / 2, so the light is seen where q_x > -x_p: the colour is the light's mean
-    term I k_d N.L = 4 / |q - P| over that part of it (a midpoint sum of 2000 x 1000 in
-    float64 here, 1e-9 accurate), the whole light's mean where x_p >= 1 and 0 where x_p <= -1
-    (the umbra). The twin with 1024 stratified points a pixel, 16 pixels, lands within 2e-3
+    term I k_d N.L cos_q = (4 / |q - P|)^2 over that part of it (Lambert's cosine at the light,
+    facing down, is 4 / |q - P| too; a midpoint sum of 2000 x 1000 in float64 here, 1e-9
+    accurate), the whole light's mean where x_p >= 1 and 0 where x_p <= -1 (the umbra). The twin with 1024 stratified points a pixel, 16 pixels, lands within 2e-3
     of it (2.5e-4 measured: the edge crosses 32 strata of the 1024, each seen or not)."""
     blocker = {"name": "blocker", "mesh": {"primitive": "plane", "size": 20}, "translate": [-10, 2, 0],
                "material": "white"}
@@ -188,25 +193,44 @@ def test_the_visible_share_of_a_rectangle_light_beside_a_blockers_edge():
         qx = start + (np.arange(2000) + 0.5) * (1.0 - start) / 2000
         qz = -0.5 + (np.arange(1000) + 0.5) / 1000
         d = np.sqrt((qx[:, None] - x_p) ** 2 + 16.0 + qz[None, :] ** 2)
-        return (4.0 / d).mean() * (1.0 - start) / 2.0
+        return ((4.0 / d) ** 2).mean() * (1.0 - start) / 2.0
     got = converged(scene, np.stack([xs, 0 * xs, 0 * xs], 1))
     want = np.array([expected(x) for x in xs])
     assert want[0] == 0 and got[0].tolist() == [0, 0, 0]            # the umbra: no point seen
     assert np.allclose(got, want[:, None], atol=2e-3, rtol=0), (got[:, 0], want)
 
 
-def test_a_disc_lights_irradiance_on_its_axis_is_the_closed_form():
-    """Each point of a uniform disc of radius r is an isotropic point light, attenuation
-    (0, 0, 1): on the axis at height h the mean over the disc of I cos(theta) / d^2 is
-    E = (2 I / r^2)(1 - h / sqrt(h^2 + r^2)) (the integral of h / (h^2 + rho^2)^(3/2) over the
-    disc, over pi r^2). The twin, 1024 stratified points a pixel over 16 pixels, lands within
-    2e-3 relative (7e-4 measured at h = r / 3, whose integrand peaks at 1 / h^2; 8e-5 at 4r / 3)."""
+def test_a_lambertian_disc_lights_irradiance_on_its_axis_is_the_closed_form():
+    """A disc light of radius r facing down is a Lambertian emitter of intensity I along its
+    normal (radiance I / (pi r^2)), attenuation (0, 0, 1): on the axis at height h the mean over
+    the disc of I cos(theta_P) cos(theta_q) / d^2 is the disc's irradiance
+    E = I / (h^2 + r^2) (the integral of h^2 / (h^2 + rho^2)^2 over the disc is
+    pi r^2 / (h^2 + r^2)). The float64 twin, 4096 stratified points a pixel (64 samples of 64
+    light points) over 16 pixels, lands within 1e-3 relative (at 1024 points, 1.3e-3 at
+    h = r / 3, whose integrand peaks at 1 / h^2); the isotropic points of before,
+    2 I / r^2 (1 - h / sqrt(h^2 + r^2)), are 52 %, 11 % and 1.5 % off it."""
     r, I = 1.5, 1.0
     for h in (0.5, 2.0, 6.0):
         scene = floor_scene({"position": [0, h, 0], "area": "disc", "radius": r}, attenuation=(0, 0, 1))
-        E = 2 * I / r ** 2 * (1 - h / math.sqrt(h * h + r * r))
-        got = converged(scene, [(0.0, 0.0, 0.0)])[0]
-        assert np.allclose(got, E, rtol=2e-3, atol=0), (h, got, E)
+        E = I / (h * h + r * r)
+        got = converged(scene, [(0.0, 0.0, 0.0)], light_samples=64)[0]
+        assert np.allclose(got, E, rtol=1e-3, atol=0), (h, got, E)
+        isotropic = 2 * I / r ** 2 * (1 - h / math.sqrt(h * h + r * r))
+        assert abs(isotropic / E - 1) > 0.01
+
+
+def test_a_lambertian_light_is_dark_behind_and_a_sphere_far_away_is_the_point_light():
+    """Below a disc light facing up, the floor gets nothing (one-sided); a sphere light of
+    radius 0.5 seen from 40 units is the point light (a Lambertian sphere's light outside it is
+    its centre's exactly), within the 4096 points' 1e-3 (Lambert's 4 cos over the sphere
+    averages 1; the terminator makes it a step)."""
+    up = floor_scene({"position": [0, 2, 0], "area": "disc", "radius": 1.0, "normal": [0, 1, 0]})
+    assert converged(up, [(0.0, 0.0, 0.0)], samples=4, light_samples=4, pixels=2)[0].tolist() == [0, 0, 0]
+    far = floor_scene({"position": [0, 40, 0], "area": "sphere", "radius": 0.5}, attenuation=(0, 0, 1))
+    point = floor_scene({"position": [0, 40, 0]}, attenuation=(0, 0, 1))
+    got = converged(far, [(0.0, 0.0, 0.0)], light_samples=64)[0]
+    want = converged(point, [(0.0, 0.0, 0.0)], samples=1, light_samples=1, pixels=1)[0]
+    assert np.allclose(got, want, rtol=1e-3, atol=0), (got, want)
 
 
 # --------------------------------------------------------------------------- limits and the GPU

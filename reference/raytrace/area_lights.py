@@ -37,9 +37,29 @@ def area_light_point(areas, i: int, centre, u) -> np.ndarray:
     return centre + offset
 
 
+def area_emission(areas, i: int, u, Q, P) -> np.ndarray:
+    """(R,) Lambert's cosine law at points Q (R, 3) of light i's area drawn at u, towards P
+    (the GLSL's area_emission): the cosine between the emitting normal (a rectangle's or disc's
+    unit normal, row 3i + 2; a sphere's point square_to_sphere(u), times 4) and P - Q, 0
+    behind; 1 for an area of size 0 (row 3i + 1's w 0: the isotropic point light)."""
+    t = Q.dtype.type
+    if areas[3 * i + 1, 3] == 0:
+        return np.ones(len(Q), t)
+    planar = areas[3 * i, 3] in (AREA_SHAPE_CODES["rectangle"], AREA_SHAPE_CODES["disc"])
+    n = np.broadcast_to(areas[3 * i + 2, :3].astype(t), Q.shape) if planar else \
+        square_to_sphere(np.asarray(u).astype(t))
+    to_P = P - Q
+    c = n[:, 0] * to_P[:, 0] + n[:, 1] * to_P[:, 1] + n[:, 2] * to_P[:, 2]
+    length = np.sqrt(to_P[:, 0] * to_P[:, 0] + to_P[:, 1] * to_P[:, 1] + to_P[:, 2] * to_P[:, 2])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = np.where(c > 0, c / length, t(0))
+    return c if planar else t(4) * c
+
+
 def area_light_terms(lights: Lights, areas, draw, shadow=None):
     """The area_light callable of lighting.py (the GLSL's has_area and area_light_term): for
-    point light i with an area (row 3i's w not NO_AREA), the mean of point_term_at(q_m) over
+    point light i with an area (row 3i's w not NO_AREA), the mean of point_term_at(q_m) times
+    area_emission(q_m) over
     its M points q_m = area_light_point(u_m), u_m = draw(i, m), each times the visibility of
     q_m (shadow(i, m, q_m, P, needed, N) -> blocked per hit, asked only where the term is not 0;
     None: no shadow rays), summed in m order; None for a light without an area."""
@@ -51,9 +71,10 @@ def area_light_terms(lights: Lights, areas, draw, shadow=None):
         t = P.dtype.type
         total = np.zeros(P.shape, t)
         for m in range(M):
-            Q = area_light_point(areas, i, lights.u_point_position[i], draw(i, m))
+            u = draw(i, m)
+            Q = area_light_point(areas, i, lights.u_point_position[i], u)
             term = point_term_at(P, N, V, Q, lights.u_point_intensity[i], lights.u_point_attenuation[i],
-                                 material)
+                                 material) * area_emission(areas, i, u, Q, P)[:, None]
             if shadow is not None:
                 blocked = shadow(i, m, Q, P, (term != 0).any(-1), N)
                 term = np.where(blocked, t(0), t(1))[:, None] * term

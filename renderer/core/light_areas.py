@@ -16,6 +16,13 @@ the uniform `u_point_area` (AREA_UNIFORM): rows 3i .. 3i + 2 are (a_j, 0), and r
 the light's shape code (AREA_SHAPE_CODES; 0 for a light without an area, which keeps the
 point light's code). An area of size 0 has a = 0, so q = Q_i exactly: p is finite and
 0 p = 0.
+
+Emission (docs/conventions.md, "Area lights"): an area with a size is a one-sided Lambertian
+emitter. Row 3i + 1's w is 1 for it (LAMBERTIAN; 0 for an area of size 0, the isotropic point
+light); a rectangle's or disc's row 3i + 2 holds its unit normal n instead of a_2 = 0 (its
+points have p.z = 0, so the offset is the same), and its point q shines I cos(n, P - q) on the
+side n faces, none behind; a sphere's point p shines 4 I cos(p, P - q) outward (4: the mean of
+the positive cosine over the sphere is 1/4, so that far away it is the point light).
 """
 
 from __future__ import annotations
@@ -28,6 +35,7 @@ from renderer.core.scene import AREA_SHAPES, LightArea, Scene
 AREA_SHAPE_CODES = {shape: code for code, shape in enumerate(AREA_SHAPES, start=1)}
 NO_AREA = 0
 AREA_UNIFORM = "u_point_area"          # vec4[3 * NUM_POINT_LIGHTS]
+LAMBERTIAN = 1.0                       # row 3i + 1's w: the area is a Lambertian emitter
 def orthonormal_basis(n) -> tuple[np.ndarray, np.ndarray]:
     """(b1, b2) completing the unit vector n to a right-handed orthonormal basis (b1, b2, n):
     Duff, Burgess, Christensen, Hery, Kensler, Liani and Villemin, "Building an Orthonormal
@@ -58,12 +66,17 @@ def area_axes(area: LightArea | None) -> np.ndarray:
 
 
 def area_light_uniforms(scene: Scene) -> dict[str, np.ndarray]:
-    """{AREA_UNIFORM: (3 Lp, 4) float64}: each point light's axes and shape code (module
-    docstring); no rows when the scene has no point light."""
+    """{AREA_UNIFORM: (3 Lp, 4) float64}: each point light's axes, shape code, normal and
+    emission (module docstring); no rows when the scene has no point light."""
     rows = np.zeros((3 * len(scene.point_lights), 4))
     for i, light in enumerate(scene.point_lights):
         rows[3 * i:3 * i + 3, :3] = area_axes(light.area)
         rows[3 * i, 3] = NO_AREA if light.area is None else AREA_SHAPE_CODES[light.area.shape]
+        if light.area is not None and light.area.shape != "sphere":
+            normal = np.asarray(light.area.normal, np.float64)
+            rows[3 * i + 2, :3] = normal / np.linalg.norm(normal)
+        if light.area is not None and light.area.has_size:
+            rows[3 * i + 1, 3] = LAMBERTIAN
     return {AREA_UNIFORM: rows}
 
 

@@ -3,7 +3,7 @@ printed and written to benchmarks/results/pathtrace.json and .md (docs/pathtrace
 the .md):
 
     .venv/bin/python benchmarks/bench_pathtrace.py [--size 160x120] [--truth-frames 16]
-                                                   [--sizes 0.12,0.08,0.05,0.035] [--hemicube 64]
+                                                   [--sizes 0.12,0.08,0.05,0.035,0.025] [--hemicube 64]
 
 The Cornell box (scene cornell_box_radiosity), its light an emitting surface, which both methods
 read the same way (docs/pathtrace.md, "Units"). The truth: the GPU path tracer's average of
@@ -67,7 +67,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--size", default="160x120")
     parser.add_argument("--truth-frames", type=int, default=16)
-    parser.add_argument("--sizes", default="0.12,0.08,0.05,0.035")
+    parser.add_argument("--sizes", default="0.12,0.08,0.05,0.035,0.025")
     parser.add_argument("--hemicube", type=int, default=64)
     args = parser.parse_args()
     size = tuple(int(v) for v in args.size.split("x"))

@@ -21,6 +21,7 @@ TOOLS = ROOT / "tools"
 # says what the picture is and how to run it).
 MAKERS = {
     "output-methods.png": "make_output_figure",
+    "pathtrace-vs-radiosity.png": "make_pathtrace_figure",
     "texture-filters.png": "make_texture_figure",
     "classic-raytrace.png": "make_docs_images",
     "distributed-soft_shadows.png": "make_docs_images",

@@ -163,7 +163,7 @@ vec3 path_trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out fl
         vec3 T;
         bool refracted = ray_refract(Du, N_in, eta, T);
         vec3 w_r = kr + kt * F;
-        vec3 w_t = refracted ? kt * (1.0 - F) : vec3(0.0);
+        vec3 w_t = refracted ? kt * transmitted_share(F, eta) : vec3(0.0);
         float p_d = largest(kd);
         float p_r = largest(w_r);
         float p_t = largest(w_t);

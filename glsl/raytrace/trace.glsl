@@ -415,6 +415,18 @@ float trace_sample_time() {
 #include "raytrace/textures.glsl"
 #endif
 
+// The share of the light a refracted ray brings back through a surface of Fresnel reflectance F,
+// eta = n_i / n_t the indices on the ray's side over the far side's: 1 - F, and under
+// RADIANCE_SCALING (the physical model, renderer/core/physical.py) times eta^2, radiance being
+// n^2 times as high in a medium of index n (renderer/core/raytrace_scene.py radiance_scaling).
+float transmitted_share(float F, float eta) {
+#ifdef RADIANCE_SCALING
+    return (1.0 - F) * (eta * eta);
+#else
+    return 1.0 - F;
+#endif
+}
+
 // The hit's material (rows m0, m1, m2 of u_materials) into lighting.glsl's variables, the viewer
 // at the ray's origin O, its texture applied; and the hit's geometric normal, shape and ray key
 // for its shadow rays and distributed numbers.
@@ -492,7 +504,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
                 float eta = back ? m2.w : 1.0 / m2.w;
                 float F = m4.w > 0.5 ? fresnel_exact(Du, N_in, eta) : fresnel_schlick(Du, N_in, eta);
                 vec3 w_r = w * (kr + kt * F);
-                vec3 w_t = w * (kt * (1.0 - F));
+                vec3 w_t = w * (kt * transmitted_share(F, eta));
                 vec3 T;
                 bool refracted = ray_refract(Du, N_in, eta, T);
                 bool transmit = any(greaterThanEqual(w_t, vec3(TRACE_WEIGHT_CUTOFF))) && refracted;

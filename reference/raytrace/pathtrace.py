@@ -33,7 +33,8 @@ from reference.raytrace.intersect import MISS, triangle_normal
 from reference.raytrace.optics import fresnel_exact, fresnel_schlick, ray_reflect, ray_refract
 from reference.raytrace.trace import (ROOT_PATH, SHADOW, _at, _dot, area_light_shadow, blocked_towards,
                                       leaving_s_min, materials, mix64, ray_origin, ray_tree_event,
-                                      sample_times, scene_hit, shadow_visibility, shape_id, surface)
+                                      sample_times, scene_hit, shadow_visibility, shape_id, surface,
+                                      transmitted_share)
 from reference.raytrace.warp import orthonormal_basis, square_to_cosine_hemisphere
 from renderer.core.path_options import (BOUNCE_DIMENSION, EMITTER_CHOICE_DIMENSION,
                                         EMITTER_POINT_DIMENSION, LOBE_DIMENSION, ROULETTE_DEPTH,
@@ -158,7 +159,7 @@ def path_trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: in
         F = np.where(rs.fresnel_exact[obj], fresnel_exact(Du, N_in, eta), fresnel_schlick(Du, N_in, eta))
         refracted, T = ray_refract(Du, N_in, eta)
         w_r = kr + kt * F[:, None]
-        w_t = np.where(refracted[:, None], kt * (t(1) - F)[:, None], t(0))
+        w_t = np.where(refracted[:, None], kt * transmitted_share(rs, F[:, None], eta), t(0))
         p_d, p_r, p_t = _largest(kd), _largest(w_r), _largest(w_t)
         total = p_d + p_r + p_t
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -164,6 +164,15 @@ def _per_hit(values, k, rays):
     return stacked[k, rays] if stacked.ndim == 3 else stacked[k]
 
 
+def transmitted_share(rs, F, eta):
+    """(R, 1) the share of the light a refracted ray brings back (the GLSL's transmitted_share):
+    1 - F, times eta^2 where the scene scales radiance across refraction (the physical model:
+    rs.radiance_scaling; eta = n_i / n_t)."""
+    t = F.dtype.type
+    share = t(1) - F
+    return share * (eta * eta)[:, None] if rs.radiance_scaling else share
+
+
 def shape_id(rs, kind, index):
     """The analytic shape of hits (kind, index), as from_shape: sphere k is k, plane k is
     (number of spheres) + k; -1 for a triangle or a miss (the GLSL's g_shape)."""
@@ -423,7 +432,7 @@ def trace(rs, lights: Lights, O, D, s_min, s_max, background, max_depth: int, sh
                      fresnel_schlick(Du, N_in, eta))[:, None]
         kr, kt = rs.kr[obj].astype(t), rs.kt[obj].astype(t)
         w_r = weight * (kr + kt * F)
-        w_t = weight * (kt * (t(1) - F))
+        w_t = weight * (kt * transmitted_share(rs, F, eta))
         refracted, T = ray_refract(Du, N_in, eta)
         go_r = w_r.max(-1) >= RAY_WEIGHT_CUTOFF
         go_t = (w_t.max(-1) >= RAY_WEIGHT_CUTOFF) & refracted

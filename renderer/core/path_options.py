@@ -12,6 +12,7 @@ roulette ends most paths long before it (ROULETTE_DEPTH). The rest is RayOptions
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 from renderer.core.ray_options import RayOptions
 from renderer.errors import OptionError
@@ -41,6 +42,7 @@ class PathOptions(RayOptions):
     samples: int = DEFAULT_PATH_SAMPLES
     pattern: str = DEFAULT_PATH_PATTERN
     max_depth: int = DEFAULT_PATH_DEPTH
+    METHOD: ClassVar[str] = "pathtrace"          # a physical scene in exitance units (scene_for)
 
     def __post_init__(self):
         super().__post_init__()

@@ -57,8 +57,10 @@ class RadiosityOptions:
         return self.element_size if self.element_size is not None else diameter / self.elements_across
 
     def scene_for(self, scene):
-        """The scene as radiosity draws it: as given (a pinhole camera, as the rasteriser's)."""
-        return scene
+        """The scene as radiosity draws it: as given (a pinhole camera, as the rasteriser's); a
+        physical one in exitance units (renderer/core/physical.py)."""
+        from renderer.core.physical import for_method
+        return for_method(scene, "radiosity")
 
     def replace(self, **changes) -> "RadiosityOptions":
         return dataclasses.replace(self, **changes)

@@ -28,8 +28,11 @@ class RasterOptions:
             raise OptionError("shading", f"unknown shading {self.shading!r}; one of {', '.join(SHADING_MODES)}")
 
     def scene_for(self, scene):
-        """The scene as these options draw it: every material in `shading` where given (the
+        """The scene as these options draw it: a physical scene in the lighting equation's
+        terms (renderer/core/physical.py), every material in `shading` where given (the
         rasteriser's camera is a pinhole; RayOptions.scene_for sets a lens)."""
+        from renderer.core.physical import for_method
+        scene = for_method(scene, "raster")
         return scene if self.shading is None else scene.with_shading(self.shading)
 
     def replace(self, **changes) -> "RasterOptions":

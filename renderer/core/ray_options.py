@@ -46,6 +46,7 @@ class RayOptions:
     # identity (the seed is each item's own).
     SETTING_FIELDS: ClassVar[tuple[str, ...]] = ("samples", "pattern", "max_depth",
                                                  "adaptive_threshold", "light_samples")
+    METHOD: ClassVar[str] = "raytrace"          # what a physical scene is drawn as (scene_for)
 
     def __post_init__(self):
         if isinstance(self.max_depth, bool) or not isinstance(self.max_depth, int) \
@@ -80,9 +81,12 @@ class RayOptions:
         return {key: getattr(self, key) for key in LENS_FIELDS if getattr(self, key) is not None}
 
     def scene_for(self, scene):
-        """`scene` with the lens overrides on its camera, checked as the scene file's [camera]
+        """`scene` as this method draws it (a physical one in its units: renderer/core/
+        physical.py) with the lens overrides on its camera, checked as the scene file's [camera]
         keys are (renderer/core/scene_file.py, with_lens: an aperture on a parallel camera,
         a focus distance whose inverse float32 cannot hold): OptionError naming the field."""
+        from renderer.core.physical import for_method
+        scene = for_method(scene, self.METHOD)
         if not self.lens:
             return scene
         return dataclasses.replace(scene, camera=self._with_lens(scene.camera, scene.source or scene.name))

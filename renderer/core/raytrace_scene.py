@@ -31,6 +31,7 @@ import numpy as np
 from renderer.core.bvh import Bvh, build_bvh, forest, refit, roots
 from renderer.core.motion import SceneMotion, declares_motion, has_motion, scene_motion
 from renderer.core.ray_textures import RayTextures, mesh_uvs, ray_textures
+from renderer.core.physical import is_physical
 from renderer.core.scene import Scene, WorldPlane, WorldSphere
 
 
@@ -62,6 +63,7 @@ class RayScene:
     mesh_object: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     # (K,) per tree of `bvh`: the object it moves with, -1 for the static triangles' tree
     textures: RayTextures | None = None  # None: no material is textured (no texture code)
+    radiance_scaling: bool = False   # the physical model: refraction scales radiance by eta^2
 
     @property
     def mesh_roots(self) -> np.ndarray:
@@ -150,6 +152,7 @@ def ray_scene(scene: Scene, tree: Bvh | None = None, motion: bool | None = None)
         motion=scene_motion(scene) if motion else None, mesh_object=mesh_object,
         textures=ray_textures(scene, [k for k, _ in spheres], [k for k, _ in planes],
                               np.concatenate(uvs) if uvs else np.zeros((0, 3, 2))),
+        radiance_scaling=is_physical(scene),
     )
 
 

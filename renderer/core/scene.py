@@ -379,6 +379,9 @@ class Scene:
     background: tuple = (0.0, 0.0, 0.0)
     name: str = "scene"
     source: str = ""             # file it was read from, if any
+    # "phong" (the notes' lighting equation) or "physical" (radiometric units: renderer/core/
+    # physical.py, which each method's options' scene_for applies)
+    model: str = "phong"
 
     def world_matrices(self) -> list[np.ndarray]:
         """World matrix of each object, parents applied (M_world = M_parent_world · M_local).

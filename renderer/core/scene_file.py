@@ -34,6 +34,7 @@ from renderer.errors import SceneError, UserError, show_number
 from renderer.core import memory
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE, MAX_COORDINATE, load_mesh
 from renderer.core.paths import checked_path
+from renderer.core.physical import MODELS
 from renderer.core.user_files import SCENE_FILE, USER_FILE_CAPS, FileRefused, read_user_file
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
@@ -51,7 +52,7 @@ PROJECTIONS = ("perspective", "parallel")
 CULL_MODES = ("none", "back", "front")
 LIGHT_TYPES = ("directional", "point")
 
-TOP_KEYS = ("name", "description", "background", "ambient", "camera", "materials", "lights",
+TOP_KEYS = ("name", "description", "model", "background", "ambient", "camera", "materials", "lights",
             "objects")
 LENS_KEYS = ("aperture", "focus_distance")
 CAMERA_KEYS = ("eye", "look", "up", "projection", "fov_y", "height", "near", "far", "reversed_z",
@@ -448,6 +449,7 @@ class _Reader(TableReader):
         self.primitive_triangles = 0      # so far, for the memory check before building more
         self.tally = memory.TriangleTally()    # every mesh's, against the command's plan
         self.textures: dict = {}          # each image, checker and mesh file's texture, made once
+        self.physical = False             # model = "physical": its materials' and lights' rules
 
     # ---- the scene
 
@@ -458,6 +460,9 @@ class _Reader(TableReader):
             scene.name = self.string(data["name"], "name")
         if "description" in data:
             self.string(data["description"], "description")
+        if "model" in data:
+            scene.model = self.choice(data["model"], "model", "model", MODELS)
+        self.physical = scene.model == "physical"
         if "background" in data:
             scene.background = self.colour(data["background"], "background")
         if "ambient" in data:
@@ -601,6 +606,11 @@ class _Reader(TableReader):
             mat.ior = self.number(raw["ior"], _join(path, "ior"), above=0.0)
         if "fresnel" in raw:
             mat.fresnel = self.choice(raw["fresnel"], _join(path, "fresnel"), "Fresnel mode", FRESNEL_MODES)
+        elif self.physical:
+            mat.fresnel = "exact"                        # the physical model's default
+        if self.physical and max(mat.kd) > 1.0:
+            self.fail(_join(path, "kd"), f"is a reflectance in the physical model (model = \"physical\"): "
+                                         f"at most 1 in each channel, got {max(mat.kd):g}")
         if "gloss" in raw:
             mat.gloss = self.gloss(raw["gloss"], _join(path, "gloss"))
         if "texture" in raw:
@@ -644,6 +654,9 @@ class _Reader(TableReader):
             light = PointLight()
             if "position" in raw:
                 light.position = self.vec3(raw["position"], key("position"))
+            if "attenuation" in raw and self.physical:
+                self.fail(key("attenuation"), "the physical model's point lights fall off as the inverse "
+                                              "square (model = \"physical\"); leave attenuation out")
             if "attenuation" in raw:
                 light.attenuation = self.vec3(raw["attenuation"], key("attenuation"), minimum=0.0)
                 if not any(light.attenuation):

@@ -130,6 +130,7 @@ class RayTracer(ContextRenderer):
             "GLOSSY": (rs.glossy or every) and self.max_depth > 0,
             "MAX_DEPTH": self.max_depth,
             "LENS": scene.camera.has_lens or every,
+            "RADIANCE_SCALING": rs.radiance_scaling,
             **sampling_defines(self.sampling),
             **area_light_defines(scene, every),
             **self._motion_defines(rs),

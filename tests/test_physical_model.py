@@ -136,3 +136,10 @@ def test_the_physical_furnace_is_e_over_pi_over_one_minus_rho(gl_contexts):
     truth = 0.2 * (1 - 0.5 ** 34) / (math.pi * 0.5)
     sigma = values.std(ddof=1) / math.sqrt(values.size)
     assert abs(values.mean() - truth) < 3 * sigma, (values.mean(), truth, sigma)
+
+
+def test_a_physical_scenes_ground_truth_is_not_its_phong_twins(tmp_path):
+    """The report's truth cache keys the model: the same data in the two models are two truths."""
+    from renderer.study.ground_truth import cache_path
+    paths = {cache_path(floor_under_a_lamp(model), 8, 6, tmp_path, "raytrace") for model in ("phong", "physical")}
+    assert len(paths) == 2

@@ -82,12 +82,14 @@ def truth_scene(scene: Scene) -> Scene:
 
 def scene_digest(scene: Scene) -> str:
     """SHA-256 of everything that decides the image: camera, lights, ambient, background,
-    and per object its name, material, transform, parent, culling, motion and mesh arrays
+    the model (renderer/core/physical.py), and per object its name, material, transform, parent, culling, motion and mesh arrays
     (with a textured material, its UVs and texture levels)."""
     digest = hashlib.sha256()
     for part in (scene.camera, scene.directional_lights, scene.point_lights, scene.ambient,
                  scene.background):
         digest.update(repr(part).encode())
+    if scene.model != "phong":            # (Phong scenes keep their cached truths)
+        digest.update(f"model={scene.model}".encode())
     for obj in scene.objects:
         digest.update(repr((obj.name, obj.material, obj.transform, obj.parent, obj.cull)).encode())
         if obj.velocity is not None or obj.angular_velocity is not None:   # (still objects keep

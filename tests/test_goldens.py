@@ -177,10 +177,16 @@ RADIATED_IDS = [f"{name}-{RADIOSITY}" for name in RADIATED]
 @pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
 @pytest.mark.parametrize("name", RADIATED, ids=RADIATED_IDS)
 def test_radiosity_matches_golden(name, context_kind, gl_contexts, golden):
-    frame = golden.check_scene(scene_variant(name, AS_AUTHORED), f"{name}-{RADIOSITY}",
-                               size=RADIOSITY_SIZE, context=gl_contexts[context_kind], method=RADIOSITY)
+    assert_method_matches_golden(golden, name, RADIOSITY, gl_contexts[context_kind])
+
+
+def assert_method_matches_golden(golden, name, method, ctx, **options):
+    """SCENE-METHOD's golden held to the GPU's frame at RADIOSITY_SIZE (the scene drawing
+    something), exactly where the golden was made."""
+    frame = golden.check_scene(scene_variant(name, AS_AUTHORED), f"{name}-{method}", size=RADIOSITY_SIZE,
+                               context=ctx, method=method, **options)
     assert (frame.rgba8[..., 3] == 255).mean() > 0.02
-    assert_exact_where_made(f"{name}-{RADIOSITY}", frame)
+    assert_exact_where_made(f"{name}-{method}", frame)
 
 
 @pytest.mark.slow
@@ -206,11 +212,7 @@ PATH_TRACED_IDS = [f"{name}-{PATHTRACE}" for name in PATH_TRACED]
 @pytest.mark.parametrize("context_kind", ("egl", pytest.param("osmesa", marks=pytest.mark.slow)))
 @pytest.mark.parametrize("name", PATH_TRACED, ids=PATH_TRACED_IDS)
 def test_path_tracer_matches_golden(name, context_kind, gl_contexts, golden):
-    frame = golden.check_scene(scene_variant(name, AS_AUTHORED), f"{name}-{PATHTRACE}",
-                               size=RADIOSITY_SIZE, context=gl_contexts[context_kind], method=PATHTRACE,
-                               **PATH_OPTIONS)
-    assert (frame.rgba8[..., 3] == 255).mean() > 0.02
-    assert_exact_where_made(f"{name}-{PATHTRACE}", frame)
+    assert_method_matches_golden(golden, name, PATHTRACE, gl_contexts[context_kind], **PATH_OPTIONS)
 
 
 @pytest.mark.slow

@@ -129,12 +129,7 @@ vec3 path_trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out fl
         int index;
         float s;
         vec2 uv;
-        int kind = scene_hit(O, D, depth == 0 ? s_min : trace_s_min(O),
-                             depth == 0 ? s_max : TRACE_INF, from_shape, index, s, uv);
-        if (depth == 0) {
-            hit = kind != TRACE_MISS;
-            s_hit = s;
-        }
+        int kind = ray_hit(O, D, depth, s_min, s_max, from_shape, index, s, uv, hit, s_hit);
         if (kind == TRACE_MISS) {
             colour += w * u_background;
             break;

@@ -415,6 +415,20 @@ float trace_sample_time() {
 #include "raytrace/textures.glsl"
 #endif
 
+// The nearest hit of a ray at `depth` of a tree or path (scene_hit): the camera ray's (depth 0)
+// between s_min and s_max, its hit and s recorded in hit and s_hit; a later ray's from
+// trace_s_min(O) on.
+int ray_hit(vec3 O, vec3 D, int depth, float s_min, float s_max, int from_shape, out int index,
+            out float s, out vec2 uv, inout bool hit, inout float s_hit) {
+    int kind = scene_hit(O, D, depth == 0 ? s_min : trace_s_min(O), depth == 0 ? s_max : TRACE_INF,
+                         from_shape, index, s, uv);
+    if (depth == 0) {
+        hit = kind != TRACE_MISS;
+        s_hit = s;
+    }
+    return kind;
+}
+
 // The share of the light a refracted ray brings back through a surface of Fresnel reflectance F,
 // eta = n_i / n_t the indices on the ray's side over the far side's: 1 - F, and under
 // RADIANCE_SCALING (the physical model, renderer/core/physical.py) times eta^2, radiance being
@@ -473,12 +487,7 @@ vec3 trace(vec3 O0, vec3 D0, float s_min, float s_max, out bool hit, out float s
         int index;
         float s;
         vec2 uv;
-        int kind = scene_hit(O, D, depth == 0 ? s_min : trace_s_min(O),
-                             depth == 0 ? s_max : TRACE_INF, from_shape, index, s, uv);
-        if (depth == 0) {
-            hit = kind != TRACE_MISS;
-            s_hit = s;
-        }
+        int kind = ray_hit(O, D, depth, s_min, s_max, from_shape, index, s, uv, hit, s_hit);
         bool next = false;                  // a child of this ray is traced next
         if (kind == TRACE_MISS) {
             colour += w * u_background;

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
+from renderer.core.path_options import PATH_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
 from renderer.core.radiosity_options import DEFAULT_ELEMENTS_ACROSS, MAX_HEMICUBE, SOLVERS
 from renderer.errors import OptionError, UsageError, UserError
@@ -104,7 +105,8 @@ def raytrace_options(p) -> None:
                         "clamped colours differ by more than T in some channel (default 2/255)")
     p.add_argument("--max-depth", type=int, default=None, metavar="D",
                    help="ray tracer: bounces of reflection and refraction, 0 to "
-                        f"{MAX_DEPTH_LIMIT} (default 4); path tracer: bounces of a path (default 32)")
+                        f"{MAX_DEPTH_LIMIT} (default 4); path tracer: bounces of a path, 0 to "
+                        f"{PATH_DEPTH_LIMIT} (default 32)")
     p.add_argument("--seed", type=int, default=None, metavar="S",
                    help="ray tracer: seed of the random numbers (0 to 2^32 - 1)")
     p.add_argument("--light-samples", type=int, default=None, metavar="M",

@@ -20,6 +20,11 @@ from renderer.errors import OptionError
 DEFAULT_PATH_SAMPLES = 16
 DEFAULT_PATH_PATTERN = "jittered"       # stratified and unbiased: regular's cell centres are not
 DEFAULT_PATH_DEPTH = 32
+# The deepest path asked for: a closed room of reflectance rho loses rho^(D + 2) of its light to
+# the cut-off (0.99^1026 = 3e-5), while Russian roulette ends nearly every path long before. A
+# pass traces one sample, so llvmpipe's 65535 loop iterations an invocation (renderer/gpu/
+# pathtracer.py) bound a path's bounces times its BVH steps: about 60 steps a bounce here.
+PATH_DEPTH_LIMIT = 1024
 # Russian roulette (Arvo and Kirk 1990) from this bounce on: a path goes on with probability
 # q = min(1, the largest channel of its weight) and its weight is divided by q, so that the
 # estimate stays unbiased while a dim path ends early. The GLSL's ROULETTE_DEPTH (a #define).
@@ -43,6 +48,8 @@ class PathOptions(RayOptions):
     pattern: str = DEFAULT_PATH_PATTERN
     max_depth: int = DEFAULT_PATH_DEPTH
     METHOD: ClassVar[str] = "pathtrace"          # a physical scene in exitance units (scene_for)
+
+    DEPTH_LIMIT: ClassVar[int] = PATH_DEPTH_LIMIT
 
     def __post_init__(self):
         super().__post_init__()

@@ -47,11 +47,12 @@ class RayOptions:
     SETTING_FIELDS: ClassVar[tuple[str, ...]] = ("samples", "pattern", "max_depth",
                                                  "adaptive_threshold", "light_samples")
     METHOD: ClassVar[str] = "raytrace"          # what a physical scene is drawn as (scene_for)
+    DEPTH_LIMIT: ClassVar[int] = MAX_DEPTH_LIMIT  # max_depth's most (the path tracer's: deeper)
 
     def __post_init__(self):
         if isinstance(self.max_depth, bool) or not isinstance(self.max_depth, int) \
-                or not 0 <= self.max_depth <= MAX_DEPTH_LIMIT:
-            raise OptionError("max_depth", f"must be between 0 and {MAX_DEPTH_LIMIT}, got {self.max_depth}")
+                or not 0 <= self.max_depth <= self.DEPTH_LIMIT:
+            raise OptionError("max_depth", f"must be between 0 and {self.DEPTH_LIMIT}, got {self.max_depth}")
         object.__setattr__(self, "_sampling", ray_sampling(
             self.pattern, self.samples, self.seed, self.adaptive_threshold, self.light_samples))
         self._check_lens()

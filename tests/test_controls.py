@@ -198,16 +198,20 @@ def test_m_toggles_the_ray_tracer_and_changes_the_picture():
                                "title counts the samples per pixel)"]
     viewer.state.scene_changed = False
     viewer.press(glfw.KEY_M)
-    assert viewer.state.method == "raster" and viewer.state.scene_changed
+    assert viewer.state.method == "pathtrace" and viewer.state.scene_changed
+    assert viewer.messages[-1].startswith("method: path tracer; it refines while the view is still")
+    viewer.press(glfw.KEY_M)
+    assert viewer.state.method == "raster"
     assert viewer.messages[-1] == "method: rasteriser"
-    assert "  M     rasteriser / ray tracer (refines while the view is still)" in help_lines()
+    assert ("  M     rasteriser / ray tracer / path tracer (the tracers refine while the view is "
+            "still)") in help_lines()
 
 
-def test_m_from_radiosity_steps_on_to_the_rasteriser():
+def test_m_from_radiosity_steps_on_in_registration_order():
     viewer = Viewer()
     viewer.state.method = "radiosity"
     viewer.press(glfw.KEY_M)
-    assert viewer.state.method == "raster"
+    assert viewer.state.method == "pathtrace"
 
 
 def test_o_toggles_shadows():

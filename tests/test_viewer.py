@@ -382,7 +382,10 @@ def test_the_reference_is_asked_again_only_for_a_new_image(on_x_display):
 def test_ray_tracing_refines_while_still_and_starts_again_when_the_camera_moves(on_x_display):
     """M (or method="raytrace") traces one sample per pixel a frame into the running mean;
     the window shows the mean, the title counts its samples, a camera move starts again with
-    sample 0 of the new view (the headless RayTracer's frame), M back and forth goes on."""
+    sample 0 of the new view (the headless RayTracer's frame); M on: the path tracer's own mean
+    (the headless PathTracer's frame), then the rasteriser, then the ray tracer anew."""
+    from renderer.core.path_options import PathOptions
+    from renderer.gpu.pathtracer import PathTracer
     from renderer.gpu.raytracer import RayTracer
     from renderer.viewer.progressive import PATTERN, SAMPLES_PER_FRAME
     messages = []
@@ -400,12 +403,19 @@ def test_ray_tracing_refines_while_still_and_starts_again_when_the_camera_moves(
             expected = tracer.render(first_sample=0).rgba8[..., :3]
         assert (viewer.shown_image() == expected).all()
 
+        tracer = viewer._tracer
+        press(viewer, glfw.KEY_M)                         # the path tracer: its own mean
+        viewer.frame()
+        assert viewer.samples == 1 and "path tracing: 1 spp" in viewer.title()
+        assert tracer._released and any(line.startswith("path tracer ready") for line in messages)
+        with PathTracer(moved, *SIZE, PathOptions(samples=SAMPLES_PER_FRAME, pattern=PATTERN)) as paths:
+            assert (viewer.shown_image() == paths.render(first_sample=0).rgba8[..., :3]).all()
         press(viewer, glfw.KEY_M)                         # the rasteriser, the same view
         assert_matches(shown_after_a_frame(viewer), headless(moved))
-        assert viewer.samples is None and "ray tracing" not in viewer.title()
-        press(viewer, glfw.KEY_M)                         # back: the mean goes on
+        assert viewer.samples is None and "tracing" not in viewer.title()
+        press(viewer, glfw.KEY_M)                         # the ray tracer again: a new mean
         viewer.frame()
-        assert viewer.samples == 2
+        assert viewer.samples == 1
         tracer = viewer._tracer
     assert tracer._released                               # closed with the viewer
 

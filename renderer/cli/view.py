@@ -30,9 +30,10 @@ def add_parser(sub) -> None:
     view.add_argument("--triple-buffering", action="store_true",
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
-    view.add_argument("--method", choices=("raster", "raytrace"), default="raster",
-                      help="start with the rasteriser (default) or the ray tracer, which refines "
-                           "while the view is still, one sample per pixel a frame (the M key)")
+    view.add_argument("--method", choices=("raster", "raytrace", "pathtrace"), default="raster",
+                      help="start with the rasteriser (default), the ray tracer or the path tracer; "
+                           "the tracers refine while the view is still, one sample per pixel a "
+                           "frame (the M key)")
     memory_option(view)
 
 
@@ -74,7 +75,7 @@ def run(args) -> int:
         if figures is not None:
             print(figures_line(figures))
         if samples is not None:
-            print(f"ray tracing: {samples} spp")
+            print(f"{'path' if args.method == 'pathtrace' else 'ray'} tracing: {samples} spp")
         if args.screenshot is not None:
             print(f"wrote {args.screenshot}")
     return 0

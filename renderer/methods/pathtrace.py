@@ -37,7 +37,7 @@ def _words(options: PathOptions, frame: Frame) -> str:
     return f"pathtrace {options.samples} spp, up to {options.max_depth} bounces"
 
 
-# The viewer's M key does not step to it: a frame of 16 paths a pixel takes llvmpipe seconds at
-# a window's size (docs/pathtrace.md).
+# The viewer's M key steps to it after the ray tracer: one path a pixel a frame, the mean refining
+# while the view is still (renderer/viewer/progressive.py).
 METHOD = Method("pathtrace", "path tracer", PathOptions, _open_gpu, _open_reference, _need,
-                _words, _samples, progressive=True, seeded=True, shutter=True, stepped_to=False)
+                _words, _samples, progressive=True, seeded=True, shutter=True)

@@ -9,8 +9,9 @@ overlay beside or over it; then swap. The reference view is the NumPy reference 
 view, made in a background process (renderer/viewer/reference_view.py), side by side with the GPU
 image or as a heat map of their difference with its figures.
 
-With the ray tracer on (the M key, `method="raytrace"`) a frame is one sample per pixel traced
-by a RayTracer made on first use in the window's context (renderer/gpu/raytracer.py) and added
+With the ray tracer on (the M key, `method="raytrace"`; or the path tracer, `"pathtrace"`, the
+key's next step) a frame is one sample per pixel traced by a RayTracer (PathTracer) made on
+first use in the window's context (renderer/gpu/raytracer.py, pathtracer.py) and added
 to the running mean of the view's samples (renderer/viewer/progressive.py); the window shows
 the mean, and the title the samples per pixel so far. A change of the picture (camera, size,
 shading, lights, materials) takes the tracer's update() and starts the mean again; once it
@@ -41,7 +42,6 @@ from renderer.checks.methods import without_shadow_maps
 from renderer.viewer.controls import (Controls, ViewState, apply_view, help_lines, light_names_of,
                                       shown_light, working_copy)
 from renderer.gpu.context import activate
-from renderer.core.ray_options import RayOptions
 from renderer.methods import METHODS, open_renderer
 from renderer.core.imageio import write_image
 from renderer.core.paths import default_output, output_stem
@@ -124,7 +124,8 @@ class Viewer:
             self._difference_image = CpuImage(self.ctx)  # the heat map
             self._overlay = CpuImage(self.ctx)
             self._overlay_lines: tuple = ()
-            self._tracer = None                # the RayTracer, made on first use
+            self._tracer = None                # the RayTracer or PathTracer, made on first use
+            self._tracer_method = None         # which of them
             self._traced_version = -1          # the version it and the mean were made for
             self.accumulator = Accumulator()
             self._traced = CpuImage(self.ctx)  # the mean so far
@@ -282,16 +283,22 @@ class Viewer:
         return METHODS[self.state.method].progressive
 
     def _trace(self):
-        """The ray tracer's frame: the tracer brought to the current view (made, or updated
-        and the mean restarted, when the version moved on), one more frame added to the mean
-        unless it is complete, and the mean uploaded; its framebuffer."""
+        """The ray or path tracer's frame: the tracer of the method shown brought to the
+        current view (made, or updated and the mean restarted, when the version moved on; made
+        again when the method changed), one more frame added to the mean unless it is complete,
+        and the mean uploaded; its framebuffer."""
         size = (self.gpu.width, self.gpu.height)
+        method = METHODS[self.state.method]
+        if self._tracer is not None and self._tracer_method != method.name:
+            self._tracer.release()                    # the other tracer's: its mean is not this one's
+            self._tracer = None
         if self._tracer is None:
             started = time.perf_counter()
-            self._tracer = open_renderer(self.shown, size, method="raytrace", context=self.ctx,
-                                         options=RayOptions(samples=SAMPLES_PER_FRAME, pattern=PATTERN))
+            self._tracer = open_renderer(self.shown, size, method=method.name, context=self.ctx,
+                                         options=method.options(samples=SAMPLES_PER_FRAME, pattern=PATTERN))
+            self._tracer_method, self._traced_version = method.name, -1      # its mean starts
             rs = self._tracer.ray_scene
-            self.say(f"ray tracer ready in {time.perf_counter() - started:.1f} s "
+            self.say(f"{method.title} ready in {time.perf_counter() - started:.1f} s "
                      f"({len(rs.triangles):,} triangles, {len(rs.sphere_radius)} spheres, "
                      f"{len(rs.plane_offset)} planes)")
         elif self._traced_version != self._version:
@@ -377,7 +384,7 @@ class Viewer:
         latency_text = "" if latency is None else f", latency {latency:.1f} ms"
         tracing = ""
         if self._progressive:
-            tracing = f" | ray tracing: {self.accumulator.samples} spp" + (
+            tracing = f" | {'path' if self.state.method == 'pathtrace' else 'ray'} tracing: {self.accumulator.samples} spp" + (
                 " (done)" if self.accumulator.done else "")
         shadows = f" | shadows {'on' if self.state.shadows else 'off'}"
         if self._map_shown:

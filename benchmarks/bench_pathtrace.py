@@ -211,7 +211,7 @@ def markdown(document: dict) -> str:
         lines += ["", "Element by element: each element's radiosity against its path-traced value "
                   f"({by_element[0]['element_paths']:,} paths onto uniform points of it; the emitting "
                   "elements left out), area-weighted, in 8-bit levels:", "",
-                  "| elements | mean \|difference\| | paths' standard error | RMS less the paths' noise |",
+                  r"| elements | mean \|difference\| | paths' standard error | RMS less the paths' noise |",
                   "| ---: | ---: | ---: | ---: |"]
         lines += [f"| {r['elements']:,} | {r['element_levels']:.2f} | {r['element_noise_levels']:.2f} | "
                   f"{r['element_rms_levels']:.2f} |" for r in by_element]

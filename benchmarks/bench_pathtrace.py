@@ -14,7 +14,7 @@ mean over the pixels of |difference| x 255, and its 95th percentile):
 - the path tracer at 16, 64 and 256 paths a pixel (error against time: Monte Carlo's slope -1/2);
 - radiosity (Gauss-Seidel, hemicubes of --hemicube) at each element size: its form factors,
   solution and display timed together, the display drawn at 4 times the size and each 4 x 4
-  block averaged (renderer/study/radiosity_report.py footprint_image: the pixel's mean, as the
+  block averaged (renderer/checks/radiosity_vs_pathtrace.py footprint_image: the pixel's mean, as the
   truth's paths; a pixel-centre image would add its edges' aliasing to radiosity's error);
 - and element by element, for the element sizes of at most --elements-up-to elements (the
   twin's paths are slow): each
@@ -43,8 +43,7 @@ from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
-from renderer.study.radiosity_report import footprint_image
-from renderer.study.report_settings import FOOTPRINT
+from renderer.checks.radiosity_vs_pathtrace import FOOTPRINT, footprint_image
 
 from common import measured_line, write_results          # benchmarks/common.py
 

@@ -208,3 +208,24 @@ def test_osmesa_draws_the_egl_paths(gl_contexts):
     frames = [path_frame(s, (32, 24), PathOptions(samples=2), "gpu", gl_contexts[kind]).linear
               for kind in ("egl", "osmesa")]
     assert np.array_equal(*frames)
+
+
+def test_radiosity_against_the_path_tracer_comes_closer_as_its_elements_refine():
+    """renderer/checks/radiosity_vs_pathtrace.py on the Cornell box at 16 x 12 (two frames of
+    256 paths a pixel): three element sizes, each half the last, the mean difference falling."""
+    from renderer.checks.radiosity_vs_pathtrace import radiosity_vs_pathtrace
+    result = radiosity_vs_pathtrace(scene("cornell_box_radiosity"), 16, 12, element_size=0.3, truth_frames=2)
+    rows = result.rows
+    assert [r["element_size"] for r in rows] == [0.3, 0.15, 0.075]
+    assert rows[0]["elements"] < rows[1]["elements"] < rows[2]["elements"]
+    assert rows[2]["mean_levels"] < rows[0]["mean_levels"]
+    assert result.image().shape == (12, 16, 3) and "512 paths a pixel" in result.line()
+    assert result.as_dict()["truth_paths"] == 512
+
+
+def test_radiosity_against_the_path_tracer_is_one_comparison_of_its_own(cli):
+    for flags, reason in ((["--methods"], "two different comparisons"),
+                          (["--method", "radiosity"], "leave out --method radiosity"),
+                          (["--hemicube", "5"], "--hemicube 5: must be a power of two")):
+        result = cli("compare", "cornell_box_radiosity", "--radiosity-vs-pathtrace", *flags)
+        assert result.returncode == 2 and reason in result.stderr, result.stderr

@@ -1,7 +1,7 @@
 """`renderer compare`: a scene through the GPU and the NumPy reference against the pipeline
 tolerance; with --methods the rasteriser against the ray tracer, with --shadows-vs-truth the
 shadow maps against ray-cast shadows, with --depth-vs-truth the GPU's depth against ray-cast
-depth."""
+depth, with --radiosity-vs-pathtrace radiosity against the path tracer."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ from pathlib import Path
 
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.cli.options import (channel_threshold, check_raytrace_options, load, load_traced,
-                                  memory_option, output_path, raytrace_options, scene_options,
+                                  memory_option, output_path, raytrace_options, scene_options, spelled,
                                   warn_if_nothing_drawn)
 from renderer.core.memory import raster_need
-from renderer.errors import UserError
+from renderer.errors import OptionError, UserError
 
 
 def add_parser(sub) -> None:
@@ -29,7 +29,8 @@ def add_parser(sub) -> None:
                     "(what fails is said on stderr), 2 for bad input. With --methods: the "
                     "rasteriser against the ray tracer instead, status 0; with --shadows-vs-truth: "
                     "the rasteriser's shadow maps against ray-cast shadows, status 0; with "
-                    "--depth-vs-truth: the GPU's depth against ray-cast depth, status 0.")
+                    "--depth-vs-truth: the GPU's depth against ray-cast depth, status 0; with "
+                    "--radiosity-vs-pathtrace: radiosity against the path tracer, status 0.")
     scene_options(compare)
     raytrace_options(compare)
     compare.add_argument("--out", type=output_path, help="folder for gpu.png, reference.png, diff.png "
@@ -51,6 +52,13 @@ def add_parser(sub) -> None:
                               "99.9th percentile and maximum, in all and per object; writes "
                               "depth_truth.png and depth_truth.json (default folder: "
                               "compare-depth-SCENE_NAME)")
+    compare.add_argument("--radiosity-vs-pathtrace", action="store_true",
+                         help="radiosity against the path tracer (4096 paths a pixel) at three "
+                              "element sizes, each half the last (--element-size, default the "
+                              "scene's diagonal / 6; --hemicube): the mean |difference| as the "
+                              "elements refine; writes radiosity_vs_pathtrace.png (the finest "
+                              "size's difference) and .json (default folder: "
+                              "compare-radiosity-SCENE_NAME)")
     compare.add_argument("--threshold", type=channel_threshold, default=PIPELINE_TOLERANCE.threshold,
                          metavar="LEVELS",
                          help="per-channel threshold in levels of 255, 0 to 255; the pipeline "
@@ -162,6 +170,27 @@ def run_depth(args) -> int:
     return _write_measurement(names, depth_vs_truth(scene, *args.size, context=args.context))
 
 
+def run_radiosity(args) -> int:
+    """`compare --radiosity-vs-pathtrace` (from run): the figures as one JSON line and one
+    readable line, the difference image and the figures in --out; status 0 (a measurement)."""
+    from renderer.checks.radiosity_vs_pathtrace import radiosity_vs_pathtrace
+    from renderer.core.radiosity_options import RadiosityOptions
+    others = [flag for flag, given in (("--methods", args.methods), ("--shadows-vs-truth", args.shadows_vs_truth),
+                                       ("--depth-vs-truth", args.depth_vs_truth)) if given]
+    if others:
+        args.parser.error(f"--radiosity-vs-pathtrace and {others[0]} are two different comparisons; give one")
+    if args.method is not None:
+        args.parser.error(f"--radiosity-vs-pathtrace draws both methods; leave out --method {args.method}")
+    try:
+        options = RadiosityOptions(element_size=args.element_size, hemicube=args.hemicube or 64)
+    except OptionError as error:
+        args.parser.error(spelled(error, args))
+    scene = load(args.scene, raster_need(args.size, ["gpu"]))
+    names = _measurement_files(args, scene, "radiosity", "radiosity_vs_pathtrace")
+    return _write_measurement(names, radiosity_vs_pathtrace(scene, *args.size, options.element_size,
+                                                            options.hemicube, args.context))
+
+
 def run(args) -> int:
     """The GPU's frame (the median of three) against the reference's: the figures as one JSON
     line, the images in --out; status 1 when they fail the pipeline tolerance. The other
@@ -173,6 +202,8 @@ def run(args) -> int:
     from renderer.core.jsonio import to_json
     if args.out is not None:
         check_folder(args.out)
+    if args.radiosity_vs_pathtrace:
+        return run_radiosity(args)
     if args.depth_vs_truth:
         return run_depth(args)
     if args.shadows_vs_truth:

@@ -28,19 +28,13 @@ import numpy as np
 from renderer.core.radiosity import elements_for
 from renderer.core.radiosity_options import DEFAULT_ELEMENTS_ACROSS, RadiosityOptions
 from renderer.study.metrics import metrics
-from renderer.study.report_settings import (FOOTPRINT, RADIOSITY_CSV_COLUMNS, RADIOSITY_DEFAULT_SIZE,
-                                            RADIOSITY_MAX_SIZE, RADIOSITY_QUICK_SIZE, TWIN_ACROSS)
-from renderer.study.supersample import clamped
+from renderer.checks.radiosity_vs_pathtrace import FOOTPRINT, footprint_image
+from renderer.study.report_settings import (RADIOSITY_CSV_COLUMNS, RADIOSITY_DEFAULT_SIZE, RADIOSITY_MAX_SIZE,
+                                            RADIOSITY_QUICK_SIZE, TWIN_ACROSS)
 from renderer.study.timing import median_timed
 
 
 
-def footprint_image(renderer_frame, width: int, height: int) -> np.ndarray:
-    """(H, W, 3) float64: a frame drawn at FOOTPRINT times (width, height), each block's mean
-    linear colour, clamped to [0, 1] (as the truth: the mean, then the clamp)."""
-    linear = renderer_frame.linear[..., :3].astype(np.float64)
-    blocks = linear.reshape(height, FOOTPRINT, width, FOOTPRINT, 3).mean(axis=(1, 3))
-    return clamped(blocks)
 
 
 @dataclass(frozen=True)

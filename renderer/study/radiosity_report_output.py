@@ -11,7 +11,8 @@ import numpy as np
 from renderer.study.ground_truth import (PATH_TRUTH_DEPTH, PATH_TRUTH_PASSES, PATH_TRUTH_SAMPLES,
                                          RAY_TRUTH_SEED)
 from renderer.study.report_output import cheapest_sections, errors_bullet, generated_line, plots_section
-from renderer.study.report_settings import FOOTPRINT, SWEEP_FLAGS, TWIN_ACROSS
+from renderer.checks.radiosity_vs_pathtrace import FOOTPRINT
+from renderer.study.report_settings import SWEEP_FLAGS, TWIN_ACROSS
 
 
 def slope(rows: list[dict], x: str) -> float | None:

@@ -71,7 +71,6 @@ RADIOSITY_QUICK_SIZE = (64, 48)
 RADIOSITY_QUICK_SCENES = ("cornell_box_radiosity",)
 RADIOSITY_MAX_SIZE = (320, 240)      # its path-traced truth: 4096 paths a pixel on the GPU
 TWIN_ACROSS = 6                      # the twin's element sizes: at most this many across
-FOOTPRINT = 4                        # the display drawn at 4x the size, each 4 x 4 block averaged
 RADIOSITY_CSV_COLUMNS = ("scene", "knob", "setting", "backend", "samples", "elements_across", "hemicube",
                          "iterations", "runs", "median_ms", "worker", "rmse", "max_abs", "psnr",
                          "flip_mean", "mismatched_fraction")

@@ -43,7 +43,7 @@ from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene_file import load_scene
 from renderer.gpu.context import make_context
 from renderer.methods import open_renderer
-from renderer.checks.radiosity_vs_pathtrace import FOOTPRINT, footprint_image
+from renderer.checks.radiosity_vs_pathtrace import FOOTPRINT, footprint_image, path_traced
 
 from common import measured_line, write_results          # benchmarks/common.py
 
@@ -60,15 +60,7 @@ def levels(image, truth):
 def path_frames(scene, size, samples, frames, ctx, first=0):
     """(mean linear RGB over `frames` frames of `samples` paths from sample index `first`,
     seconds, the standard error of the mean from the frames' spread)."""
-    start = time.perf_counter()
-    with open_renderer(scene, size, method="pathtrace", options=PathOptions(samples=samples),
-                       context=ctx) as tracer:
-        each = [tracer.render(first_sample=first + k * samples).linear[..., :3].astype(np.float64)
-                for k in range(frames)]
-    seconds = time.perf_counter() - start
-    total = np.mean(each, axis=0)
-    spread = np.std(each, axis=0, ddof=1).mean() / math.sqrt(frames) if frames > 1 else float("nan")
-    return total, seconds, spread
+    return path_traced(scene, size, PathOptions(samples=samples), frames, first=first, context=ctx)
 
 
 def main() -> None:

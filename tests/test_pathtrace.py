@@ -229,3 +229,20 @@ def test_radiosity_against_the_path_tracer_is_one_comparison_of_its_own(cli):
                           (["--hemicube", "5"], "--hemicube 5: must be a power of two")):
         result = cli("compare", "cornell_box_radiosity", "--radiosity-vs-pathtrace", *flags)
         assert result.returncode == 2 and reason in result.stderr, result.stderr
+
+
+def test_update_takes_new_emissions_and_refuses_another_number_of_emitters(gl_contexts):
+    """A new emission is written into the tracer's textures (the image of a tracer made afresh);
+    an emitter switched off changes the emitters' table's size: one line, before any write."""
+    from renderer.gpu.pathtracer import PathTracer
+    room = scene("cornell_box_radiosity")
+    with PathTracer(room, 16, 12, PathOptions(samples=2), context=gl_contexts["egl"]) as tracer:
+        tracer.render()
+        room.objects[3].material.emission = (10.0, 10.0, 10.0)
+        tracer.update()
+        updated = tracer.render()
+        with PathTracer(room, 16, 12, PathOptions(samples=2), context=gl_contexts["egl"]) as fresh:
+            assert np.array_equal(updated.linear, fresh.render().linear)
+        room.objects[3].material.emission = (0.0, 0.0, 0.0)
+        with pytest.raises(ValueError, match="emitting triangles changed in number"):
+            tracer.update()

@@ -39,6 +39,23 @@ def footprint_image(frame, width: int, height: int) -> np.ndarray:
     return np.clip(linear.reshape(height, FOOTPRINT, width, FOOTPRINT, 3).mean(axis=(1, 3)), 0.0, 1.0)
 
 
+def path_traced(scene, size, options, frames: int, *, first: int = 0, context=None, progress=None):
+    """(the mean linear colour (H, W, 3) float64 of `frames` path-traced frames with PathOptions
+    `options`, each new paths (sample indices from `first` on), the seconds taken, the mean
+    standard error of that mean from the frames' spread (nan for one frame)); on `context` (None:
+    a new one); `progress(share done)` after each frame. The truth of this comparison, of the
+    radiosity report (renderer/study/ground_truth.py) and of benchmarks/bench_pathtrace.py."""
+    from renderer.methods import open_renderer
+    start, each = time.perf_counter(), []
+    with open_renderer(scene, size, method="pathtrace", options=options, context=context) as tracer:
+        for k in range(frames):
+            each.append(tracer.render(first_sample=first + k * options.samples).linear[..., :3].astype(np.float64))
+            if progress is not None:
+                progress((k + 1) / frames)
+    error = float(np.std(each, axis=0, ddof=1).mean() / np.sqrt(frames)) if frames > 1 else float("nan")
+    return np.mean(each, axis=0), time.perf_counter() - start, error
+
+
 def _rgba8(image: np.ndarray) -> np.ndarray:
     from renderer.core.gl_rules import to_unorm8
     return to_unorm8(np.concatenate([image, np.ones(image.shape[:2] + (1,))], -1).astype(np.float32))
@@ -81,20 +98,14 @@ def radiosity_vs_pathtrace(scene, width: int, height: int, element_size: float |
     from renderer.methods import open_renderer
     ctx = make_context(context_kind)
     try:
-        start = time.perf_counter()
-        with open_renderer(scene, (width, height), method="pathtrace", context=ctx,
-                           options=PathOptions(samples=TRUTH_SAMPLES)) as tracer:
-            frames = [tracer.render(first_sample=TRUTH_FIRST + k * TRUTH_SAMPLES).linear[..., :3].astype(np.float64)
-                      for k in range(truth_frames)]
-        truth = np.clip(np.mean(frames, axis=0), 0.0, 1.0)
-        error = (float(np.std(frames, axis=0, ddof=1).mean() / np.sqrt(truth_frames)) if truth_frames > 1
-                 else float("nan"))
+        mean, seconds, error = path_traced(scene, (width, height), PathOptions(samples=TRUTH_SAMPLES),
+                                           truth_frames, first=TRUTH_FIRST, context=ctx)
+        truth = np.clip(mean, 0.0, 1.0)
         result = RadiosityVsPathtrace(scene.name, (width, height), TRUTH_SAMPLES * truth_frames,
-                                      time.perf_counter() - start, error, _truth=truth)
-        sizes = ([element_size, element_size / 2, element_size / 4] if element_size is not None
-                 else [None, None, None])
-        for step, size in enumerate(sizes):
-            options = (RadiosityOptions(element_size=size, hemicube=hemicube) if size is not None else
+                                      seconds, error, _truth=truth)
+        for step in range(3):                   # each element size half the last
+            options = (RadiosityOptions(element_size=element_size / 2 ** step, hemicube=hemicube)
+                       if element_size is not None else
                        RadiosityOptions(elements_across=COARSEST_ACROSS << step, hemicube=hemicube))
             start = time.perf_counter()
             with open_renderer(scene, (FOOTPRINT * width, FOOTPRINT * height), method="radiosity",
@@ -103,7 +114,8 @@ def radiosity_vs_pathtrace(scene, width: int, height: int, element_size: float |
                 elements = len(radiosity.solution.elements)
             seconds = time.perf_counter() - start
             difference = np.abs(image - truth).max(axis=-1) * LEVELS
-            result.rows.append({"element_size": size, "elements_across": None if size else COARSEST_ACROSS << step,
+            result.rows.append({"element_size": options.element_size,
+                                "elements_across": None if element_size is not None else options.elements_across,
                                 "elements": elements, "seconds": seconds,
                                 "mean_levels": float(difference.mean()),
                                 "p95_levels": float(np.percentile(difference, 95))})

@@ -34,7 +34,7 @@ INVERSE_SQUARE = (0.0, 0.0, 1.0)
 
 
 def is_physical(scene: Scene) -> bool:
-    return getattr(scene, "model", "phong") == "physical"
+    return scene.model == "physical"
 
 
 def _scaled(values, factor: float) -> tuple:

@@ -31,10 +31,16 @@ class PathTracer(RayTracer):
     """Path traces one scene at one size (module docstring); `options` a PathOptions."""
 
     def __init__(self, scene, width, height, options: PathOptions | None = None, **keywords):
+        self.emitters = None                     # the scene's (_defines), kept in number by update()
         super().__init__(scene, width, height, PathOptions() if options is None else options, **keywords)
 
     def _defines(self, rs) -> dict:
-        self.emitters = path_emitters(self.scene, rs)
+        emitters = path_emitters(self.scene, rs)
+        if self.emitters is not None and emitters.count != self.emitters.count:
+            # before any texture is written again: the emitters' texture has another size
+            raise ValueError("the scene's emitting triangles changed in number since this "
+                             "PathTracer was made; make a new one")
+        self.emitters = emitters
         defines = super()._defines(rs)
         defines.update({"PATH_TRACE": True, "SAMPLE_PASSES": True, "SECONDARY": False,
                         "ROULETTE_DEPTH": ROULETTE_DEPTH,
@@ -92,10 +98,3 @@ class PathTracer(RayTracer):
         per_row = self.width * self.sampling.light_samples
         rows = max(1, BAND_SAMPLES // per_row)
         return [(y, min(rows, self.height - y)) for y in range(0, self.height, rows)]
-
-    def _take_scene(self) -> None:
-        before = self.emitters.count
-        super()._take_scene()
-        if self.emitters.count != before:        # the emitters' texture has another size
-            raise ValueError("the scene's emitting triangles changed in number since this "
-                             "PathTracer was made; make a new one")

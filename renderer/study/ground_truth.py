@@ -166,16 +166,11 @@ def _path_recipe(scene: Scene) -> str:
 def render_path_truth(scene: Scene, width: int, height: int, progress=None) -> np.ndarray:
     """(H, W, 3) float64: radiosity's truth, path traced now (module docstring);
     `progress(share done)` after each frame."""
+    from renderer.checks.radiosity_vs_pathtrace import path_traced
     from renderer.core.path_options import PathOptions
     options = PathOptions(samples=PATH_TRUTH_SAMPLES, pattern="jittered", max_depth=PATH_TRUTH_DEPTH,
                           seed=RAY_TRUTH_SEED)
-    total = np.zeros((height, width, 3))
-    with open_renderer(scene, (width, height), method="pathtrace", options=options) as truth:
-        for frame in range(PATH_TRUTH_PASSES):
-            total += truth.render(first_sample=frame * PATH_TRUTH_SAMPLES).linear[..., :3]
-            if progress is not None:
-                progress((frame + 1) / PATH_TRUTH_PASSES)
-    return clamped(total / PATH_TRUTH_PASSES)
+    return clamped(path_traced(scene, (width, height), options, PATH_TRUTH_PASSES, progress=progress)[0])
 
 
 @dataclass(frozen=True)

@@ -105,10 +105,11 @@ class RadiositySceneRun:
             with open_renderer(self.scene, (FOOTPRINT * self.width, FOOTPRINT * self.height),
                                method="radiosity", backend=setting.backend, options=setting.options(),
                                context=self.ctx) as renderer:
-                return footprint_image(renderer.render(linear=True), self.width, self.height)
+                image = footprint_image(renderer.render(linear=True), self.width, self.height)
+                return image, len(renderer.solution.elements)
         # the GPU's first compiles its programs; the twin has nothing to warm
-        image, ms = median_timed(drawn, runs, warm_up=setting.backend == "gpu")
-        return image, float(len(elements_for(self.scene, setting.options()))), ms
+        (image, elements), ms = median_timed(drawn, runs, warm_up=setting.backend == "gpu")
+        return image, float(elements), ms
 
     def errors(self, setting, image: np.ndarray, truth: np.ndarray) -> dict:
         return metrics(image, truth)

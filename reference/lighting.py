@@ -33,6 +33,8 @@ from typing import ClassVar
 
 import numpy as np
 
+from reference import glsl_builtins
+
 from renderer.core.uniforms import light_uniforms, material_uniforms
 
 # The parts a textured material's flat and Gouraud lighting is handed on in (glsl/lighting.glsl).
@@ -95,13 +97,14 @@ class MaterialUniforms:
 
 
 def dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """GLSL dot() of 3-vectors over the last axis, kept as length 1 to broadcast against RGB."""
-    return (a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2])[..., None]
+    """GLSL dot() of 3-vectors over the last axis (as llvmpipe sums it, glsl_builtins.py), kept
+    as length 1 to broadcast against RGB."""
+    return glsl_builtins.dot(a, b)[..., None]
 
 
 def normalize(v: np.ndarray) -> np.ndarray:
-    """GLSL normalize() over the last axis."""
-    return v / np.sqrt(dot(v, v))
+    """GLSL normalize() over the last axis (as llvmpipe computes it, glsl_builtins.py)."""
+    return glsl_builtins.normalize(v)
 
 
 def normalize_or_zero(v: np.ndarray) -> np.ndarray:

@@ -126,10 +126,11 @@ TEXTURE_SCENES = frozenset({"textured_mesh", "checker_horizon", "globe"})
 SHADOW_CASE_SCENES = frozenset({"shadow_boxes", "shadow_thin_contact", "shadow_big_floor",
                                 "shadow_lowpoly_sphere", "shadow_knot_floor"})
 # The built-in scenes made for `--method radiosity` (issue 33): lit by emitting surfaces, which
-# the rasteriser does not read (it shows them by their ambient term); the rasteriser's tests
-# over every built-in scene hold them in the full run only, as the ray tracer's scenes.
+# the rasteriser does not read (it shows them by their ambient term), or by the sun through a
+# window (radiosity_window); the rasteriser's tests over every built-in scene hold them in the
+# full run only, as the ray tracer's scenes.
 # Their radiosity tests are tests/test_radiosity_method.py and their goldens tests/test_goldens.py.
-RADIOSITY_SCENES = frozenset({"radiosity_furnace", "radiosity_plates", "cornell_box_radiosity"})
+RADIOSITY_SCENES = frozenset({"radiosity_furnace", "radiosity_plates", "cornell_box_radiosity", "radiosity_window"})
 
 
 def raster_scene_params(names, ids=None):

@@ -48,3 +48,33 @@ class ShaderProbe:
     def __exit__(self, *exc):
         for thing in (self.vao, self.framebuffer, self.texture, self.program):
             thing.release()
+
+
+def float_probe(ctx, fragment: str, inputs: dict, outputs: int, defines: dict | None = None,
+                uniforms: dict | None = None) -> list[np.ndarray]:
+    """Run test shader `fragment` once over the size of its inputs: `inputs` {sampler name:
+    (H, W, 3) float32 array}, each bound as an RGB32F texture read with texelFetch at the
+    fragment's pixel; `uniforms` {name: value} set with .value; the `outputs` RGBA32F colour
+    attachments read back, (H, W, 4) each, row 0 at the bottom."""
+    activate(ctx)
+    height, width = next(iter(inputs.values())).shape[:2]
+    program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
+                          fragment_shader=shader_source(fragment, defines or {}, directory=GLSL).text)
+    textures = [ctx.texture((width, height), 3, np.ascontiguousarray(a, np.float32).tobytes(), dtype="f4")
+                for a in inputs.values()]
+    targets = [ctx.texture((width, height), 4, dtype="f4") for _ in range(outputs)]
+    framebuffer = ctx.framebuffer(targets)
+    vao = ctx.vertex_array(program, [])
+    try:
+        for unit, (texture, name) in enumerate(zip(textures, inputs)):
+            texture.filter = (ctx.NEAREST, ctx.NEAREST)
+            texture.use(unit)
+            program[name].value = unit
+        for name, value in (uniforms or {}).items():
+            program[name].value = value
+        framebuffer.use()
+        vao.render(vertices=3)
+        return [np.frombuffer(t.read(), np.float32).reshape(height, width, 4) for t in targets]
+    finally:
+        for thing in (vao, framebuffer, program, *textures, *targets):
+            thing.release()

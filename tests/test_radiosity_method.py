@@ -51,7 +51,8 @@ def test_the_white_plate_gets_rho_e_times_c11(gl_contexts):
     """The white plate's area-weighted mean radiosity against 0.8 x 1 x F(C-11), within the
     hemicubes' and the elements' error (measured: 1.6 % at elements of 0.1 and N = 64; the
     plates' edges run along pixel rows, so that it does not fall steadily with N:
-    tests/test_form_factors.py)."""
+    tests/test_form_factors.py), plus the sky's: the background's radiosity times what each
+    element's hemicube saw of nothing, times rho."""
     options = RadiosityOptions(element_size=0.1, hemicube=64)
     with open_renderer(scene("radiosity_plates"), (32, 24), method="radiosity", options=options,
                        context=gl_contexts["egl"]) as renderer:
@@ -59,7 +60,8 @@ def test_the_white_plate_gets_rho_e_times_c11(gl_contexts):
     elements, b = solution.elements, solution.solution.radiosity
     white = elements.obj == 1
     mean = (elements.areas[white, None] * b[white]).sum(axis=0) / elements.areas[white].sum()
-    exact = 0.8 * parallel_rectangles(1, 1, 1)
+    unseen = (elements.areas[white] * solution.form_factors.unseen[white]).sum() / elements.areas[white].sum()
+    exact = 0.8 * (parallel_rectangles(1, 1, 1) + unseen * np.array(scene("radiosity_plates").background))
     assert np.allclose(mean, exact, rtol=0.02), (mean, exact)
     assert np.all(b[~white] == 1.0)                                # black emitter: E only
     assert solution.form_factors.unseen.min() > 0.7                # open: most light leaves
@@ -157,7 +159,9 @@ def test_the_command_line_renders_radiosity_and_refuses_in_one_line(cli, tmp_pat
 
 def test_a_scene_where_light_does_not_bounce_draws_no_hemicube(gl_contexts):
     """The rule of leaving out what a scene does not need: with nothing emitting, or nothing
-    reflecting, B = E exactly and no hemicube is drawn; once light can bounce, they are."""
+    reflecting, B = E exactly and no hemicube is drawn; once light can bounce, they are. One
+    convex solid lit from outside (the sphere under its two lights) cannot light itself:
+    B = rho (H + sky), its hemicubes seeing nothing but the background, and none is drawn."""
     options = RadiosityOptions(element_size=0.25, hemicube=16)
     plates = scene("radiosity_plates")
     plates.objects[1].material.kd = (0.0, 0.0, 0.0)               # nothing reflects
@@ -173,9 +177,13 @@ def test_a_scene_where_light_does_not_bounce_draws_no_hemicube(gl_contexts):
         assert renderer.form_factor_draws == 1 and renderer.solution.form_factors.drawn
         white = renderer.solution.elements.obj == 1
         assert (renderer.solution.solution.radiosity[white] > 0).all()
-    with open_renderer(scene("sphere"), (16, 12), method="radiosity", options=options,
-                       backend="reference") as twin:                 # nothing emits: black
+    with open_renderer(scene("sphere"), (16, 12), method="radiosity", options=options.replace(light_buffer=64),
+                       backend="reference") as twin:
         frame = twin.render(linear=True)
-        assert twin.solution.form_factors.drawn is False
+        solution = twin.solution
+        assert solution.form_factors.drawn is False and not solution.elements.see_each_other
+        sky = np.array(scene("sphere").background)
+        assert np.allclose(solution.solution.radiosity, solution.elements.reflectance * (solution.irradiance + sky),
+                           rtol=1e-12, atol=0)
         drawn = frame.rgba8[..., 3] == 255
-        assert drawn.any() and not frame.linear[drawn][:, :3].any()
+        assert drawn.any() and frame.linear[drawn][:, :3].any()

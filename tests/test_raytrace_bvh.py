@@ -5,9 +5,11 @@ random rays for a triangle soup and the 20,480-triangle icosphere, and the GLSL 
 (EGL, OSMesa) against the twin.
 
 Ties: a ray through an edge or vertex that triangles share hits them all at the same s (docs/
-conventions.md, "Rays"); any of them is the closest hit, so where two answers name different
-triangles, each must be hit by the ray at the other's s (exactly, for the twin against brute
-force, which share ray_triangle; within the GPU tolerance for the GLSL)."""
+conventions.md, "Rays"). The closest hit is then the lowest original index among them, whatever
+order a walk meets them in (the GPU's depth first, the twin's level by level): a corner where
+two walls meet is the case (test_a_tie_goes_to_the_lowest_index_whatever_the_walk). Where the
+GPU's s is an ulp off the twin's, two answers may still name different triangles: each must be
+hit by the ray at the other's s (within the GPU tolerance)."""
 
 from pathlib import Path
 
@@ -418,6 +420,56 @@ def test_twin_equals_brute_force_on_the_icosphere(sphere):
 
 
 # -- the GLSL against the twin -----------------------------------------------------------------
+
+def grid(origin, u, v, k):
+    """(2 k^2, 3, 3) float32: the parallelogram origin + [0, 1] u + [0, 1] v in k x k squares."""
+    o, u, v = (np.asarray(a, np.float64) for a in (origin, u, v))
+    i, j = np.meshgrid(np.arange(k), np.arange(k), indexing="ij")
+    a = o + (i.ravel()[:, None] * u + j.ravel()[:, None] * v) / k
+    b, c, d = a + u / k, a + (u + v) / k, a + v / k
+    return np.concatenate([np.stack([a, b, c], 1), np.stack([a, c, d], 1)]).astype(F32)
+
+
+def corner_rays(count, seed):
+    """A floor (y = 0) and a wall (z = -2) meeting along a corner, each of 128 triangles (so
+    that a walk meets them in different leaves); rays from the room's inside aimed at points of
+    the corner line, kept where a floor's and a wall's triangle are hit at one float32 s."""
+    floor = grid((-2, 0, -2), (4, 0, 0), (0, 0, 4), 8)
+    wall = grid((-2, 0, -2), (0, 2, 0), (4, 0, 0), 8)
+    rng = np.random.default_rng(seed)
+    O = np.stack([rng.uniform(-1.5, 1.5, count), rng.uniform(0.2, 1.8, count), rng.uniform(-1, 1.5, count)], 1).astype(F32)
+    target = np.stack([rng.uniform(-1.9, 1.9, count), np.zeros(count), np.full(count, -2.0)], 1)
+    D = (target - O).astype(F32)
+    s = np.stack([ray_triangle(O, D, *(t[k] for k in range(3)), F32(0), F32(INF))[1]
+                  for t in np.concatenate([floor, wall])])
+    tied = np.isfinite(s).sum(0) >= 2
+    tied &= np.array([len(set(c[np.isfinite(c)].tolist())) == 1 for c in s.T])
+    return floor, wall, O[tied], D[tied]
+
+
+@pytest.mark.parametrize("wall_first", [False, True])
+def test_a_tie_goes_to_the_lowest_index_whatever_the_walk(gl_contexts, wall_first):
+    """Rays through a corner hit the floor and the wall at one s: the GPU's walk (depth first,
+    the nearer box first: the two flat boxes meet the ray at that same s too), the twin's
+    (level by level) and brute force all name the lower original index, floor or wall, each
+    way round; before this rule the walks' orders decided, and a path through a corner went
+    one way on the GPU and the other in the twin (radiosity_window at 16 paths a pixel)."""
+    floor, wall, O, D = corner_rays(4000, 30)
+    assert len(O) > 100
+    first, second = (wall, floor) if wall_first else (floor, wall)
+    V = np.concatenate([first, second])
+    bvh = build_bvh(V)
+    n = 16 * (len(O) // 16)
+    O, D = O[:n], D[:n]
+    expected = closest_hit_brute_force(V, O, D)
+    twin = closest_hit(bvh, O, D, 0.0, F32(1e30))
+    assert np.array_equal(twin[3], expected[3]) and np.array_equal(twin[1], expected[1])
+    assert (twin[3] < len(first)).all()                    # the first surface's, every one
+    for kind, ctx in gl_contexts.items():
+        out = gpu_closest_hits(ctx, bvh, O.reshape(16, -1, 3), D.reshape(16, -1, 3)).reshape(-1, 4)
+        assert np.array_equal(out[:, 1].astype(np.int64), twin[3]), kind
+        assert np.array_equal(out[:, 0], twin[1]), kind
+
 
 WIDTH, HEIGHT = 64, 64
 

@@ -3,16 +3,14 @@ worked out by hand, the robust sphere form against the textbook quadratic, and t
 llvmpipe (EGL, OSMesa; float32) against the NumPy twin in float32 for seeded random rays."""
 
 from fractions import Fraction
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from glsl_harness import float_probe
 from reference.raytrace.intersect import (plane_normal, ray_plane, ray_sphere, ray_triangle,
                                           sphere_discriminant, sphere_normal, triangle_normal)
-from renderer.gpu.shaders import shader_source
 
-GLSL = Path(__file__).parent / "glsl"
 INF = np.inf
 F32 = np.float32
 EPS32 = float(np.finfo(np.float32).eps)
@@ -166,25 +164,8 @@ def seeded_rays():
 
 def gpu_intersections(ctx, O, D):
     """(out_s, out_extra, out_uv) of tests/glsl/raytrace_intersect.frag, (HEIGHT, WIDTH, 4) each."""
-    program = ctx.program(vertex_shader=shader_source("fullscreen.vert", directory=GLSL).text,
-                          fragment_shader=shader_source("raytrace_intersect.frag", directory=GLSL).text)
-    inputs = [ctx.texture((WIDTH, HEIGHT), 3, array.tobytes(), dtype="f4") for array in (O, D)]
-    outputs = [ctx.texture((WIDTH, HEIGHT), 4, dtype="f4") for _ in range(3)]
-    framebuffer = ctx.framebuffer(outputs)
-    vao = ctx.vertex_array(program, [])
-    try:
-        for unit, (texture, name) in enumerate(zip(inputs, ("u_origins", "u_directions"))):
-            texture.filter = (ctx.NEAREST, ctx.NEAREST)
-            texture.use(unit)
-            program[name].value = unit
-        for name, value in SCENE.items():
-            program[name].value = value
-        framebuffer.use()
-        vao.render(vertices=3)
-        return [np.frombuffer(t.read(), np.float32).reshape(HEIGHT, WIDTH, 4) for t in outputs]
-    finally:
-        for thing in (vao, framebuffer, program, *inputs, *outputs):
-            thing.release()
+    return float_probe(ctx, "raytrace_intersect.frag", {"u_origins": O, "u_directions": D}, outputs=3,
+                       uniforms=SCENE)
 
 
 def norm(v):
@@ -263,7 +244,7 @@ def test_glsl_intersections_agree_with_the_float32_twin(gl_contexts):
 
 
 def test_glsl_intersections_are_the_float32_twins_bit_for_bit(gl_contexts):
-    """With the twin's dot summed as llvmpipe sums GLSL's (z first: intersect.py's _dot), every
+    """With the twin's dot summed as llvmpipe sums GLSL's (z first: reference/glsl_builtins.py's dot), every
     probe ray's hit or miss, s and the triangle's (u, v) are the GPU's exactly (summed x first,
     only 58 % of the triangle's s and 34 % of its (u, v) were)."""
     O, D = seeded_rays()

@@ -123,9 +123,12 @@ bool bvh_meets_root(usampler2D entries, int root, vec3 O, vec3 inv_D, float s_mi
 }
 
 // Whether the ray hits triangle j of the triangles texture (vertices A, B, C, original index)
-// with s_min < s' < s, nearer than the hit so far: (s, uv, triangle) then become that hit's
-// parameter, barycentric (u, v) and original index. `last`: whether j ends its leaf. Both
-// walks test a leaf's triangles so.
+// with s_min < s' < s, nearer than the hit so far, or with s' = s and a lower original index
+// than the hit so far's (`triangle`, -1 for none): (s, uv, triangle) then become that hit's
+// parameter, barycentric (u, v) and original index. So the closest hit is the nearest, of equal
+// ones the lowest original index, whatever order the walk meets them in (two walls meeting at
+// a corner give a ray through it the same s; the twin's walk goes level by level).
+// `last`: whether j ends its leaf. Both walks test a leaf's triangles so.
 bool bvh_nearer_triangle(sampler2D triangles, int j, vec3 O, vec3 D, float s_min,
                          inout float s, inout vec2 uv, inout int triangle, out bool last) {
     vec4 a = bvh_texel(triangles, 3 * j);
@@ -133,8 +136,10 @@ bool bvh_nearer_triangle(sampler2D triangles, int j, vec3 O, vec3 D, float s_min
     last = b.w > 0.0;
     float hit_s;
     vec2 hit_uv;
-    bool hit = ray_triangle(O, D, a.xyz, b.xyz, bvh_texel(triangles, 3 * j + 2).xyz, s_min, s,
-                            hit_s, hit_uv);
+    // s's next float up (s > s_min >= 0), so that ray_triangle's s' < s_max lets s' = s through
+    float s_tie = isinf(s) ? s : uintBitsToFloat(floatBitsToUint(s) + 1u);
+    bool hit = ray_triangle(O, D, a.xyz, b.xyz, bvh_texel(triangles, 3 * j + 2).xyz, s_min, s_tie,
+                            hit_s, hit_uv) && (hit_s < s || int(a.w) < triangle);
     if (hit) {
         s = hit_s;
         uv = hit_uv;
@@ -230,7 +235,7 @@ bool bvh_any_hit(usampler2D entries, sampler2D triangles, int root, vec3 O, vec3
         if (ref < 0) {
             float s = s_max;                        // stays: the first hit ends the walk
             vec2 uv;
-            int triangle;
+            int triangle = -1;
             int j = -ref - 1;
             bool last;
             do {                                    // the test at the end: see bvh_closest_hit

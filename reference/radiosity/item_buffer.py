@@ -55,9 +55,11 @@ def _clip_coordinates(positions32: np.ndarray, matrices: np.ndarray) -> np.ndarr
     return clip + m[:, None, :, 3]
 
 
-def draw_hemicube(positions32: np.ndarray, matrices: np.ndarray, resolution: int):
+def draw_hemicube(positions32: np.ndarray, matrices: np.ndarray, resolution: int, horizon: int | None = None):
     """One hemicube's five layers: (items (5, N, N) uint32, tied (5, N, N) bool), row 0 at the
-    top. `positions32`: (3 E, 3) float32, element e's corners at rows 3e .. 3e + 2."""
+    top. `positions32`: (3 E, 3) float32, element e's corners at rows 3e .. 3e + 2. `horizon`
+    (N / 2 by default): the GL rows below it on a side face are not drawn; 0 for whole views
+    (a light's, `draw_views`), whatever their number."""
     n, faces = resolution, len(matrices)
     elements = len(positions32) // 3
     clip = _clip_coordinates(positions32, matrices).reshape(faces * elements, 3, 4)
@@ -68,7 +70,7 @@ def draw_hemicube(positions32: np.ndarray, matrices: np.ndarray, resolution: int
     layer, element = source // elements, source % elements
     x0, y0, z0, dzdx, dzdy = depth_planes(window)
     pixel_parts, z_parts, t_parts, slack_parts = [], [], [], []
-    horizon = n // 2                                       # glsl's u_horizon
+    horizon = n // 2 if horizon is None else horizon       # glsl's u_horizon
     for t, px, py in coverage(window, n, n):
         above = (layer[t] == 0) | (py >= horizon)          # a side face: its upper half only
         t, px, py = t[above], px[above], py[above]
@@ -113,3 +115,29 @@ def draw(elements, resolution: int, indices=None) -> Items:
     shape = (0, len(FACES), resolution, resolution)
     return Items(np.stack([d[0] for d in drawn]) if drawn else np.zeros(shape, np.uint32),
                  np.stack([d[1] for d in drawn]) if drawn else np.zeros(shape, bool))
+
+
+def draw_views(elements, resolution: int, matrices) -> Items:
+    """The item buffers of whole views (F, 4, 4) of `elements` (a light's,
+    renderer/core/light_buffers.py), as ItemBuffers.views draws them: (F, N, N), row 0 at the
+    top, every row drawn."""
+    origin, _ = elements.extent()
+    positions32 = (elements.corners - origin).astype(np.float32).reshape(-1, 3)
+    items, tied = draw_hemicube(positions32, np.asarray(matrices, np.float64), resolution, horizon=0)
+    return Items(items, tied)
+
+
+class ItemBuffers:
+    """The twin of renderer/gpu/item_buffers.py's ItemBuffers for radiosity's solve
+    (renderer/core/radiosity.py `refreshed`): `draw(indices)` hemicubes, `batch` of them at a
+    time, and `views(matrices)`, the items only."""
+    batch = 16                      # hemicubes summed at once (each drawn on its own)
+
+    def __init__(self, elements, resolution: int):
+        self.elements, self.resolution = elements, int(resolution)
+
+    def draw(self, indices) -> np.ndarray:
+        return draw(self.elements, self.resolution, indices).items
+
+    def views(self, matrices) -> np.ndarray:
+        return draw_views(self.elements, self.resolution, matrices).items

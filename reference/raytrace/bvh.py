@@ -5,8 +5,9 @@ float32 as the GLSL (or float64, the ground truth), vectorised over rays: a wave
 (ray, node) pairs, one level of the tree per step (no Python loop over rays or nodes). The
 ray-box test and the triangle test are the GLSL's (`ray_box` below; `ray_triangle` of
 intersect.py), so each pair decides as the GLSL does; the order differs (the GLSL goes depth
-first, nearer child first), which changes the answer only where two triangles are hit at the
-same s (an edge or vertex they share): either is the closest hit then. `any_hit` (shadow rays)
+first, nearer child first), so where triangles are hit at the same s (an edge or vertex they
+share, a corner where two walls meet) both take the lowest original index among them, the
+order's answer in neither (docs/conventions.md, BVH). `any_hit` (shadow rays)
 answers whether closest_hit would hit, dropping each ray from the wavefront at its first hit,
 as the GLSL's bvh_any_hit stops at its first. Both walk the tree whose root node is `root`: 0,
 or one of the trees of a forest (renderer/core/bvh.py, motion blur).
@@ -131,28 +132,27 @@ def closest_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None, root=0):
     R = len(O)
     best_s = np.full(R, dtype.type(s_max), dtype)
     best_uv = np.zeros((R, 2), dtype)
-    best_tri = np.full(R, -1, np.int64)
+    best = np.full(R, -1, np.int64)                     # the hit's original index
     ray = np.arange(R)
     node = np.full(R, root, np.int64)
     while ray.size:
         ray, node, n0, leaf = _visit(nodes, O, inv_D, ray, node, s_min[ray], best_s[ray])
-        # leaves: every (ray, triangle) pair, then the nearest hit per ray
+        # leaves: every (ray, triangle) pair, then the nearest hit per ray, of equal ones the
+        # lowest original index (the GLSL's bvh_nearer_triangle: whatever the walk's order)
         r, t = _leaf_pairs(ray, n0, leaf, nodes[node, 1, 3])
         if r.size:
-            h, s, uv = _triangles(O, D, tris, r, t, s_min, best_s)
-            r, s, uv, t = r[h], s[h], uv[h], t[h]
+            h, s, uv = _triangles(O, D, tris, r, t, s_min, np.nextafter(best_s, dtype.type(np.inf)))
+            r, s, uv, t = r[h], s[h], uv[h], bvh.original_index[t[h]]
             if r.size:
-                order = np.lexsort((t, s, r))           # per ray: nearest s, then leaf order
+                order = np.lexsort((t, s, r))           # per ray: nearest s, then lowest index
                 r, s, uv, t = r[order], s[order], uv[order], t[order]
                 first = np.r_[True, r[1:] != r[:-1]]
                 r, s, uv, t = r[first], s[first], uv[first], t[first]
-                better = s < best_s[r]
+                better = (s < best_s[r]) | ((s == best_s[r]) & (t < best[r]))
                 r, s, uv, t = r[better], s[better], uv[better], t[better]
-                best_s[r], best_uv[r], best_tri[r] = s, uv, t
+                best_s[r], best_uv[r], best[r] = s, uv, t
         ray, node = _children(ray, node, n0, ~leaf)
-    hit = best_tri >= 0
-    original = np.where(hit, bvh.original_index[np.maximum(best_tri, 0)], -1)
-    return hit, best_s, best_uv, original
+    return best >= 0, best_s, best_uv, best
 
 
 def any_hit(bvh, O, D, s_min=0.0, s_max=np.inf, vertices=None, root=0):

@@ -10,12 +10,11 @@ from __future__ import annotations
 
 import numpy as np
 
+from reference.glsl_builtins import dot as _dot
+
 from reference.raytrace.warp import orthonormal_basis, square_to_phong_lobe
 from renderer.core.ray_sampling import GLOSSY_DIMENSION
 
-
-def _dot(a, b):
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def glossy_reflection(R, Ng_in, gloss, u):

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from reference.glsl_builtins import cross as _cross, dot as _dot, normalize as _normalize
+
 # The kinds of surface a ray hits (trace.py's scene_hit; the GLSL's TRACE_MISS ... in trace.glsl).
 MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
 
@@ -22,24 +24,6 @@ MISS, SPHERE, PLANE, TRIANGLE = 0, 1, 2, 3
 def _float_dtype(*arrays) -> np.dtype:
     dtype = np.result_type(*arrays)
     return dtype if dtype.kind == "f" else np.dtype(np.float64)
-
-
-def _dot(a, b):
-    """GLSL's dot as llvmpipe sums it: the products added z first, (z + y) + x (NIR scalarises
-    the reduction from its last component). Summed x first, a third to two fifths of the hits
-    parted from the GPU's by an ulp or so of s or (u, v); so, bit for bit on EGL and OSMesa
-    (tests/test_raytrace_intersect.py)."""
-    return a[..., 2] * b[..., 2] + a[..., 1] * b[..., 1] + a[..., 0] * b[..., 0]
-
-
-def _cross(a, b):
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
-
-def _normalize(v):
-    return v / np.sqrt(_dot(v, v))[..., None]
 
 
 def _as(dtype, *values):

@@ -19,6 +19,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from reference.glsl_builtins import dot as _dot
+
 
 @dataclass(frozen=True)
 class Motion:
@@ -35,9 +37,6 @@ def _cross(a, b):
                      a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
                      a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
 
-
-def _dot(a, b):
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def motion_time(shutter, u):

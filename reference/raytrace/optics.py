@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from reference.glsl_builtins import dot as _dot
+
 RAY_OFFSET_ORIGIN = np.float32(1.0 / 32.0)
 RAY_OFFSET_FLOAT_SCALE = np.float32(1.0 / 65536.0)
 RAY_OFFSET_INT_SCALE = np.float32(256.0)
@@ -30,10 +32,6 @@ def _float_dtype(*arrays) -> np.dtype:
     dtype = np.result_type(*arrays)
     return dtype if dtype.kind == "f" else np.dtype(np.float64)
 
-
-def _dot(a, b):
-    """Sum of the three products in x, y, z order (as GLSL's dot)."""
-    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
 
 
 def _as(dtype, *values):

@@ -12,7 +12,8 @@ from pathlib import Path
 from renderer.core.ray_depth import MAX_DEPTH_LIMIT
 from renderer.core.path_options import PATH_DEPTH_LIMIT
 from renderer.core.ray_sampling import MAX_LIGHT_SAMPLES, RAY_PATTERNS
-from renderer.core.radiosity_options import DEFAULT_ELEMENTS_ACROSS, MAX_HEMICUBE, SOLVERS
+from renderer.core.radiosity_options import (DEFAULT_ELEMENTS_ACROSS, MAX_AREA_SAMPLES, MAX_HEMICUBE,
+                                             MAX_LIGHT_BUFFER, MAX_REFINE, SOLVERS)
 from renderer.errors import OptionError, UsageError, UserError
 
 DEFAULT_SIZE = (640, 480)
@@ -121,6 +122,18 @@ def raytrace_options(p) -> None:
                         f"{MAX_HEMICUBE} (default 64)")
     p.add_argument("--solver", default=None, metavar="|".join(SOLVERS),
                    help="radiosity: how the equation is solved (default gauss-seidel)")
+    p.add_argument("--light-buffer", type=int, default=None, metavar="N",
+                   help="radiosity: pixels across each view a point or directional light sees the "
+                        f"elements through, a power of two from 4 to {MAX_LIGHT_BUFFER} (default 512)")
+    p.add_argument("--area-samples", type=int, default=None, metavar="K",
+                   help=f"radiosity: an area light seen from K x K of its points, 1 to {MAX_AREA_SAMPLES} "
+                        "(default 4)")
+    p.add_argument("--refine", type=int, default=None, metavar="L",
+                   help=f"radiosity: cut the elements where radiosity changes fast in four, L times, 0 to "
+                        f"{MAX_REFINE} (default 0; docs/radiosity.md)")
+    p.add_argument("--refine-threshold", type=float, default=None, metavar="T",
+                   help="radiosity: an element is cut where its Gouraud display differs from its own "
+                        "radiosity by more than T levels of 255 (default 4)")
 
 
 def lens_options(p) -> None:
@@ -172,7 +185,9 @@ def load(scene_arg, *needs):
 RAY_FLAGS = {"samples": "--spp", "pattern": "--pattern", "max_depth": "--max-depth", "seed": "--seed",
              "adaptive_threshold": "--adaptive-threshold", "light_samples": "--light-samples",
              "aperture": "--aperture", "focus_distance": "--focus-distance",
-             "element_size": "--element-size", "hemicube": "--hemicube", "solver": "--solver"}
+             "element_size": "--element-size", "hemicube": "--hemicube", "solver": "--solver",
+             "light_buffer": "--light-buffer", "area_samples": "--area-samples", "refine": "--refine",
+             "refine_threshold": "--refine-threshold"}
 
 
 def _dest(flag: str) -> str:

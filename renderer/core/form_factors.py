@@ -35,11 +35,12 @@ class FormFactors:
     drawn: bool = True           # False: none drawn, the scene needing none (FormFactors.none)
 
     @classmethod
-    def none(cls, elements: int) -> "FormFactors":
+    def none(cls, elements: int, unseen: float = 0.0) -> "FormFactors":
         """No pair stored and no hemicube drawn: for a scene where light does not bounce
-        (renderer/core/radiosity.py interreflects), whose solution is B = E."""
+        (renderer/core/radiosity.py interreflects); `unseen` each row's share of nothing (1 for
+        one convex solid seen from outside: its hemicubes would see nothing of it)."""
         return cls(np.zeros(elements + 1, np.int64), np.zeros(0, np.int64), np.zeros(0),
-                   np.zeros(elements), np.zeros(elements), drawn=False)
+                   np.full(elements, float(unseen)), np.zeros(elements), drawn=False)
 
     def __len__(self) -> int:
         return len(self.indptr) - 1

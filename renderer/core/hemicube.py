@@ -68,11 +68,12 @@ def face_shape(face: Face, resolution: int) -> tuple[int, int]:
     return (n, n) if face.name == "top" else (n // 2, n)
 
 
-def pixel_centres(face: Face, resolution: int) -> np.ndarray:
+def pixel_centres(face: Face, resolution: int, rows: int | None = None) -> np.ndarray:
     """(rows, columns, 3): each pixel's centre on the unit hemicube, in the element's frame,
-    row 0 at the top of the face's image (towards `up`), column 0 at its left."""
+    row 0 at the top of the face's image (towards `up`), column 0 at its left; `rows` N for the
+    whole face (a light's cube, renderer/core/light_buffers.py), else face_shape's."""
     n = _check(resolution)
-    rows, cols = face_shape(face, n)
+    rows, cols = face_shape(face, n) if rows is None else (rows, n)
     forward, up = np.array(face.forward, float), np.array(face.up, float)
     right = np.cross(forward, up)                   # a camera looking along forward, up at the top
     across = -1 + (2 * np.arange(cols) + 1) / n     # left to right
@@ -104,14 +105,14 @@ def weights(resolution: int) -> np.ndarray:
     return table / table.sum()
 
 
-def face_views(frames: np.ndarray, centres: np.ndarray, origin=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """(E, 5, 4, 4) float64: for each element (its frame's rows u, v, n in world coordinates and
-    its centre) the view matrix of each face of FACES: the camera at the centre looking along
+def face_views(frames: np.ndarray, centres: np.ndarray, origin=(0.0, 0.0, 0.0), faces=FACES) -> np.ndarray:
+    """(E, F, 4, 4) float64: for each element (its frame's rows u, v, n in world coordinates and
+    its centre) the view matrix of each face of `faces` (FACES): the camera at the centre looking along
     the face's forward with its up at the top (transforms.look_at's convention: forward to -z,
     up to +y), of points given relative to `origin` (as the GPU's float32 positions are)."""
     frames = np.asarray(frames, np.float64)
-    forward = np.array([f.forward for f in FACES], np.float64) @ frames          # (E, 5, 3)
-    up = np.array([f.up for f in FACES], np.float64) @ frames
+    forward = np.array([f.forward for f in faces], np.float64) @ frames          # (E, F, 3)
+    up = np.array([f.up for f in faces], np.float64) @ frames
     right = np.cross(forward, up)
     rotation = np.stack([right, up, -forward], axis=-2)                          # (E, 5, 3, 3)
     eye = np.asarray(centres, np.float64) - np.asarray(origin, np.float64)

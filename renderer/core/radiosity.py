@@ -5,32 +5,33 @@ drawn from, step by step.
 1. Elements: every object's surface cut into triangles of at most the options' element size
    (renderer/core/radiosity_elements.py), each with its material's reflectance rho = k_d and
    emitted radiosity E = `emission` (exitance, linear RGB, shown as is).
-2. Form factors: each element's hemicube drawn (the GPU's item buffers or the twin's, the one
-   `draw` given) and summed (renderer/core/form_factors.py).
-3. The solution B = E + rho F B (renderer/core/radiosity_solve.py, the options' solver).
-4. The display: Gouraud interpolation as in the notes: each element corner's value is the
+2. Direct light: the scene's point and directional lights' mean irradiance H on each element,
+   from item buffers drawn at the lights (renderer/core/light_buffers.py), shadows included.
+3. Form factors: each element's hemicube drawn (the GPU's item buffers or the twin's, the one
+   `open_drawer` gives) and summed (renderer/core/form_factors.py).
+4. The solution B = E + rho (H + F B) (renderer/core/radiosity_solve.py, the options' solver).
+5. The display: Gouraud interpolation as in the notes: each element corner's value is the
    area-weighted mean of B over the elements of the same object meeting at that point (so a
    surface shades smoothly, and a crease between two objects stays sharp); the display pass
    (glsl/radiosity/display.*, twin reference/radiosity/display.py) interpolates them across
    each element.
 
-What a radiosity frame shows is B: the scene's point and directional lights and its ambient
-term take no part (the light comes from emitting surfaces), nor do specular, mirror and glass
-terms (docs/radiosity.md).
+What a radiosity frame shows is B: the scene's ambient term takes no part (interreflection is
+what it stands for), nor do specular, mirror and glass terms (docs/radiosity.md).
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Callable
+import dataclasses
+from dataclasses import dataclass, field
 
 import numpy as np
 
-from renderer.core import memory
+from renderer.core import light_buffers, memory
 from renderer.core.form_factors import FormFactors, form_factors
 from renderer.core.meshio import DEFAULT_CREASE_ANGLE
-from renderer.core.radiosity_elements import Elements, scene_elements
-from renderer.core.radiosity_options import RadiosityOptions
+from renderer.core.radiosity_elements import Elements, refined, scene_elements
+from renderer.core.radiosity_options import MAX_LIGHT_BUFFER, RadiosityOptions
 from renderer.core.radiosity_solve import Solution, direct, gauss_seidel, progressive
 
 # Element corners closer than this fraction of the scene's diagonal are one point of the
@@ -43,12 +44,37 @@ CREASE_DEGREES = DEFAULT_CREASE_ANGLE
 CREASE_COSINE = float(np.cos(np.radians(CREASE_DEGREES)))
 
 
+@dataclass(frozen=True)
+class Lighting:
+    """What lights a radiosity solution besides its emitting surfaces (lighting_for): the
+    lights' sources (renderer/core/light_buffers.py) with the light buffer's resolution, and
+    the sky: the scene's background, a uniform surround whose light reaches an element through
+    what its hemicube sees of nothing (FormFactors.unseen), as a path that leaves the scene
+    brings the background back in the path tracer."""
+    sources: tuple = ()
+    resolution: int = 0
+    sky: tuple = (0.0, 0.0, 0.0)
+
+    def finer(self, level: int) -> "Lighting":
+        """The light buffer 2^level times as fine (at most MAX_LIGHT_BUFFER): refinement's."""
+        return dataclasses.replace(self, resolution=min(MAX_LIGHT_BUFFER, self.resolution << level))
+
+
 @dataclass
 class RadiositySolution:
     elements: Elements
     form_factors: FormFactors
     solution: Solution
     corner_radiosity: np.ndarray        # (E, 3, C): each element corner's displayed value
+    irradiance: np.ndarray | None = None   # (E, 3): the lights' direct H (None: no light drawn)
+    lighting: Lighting = field(default_factory=lambda: Lighting())   # what it was lit by
+    base: Elements | None = None        # the scene's elements before refinement (None: `elements`)
+    levels: int = 0                     # the refinements made (options.refine at most)
+    source: np.ndarray | None = None    # (E, 3) what the solver took as emission: E + rho (H + S)
+
+    @property
+    def unrefined(self) -> Elements:
+        return self.elements if self.base is None else self.base
 
 
 def elements_for(scene, options: RadiosityOptions) -> Elements:
@@ -57,69 +83,131 @@ def elements_for(scene, options: RadiosityOptions) -> Elements:
     return scene_elements(scene, options.size_for, emission=emission)
 
 
-def interreflects(elements: Elements) -> bool:
-    """Whether light bounces at all: some element emits and some element reflects. When not,
-    B = E exactly (the light reaching a surface that reflects nothing, or no light at all), and
-    no hemicube is drawn (the rule of leaving out what a scene does not need)."""
-    return bool((elements.emission > 0).any() and (elements.reflectance > 0).any())
+def lighting_for(scene, options: RadiosityOptions) -> Lighting:
+    """The scene's Lighting: its lights' sources at the options' light buffer, its sky."""
+    sources = light_buffers.light_sources(scene, options.area_samples)
+    return Lighting(sources, options.light_buffer if sources else 0,
+                    tuple(float(c) for c in scene.background[:3]))
 
 
-def what_changed(old: RadiositySolution | None, elements: Elements) -> str:
-    """What a new scene's `elements` need, given the solution `old` was made for: "nothing"
-    (only the camera moved: the solution stands), "materials" (the same triangles with other
-    reflectances or emissions: solve again with the same form factors) or "geometry" (draw the
-    hemicubes again)."""
-    if old is None or not (np.array_equal(old.elements.corners, elements.corners)
-                           and np.array_equal(old.elements.obj, elements.obj)):
+def interreflects(elements: Elements, irradiance: np.ndarray | None = None, sky=(0.0, 0.0, 0.0)) -> bool:
+    """Whether the hemicubes are needed: some element reflects, elements can see each other
+    (not one convex solid seen from outside: Elements.see_each_other), and light comes from
+    somewhere (an element emits or reflects some of the lights' irradiance, or the sky shines).
+    When not, B = E + rho (H + sky) exactly (a convex solid's hemicubes see nothing but sky) or
+    B = E + rho H, and no hemicube is drawn (the rule of leaving out what a scene does not need)."""
+    sends = (elements.emission > 0).any() or (
+        irradiance is not None and (elements.reflectance * irradiance > 0).any()) or any(c > 0 for c in sky)
+    return bool(sends and (elements.reflectance > 0).any() and elements.see_each_other)
+
+
+def what_changed(old: RadiositySolution | None, elements: Elements, lighting: Lighting = Lighting()) -> str:
+    """What a new scene's `elements` and `lighting` (lighting_for) need, given the solution `old`
+    was made for: "nothing" (only the camera moved: the solution stands), "materials" (the same
+    triangles and lights with other reflectances, emissions or sky: solve again with the same
+    form factors and irradiance), "lights" (draw the lights' buffers again, keep the form
+    factors) or "geometry" (draw everything again)."""
+    before = None if old is None else old.unrefined
+    if before is None or not (np.array_equal(before.corners, elements.corners)
+                              and np.array_equal(before.obj, elements.obj)):
         return "geometry"
-    if not old.form_factors.drawn and interreflects(elements):
+    if (old.lighting.sources, old.lighting.resolution) != (lighting.sources, lighting.resolution):
+        return "lights"
+    if not old.form_factors.drawn and interreflects(elements, old.irradiance, lighting.sky):
         return "geometry"                     # light bounces now: the hemicubes are needed
-    if (np.array_equal(old.elements.reflectance, elements.reflectance)
-            and np.array_equal(old.elements.emission, elements.emission)):
+    if (np.array_equal(before.reflectance, elements.reflectance)
+            and np.array_equal(before.emission, elements.emission) and old.lighting.sky == lighting.sky):
         return "nothing"
     return "materials"
 
 
-def refreshed(old: RadiositySolution | None, elements: Elements, options: RadiosityOptions,
+def refreshed(old: RadiositySolution | None, elements: Elements, lighting: Lighting, options: RadiosityOptions,
               open_drawer, backend: str, name: str) -> RadiositySolution | None:
-    """The solution for a scene's new `elements`, or None where `old` stands (what_changed):
-    the same form factors for new materials; B = E without a hemicube where light cannot bounce;
-    else the memory checked (memory.check_radiosity) and the hemicubes drawn by
-    `open_drawer(elements)`, a context manager giving (draw, batch): the GPU's item buffers or
-    the twin's. One rule for both backends."""
-    change = what_changed(old, elements)
+    """The solution for a scene's new `elements` and `lighting` (lighting_for), or None where `old`
+    stands (what_changed): the same form factors for new materials or lights; no hemicube where
+    light cannot bounce; else the memory checked (memory.check_radiosity) and the hemicubes
+    drawn. `open_drawer(elements, resolution, what)` ("lights" or "hemicubes") is a context
+    manager giving the item buffers, the GPU's or the twin's (`draw(indices)` hemicubes `batch`
+    at a time, `views(matrices)` a light's). One rule for both backends.
+
+    With `options.refine` levels, each solution's elements where the display would differ from
+    their radiosity by more than the threshold (needs_refining) are cut in four
+    (radiosity_elements.refined) and everything drawn and solved again, the light buffer twice
+    as fine at each level (at most MAX_LIGHT_BUFFER); the refinement follows the solution, so
+    that anything but the camera changing starts again from the scene's elements."""
+    change = what_changed(old, elements, lighting)
     if change == "nothing":
         return None
+    if options.refine:
+        change, old = "geometry", None
+    solution = _solved(old, change, elements, lighting, options, open_drawer, backend, name)
+    for level in range(1, options.refine + 1):
+        split = needs_refining(solution, options.refine_threshold)
+        if not split.any():
+            break
+        # the light buffer doubles with each level, so that an element keeps its pixels
+        solution = _solved(None, "geometry", refined(solution.elements, split), lighting.finer(level),
+                           options, open_drawer, backend, name)
+        solution.levels = level
+    solution.base, solution.lighting = elements, lighting
+    return solution
+
+
+def needs_refining(solution: RadiositySolution, threshold_levels: float) -> np.ndarray:
+    """(E,) bool: the elements whose display (Gouraud from the corners' values, each channel
+    clamped to [0, 1] as the frame shows it) differs from their own radiosity by more than
+    `threshold_levels` / 255 at some corner: where radiosity changes fast (across a shadow's
+    edge, near an emitter), which a finer mesh draws better (Cohen, Greenberg, Immel and
+    Brock, "An Efficient Radiosity Approach for Realistic Image Synthesis", IEEE CG&A 1986)."""
+    shown = np.minimum(solution.solution.radiosity, 1.0)
+    corners = np.minimum(solution.corner_radiosity, 1.0)
+    return np.abs(corners - shown[:, None, :]).max(axis=(1, 2)) > threshold_levels / 255.0
+
+
+def _solved(old, change: str, elements: Elements, lighting: Lighting, options: RadiosityOptions,
+            open_drawer, backend: str, name: str) -> RadiositySolution:
+    """The solution for `elements` given what `change`d since `old`'s (refreshed)."""
     if change == "materials":
-        return solve(elements, options, matrix=old.form_factors)
-    if not interreflects(elements):
-        return solve(elements, options)
-    memory.check_radiosity(len(elements), options.hemicube, backend, name,
-                           direct=options.solver == "direct")
-    with open_drawer(elements) as (draw, batch):
-        return solve(elements, options, draw, batch)
+        h = old.irradiance
+    elif lighting.sources and len(elements):
+        with open_drawer(elements, lighting.resolution, "lights") as drawer:
+            h = light_buffers.irradiance(elements, lighting.sources, drawer.views)
+    else:
+        h = None
+    matrix = None if change == "geometry" else old.form_factors
+    if interreflects(elements, h, lighting.sky) and (matrix is None or not matrix.drawn):
+        memory.check_radiosity(len(elements), options.hemicube, backend, name,
+                               direct=options.solver == "direct")
+        with open_drawer(elements, options.hemicube, "hemicubes") as drawer:
+            matrix = form_factors(len(elements), options.hemicube, drawer.draw, drawer.batch)
+    return solve(elements, options, matrix, h, lighting)
 
 
-def solve(elements: Elements, options: RadiosityOptions, draw: Callable[[np.ndarray], np.ndarray] | None = None,
-          batch: int = 1, matrix: FormFactors | None = None) -> RadiositySolution:
-    """Form factors from `draw` (item buffers of the given elements' hemicubes, `batch` at a
-    time; or `matrix`, those of the same elements kept from before), the options' solver, the
-    corners' display values."""
+def solve(elements: Elements, options: RadiosityOptions, matrix: FormFactors | None = None,
+          irradiance: np.ndarray | None = None, lighting: Lighting = Lighting()) -> RadiositySolution:
+    """The options' solver with form factors `matrix` (None: none drawn, FormFactors.none) and
+    the lights' `irradiance` H (None: no light), and the corners' display values:
+    B = E + rho (H + S + F B), S the sky's light, its radiosity times what each hemicube saw of
+    nothing (all of it for one convex solid seen from outside, whose hemicubes would see nothing
+    else): the solver's emission is E + rho (H + S)."""
     if matrix is None:
-        matrix = (form_factors(len(elements), options.hemicube, draw, batch) if interreflects(elements)
-                  else FormFactors.none(len(elements)))
+        matrix = FormFactors.none(len(elements), unseen=0.0 if elements.see_each_other else 1.0)
+    emission = elements.emission if irradiance is None else elements.emission + elements.reflectance * irradiance
+    sky = np.asarray(lighting.sky, np.float64)
+    if sky.any():
+        emission = emission + elements.reflectance * matrix.unseen[:, None] * sky
     limit = {} if options.max_iterations is None else (
         {"max_sweeps": options.max_iterations} if options.solver == "gauss-seidel"
         else {"max_shots": options.max_iterations})
     if options.solver == "gauss-seidel":
-        solution = gauss_seidel(matrix, elements.reflectance, elements.emission,
-                                tolerance=options.tolerance, **limit)
+        solution = gauss_seidel(matrix, elements.reflectance, emission, tolerance=options.tolerance, **limit)
     elif options.solver == "direct":
-        solution = direct(matrix, elements.reflectance, elements.emission)
+        solution = direct(matrix, elements.reflectance, emission)
     else:
-        solution = progressive(matrix, elements.areas, elements.reflectance, elements.emission,
+        solution = progressive(matrix, elements.areas, elements.reflectance, emission,
                                tolerance=options.tolerance, **limit)
-    return RadiositySolution(elements, matrix, solution, corner_values(elements, solution.radiosity))
+    return RadiositySolution(elements, matrix, solution, corner_values(elements, solution.radiosity),
+                             irradiance, lighting, source=emission)
 
 
 def corner_values(elements: Elements, radiosity: np.ndarray) -> np.ndarray:

@@ -26,6 +26,7 @@ from functools import cached_property
 
 import numpy as np
 
+from renderer.core.convexity import convex_body
 from renderer.core.transforms import normal_matrix
 
 
@@ -37,6 +38,9 @@ class Elements:
     obj: np.ndarray              # (E,) int64 index of the scene object
     reflectance: np.ndarray      # (E, 3) float64 rho per channel
     emission: np.ndarray         # (E, 3) float64 emitted radiosity per channel
+    # False where no element can see another's front: the scene is one object whose mesh
+    # bounds a convex solid, its normals outward (scene_elements; renderer/core/convexity.py)
+    see_each_other: bool = True
 
     def __len__(self) -> int:
         return len(self.corners)
@@ -90,6 +94,62 @@ def split_triangle(corners: np.ndarray, k: int) -> np.ndarray:
             + steps[None, ..., 1:] * (c - a)[:, None, None]).reshape(-1, 3, 3)
 
 
+# Corners closer than this fraction of the elements' extent are one vertex of the refined mesh.
+REFINE_WELD_FRACTION = 1e-9
+
+
+def refined(elements: Elements, split: np.ndarray) -> Elements:
+    """The elements with those marked in `split` (E,) bool cut in four at their edges' midpoints,
+    and the mesh kept conforming (red-green refinement): an element with two or three of its
+    edges cut by its neighbours' splits is cut in four too (repeated until none is left), one
+    with one such edge in two, from the opposite corner to that edge's midpoint. So every
+    new vertex is a corner of the elements on both sides of its edge, and no T-junction opens
+    a crack in the display. Corners are welded (within REFINE_WELD_FRACTION of the extent, each
+    vertex one position) and a midpoint is (P_i + P_j) / 2 of the welded ends in index order,
+    the same bits from either side. Each element's pieces stand in its place, wound as it was,
+    with its object, reflectance and emission."""
+    split = np.asarray(split, bool)
+    count = len(elements)
+    _, diameter = elements.extent()
+    step = max(diameter, np.finfo(float).tiny) * REFINE_WELD_FRACTION
+    points = elements.corners.reshape(-1, 3)
+    _, first, vertex = np.unique(np.round(points / step).astype(np.int64), axis=0,
+                                 return_index=True, return_inverse=True)
+    position, vertex = points[first], vertex.reshape(count, 3)
+    ends = np.stack([vertex, np.roll(vertex, -1, axis=1)], axis=-1)          # edge k: corner k to k + 1
+    low, high = ends.min(axis=-1), ends.max(axis=-1)
+    key = low * len(position) + high                                         # (E, 3)
+    red = split.copy()
+    while True:
+        cut = np.isin(key, key[red])
+        grown = red | (cut.sum(axis=1) >= 2)
+        if np.array_equal(grown, red):
+            break
+        red = grown
+    green = ~red & cut.any(axis=1)
+    middle = (position[low] + position[high]) * 0.5                          # (E, 3, 3): edge k's
+    corner = position[vertex]                                                # (E, 3, 3) welded
+    pieces = np.where(red, 4, np.where(green, 2, 1))
+    source = np.repeat(np.arange(count), pieces)
+    out = np.empty((len(source), 3, 3))
+    start = np.cumsum(pieces) - pieces
+    keep = ~red & ~green
+    out[start[keep]] = corner[keep]
+    r = np.flatnonzero(red)
+    a, b, c = corner[r, 0], corner[r, 1], corner[r, 2]
+    m_ab, m_bc, m_ca = middle[r, 0], middle[r, 1], middle[r, 2]
+    for offset, piece in enumerate(([a, m_ab, m_ca], [m_ab, b, m_bc], [m_ca, m_bc, c], [m_ab, m_bc, m_ca])):
+        out[start[r] + offset] = np.stack(piece, axis=1)
+    g = np.flatnonzero(green)
+    k = np.argmax(cut[g], axis=1)                                            # the one cut edge
+    here, there, opposite = (corner[g, (k + j) % 3] for j in range(3))
+    m = middle[g, k]
+    out[start[g]] = np.stack([here, m, opposite], axis=1)
+    out[start[g] + 1] = np.stack([m, there, opposite], axis=1)
+    return Elements(out, elements.obj[source], elements.reflectance[source], elements.emission[source],
+                    see_each_other=elements.see_each_other)
+
+
 def mesh_triangles(positions, faces, normals, model) -> tuple[np.ndarray, np.ndarray]:
     """(T, 3, 3) world triangles of a mesh through `model`, each counter-clockwise seen from the
     side its vertex normals point to, and (T, 3) that side's unit normal (the winding's)."""
@@ -141,4 +201,14 @@ def scene_elements(scene, size, reflectance=None, emission=None) -> Elements:
     rho = np.array([o.material.kd for o in scene.objects], np.float64).reshape(-1, 3) if reflectance is None \
         else np.asarray(reflectance, np.float64)
     emitted = np.zeros((len(scene.objects), 3)) if emission is None else np.asarray(emission, np.float64)
-    return Elements(corners, obj, rho[obj], emitted[obj])
+    return Elements(corners, obj, rho[obj], emitted[obj], see_each_other=not _one_convex_solid(scene))
+
+
+def _one_convex_solid(scene) -> bool:
+    """Whether the scene is one object whose mesh bounds a convex solid with its normals
+    outward: its faces' fronts look away from one another (and a scene's transforms are never
+    mirrored, so its world matrix keeps that), and no hemicube of it sees anything."""
+    if len(scene.objects) != 1:
+        return False
+    body = convex_body(scene.objects[0].mesh)
+    return body is not None and body.normals_outward is True

@@ -3,6 +3,7 @@ face sees, drawn by GL's rasteriser with glsl/radiosity/item_buffer.vert, .geom 
 
     buffers = ItemBuffers(ctx, elements, resolution)
     items = buffers.draw(indices)          # (len(indices), 5, N, N) uint32, row 0 at the top
+    light = buffers.views(matrices)        # (F, N, N): whole views, a light's (light_buffers.py)
 
 The elements' triangles sit in one vertex buffer (float32, relative to the elements' centre),
 uploaded once. A batch of hemicubes is one instanced draw: an instance per face of each
@@ -82,7 +83,6 @@ class ItemBuffers:
             self._objects = [self.program, self.vbo, self.vao, self.matrices, self.items, self.depth]
             self._framebuffer_name, self.framebuffer = layered_framebuffer(ctx, self._gl, self.items, self.depth)
             self.program["u_clip_from_world"].value = 0
-            self.program["u_horizon"].value = n / 2
         except BaseException:
             self.release()
             raise
@@ -95,12 +95,29 @@ class ItemBuffers:
         """The item buffers of the hemicubes on elements `indices` (at most `batch` of them):
         (len, 5, N, N) uint32, faces in FACES' order, row 0 at the top of each face."""
         indices = np.asarray(indices, np.int64)
-        count, n, ctx = len(indices), self.resolution, self.ctx
+        count, n = len(indices), self.resolution
         if not 0 < count <= self.batch:
             raise ValueError(f"draw takes 1 to {self.batch} hemicubes, got {count}")
+        layers = self._draw_layers(self.matrices_of(indices).reshape(-1, 4, 4), horizon=n / 2)
+        return layers.reshape(count, len(FACES), n, n)
+
+    def views(self, matrices) -> np.ndarray:
+        """The item buffers of whole views (F, 4, 4) clip_from_world, relative to the elements'
+        centre (a light's, renderer/core/light_buffers.py): (F, N, N) uint32, row 0 at the top;
+        every row drawn (no horizon), as many layers at a time as the batch holds."""
+        matrices = np.asarray(matrices, np.float64)
+        layers = len(FACES) * self.batch
+        return np.concatenate([self._draw_layers(matrices[s:s + layers], horizon=0.0)
+                               for s in range(0, len(matrices), layers)])
+
+    def _draw_layers(self, matrices: np.ndarray, horizon: float) -> np.ndarray:
+        """(F, N, N): the elements through each of `matrices` (F, 4, 4), a layer each; on a side
+        face of a hemicube (every layer but each fifth's first) rows below `horizon` drawn not."""
+        n, ctx = self.resolution, self.ctx
         activate(ctx)
-        faces = len(FACES) * count
-        columns = np.swapaxes(self.matrices_of(indices), -1, -2)        # each matrix by columns
+        faces = len(matrices)
+        self.program["u_horizon"].value = horizon
+        columns = np.swapaxes(matrices, -1, -2)                         # each matrix by columns
         self.matrices.write(columns.astype(np.float32).tobytes(), viewport=(0, 0, 4 * faces, 1))
         self.framebuffer.use()
         ctx.viewport = (0, 0, n, n)                   # every layer from texel (0, 0)
@@ -118,8 +135,7 @@ class ItemBuffers:
             ctx.depth_func = STANDARD_DEPTH.depth_func
             ctx.disable(moderngl.DEPTH_TEST)
         data = np.frombuffer(self.items.read(), np.uint32)
-        layers = data.reshape(-1, n, n)[:faces]
-        return layers[:, ::-1].reshape(count, len(FACES), n, n).copy()     # GL rows to row 0 top
+        return data.reshape(-1, n, n)[:faces, ::-1].copy()              # GL rows to row 0 top
 
     def draw_all(self) -> list[np.ndarray]:
         """Every element's hemicube, batch by batch: a list of draw()'s arrays."""

@@ -5,8 +5,8 @@ radiosity interpolated (glsl/radiosity/display.vert, display.frag; Gouraud shadi
 
 The solution is kept while only the camera moves: update() compares the new scene's elements
 with the last ones and draws the hemicubes again only when the geometry changed; new
-reflectances or emissions re-solve with the same form factors (`solves`, `form_factor_draws`
-count each). Frames: RGBA32F colour and R32F view depth, read back row 0 at the top; GL's
+reflectances or emissions re-solve with the same form factors, moved lights draw only the
+lights' buffers again (`solves`, `form_factor_draws`, `light_draws` count each). Frames: RGBA32F colour and R32F view depth, read back row 0 at the top; GL's
 standard depth test (or reversed-Z's, with glClipControl, as the camera says), no culling
 (an element's back hides what is behind it, and shows black: elements reflect and emit from
 their front only).
@@ -25,7 +25,7 @@ import numpy as np
 
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, depth_mapping, to_unorm8
-from renderer.core.radiosity import RadiositySolution, elements_for, refreshed
+from renderer.core.radiosity import RadiositySolution, elements_for, lighting_for, refreshed
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
@@ -46,7 +46,7 @@ class RadiosityRenderer(ContextRenderer):
         self.width, self.height = image_size(width, height)
         self.options = options or RadiosityOptions()
         self.solution: RadiositySolution | None = None
-        self.solves = self.form_factor_draws = 0
+        self.solves = self.form_factor_draws = self.light_draws = 0
         self._open_context(context, context_kind)
         self._resources: list = []
         self._mesh: list = []
@@ -83,8 +83,9 @@ class RadiosityRenderer(ContextRenderer):
         if scene is not None:
             self.scene = scene
         activate(self.ctx)
-        solution = refreshed(self.solution, elements_for(self.scene, self.options), self.options,
-                             self._item_buffers, "gpu", self.scene.name)
+        solution = refreshed(self.solution, elements_for(self.scene, self.options),
+                             lighting_for(self.scene, self.options), self.options, self._item_buffers,
+                             "gpu", self.scene.name)
         if solution is None:                       # only the camera moved
             return
         self.solution = solution
@@ -92,14 +93,18 @@ class RadiosityRenderer(ContextRenderer):
         self._upload_mesh()
 
     @contextlib.contextmanager
-    def _item_buffers(self, elements):
-        """(draw, batch) of GL's item buffers for `elements`, released after (`refreshed`)."""
-        buffers = ItemBuffers(self.ctx, elements, self.options.hemicube)
+    def _item_buffers(self, elements, resolution, what):
+        """GL's item buffers for `elements` at `resolution`, released after (`refreshed`); each
+        use counted (`form_factor_draws`, `light_draws`) by `what` it drew."""
+        buffers = ItemBuffers(self.ctx, elements, resolution)
         try:
-            yield buffers.draw, buffers.batch
+            yield buffers
         finally:
             buffers.release()
-        self.form_factor_draws += 1
+        if what == "hemicubes":
+            self.form_factor_draws += 1
+        else:
+            self.light_draws += 1
 
     def _upload_mesh(self, origin=None) -> None:
         """The elements' corners relative to the camera's `origin` (the frame's) and their values."""

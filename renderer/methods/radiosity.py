@@ -10,14 +10,10 @@ import contextlib
 
 from renderer.core.frame import Frame
 from renderer.core.memory import Need, raster_need
-from renderer.core.radiosity import elements_for, refreshed
+from renderer.core.radiosity import elements_for, lighting_for, refreshed
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
-
-
-# Hemicubes the twin draws and sums at once (each drawn on its own: this bounds the rows summed).
-TWIN_BATCH = 16
 
 
 class ReferenceRadiosity(ReferenceRenderer):
@@ -35,18 +31,18 @@ class ReferenceRadiosity(ReferenceRenderer):
     @property
     def solution(self):
         if self._stale:
-            solution = refreshed(self._solution, elements_for(self.scene, self.options), self.options,
-                                 self._item_buffers, "reference", self.scene.name)
+            solution = refreshed(self._solution, elements_for(self.scene, self.options),
+                                 lighting_for(self.scene, self.options), self.options, self._item_buffers,
+                                 "reference", self.scene.name)
             self._solution = self._solution if solution is None else solution
             self._stale = False
         return self._solution
 
     @contextlib.contextmanager
-    def _item_buffers(self, elements):
-        """(draw, batch) of the twin's item buffers for `elements` (`refreshed`)."""
-        from reference.radiosity.item_buffer import draw
-        n = self.options.hemicube
-        yield (lambda indices: draw(elements, n, indices).items), TWIN_BATCH
+    def _item_buffers(self, elements, resolution, what):
+        """The twin's item buffers for `elements` at `resolution` (`refreshed`)."""
+        from reference.radiosity.item_buffer import ItemBuffers
+        yield ItemBuffers(elements, resolution)
 
     def _scene_changed(self) -> None:
         self._stale = True

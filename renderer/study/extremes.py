@@ -291,7 +291,8 @@ def measure_radiosity(scene, size: tuple[int, int], contexts: dict, options: Rad
     """Figures of one radiosity scene, as measure_scene: each GPU context's frame against the
     twin's in float64 (depth ties accepted either way), whether the GPU's form factors are the
     twin's exactly (identical item buffers), and the solution's elements, iterations,
-    convergence and residual (the whole residual, max |E + rho F B - B|)."""
+    convergence and residual (the whole residual, max |E + rho (H + S + F B) - B|: the solver's
+    source, with the lights' and the sky's light)."""
     gpu_frames, matrices = {}, {}
     for kind, ctx in contexts.items():
         with open_renderer(scene, size, method="radiosity", options=options, context=ctx) as gpu:
@@ -311,7 +312,7 @@ def measure_radiosity(scene, size: tuple[int, int], contexts: dict, options: Rad
     same = all(all(np.array_equal(getattr(m, name), getattr(solved.form_factors, name))
                    for name in ("indptr", "columns", "values")) for m in matrices.values())
     e = solved.elements
-    whole = residual(solved.form_factors, e.reflectance, e.emission, solved.solution.radiosity)
+    whole = residual(solved.form_factors, e.reflectance, solved.source, solved.solution.radiosity)
     return {"finite": finite, "tie_pixels": depth_tie_pixels(truth),
             "contexts": per_context, "worst": _worst(per_context),
             "truth": against_truth, "worst_truth": _worst(against_truth),

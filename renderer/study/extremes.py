@@ -292,7 +292,8 @@ def measure_radiosity(scene, size: tuple[int, int], contexts: dict, options: Rad
     twin's in float64 (depth ties accepted either way), whether the GPU's form factors are the
     twin's exactly (identical item buffers), and the solution's elements, iterations,
     convergence and residual (the whole residual, max |E + rho (H + S + F B) - B|: the solver's
-    source, with the lights' and the sky's light)."""
+    source, with the lights' and the sky's light; and over the largest source, as the solvers'
+    tolerance reads it)."""
     gpu_frames, matrices = {}, {}
     for kind, ctx in contexts.items():
         with open_renderer(scene, size, method="radiosity", options=options, context=ctx) as gpu:
@@ -318,6 +319,7 @@ def measure_radiosity(scene, size: tuple[int, int], contexts: dict, options: Rad
             "truth": against_truth, "worst_truth": _worst(against_truth),
             "elements": len(e), "same_form_factors": same, "iterations": solved.solution.iterations,
             "converged": solved.solution.converged, "residual": whole,
+            "relative_residual": whole / max(float(np.abs(solved.source).max()), np.finfo(float).tiny),
             "passes": (all(finite.values()) and solved.solution.converged
                        and all(TOLERANCE.passes(c) for c in per_context.values()))}
 

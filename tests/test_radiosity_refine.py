@@ -102,6 +102,7 @@ def test_the_gpu_and_the_twin_refine_alike(gl_contexts, kind, levels):
     assert PIPELINE_TOLERANCE.passes(result) and result.mismatched_pixels == 0
 
 
+@pytest.mark.slow
 def test_the_refined_image_has_no_crack(gl_contexts):
     """Every pixel that shows the background in the refined radiosity image (a crack would)
     lies within a pixel of one that shows it in the rasteriser's image of the same room: the

@@ -34,7 +34,6 @@ from typing import ClassVar
 import numpy as np
 
 from reference import glsl_builtins
-
 from renderer.core.uniforms import light_uniforms, material_uniforms
 
 # The parts a textured material's flat and Gouraud lighting is handed on in (glsl/lighting.glsl).

@@ -103,13 +103,19 @@ def draw_hemicube(positions32: np.ndarray, matrices: np.ndarray, resolution: int
     return items.reshape(shape)[:, ::-1], tied.reshape(shape)[:, ::-1]      # GL rows to row 0 top
 
 
+def _positions32(elements) -> np.ndarray:
+    """(3 E, 3) float32: the elements' corners relative to their centre, as the GPU's buffer."""
+    origin, _ = elements.extent()
+    return (elements.corners - origin).astype(np.float32).reshape(-1, 3)
+
+
 def draw(elements, resolution: int, indices=None) -> Items:
     """The item buffers of the hemicubes on `elements`' `indices` (all by default), as
     renderer/gpu/item_buffers.py ItemBuffers draws them."""
     indices = np.arange(len(elements)) if indices is None else np.asarray(indices, np.int64)
     origin, diameter = elements.extent()
     near, far = depth_range(elements.shortest_edge(), diameter)
-    positions32 = (elements.corners - origin).astype(np.float32).reshape(-1, 3)
+    positions32 = _positions32(elements)
     matrices = clip_from_world(elements.frames()[indices], elements.centres[indices], origin, near, far)
     drawn = [draw_hemicube(positions32, m, resolution) for m in matrices]
     shape = (0, len(FACES), resolution, resolution)
@@ -121,9 +127,7 @@ def draw_views(elements, resolution: int, matrices) -> Items:
     """The item buffers of whole views (F, 4, 4) of `elements` (a light's,
     renderer/core/light_buffers.py), as ItemBuffers.views draws them: (F, N, N), row 0 at the
     top, every row drawn."""
-    origin, _ = elements.extent()
-    positions32 = (elements.corners - origin).astype(np.float32).reshape(-1, 3)
-    items, tied = draw_hemicube(positions32, np.asarray(matrices, np.float64), resolution, horizon=0)
+    items, tied = draw_hemicube(_positions32(elements), np.asarray(matrices, np.float64), resolution, horizon=0)
     return Items(items, tied)
 
 

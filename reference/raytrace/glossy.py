@@ -11,10 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from reference.glsl_builtins import dot as _dot
-
 from reference.raytrace.warp import orthonormal_basis, square_to_phong_lobe
 from renderer.core.ray_sampling import GLOSSY_DIMENSION
-
 
 
 def glossy_reflection(R, Ng_in, gloss, u):

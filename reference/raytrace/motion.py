@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.glsl_builtins import dot as _dot
+from reference.glsl_builtins import cross as _cross, dot as _dot
 
 
 @dataclass(frozen=True)
@@ -30,13 +30,6 @@ class Motion:
     axis: np.ndarray
     sine: np.ndarray             # sin(t |w|)
     versine: np.ndarray          # 1 - cos(t |w|)
-
-
-def _cross(a, b):
-    return np.stack([a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-                     a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-                     a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]], axis=-1)
-
 
 
 def motion_time(shutter, u):

@@ -33,7 +33,6 @@ def _float_dtype(*arrays) -> np.dtype:
     return dtype if dtype.kind == "f" else np.dtype(np.float64)
 
 
-
 def _as(dtype, *values):
     return [np.asarray(v, dtype=dtype) for v in values]
 

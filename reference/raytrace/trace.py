@@ -38,7 +38,6 @@ from __future__ import annotations
 import numpy as np
 
 from reference.glsl_builtins import dot as _dot
-
 from reference.lighting import Lights, MaterialUniforms, lighting, normalize, normalize_or_zero
 from reference.raytrace.bvh import any_hit as bvh_any_hit, closest_hit as bvh_closest_hit
 from reference.raytrace.intersect import (MISS, PLANE, SPHERE, TRIANGLE, plane_normal, ray_plane,
@@ -57,7 +56,6 @@ F32 = np.float32
 # GLSL's TRACE_HIT_TIE): 64 eps32, above the few ulps by which the rounding of a triangle's
 # vertices and of the two intersection formulas moves a triangle lying in a plane off it.
 HIT_TIE = 2.0 ** -18
-
 
 
 def leaving_s_min(O):

@@ -44,7 +44,7 @@ import numpy as np
 from renderer.core.hemicube import (FACES, ITEM_BACK_BIT, ITEM_INDEX_MASK, Face, depth_range,
                                     face_views, pixel_centres, projection)
 from renderer.core.light_areas import area_axes
-from renderer.core.transforms import fallback_up, orthographic
+from renderer.core.transforms import fallback_up, look_at, orthographic
 
 # The six faces of a point light's cube: the hemicube's five around +z, and -z.
 CUBE_FACES = FACES + (Face("bottom", (0, 0, -1), (0, 1, 0)),)
@@ -127,13 +127,8 @@ def views(source: LightSource, elements) -> np.ndarray:
         far = 2.0 * (np.linalg.norm(q - origin) + radius) + edge
         return projection(near, far) @ face_views(np.eye(3)[None], q[None], origin, CUBE_FACES)[0]
     forward = np.asarray(source.where, np.float64)
-    right = np.cross(forward, fallback_up(forward))
-    right /= np.linalg.norm(right)
-    rotation = np.stack([right, np.cross(right, forward), -forward])
-    view = np.eye(4)
-    view[:3, :3] = rotation
-    view[:3, 3] = rotation @ (forward * PARALLEL_DISTANCE * radius)     # eye at -forward 2R
     distance = PARALLEL_DISTANCE * radius
+    view = look_at(-forward * distance, np.zeros(3), fallback_up(forward))     # eye at -forward 2R
     parallel = orthographic(2 * radius, 1.0, distance - 1.5 * radius, distance + 1.5 * radius, reversed_z=True)
     return (parallel @ view)[None]
 

@@ -130,7 +130,8 @@ SHADOW_CASE_SCENES = frozenset({"shadow_boxes", "shadow_thin_contact", "shadow_b
 # window (radiosity_window); the rasteriser's tests over every built-in scene hold them in the
 # full run only, as the ray tracer's scenes.
 # Their radiosity tests are tests/test_radiosity_method.py and their goldens tests/test_goldens.py.
-RADIOSITY_SCENES = frozenset({"radiosity_furnace", "radiosity_plates", "cornell_box_radiosity", "radiosity_window"})
+RADIOSITY_SCENES = frozenset({"radiosity_furnace", "radiosity_plates", "cornell_box_radiosity", "radiosity_window",
+                              "radiosity_specular"})
 
 
 def raster_scene_params(names, ids=None):

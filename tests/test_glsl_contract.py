@@ -915,12 +915,17 @@ RADIOSITY_FILES = tuple(sorted(path.relative_to(glsl_dir()).as_posix()
                                for path in (glsl_dir() / "radiosity").iterdir()))
 # What the twin (reference/radiosity/) reads for each uniform.
 RADIOSITY_TWIN_NAMES = {"u_clip_from_world": ("clip_from_world",), "u_horizon": ("horizon",),
-                        "u_view": ("view",), "u_projection": ("projection",)}
+                        "u_view": ("view",), "u_projection": ("projection",),
+                        # the specular term's (renderer/core/radiosity.py SpecularDisplay)
+                        "u_light_surfaces": ("surfaces",), "u_light_view": ("views",),
+                        "u_source_where": ("where",), "u_source_intensity": ("intensity",),
+                        "u_source_attenuation": ("attenuation",), "u_source_emitter": ("emitter",)}
 
 
 def radiosity_uploads(ctx) -> set[str]:
     """Every uniform name ItemBuffers sets on its program while drawing a hemicube, and the
-    radiosity renderer on its display's while drawing a frame."""
+    radiosity renderer on its display's while drawing a frame, with and without the specular
+    term (radiosity_specular, radiosity_plates)."""
     from renderer.core.builtin import builtin_scenes
     from renderer.core.radiosity_elements import Elements
     from renderer.core.radiosity_options import RadiosityOptions
@@ -943,9 +948,11 @@ def radiosity_uploads(ctx) -> set[str]:
             buffers.draw([0])
         finally:
             buffers.release()
-        scene = load_scene(builtin_scenes()["radiosity_plates"])
-        with RadiosityRenderer(scene, 8, 6, RadiosityOptions(element_size=1.0, hemicube=4), context=ctx) as r:
-            r.render()
+        for name in ("radiosity_plates", "radiosity_specular"):
+            scene = load_scene(builtin_scenes()[name])
+            with RadiosityRenderer(scene, 8, 6, RadiosityOptions(element_size=1.0, hemicube=4, light_buffer=16),
+                                   context=ctx) as r:
+                r.render()
     return names
 
 

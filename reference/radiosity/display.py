@@ -9,9 +9,13 @@ perspective-correct where its front is seen (counter-clockwise in the window), b
 back is, alpha 1, and its view depth -z_eye likewise; the background elsewhere
 (reference/framebuffer.py). Where two elements are closer in depth than GL can order, the
 runner-up's colour goes beside the winner's (Frame.rgba8_tie), as the rasteriser's twin does.
+With a SpecularDisplay (a scene with a specular term, renderer/core/radiosity.py), a front seen
+adds the direct specular term at the fragment's interpolated position and renormalised
+interpolated normal (reference/radiosity/specular.py).
 
 Inputs: the element corners (E, 3, 3) world, their displayed radiosity (E, 3, C)
-(renderer/core/radiosity.py), the scene (its camera and background), the image size.
+(renderer/core/radiosity.py), the scene (its camera and background), the image size, and the
+specular term's SpecularDisplay or None.
 """
 
 from __future__ import annotations
@@ -23,23 +27,34 @@ import numpy as np
 from reference.clipping import clip_triangles
 from reference.depth_buffer import DepthBuffer
 from reference.framebuffer import compose_frame
+from reference.radiosity.specular import normalize_or_zero, radiosity_specular
 from reference.rasterizer import rasterize, setup_triangles
 from renderer.core.frame import Frame
 from renderer.core.gl_rules import SUBPIXEL_BITS
 
 
-def _colour(values, view_depth, payload, which, dtype):
-    """(colour (P, 4), view depth (P,)) of the fragments recorded in `payload` at pixels `which`."""
+def _colour(values, view_depth, payload, which, dtype, points=None, specular=None):
+    """(colour (P, 4), view depth (P,)) of the fragments recorded in `payload` at pixels `which`
+    (`points` (E, 3, 3) the corners camera-relative, for the specular term's positions)."""
     source, weights = payload["triangle"][which], payload["weights"][which].astype(dtype)
     rgb = np.einsum("pk,pkc->pc", weights, values[source].astype(dtype))
-    rgb = np.where(payload["front"][which][:, None], rgb, 0)       # a back seen is black
+    front = payload["front"][which]
+    if specular is not None and front.any():
+        f = np.flatnonzero(front)
+        s, w = source[f], weights[f]
+        P = np.einsum("pk,pkc->pc", w, points[s])
+        N = normalize_or_zero(np.einsum("pk,pkc->pc", w, specular.normals[s].astype(dtype)))
+        rgb[f] += radiosity_specular(P, N, specular.ks[s], specular.shininess[s], specular.obj[s], specular)
+    rgb = np.where(front[:, None], rgb, 0)                         # a back seen is black
     colour = np.concatenate([rgb, np.ones((len(which), 1), dtype)], axis=1)
     return colour, np.einsum("pk,pk->p", weights, view_depth[source].astype(dtype))
 
 
 def render(corners, values, scene, width: int, height: int, *, dtype=np.float64,
-           subpixel_bits: int = SUBPIXEL_BITS, linear: bool = False, depth: bool = True) -> Frame:
-    """The elements drawn as renderer/gpu/radiosity.py RadiosityRenderer draws them."""
+           subpixel_bits: int = SUBPIXEL_BITS, linear: bool = False, depth: bool = True,
+           specular=None) -> Frame:
+    """The elements drawn as renderer/gpu/radiosity.py RadiosityRenderer draws them (`specular`:
+    the SpecularDisplay relative to the frame's origin, or None)."""
     start = time.perf_counter()
     dtype = np.dtype(dtype)
     reversed_z = scene.camera.reversed_z
@@ -69,13 +84,15 @@ def render(corners, values, scene, width: int, height: int, *, dtype=np.float64,
     shown_depth = np.full(width * height, np.inf, dtype)
     which = np.flatnonzero(drawn)
     if len(which):
-        colour[which], shown_depth[which] = _colour(values, view_depth, buffer.payload, which, dtype)
+        colour[which], shown_depth[which] = _colour(values, view_depth, buffer.payload, which, dtype,
+                                                    points.reshape(count, 3, 3), specular)
     frame = compose_frame(colour, drawn, shown_depth if depth else None, scene.background, width, height,
                           linear=linear, milliseconds=(time.perf_counter() - start) * 1000.0)
     ties = np.flatnonzero(buffer.depth_ties())
     if len(ties):
         alternative = colour.copy()
-        alternative[ties] = _colour(values, view_depth, buffer.payload_second, ties, dtype)[0]
+        alternative[ties] = _colour(values, view_depth, buffer.payload_second, ties, dtype,
+                                    points.reshape(count, 3, 3), specular)[0]
         frame.rgba8_tie = compose_frame(alternative, drawn, None, scene.background, width, height,
                                         linear=False).rgba8
     return frame

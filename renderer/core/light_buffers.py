@@ -174,11 +174,68 @@ def power(source: LightSource, elements, items: np.ndarray) -> np.ndarray:
     return np.bincount(j, weights=weight, minlength=count)[:, None] * intensity
 
 
-def irradiance(elements, sources, draw_views: Callable[[np.ndarray], np.ndarray]) -> np.ndarray:
+def irradiance(elements, sources, draw_views: Callable[[np.ndarray], np.ndarray],
+               keep: list | None = None) -> np.ndarray:
     """(E, 3) float64: each element's mean direct irradiance H (module docstring) from `sources`,
     each source's views drawn by `draw_views(matrices)` (the item buffers (F, N, N), row 0 at
-    the top: the GPU's ItemBuffers.views or the twin's)."""
+    the top: the GPU's ItemBuffers.views or the twin's). `keep`, a list: the LightSurfaces of
+    the same draws appended to it (the specular term's shadows), no view drawn twice."""
     total = np.zeros((len(elements), 3))
+    drawn = []
     for source in sources:
-        total += power(source, elements, draw_views(views(source, elements)))
+        these = views(source, elements)
+        items = draw_views(these)
+        total += power(source, elements, items)
+        if keep is not None:
+            drawn.append((these, surfaces_seen(items, elements.obj)))
+    if keep is not None:
+        keep.append(_kept(elements, drawn))
     return total / elements.areas[:, None]
+
+
+@dataclass(frozen=True)
+class LightSurfaces:
+    """What each source's light buffer saw, kept for radiosity's direct specular term (its
+    shadows: glsl/radiosity/specular.glsl, reference/radiosity/specular.py): per view, which
+    object's front each pixel saw. A fragment of object o is lit by a source where the pixel of
+    the source's view under it saw o's front: objects, not elements, are compared, so that an
+    element's neighbour on the same surface does not shadow it (a surface cannot shadow itself
+    where its normal faces the light, save a concave mesh's folds, which this leaves lit).
+
+    `matrices` (V, 4, 4) float64 are clip_from_world of positions relative to `origin` (the
+    elements' centre, as views() makes them); `surfaces` (V, N, N) uint32, row 0 at the top,
+    hold object + 1 where the pixel saw that object's front, else 0; `counts` (S,) the views of
+    each source in `sources`' order (six at a point, one for a directional light)."""
+    origin: np.ndarray
+    matrices: np.ndarray
+    surfaces: np.ndarray
+    counts: tuple
+
+    @property
+    def nbytes(self) -> int:
+        return int(self.surfaces.nbytes)
+
+
+def surfaces_seen(items: np.ndarray, obj: np.ndarray) -> np.ndarray:
+    """(F, N, N) uint32: object + 1 where a pixel of item buffers `items` saw an element's front
+    (`obj` (E,) each element's object), 0 where it saw nothing or a back."""
+    index = (items & ITEM_INDEX_MASK).astype(np.int64) - 1
+    front = (index >= 0) & ((items & ITEM_BACK_BIT) == 0)
+    owner = np.concatenate([np.asarray(obj, np.int64) + 1, [0]]).astype(np.uint32)
+    return np.where(front, owner[np.where(front, index, -1)], np.uint32(0)).astype(np.uint32)
+
+
+def light_surfaces(elements, sources, draw_views: Callable[[np.ndarray], np.ndarray]) -> LightSurfaces:
+    """The LightSurfaces of `sources` seeing `elements`, each source's views drawn by
+    `draw_views(matrices)` (as irradiance's)."""
+    drawn = []
+    for source in sources:
+        these = views(source, elements)
+        drawn.append((these, surfaces_seen(draw_views(these), elements.obj)))
+    return _kept(elements, drawn)
+
+
+def _kept(elements, drawn: list) -> LightSurfaces:
+    """The LightSurfaces of [(matrices (F, 4, 4), surfaces (F, N, N))], a pair per source."""
+    return LightSurfaces(elements.extent()[0], np.concatenate([m for m, _ in drawn]),
+                         np.concatenate([s for _, s in drawn]), tuple(len(m) for m, _ in drawn))

@@ -16,8 +16,12 @@ drawn from, step by step.
    (glsl/radiosity/display.*, twin reference/radiosity/display.py) interpolates them across
    each element.
 
-What a radiosity frame shows is B: the scene's ambient term takes no part (interreflection is
-what it stands for), nor do specular, mirror and glass terms (docs/radiosity.md).
+What a radiosity frame shows is B, plus the direct specular term where a material has one (the
+lighting equation's k_s term of each light-buffer source, shadowed by what that source's light
+buffer saw: Lighting.specular, RadiositySolution.light_surfaces; glsl/radiosity/specular.glsl):
+the scene's ambient term takes no part (interreflection is what it stands for), nor do mirror
+and glass terms, nor light that reaches the eye by a specular bounce from another surface
+(docs/radiosity.md).
 """
 
 from __future__ import annotations
@@ -50,10 +54,13 @@ class Lighting:
     lights' sources (renderer/core/light_buffers.py) with the light buffer's resolution, and
     the sky: the scene's background, a uniform surround whose light reaches an element through
     what its hemicube sees of nothing (FormFactors.unseen), as a path that leaves the scene
-    brings the background back in the path tracer."""
+    brings the background back in the path tracer. `specular`: some object has a specular term
+    and some source lights it, so the display adds the direct specular term, shadowed by the
+    sources' light buffers (kept: RadiositySolution.light_surfaces)."""
     sources: tuple = ()
     resolution: int = 0
     sky: tuple = (0.0, 0.0, 0.0)
+    specular: bool = False
 
     def finer(self, level: int) -> "Lighting":
         """The light buffer 2^level times as fine (at most MAX_LIGHT_BUFFER): refinement's."""
@@ -71,6 +78,9 @@ class RadiositySolution:
     base: Elements | None = None        # the scene's elements before refinement (None: `elements`)
     levels: int = 0                     # the refinements made (options.refine at most)
     source: np.ndarray | None = None    # (E, 3) what the solver took as emission: E + rho (H + S)
+    # what the lights' buffers saw at lighting.resolution, for the specular term's shadows
+    # (None: the scene has no specular term to shadow, Lighting.specular)
+    light_surfaces: light_buffers.LightSurfaces | None = None
 
     @property
     def unrefined(self) -> Elements:
@@ -87,7 +97,8 @@ def lighting_for(scene, options: RadiosityOptions) -> Lighting:
     """The scene's Lighting: its lights' sources at the options' light buffer, its sky."""
     sources = light_buffers.light_sources(scene, options.area_samples)
     return Lighting(sources, options.light_buffer if sources else 0,
-                    tuple(float(c) for c in scene.background[:3]))
+                    tuple(float(c) for c in scene.background[:3]),
+                    specular=bool(sources) and any(o.material.has_specular for o in scene.objects))
 
 
 def interreflects(elements: Elements, irradiance: np.ndarray | None = None, sky=(0.0, 0.0, 0.0)) -> bool:
@@ -111,7 +122,8 @@ def what_changed(old: RadiositySolution | None, elements: Elements, lighting: Li
     if before is None or not (np.array_equal(before.corners, elements.corners)
                               and np.array_equal(before.obj, elements.obj)):
         return "geometry"
-    if (old.lighting.sources, old.lighting.resolution) != (lighting.sources, lighting.resolution):
+    if (old.lighting.sources, old.lighting.resolution, old.lighting.specular) != (
+            lighting.sources, lighting.resolution, lighting.specular):
         return "lights"
     if not old.form_factors.drawn and interreflects(elements, old.irradiance, lighting.sky):
         return "geometry"                     # light bounces now: the hemicubes are needed
@@ -140,7 +152,8 @@ def refreshed(old: RadiositySolution | None, elements: Elements, lighting: Light
         return None
     if options.refine:
         change, old = "geometry", None
-    solution = _solved(old, change, elements, lighting, options, open_drawer, backend, name)
+    solution = _solved(old, change, elements, lighting, options, open_drawer, backend, name,
+                       keep_surfaces=not options.refine)
     for level in range(1, options.refine + 1):
         split = needs_refining(solution, options.refine_threshold)
         if not split.any():
@@ -149,6 +162,11 @@ def refreshed(old: RadiositySolution | None, elements: Elements, lighting: Light
         solution = _solved(None, "geometry", refined(solution.elements, split), lighting.finer(level),
                            options, open_drawer, backend, name)
         solution.levels = level
+    if lighting.specular and solution.light_surfaces is None and len(solution.elements):
+        # the specular term's shadows at the options' light buffer, not the finest level's
+        with open_drawer(solution.elements, lighting.resolution, "lights") as drawer:
+            solution.light_surfaces = light_buffers.light_surfaces(solution.elements, lighting.sources,
+                                                                   drawer.views)
     solution.base, solution.lighting = elements, lighting
     return solution
 
@@ -165,13 +183,17 @@ def needs_refining(solution: RadiositySolution, threshold_levels: float) -> np.n
 
 
 def _solved(old, change: str, elements: Elements, lighting: Lighting, options: RadiosityOptions,
-            open_drawer, backend: str, name: str) -> RadiositySolution:
-    """The solution for `elements` given what `change`d since `old`'s (refreshed)."""
+            open_drawer, backend: str, name: str, keep_surfaces: bool = False) -> RadiositySolution:
+    """The solution for `elements` given what `change`d since `old`'s (refreshed); with
+    `keep_surfaces` and a specular scene, the light buffers' surfaces kept from the same draws."""
+    kept = [] if keep_surfaces and lighting.specular else None
     if change == "materials":
         h = old.irradiance
+        if kept is not None and old.light_surfaces is not None:
+            kept.append(old.light_surfaces)
     elif lighting.sources and len(elements):
         with open_drawer(elements, lighting.resolution, "lights") as drawer:
-            h = light_buffers.irradiance(elements, lighting.sources, drawer.views)
+            h = light_buffers.irradiance(elements, lighting.sources, drawer.views, keep=kept)
     else:
         h = None
     matrix = None if change == "geometry" else old.form_factors
@@ -180,7 +202,9 @@ def _solved(old, change: str, elements: Elements, lighting: Lighting, options: R
                                direct=options.solver == "direct")
         with open_drawer(elements, options.hemicube, "hemicubes") as drawer:
             matrix = form_factors(len(elements), options.hemicube, drawer.draw, drawer.batch)
-    return solve(elements, options, matrix, h, lighting)
+    solution = solve(elements, options, matrix, h, lighting)
+    solution.light_surfaces = kept[0] if kept else None
+    return solution
 
 
 def solve(elements: Elements, options: RadiosityOptions, matrix: FormFactors | None = None,
@@ -241,3 +265,63 @@ def corner_values(elements: Elements, radiosity: np.ndarray) -> np.ndarray:
     totals = np.zeros((count * 3, radiosity.shape[1]))
     np.add.at(totals, first, weight[:, None] * radiosity[element[second]])
     return (totals / np.bincount(first, weights=weight, minlength=count * 3)[:, None]).reshape(count, 3, -1)
+
+
+@dataclass(frozen=True)
+class SpecularDisplay:
+    """What radiosity's display needs for the direct specular term (Lighting.specular), in the
+    frame's camera-relative coordinates (positions minus the eye, as the display's corners),
+    one layout for the GPU's uniforms and vertex attributes (glsl/radiosity/specular.glsl) and
+    the twin (reference/radiosity/specular.py):
+
+    per element corner, `normals` (E, 3, 3): the area-weighted mean of the element normals of
+    its object meeting there within the crease angle (corner_values), unnormalised (the
+    fragment renormalises, as Phong shading does); per element `ks` (E, 3), `shininess` (E,),
+    `obj` (E,) its material's k_s, n and its object; per source (light_buffers.LightSource,
+    in Lighting.sources' order) `where` (S, 4): a point's position and 1, or a directional
+    light's unit direction of travel and 0; `intensity` (S, 3); `attenuation` (S, 3) (c, l, q);
+    `emitter` (S, 4): an area point's emitting normal and scale (scale 0: isotropic); per view
+    `views` (V, 4, 4) clip_from_camera-relative world and `surfaces` (V, N, N) uint32, row 0 at
+    the top (light_buffers.LightSurfaces)."""
+    normals: np.ndarray
+    ks: np.ndarray
+    shininess: np.ndarray
+    obj: np.ndarray
+    where: np.ndarray
+    intensity: np.ndarray
+    attenuation: np.ndarray
+    emitter: np.ndarray
+    views: np.ndarray
+    surfaces: np.ndarray
+    counts: tuple
+
+    @staticmethod
+    def materials(scene) -> tuple:
+        """Each object's (k_s, n): what the display reads of the scene's materials besides the
+        solution, so that a new k_s or n redraws the frame without solving again."""
+        return tuple((tuple(float(c) for c in o.material.ks), float(o.material.n)) for o in scene.objects)
+
+
+def specular_display(solution: RadiositySolution, scene, origin) -> SpecularDisplay | None:
+    """The SpecularDisplay of `solution` for `scene`'s materials, relative to the frame's
+    `origin` (the eye); None where the scene has no specular term (Lighting.specular)."""
+    surfaces = solution.light_surfaces
+    if not solution.lighting.specular or surfaces is None:
+        return None
+    elements = solution.elements
+    origin = np.asarray(origin, np.float64)
+    table = SpecularDisplay.materials(scene)
+    ks = np.array([k for k, _ in table], np.float64).reshape(-1, 3)[elements.obj]
+    shininess = np.array([n for _, n in table], np.float64)[elements.obj]
+    sources = solution.lighting.sources
+    point = np.array([s.kind == "point" for s in sources])
+    where = np.array([s.where for s in sources], np.float64).reshape(-1, 3)
+    where = np.concatenate([np.where(point[:, None], where - origin, where), point[:, None].astype(float)], axis=1)
+    emitter = np.array([(0.0, 0.0, 0.0, 0.0) if s.emitter is None else (*s.emitter, s.emitter_scale)
+                        for s in sources], np.float64).reshape(-1, 4)
+    to_surfaces = np.eye(4)
+    to_surfaces[:3, 3] = origin - surfaces.origin           # camera-relative to the views' relative
+    return SpecularDisplay(corner_values(elements, elements.normals), ks, shininess, elements.obj,
+                           where, np.array([s.intensity for s in sources], np.float64).reshape(-1, 3),
+                           np.array([s.attenuation for s in sources], np.float64).reshape(-1, 3), emitter,
+                           surfaces.matrices @ to_surfaces, surfaces.surfaces, surfaces.counts)

@@ -25,7 +25,8 @@ import numpy as np
 
 from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, depth_mapping, to_unorm8
-from renderer.core.radiosity import RadiositySolution, elements_for, lighting_for, refreshed
+from renderer.core.radiosity import (RadiositySolution, SpecularDisplay, elements_for, lighting_for, refreshed,
+                                     specular_display)
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
@@ -50,13 +51,15 @@ class RadiosityRenderer(ContextRenderer):
         self._open_context(context, context_kind)
         self._resources: list = []
         self._mesh: list = []
+        self._programs: dict = {}                  # by defines: with or without the specular term
+        self._surfaces = None                      # (LightSurfaces, its texture) uploaded
+        self._specular: SpecularDisplay | None = None
+        self._materials = None
         try:
             activate(self.ctx)
             ctx = self.ctx
             self._clip_control = gl_function(ctx, "glClipControl", None, ctypes.c_uint, ctypes.c_uint)
-            self.program = ctx.program(vertex_shader=shader_source("radiosity/display.vert").text,
-                                       fragment_shader=shader_source("radiosity/display.frag").text)
-            self._resources.append(self.program)
+            self.program = self._program_for(None)
             self._gl_info = self._context_info()
             self._build_targets()
             self.update()
@@ -86,11 +89,25 @@ class RadiosityRenderer(ContextRenderer):
         solution = refreshed(self.solution, elements_for(self.scene, self.options),
                              lighting_for(self.scene, self.options), self.options, self._item_buffers,
                              "gpu", self.scene.name)
-        if solution is None:                       # only the camera moved
+        if solution is None:                       # only the camera moved, or k_s and n
+            if SpecularDisplay.materials(self.scene) != self._materials:
+                self._upload_mesh()
             return
         self.solution = solution
         self.solves += 1
         self._upload_mesh()
+
+    def _program_for(self, display: SpecularDisplay | None) -> moderngl.Program:
+        """The display's program: with the specular term's arrays sized for `display`, or without."""
+        defines = None if display is None else {"SPECULAR": True, "NUM_SOURCES": len(display.where),
+                                                "NUM_VIEWS": len(display.views)}
+        key = tuple(sorted((defines or {}).items()))
+        if key not in self._programs:
+            program = self.ctx.program(vertex_shader=shader_source("radiosity/display.vert", defines).text,
+                                       fragment_shader=shader_source("radiosity/display.frag", defines).text)
+            self._resources.append(program)
+            self._programs[key] = program
+        return self._programs[key]
 
     @contextlib.contextmanager
     def _item_buffers(self, elements, resolution, what):
@@ -114,12 +131,43 @@ class RadiosityRenderer(ContextRenderer):
         origin = self.scene.matrices(self.width, self.height).origin if origin is None else origin
         self._origin = np.array(origin, np.float64)
         solution = self.solution
-        data = np.concatenate([(solution.elements.corners - origin).reshape(-1, 3),
-                               solution.corner_radiosity.reshape(-1, 3)], axis=1).astype(np.float32)
+        self._materials = SpecularDisplay.materials(self.scene)
+        display = self._specular = specular_display(solution, self.scene, origin)
+        self.program = self._program_for(display)
+        columns = [(solution.elements.corners - origin).reshape(-1, 3), solution.corner_radiosity.reshape(-1, 3)]
+        names = ["in_position", "in_radiosity"]
+        if display is not None:
+            columns += [display.normals.reshape(-1, 3), np.repeat(display.ks, 3, axis=0),
+                        np.repeat(display.shininess, 3)[:, None]]
+            names += ["in_normal", "in_ks", "in_shininess"]
+            self._upload_surfaces(solution.light_surfaces)
+        data = np.concatenate(columns, axis=1).astype(np.float32)
         if len(data):
             vbo = self.ctx.buffer(data.tobytes())
-            vao = self.ctx.vertex_array(self.program, [(vbo, "3f 3f", "in_position", "in_radiosity")])
-            self._mesh = [vao, vbo]
+            content = [(vbo, " ".join(f"{c.shape[1]}f" for c in columns), *names)]
+            self._mesh = [vbo]
+            if display is not None:
+                objects = self.ctx.buffer(np.repeat(display.obj, 3).astype(np.int32).tobytes())
+                content.append((objects, "1i", "in_object"))
+                self._mesh.append(objects)
+            self._mesh.insert(0, self.ctx.vertex_array(self.program, content))
+
+    def _upload_surfaces(self, surfaces) -> None:
+        """The light buffers' surfaces as an R32UI array texture, a layer a view, GL's rows
+        (bottom first), once per LightSurfaces."""
+        if self._surfaces is not None and self._surfaces[0] is surfaces:
+            return
+        self._release_surfaces()
+        views, n, _ = surfaces.surfaces.shape
+        texture = self.ctx.texture_array((n, n, views), 1, np.ascontiguousarray(surfaces.surfaces[:, ::-1]).tobytes(),
+                                         dtype="u4")
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        self._surfaces = (surfaces, texture)
+
+    def _release_surfaces(self) -> None:
+        if self._surfaces is not None:
+            self._surfaces[1].release()
+            self._surfaces = None
 
     # -- frames ----------------------------------------------------------------------------------
     def render(self, out: Frame | None = None, *, linear: bool = True, depth: bool = True,
@@ -147,6 +195,8 @@ class RadiosityRenderer(ContextRenderer):
             ctx.wireframe = False
             self.program["u_view"].write(to_glsl(matrices.view))
             self.program["u_projection"].write(to_glsl(matrices.projection))
+            if self._specular is not None:
+                self._write_specular(self._specular)
             if mapping is not STANDARD_DEPTH:
                 self._clip_control(GL_LOWER_LEFT, mapping.clip_control)
             try:
@@ -169,6 +219,18 @@ class RadiosityRenderer(ContextRenderer):
         return Frame(rgba8, colour if linear else None, view_depth if depth else None,
                      (time.perf_counter() - start) * 1000.0, gl_info=self.gl_info)
 
+    def _write_specular(self, display: SpecularDisplay) -> None:
+        """The specular term's uniforms (glsl/radiosity/specular.glsl) and its texture on unit 0."""
+        program = self.program
+        program["u_light_view"].write(np.ascontiguousarray(
+            np.swapaxes(display.views, -1, -2)).astype(np.float32).tobytes())            # by columns
+        for name, values in (("u_source_where", display.where), ("u_source_intensity", display.intensity),
+                             ("u_source_attenuation", display.attenuation), ("u_source_emitter", display.emitter)):
+            if name in program:
+                program[name].write(np.ascontiguousarray(values, np.float32).tobytes())
+        program["u_light_surfaces"].value = 0
+        self._surfaces[1].use(0)
+
     def resize(self, width: int, height: int) -> None:
         self._check_alive()
         activate(self.ctx)
@@ -181,8 +243,9 @@ class RadiosityRenderer(ContextRenderer):
         try:
             for thing in (*self._mesh, *reversed(self._resources)):
                 thing.release()
+            self._release_surfaces()
             if getattr(self, "_fbo", None) is not None:
                 self._release_targets()
         finally:
-            self._resources, self._mesh, self._fbo = [], [], None
+            self._resources, self._mesh, self._fbo, self._programs = [], [], None, {}
 

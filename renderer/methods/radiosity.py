@@ -10,7 +10,7 @@ import contextlib
 
 from renderer.core.frame import Frame
 from renderer.core.memory import Need, raster_need
-from renderer.core.radiosity import elements_for, lighting_for, refreshed
+from renderer.core.radiosity import elements_for, lighting_for, refreshed, specular_display
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
@@ -51,8 +51,10 @@ class ReferenceRadiosity(ReferenceRenderer):
         from reference.radiosity.display import render
         extra = {} if self.subpixel_bits is None else {"subpixel_bits": self.subpixel_bits}
         solution = self.solution
+        origin = self.scene.matrices(self.width, self.height).origin
         return render(solution.elements.corners, solution.corner_radiosity, self.scene, self.width,
-                      self.height, dtype=self.dtype, linear=linear, depth=depth, **extra)
+                      self.height, dtype=self.dtype, linear=linear, depth=depth,
+                      specular=specular_display(solution, self.scene, origin), **extra)
 
 
 def _open_gpu(scene, width, height, options: RadiosityOptions, context, context_kind):

@@ -404,6 +404,7 @@ def test_ray_tracing_refines_while_still_and_starts_again_when_the_camera_moves(
         assert (viewer.shown_image() == expected).all()
 
         tracer = viewer._tracer
+        press(viewer, glfw.KEY_M)                         # radiosity (not drawn: no frame)
         press(viewer, glfw.KEY_M)                         # the path tracer: its own mean
         viewer.frame()
         assert viewer.samples == 1 and "path tracing: 1 spp" in viewer.title()
@@ -418,6 +419,40 @@ def test_ray_tracing_refines_while_still_and_starts_again_when_the_camera_moves(
         assert viewer.samples == 1
         tracer = viewer._tracer
     assert tracer._released                               # closed with the viewer
+
+
+# -- radiosity: progressive refinement converging -------------------------------------------------
+def test_radiosity_converges_a_step_a_frame_and_a_camera_move_keeps_it_going(on_x_display):
+    """method="radiosity": the first frame shows the direct light (with the ambient term for the
+    bounces to come), the hemicubes come a batch a frame, then shots, the unshot light falling
+    every frame, until it converges and the loop idles; the picture is then the headless
+    radiosity's (solved by Gauss-Seidel to its own tolerance) within the pipeline tolerance. An
+    orbit on the way does not start it again; turning a light off does."""
+    from renderer.core.radiosity_progressive import HEMICUBES_PER_STEP
+    from renderer.methods import open_renderer
+    plates = scene("radiosity_specular")                 # lights, sky, a specular term
+    with Viewer(plates, *SIZE, vsync=False, method="radiosity", on_message=lambda line: None) as viewer:
+        viewer.run(frames=1)
+        assert "direct light" in viewer.title() and not viewer.idle
+        viewer.run(frames=1, orbit=5.0)                   # a camera move: the hemicubes go on
+        assert f"hemicubes {HEMICUBES_PER_STEP:,} of" in viewer.radiosity_line
+        lines = []
+        for _ in range(2000):
+            viewer.run(frames=1)
+            lines.append(viewer.radiosity_line)
+            if viewer.idle:
+                break
+        assert viewer.idle and "converged" in lines[-1] and "(done)" not in viewer.title()
+        unshot = [float(line.split("unshot ")[1].split("%")[0]) for line in lines if "unshot" in line]
+        assert len(unshot) > 3 and all(b <= a for a, b in zip(unshot, unshot[1:]))
+        moved = replace(plates, camera=viewer.orbit.camera)
+        with open_renderer(moved, SIZE, method="radiosity") as radiosity:
+            assert_matches(viewer.shown_image(), radiosity.render(depth=False).rgba8)
+        viewer.run(frames=1, orbit=5.0)                   # converged: a camera move solves nothing
+        assert "converged" in viewer.radiosity_line
+        press(viewer, glfw.KEY_1)                         # the sun off: the lights change, again
+        viewer.run(frames=1)
+        assert "direct light" in viewer.radiosity_line and not viewer.idle
 
 
 def test_ray_tracing_stops_at_the_cap_and_idles(on_x_display):

@@ -30,10 +30,10 @@ def add_parser(sub) -> None:
     view.add_argument("--triple-buffering", action="store_true",
                       help="start with triple buffering (the B key toggles it)")
     view.add_argument("--no-vsync", action="store_true", help="start with v-sync off (the V key)")
-    view.add_argument("--method", choices=("raster", "raytrace", "pathtrace"), default="raster",
-                      help="start with the rasteriser (default), the ray tracer or the path tracer; "
-                           "the tracers refine while the view is still, one sample per pixel a "
-                           "frame (the M key)")
+    view.add_argument("--method", choices=("raster", "raytrace", "pathtrace", "radiosity"), default="raster",
+                      help="start with the rasteriser (default), the ray tracer, the path tracer or "
+                           "radiosity; the tracers refine while the view is still, one sample per "
+                           "pixel a frame, radiosity converges a step a frame (the M key)")
     memory_option(view)
 
 
@@ -62,7 +62,7 @@ def run(args) -> int:
             stats = viewer.run(args.frames, args.orbit, None)     # the screenshot: below, with --stats
         except KeyboardInterrupt:              # Ctrl-C in the terminal: as good as Esc
             return 0
-        figures, samples = viewer.figures, viewer.samples
+        figures, samples, radiosity = viewer.figures, viewer.samples, viewer.radiosity_line
         shown = viewer.shown_image() if scripted and args.screenshot is not None else None
     if scripted:
         with outputs(args.screenshot, args.stats) as out:    # both or neither
@@ -70,12 +70,15 @@ def run(args) -> int:
                 out.image(args.screenshot, shown)
             if args.stats is not None:
                 out.text(args.stats, json_text(stats.summary() | {"reference": figures,
-                                                                  "raytrace_spp": samples}))
+                                                                  "raytrace_spp": samples,
+                                                                  "radiosity": radiosity}))
         print(stats.line())
         if figures is not None:
             print(figures_line(figures))
         if samples is not None:
             print(f"{'path' if args.method == 'pathtrace' else 'ray'} tracing: {samples} spp")
+        if radiosity is not None:
+            print(radiosity)
         if args.screenshot is not None:
             print(f"wrote {args.screenshot}")
     return 0

@@ -104,15 +104,40 @@ def rows_from_items(items: np.ndarray, resolution: int, elements: int):
     return unique // (elements + 1), unique % (elements + 1) - 1, values, unseen, backs
 
 
+class RowsDrawn:
+    """Form factors gathered a batch of hemicubes at a time, in element order: `add(items)` takes
+    the item buffers (H, 5, N, N) of the next H elements' hemicubes; `matrix()` the FormFactors
+    once every element's is in (form_factors at once; a viewer a batch a frame,
+    renderer/core/radiosity_progressive.py)."""
+
+    def __init__(self, elements: int, resolution: int):
+        self.elements, self.resolution = elements, resolution
+        self.done = 0
+        self._parts = []
+
+    def add(self, items: np.ndarray) -> None:
+        row, column, value, unseen, backs = rows_from_items(items, self.resolution, self.elements)
+        self._parts.append((row + self.done, column, value, unseen, backs))
+        self.done += len(items)
+
+    def next_indices(self, most: int) -> np.ndarray:
+        """The next at most `most` elements whose hemicubes are not in yet."""
+        return np.arange(self.done, min(self.done + most, self.elements))
+
+    def matrix(self) -> FormFactors:
+        if self.done != self.elements:
+            raise ValueError(f"{self.done} of {self.elements} hemicubes drawn")
+        parts = self._parts or [(np.zeros(0, np.int64),) * 2 + (np.zeros(0),) * 3]
+        row, columns, values, unseen, backs = (np.concatenate([p[k] for p in parts]) for k in range(5))
+        indptr = np.concatenate([[0], np.cumsum(np.bincount(row, minlength=self.elements))])
+        return FormFactors(indptr, columns, values, unseen, backs)
+
+
 def form_factors(elements: int, resolution: int, draw: Callable[[np.ndarray], np.ndarray],
                  batch: int) -> FormFactors:
     """Every element's row, from its hemicube drawn by `draw(indices)` (item buffers (len, 5,
     N, N), row 0 at the top: the GPU's ItemBuffers.draw or the twin's), `batch` at a time."""
-    parts = []
-    for start in range(0, elements, batch):
-        indices = np.arange(start, min(start + batch, elements))
-        row, column, value, unseen, backs = rows_from_items(draw(indices), resolution, elements)
-        parts.append((row + start, column, value, unseen, backs))
-    row, columns, values, unseen, backs = (np.concatenate([p[k] for p in parts]) for k in range(5))
-    indptr = np.concatenate([[0], np.cumsum(np.bincount(row, minlength=elements))])
-    return FormFactors(indptr, columns, values, unseen, backs)
+    rows = RowsDrawn(elements, resolution)
+    while rows.done < elements:
+        rows.add(draw(rows.next_indices(batch)))
+    return rows.matrix()

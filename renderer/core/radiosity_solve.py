@@ -92,34 +92,63 @@ def direct(form_factors: FormFactors, reflectance, emission) -> Solution:
     return solution
 
 
+class Shooter:
+    """Progressive refinement that can stop and go on (module docstring): `shoot(count)` makes
+    up to `count` more shots and says whether the unshot power is down to `tolerance` times the
+    emitted power; `solution` is the radiosity so far (Solution.unshot what is left to shoot);
+    `shown()` what a display shows meanwhile, B + rho ambient (Cohen et al. 1988). The solver
+    (`progressive`) shoots to the end; the viewer a few shots a frame (renderer/core/
+    radiosity_progressive.py)."""
+
+    def __init__(self, form_factors: FormFactors, areas, reflectance, emission, *, tolerance: float = 1e-10):
+        self.rho, e = np.asarray(reflectance, np.float64), np.asarray(emission, np.float64)
+        self.areas = np.asarray(areas, np.float64)
+        self.tolerance = tolerance
+        self.emitted = max(float((self.areas[:, None] * e).sum()), np.finfo(float).tiny)
+        self.columns = form_factors.by_column()
+        self.solution = Solution(e.copy(), unshot=e.copy())
+        self.power = self.areas * e.sum(axis=1)
+        self.solution.converged = float(self.power.sum()) <= tolerance * self.emitted
+
+    def shoot(self, count: int) -> bool:
+        colptr, rows, values = self.columns
+        solution, power, rho = self.solution, self.power, self.rho
+        b, unshot = solution.radiosity, solution.unshot
+        for _ in range(count):
+            if solution.converged:
+                break
+            i = int(np.argmax(power))
+            lo, hi = colptr[i], colptr[i + 1]
+            j = rows[lo:hi]                                  # the elements that see i, each once
+            received = rho[j] * values[lo:hi, None] * unshot[i]
+            unshot[i] = 0.0
+            b[j] += received
+            unshot[j] += received
+            power[i] = 0.0
+            power[j] = self.areas[j] * unshot[j].sum(axis=1)
+            solution.residuals.append(float(power.sum()))
+            solution.iterations += 1
+            solution.converged = solution.residuals[-1] <= self.tolerance * self.emitted
+        return solution.converged
+
+    @property
+    def unshot_fraction(self) -> float:
+        """The unshot power left over the emitted power (1 before the first shot)."""
+        return float(self.power.sum()) / self.emitted
+
+    def shown(self) -> np.ndarray:
+        """(E, C): B + rho ambient, the picture before convergence (`ambient`)."""
+        solution = self.solution
+        return solution.radiosity + self.rho * ambient(self.areas, self.rho, solution.unshot)
+
+
 def progressive(form_factors: FormFactors, areas, reflectance, emission, *, tolerance: float = 1e-10,
                 max_shots: int | None = None) -> Solution:
     """Shoots until the unshot power is at most `tolerance` times the emitted power (or
     `max_shots`, default 100 times the element count)."""
-    rho, e = np.asarray(reflectance, np.float64), np.asarray(emission, np.float64)
-    areas = np.asarray(areas, np.float64)
-    b, unshot = e.copy(), e.copy()
-    emitted = max(float((areas[:, None] * e).sum()), np.finfo(float).tiny)
-    colptr, rows, values = form_factors.by_column()
-    limit = 100 * len(b) if max_shots is None else max_shots
-    solution = Solution(b, unshot=unshot)
-    power = areas * unshot.sum(axis=1)
-    for shot in range(1, limit + 1):
-        i = int(np.argmax(power))
-        lo, hi = colptr[i], colptr[i + 1]
-        j = rows[lo:hi]                                  # the elements that see i, each once
-        received = rho[j] * values[lo:hi, None] * unshot[i]
-        unshot[i] = 0.0
-        b[j] += received
-        unshot[j] += received
-        power[i] = 0.0
-        power[j] = areas[j] * unshot[j].sum(axis=1)
-        solution.residuals.append(float(power.sum()))
-        solution.iterations = shot
-        if solution.residuals[-1] <= tolerance * emitted:
-            solution.converged = True
-            break
-    return solution
+    shooter = Shooter(form_factors, areas, reflectance, emission, tolerance=tolerance)
+    shooter.shoot(100 * len(shooter.areas) if max_shots is None else max_shots)
+    return shooter.solution
 
 
 def ambient(areas, reflectance, unshot) -> np.ndarray:

@@ -19,6 +19,7 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import time
+from typing import Iterator
 
 import moderngl
 import numpy as np
@@ -28,6 +29,7 @@ from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, depth_mapping,
 from renderer.core.radiosity import (RadiositySolution, SpecularDisplay, elements_for, lighting_for, refreshed,
                                      specular_display)
 from renderer.core.radiosity_options import RadiosityOptions
+from renderer.core.radiosity_progressive import Progress, progressive_solution
 from renderer.core.scene import Scene
 from renderer.core.transforms import to_glsl
 from renderer.errors import ContextError
@@ -42,7 +44,9 @@ class RadiosityRenderer(ContextRenderer):
     """The method "radiosity" on the GPU, for the Renderer protocol (renderer/gpu/base.py)."""
 
     def __init__(self, scene: Scene, width: int, height: int, options: RadiosityOptions | None = None, *,
-                 context: moderngl.Context | None = None, context_kind: str = "auto"):
+                 context: moderngl.Context | None = None, context_kind: str = "auto", solve: bool = True):
+        """`solve`: solve now (update()); False leaves it to progressive() (a viewer), and the
+        frames show the background until a step brings a solution."""
         self.scene = scene
         self.width, self.height = image_size(width, height)
         self.options = options or RadiosityOptions()
@@ -62,7 +66,8 @@ class RadiosityRenderer(ContextRenderer):
             self.program = self._program_for(None)
             self._gl_info = self._context_info()
             self._build_targets()
-            self.update()
+            if solve:
+                self.update()
         except BaseException:
             self.release()
             raise
@@ -89,13 +94,31 @@ class RadiosityRenderer(ContextRenderer):
         solution = refreshed(self.solution, elements_for(self.scene, self.options),
                              lighting_for(self.scene, self.options), self.options, self._item_buffers,
                              "gpu", self.scene.name)
-        if solution is None:                       # only the camera moved, or k_s and n
-            if SpecularDisplay.materials(self.scene) != self._materials:
-                self._upload_mesh()
+        if solution is None:                       # only the camera moved (or k_s and n: render())
             return
         self.solution = solution
         self.solves += 1
         self._upload_mesh()
+
+    def progressive(self, scene: Scene | None = None, **steps) -> Iterator[Progress]:
+        """Radiosity solved a step at a time for `scene` (or the scene changed in place), for a
+        viewer (renderer/core/radiosity_progressive.py; `steps`: its keywords): each step's
+        estimate becomes this renderer's solution, drawn by the next render(), and its Progress
+        is yielded. The last solution's form factors are kept where the geometry is the same."""
+        self._check_alive()
+        if scene is not None:
+            self.scene = scene
+        activate(self.ctx)
+        for progress in progressive_solution(self.solution, elements_for(self.scene, self.options),
+                                             lighting_for(self.scene, self.options), self.options,
+                                             self._item_buffers, "gpu", self.scene.name, **steps):
+            if progress.solution is not self.solution:
+                self.solution = progress.solution
+                self._upload_mesh()
+            if progress.done:
+                self.solves += 1
+            yield progress
+            activate(self.ctx)                     # a viewer may have drawn elsewhere meanwhile
 
     def _program_for(self, display: SpecularDisplay | None) -> moderngl.Program:
         """The display's program: with the specular term's arrays sized for `display`, or without."""
@@ -183,8 +206,9 @@ class RadiosityRenderer(ContextRenderer):
         if mapping is not STANDARD_DEPTH and self._clip_control is None:
             raise ContextError("reversed_z needs glClipControl (OpenGL 4.5 or ARB_clip_control), "
                                "which this GL does not have")
-        if not np.array_equal(matrices.origin, self._origin):     # the camera moved
-            self._upload_mesh(matrices.origin)
+        if self.solution is not None and (not np.array_equal(matrices.origin, self._origin)
+                                          or SpecularDisplay.materials(self.scene) != self._materials):
+            self._upload_mesh(matrices.origin)     # the camera moved, or k_s and n changed
         background = tuple(float(c) for c in self.scene.background)
         self._fbo.use()
         ctx.viewport = (0, 0, self.width, self.height)
@@ -237,7 +261,8 @@ class RadiosityRenderer(ContextRenderer):
         self.width, self.height = image_size(width, height)
         self._release_targets()
         self._build_targets()
-        self._upload_mesh()                        # camera-relative to the new size's origin
+        if self.solution is not None:
+            self._upload_mesh()                    # camera-relative to the new size's origin
 
     def _free(self) -> None:
         try:

@@ -12,6 +12,7 @@ from renderer.core.frame import Frame
 from renderer.core.memory import Need, raster_need
 from renderer.core.radiosity import elements_for, lighting_for, refreshed, specular_display
 from renderer.core.radiosity_options import RadiosityOptions
+from renderer.core.radiosity_progressive import progressive_solution
 from renderer.methods.reference_backend import ReferenceRenderer
 from renderer.methods.registry import Method
 
@@ -43,6 +44,16 @@ class ReferenceRadiosity(ReferenceRenderer):
         """The twin's item buffers for `elements` at `resolution` (`refreshed`)."""
         from reference.radiosity.item_buffer import ItemBuffers
         yield ItemBuffers(elements, resolution)
+
+    def progressive(self, scene=None, **steps):
+        """The twin of RadiosityRenderer.progressive: the same steps with the twin's item buffers."""
+        if scene is not None:
+            self.scene = scene
+        for progress in progressive_solution(self._solution, elements_for(self.scene, self.options),
+                                             lighting_for(self.scene, self.options), self.options,
+                                             self._item_buffers, "reference", self.scene.name, **steps):
+            self._solution, self._stale = progress.solution, False
+            yield progress
 
     def _scene_changed(self) -> None:
         self._stale = True
@@ -76,9 +87,9 @@ def _words(options: RadiosityOptions, frame) -> str:
     return f"radiosity, hemicubes of {options.hemicube}, {options.solver}"
 
 
-# The viewer's M key does not step to radiosity: its form factors take seconds for a scene of a
-# few thousand elements, and the viewer does not draw it yet (docs/radiosity.md).
+# The viewer shows radiosity converging a step a frame (renderer/viewer/radiosity_view.py): its
+# form factors take seconds for a scene of a few thousand elements, and no frame waits for them.
 METHOD = Method("radiosity", "radiosity", RadiosityOptions, _open_gpu, _open_reference, _need, words=_words,
-                stepped_to=False)
+                solved_in_steps=True)
 
 

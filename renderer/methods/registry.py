@@ -27,8 +27,9 @@ memory estimates and a batch's costs). `progressive`: successive frames bring ne
     samples (render(first_sample=k)), so a viewer refines while the view is still; `seeded`:
     the frames depend on a seed (reseed(seed), a batch item's own); `shutter`: objects move
 during the camera's shutter (motion blur; a method without it draws time 0), so an
-animation's frames differ; `stepped_to`: the viewer's M key steps to it (not to a method whose
-first frame may take seconds, as radiosity's form factors)."""
+animation's frames differ; `solved_in_steps`: its frames show a solution converging, a step a
+frame, which the camera does not change (radiosity: renderer/viewer/radiosity_view.py);
+`stepped_to`: the viewer's M key steps to it."""
     name: str
     title: str
     options: type
@@ -40,6 +41,7 @@ first frame may take seconds, as radiosity's form factors)."""
     progressive: bool = False
     seeded: bool = False
     shutter: bool = False
+    solved_in_steps: bool = False
     stepped_to: bool = True
 
     def check_memory(self, scene, size, backends, options) -> None:

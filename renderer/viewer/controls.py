@@ -354,7 +354,9 @@ class Controls:
         self._set("method", names[(names.index(self.state.method) + 1) % len(names)])
         shown = METHODS[self.state.method]
         self._say(f"method: {shown.title}" + ("; it refines while the view is still (the title "
-                                               "counts the samples per pixel)" if shown.progressive else ""))
+                                               "counts the samples per pixel)" if shown.progressive else
+                                               "; it converges a step a frame (the title says where)"
+                                               if shown.solved_in_steps else ""))
 
     def _shadows(self) -> None:
         self._set("shadows", not self.state.shadows)

@@ -18,6 +18,12 @@ shading, lights, materials) takes the tracer's update() and starts the mean agai
 holds progressive.MAX_SPP samples nothing more is traced and the interactive loop waits for
 events. The reference view compares the rasteriser only: it is off while ray tracing.
 
+With radiosity on (`method="radiosity"`, a method `solved_in_steps`) a frame is one step of
+radiosity's progressive solution (renderer/viewer/radiosity_view.py): the lights' direct light
+at once, the hemicubes a batch a frame, then progressive refinement's shots converging; the
+title says where it is. A camera move keeps it going; a change of lights starts it again; once
+converged the loop waits for events.
+
 Shadows (the O key) switch GpuRenderer.shadows; the reference view is then asked for the scene
 with every light's shadows off, the image the GPU draws. The shadow-map view (the D key,
 renderer/viewer/shadow_view.py) replaces the picture with the map of the chosen light as the
@@ -49,6 +55,7 @@ from renderer.viewer.orbit import OrbitCamera
 from renderer.viewer.overlay import text_panel
 from renderer.viewer.presenter import CpuImage, Presenter, fit
 from renderer.viewer.progressive import PATTERN, SAMPLES_PER_FRAME, Accumulator
+from renderer.viewer.radiosity_view import RadiosityView
 from renderer.viewer.reference_view import BackgroundReference, difference_view, figures_line
 from renderer.viewer.shadow_view import CUBE_FACE_NAMES, ShadowMapView, drawn_faces
 from renderer.core.scene import Scene
@@ -129,6 +136,9 @@ class Viewer:
             self._traced_version = -1          # the version it and the mean were made for
             self.accumulator = Accumulator()
             self._traced = CpuImage(self.ctx)  # the mean so far
+            self._radiosity = None             # the RadiosityView, made on first use
+            self._radiosity_key = None         # what of the view (not the camera) it last saw
+            self._radiosity_version = -1       # the version its last frame showed
             self._map_view = None              # the ShadowMapView, made on first use
             self._map_lines: tuple = ()        # the overlay's lines on it (none: not asked for)
             self._map_shown = False            # the picture is the map view
@@ -176,7 +186,7 @@ class Viewer:
         """Ask for the reference of the current view when it is wanted and not asked for yet,
         and take a finished one (`wait`: wait for it): its heat map against a GPU image of
         the same view."""
-        if self.state.reference == "off" or self._progressive:
+        if self.state.reference == "off" or not self._rasterising:
             return
         if self._requested != self._version:
             scene = working_copy(self.shown)
@@ -204,7 +214,7 @@ class Viewer:
         width, height = self.window.framebuffer_size
         screen.use()
         blit = self.presenter.blitter.copy
-        mode = "off" if self._progressive or self._map_shown else self.state.reference
+        mode = "off" if not self._rasterising or self._map_shown else self.state.reference
         have_reference = self._reference_version >= 0
         whole = (0, 0, width, height)
         if mode != "off" or fit(shown.size, whole) != whole:
@@ -234,13 +244,14 @@ class Viewer:
 
     def _overlay_text(self) -> tuple:
         lines = []
-        if self._progressive:
+        if not self._rasterising:
             if self.state.reference != "off":
-                lines.append("reference view: off while ray tracing (it compares the rasteriser)")
+                lines.append(f"reference view: off while {METHODS[self.state.method].title} draws "
+                             "(it compares the rasteriser)")
         elif self.state.reference == "side-by-side":
             lines.append("left: GPU (GLSL)    right: NumPy reference")
         lines += self._map_lines
-        if self.state.reference != "off" and not self._progressive and not self._map_shown:
+        if self.state.reference != "off" and self._rasterising and not self._map_shown:
             current = self._reference_version == self._version
             if self._figures is not None and self._reference_version >= 0:
                 lines.append(figures_line(self._figures) + ("" if current else " (updating)"))
@@ -256,7 +267,12 @@ class Viewer:
         self._follow_changes()
         self._follow_reference()
         started = time.perf_counter()
-        drawn = self._trace() if self._progressive else self.gpu.draw()
+        if self._progressive:
+            drawn = self._trace()
+        elif self._solved_in_steps:
+            drawn = self._radiosity_frame()
+        else:
+            drawn = self.gpu.draw()
         drawn = self._shadow_map(drawn)
         self.ctx.finish()                     # so that draw_ms is the drawing, not queued work
         self.stats.draw_ms.append((time.perf_counter() - started) * 1000.0)
@@ -281,6 +297,27 @@ class Viewer:
         """Whether the method shown refines over frames (the ray tracer: a mean of frames, no
         reference view) rather than drawing each frame whole (the rasteriser)."""
         return METHODS[self.state.method].progressive
+
+    @property
+    def _solved_in_steps(self) -> bool:
+        """Whether the method shown converges a step a frame (radiosity)."""
+        return METHODS[self.state.method].solved_in_steps
+
+    @property
+    def _rasterising(self) -> bool:
+        """Whether the rasteriser draws the picture (the reference view and the shadow maps are its)."""
+        return not (self._progressive or self._solved_in_steps)
+
+    def _radiosity_frame(self):
+        """Radiosity's next step of the current view (renderer/viewer/radiosity_view.py): its
+        framebuffer. The steps start again only when something but the camera and size changed."""
+        state = self.state
+        key = (state.shading, state.two_sided, tuple(state.lights_on))
+        if self._radiosity is None:
+            self._radiosity = RadiosityView(self.ctx, on_message=self.say)
+        changed, self._radiosity_key = key != self._radiosity_key, key
+        self._radiosity_version = self._version
+        return self._radiosity.frame(self.shown, (self.gpu.width, self.gpu.height), changed)
 
     def _trace(self):
         """The ray or path tracer's frame: the tracer of the method shown brought to the
@@ -324,8 +361,8 @@ class Viewer:
             return drawn
         name = light_names_of(self.authored)[index]
         light_map = None if plan is None else plan.layout.get(*shown_light(self.state, self.authored, index))
-        if self._progressive:
-            why = "off while ray tracing (the maps are the rasteriser's)"
+        if not self._rasterising:
+            why = f"off while {METHODS[self.state.method].title} draws (the maps are the rasteriser's)"
         elif not self.state.shadows:
             why = "shadows are off (O)"
         elif light_map is None:
@@ -356,7 +393,10 @@ class Viewer:
     @property
     def idle(self) -> bool:
         """Nothing new to draw until an event comes: the ray tracer's mean of the current view
-        is complete (the reference view is off while ray tracing)."""
+        is complete, or radiosity has converged and drawn it (the reference view is off then)."""
+        if self._solved_in_steps:
+            return (self._radiosity is not None and self._radiosity.done
+                    and self._radiosity_version == self._version)
         return (self._progressive and self._traced_version == self._version
                 and self.accumulator.done)
 
@@ -367,10 +407,17 @@ class Viewer:
         return self.accumulator.samples if self._progressive else None
 
     @property
+    def radiosity_line(self) -> str | None:
+        """Where radiosity's steps are (renderer/viewer/radiosity_view.py), None unless it draws."""
+        if not self._solved_in_steps or self._radiosity is None:
+            return None
+        return self._radiosity.line
+
+    @property
     def figures(self) -> dict | None:
         """The reference view's figures (renderer/viewer/reference_view.py) for the view on the
         screen, or None when there are none for it (not asked for, or not ready)."""
-        if self._progressive:
+        if not self._rasterising:
             return None
         return self._figures if self._reference_version == self._version else None
 
@@ -386,6 +433,8 @@ class Viewer:
         if self._progressive:
             tracing = f" | {'path' if self.state.method == 'pathtrace' else 'ray'} tracing: {self.accumulator.samples} spp" + (
                 " (done)" if self.accumulator.done else "")
+        elif self._solved_in_steps and self._radiosity is not None:
+            tracing = f" | {self._radiosity.line}"
         shadows = f" | shadows {'on' if self.state.shadows else 'off'}"
         if self._map_shown:
             shadows += f" (map of {light_names_of(self.authored)[self.state.shadow_map]})"
@@ -437,7 +486,7 @@ class Viewer:
             if orbit:
                 self.orbit.orbit(orbit, 0.0)
                 self.state.camera_changed = True
-            if last and self.state.reference != "off" and not self._progressive:
+            if last and self.state.reference != "off" and self._rasterising:
                 self._follow_changes()        # the last frame's view, orbit step included
                 self._follow_reference(wait=True)
                 self._last_swap = None        # the wait is not a frame time
@@ -450,7 +499,7 @@ class Viewer:
 
     def close(self) -> None:
         for name in ("background", "_reference_image", "_difference_image", "_overlay",
-                     "_traced", "_tracer", "_map_view", "presenter", "gpu"):
+                     "_traced", "_tracer", "_radiosity", "_map_view", "presenter", "gpu"):
             item = getattr(self, name, None)
             if item is not None:
                 (item.close if hasattr(item, "close") else item.release)()

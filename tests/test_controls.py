@@ -189,8 +189,8 @@ def test_c_cycles_the_reference_view():
 
 
 def test_m_toggles_the_ray_tracer_and_changes_the_picture():
-    """M steps between the methods it steps to (radiosity, whose form factors may take
-    seconds, opens only by name)."""
+    """M steps between the methods in registration order: the rasteriser, the ray tracer,
+    radiosity (which converges a step a frame), the path tracer."""
     viewer = Viewer()
     viewer.press(glfw.KEY_M)
     assert viewer.state.method == "raytrace" and viewer.state.scene_changed
@@ -198,13 +198,16 @@ def test_m_toggles_the_ray_tracer_and_changes_the_picture():
                                "title counts the samples per pixel)"]
     viewer.state.scene_changed = False
     viewer.press(glfw.KEY_M)
+    assert viewer.state.method == "radiosity" and viewer.state.scene_changed
+    assert viewer.messages[-1] == "method: radiosity; it converges a step a frame (the title says where)"
+    viewer.press(glfw.KEY_M)
     assert viewer.state.method == "pathtrace" and viewer.state.scene_changed
     assert viewer.messages[-1].startswith("method: path tracer; it refines while the view is still")
     viewer.press(glfw.KEY_M)
     assert viewer.state.method == "raster"
     assert viewer.messages[-1] == "method: rasteriser"
-    assert ("  M     rasteriser / ray tracer / path tracer (the tracers refine while the view is "
-            "still)") in help_lines()
+    assert ("  M     rasteriser / ray tracer / radiosity / path tracer (the tracers refine while the "
+            "view is still, radiosity converges)") in help_lines()
 
 
 def test_m_from_radiosity_steps_on_in_registration_order():

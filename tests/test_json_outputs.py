@@ -95,6 +95,7 @@ def test_view_stats_json_is_strict(tmp_path, capsys, monkeypatch):
         figures = {"rmse": 0.0, "max_abs": 0, "mismatched": 0, "mismatched_fraction": 0.0,
                    "reference_ms": 5.0}
         samples = None                          # rasterising
+        radiosity_line = None
 
         def __init__(self, *args, **kwargs):
             pass

@@ -103,7 +103,8 @@ def specular_alone(scene, backend, context, size):
     return shiny, shiny.linear[..., 0].astype(np.float64) - plain.linear[..., 0]
 
 
-@pytest.mark.parametrize("backend, size", [("gpu", (160, 120)), ("reference", (64, 48))])
+@pytest.mark.parametrize("backend, size", [("gpu", (160, 120)),
+                                           pytest.param("reference", (64, 48), marks=pytest.mark.slow)])
 def test_the_term_is_the_lighting_equations_ks_term(gl_contexts, backend, size):
     scene = glossy_floor(box=False)
     frame, term = specular_alone(scene, backend, gl_contexts["egl"], size)
@@ -113,7 +114,8 @@ def test_the_term_is_the_lighting_equations_ks_term(gl_contexts, backend, size):
     assert np.abs(term - expected)[drawn].max() < 2e-3
 
 
-@pytest.mark.parametrize("backend, size", [("gpu", (160, 120)), ("reference", (64, 48))])
+@pytest.mark.parametrize("backend, size", [("gpu", (160, 120)),
+                                           pytest.param("reference", (64, 48), marks=pytest.mark.slow)])
 def test_a_highlight_is_shadowed_where_the_light_is_hidden(gl_contexts, backend, size):
     """Where the segment to the light passes well inside the box the term is 0; well clear of
     it, the closed form; the light buffer's pixels (512 a side, about 0.006 across at the box)
@@ -148,7 +150,7 @@ def test_new_ks_or_n_redraws_without_solving_again(gl_contexts):
 
 def test_a_scene_without_a_specular_term_keeps_no_light_buffer(gl_contexts):
     scene = load_scene(builtin_scenes()["radiosity_window"])              # diffuse walls, the sun
-    with open_renderer(scene, (32, 24), method="radiosity", options=OPTIONS,
+    with open_renderer(scene, (32, 24), method="radiosity", options=dataclasses.replace(OPTIONS, element_size=1.0),
                        context=gl_contexts["egl"]) as renderer:
         assert not renderer.solution.lighting.specular and renderer.solution.light_surfaces is None
         assert renderer.light_draws == 1
@@ -159,6 +161,7 @@ def test_a_scene_without_a_specular_term_keeps_no_light_buffer(gl_contexts):
         assert surfaces.surfaces.shape == (6, 512, 512) and set(np.unique(surfaces.surfaces)) == {0, 1, 2}
 
 
+@pytest.mark.slow
 def test_refined_elements_keep_the_shadows_at_the_options_light_buffer(gl_contexts):
     scene = glossy_floor(box=True)
     options = dataclasses.replace(OPTIONS, refine=1)

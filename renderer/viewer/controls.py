@@ -142,7 +142,8 @@ KEY_BINDINGS = (
     Binding(glfw.KEY_1, "1-9",
             "light 1 to 9 on / off (directional lights first, then point lights)"),
     Binding(glfw.KEY_C, "C", "reference view: off, side by side, difference"),
-    Binding(glfw.KEY_M, "M", "rasteriser / ray tracer / path tracer (the tracers refine while the view is still)"),
+    Binding(glfw.KEY_M, "M", "rasteriser / ray tracer / radiosity / path tracer (the tracers refine while the "
+                             "view is still, radiosity converges)"),
     Binding(glfw.KEY_O, "O", "shadows on / off"),
     Binding(glfw.KEY_D, "D", "shadow map view: each light's map in turn (depth as grey), then off"),
     Binding(glfw.KEY_V, "V", "v-sync on / off"),

@@ -971,12 +971,24 @@ def test_the_radiosity_uniforms_are_names_its_twin_reads():
     assert not problems, report(problems)
 
 
+# -- the tessellator's capture harness: glsl/tessellation/ against tests/tessellation_capture.py ---
+
+TESSELLATION_FILES = tuple(sorted(path.relative_to(glsl_dir()).as_posix()
+                                  for path in (glsl_dir() / "tessellation").iterdir()))
+
+
+def test_the_tessellation_capture_takes_its_levels_from_vertices_not_uniforms():
+    """Each patch's levels ride on its one vertex (capture.vert), so that one draw holds many
+    sets: the harness declares no uniform for its Python side to upload."""
+    assert TESSELLATION_FILES and not all_uniforms(parse(read_glsl(TESSELLATION_FILES)))
+
+
 # -- coverage ------------------------------------------------------------------------------------
 
 def test_every_twinned_glsl_file_is_held_here():
     """Each file of glsl/ whose first line names its twin is one this test reads."""
     read = {*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *RAYTRACE_FILES, *OUTPUT_FILES,
-            *RADIOSITY_FILES}
+            *RADIOSITY_FILES, *TESSELLATION_FILES}
     twinned = {path.relative_to(glsl_dir()).as_posix() for path in glsl_dir().rglob("*")
                if path.is_file() and path.read_text(encoding="utf-8").startswith("// Twin:")}
     assert twinned <= read, f"not read by tests/test_glsl_contract.py: {sorted(twinned - read)}"

@@ -13,7 +13,7 @@ import re
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-SHADERS = {".glsl", ".comp", ".vert", ".frag"}
+SHADERS = {".glsl", ".comp", ".vert", ".tesc", ".tese", ".geom", ".frag"}
 FILE_SUFFIXES = SHADERS | {".py", ".md", ".toml", ".sh", ".txt", ".json", ".csv", ".png", ".obj"}
 SKIPPED = {".git", ".venv", "build", "__pycache__", "out"}
 TOKEN = re.compile(r"`([^`\s]+)`")

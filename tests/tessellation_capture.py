@@ -1,0 +1,128 @@
+"""GL's tessellator captured by transform feedback, for tests/test_tessellator.py.
+
+capture(ctx, domain, spacing, levels, ...) draws one patch a row of `levels` (N, 6): each
+patch is one vertex carrying gl_TessLevelOuter[0..3] and gl_TessLevelInner[0..1]
+(glsl/tessellation/capture.vert, capture.tesc), and the evaluation shader (capture.tese, its
+layout from defines) hands on gl_TessCoord and gl_PrimitiveID; transform feedback captures
+them vertex by vertex of each primitive (triangles, lines or points), rasterisation
+discarded. moderngl's transform() refuses GL_PATCHES, so the draw is made with GL's own entry
+points (renderer.gpu.context.gl_function) on moderngl's objects, and every GL object is
+released, and the state put back, before it returns.
+"""
+
+from __future__ import annotations
+
+import ctypes
+from dataclasses import dataclass
+
+import numpy as np
+
+from renderer.gpu.context import activate, gl_function
+from renderer.gpu.shaders import shader_source
+
+GL_POINTS, GL_LINES, GL_TRIANGLES, GL_PATCHES = 0x0000, 0x0001, 0x0004, 0x000E
+GL_TRANSFORM_FEEDBACK_BUFFER = 0x8C8E
+GL_RASTERIZER_DISCARD = 0x8C89
+GL_PRIMITIVES_GENERATED = 0x8C87
+GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN = 0x8C88
+GL_QUERY_RESULT = 0x8866
+
+CAPTURED = np.dtype([("tess_coord", "<f4", 3), ("patch_id", "<i4")])   # interleaved, 16 bytes
+VERTICES_PER_PRIMITIVE = {"triangles": 3, "lines": 2, "points": 1}
+
+
+@dataclass
+class Captured:
+    """What one draw's transform feedback holds: `tess_coord` (V, 3) float32 and `patch_id`
+    (V,) int32, V = primitives x vertices per primitive, in capture order; `generated`, the
+    primitives GL generated (more than were written when the buffer was too small)."""
+    tess_coord: np.ndarray
+    patch_id: np.ndarray
+    primitive: str
+    generated: int
+    written: int
+
+
+def capture_defines(domain: str, spacing: str, order: str, point_mode: bool) -> dict:
+    """capture.tese's defines for a layout in GL's names ("quads", "fractional_odd_spacing", "cw")."""
+    return {f"DOMAIN_{domain.upper()}": True,
+            f"SPACING_{spacing.removesuffix('_spacing').upper()}": True,
+            f"ORDER_{order.upper()}": True,
+            "POINT_MODE": bool(point_mode)}
+
+
+def _gl(ctx):
+    uint, sizei = ctypes.c_uint, ctypes.c_int
+    signatures = {
+        "glUseProgram": (uint,), "glBindVertexArray": (uint,),
+        "glBindBufferBase": (uint, uint, uint), "glEnable": (uint,), "glDisable": (uint,),
+        "glBeginTransformFeedback": (uint,), "glEndTransformFeedback": (),
+        "glDrawArrays": (uint, sizei, sizei),
+        "glGenQueries": (sizei, ctypes.POINTER(uint)), "glDeleteQueries": (sizei, ctypes.POINTER(uint)),
+        "glBeginQuery": (uint, uint), "glEndQuery": (uint,),
+        "glGetQueryObjectuiv": (uint, uint, ctypes.POINTER(uint)),
+    }
+    functions = {name: gl_function(ctx, name, None, *args) for name, args in signatures.items()}
+    missing = [name for name, function in functions.items() if function is None]
+    if missing:
+        raise RuntimeError(f"GL entry points not found: {', '.join(missing)}")
+    return functions
+
+
+def capture(ctx, domain: str, spacing: str, levels, order: str = "ccw", point_mode: bool = False,
+            capacity: int = 0, patch_vertices: int = 1) -> Captured:
+    """Draws len(levels) patches in one draw call and captures their primitives' vertices.
+    `levels`: (N, 6) outer[0..3], inner[0..1] per patch (float32). `capacity`: the vertices
+    the capture buffer holds (at least 1). `patch_vertices`: the vertices of each input patch
+    (GL_PATCH_VERTICES, 1 to 32; each a copy of the patch's levels, the first one read)."""
+    levels = np.ascontiguousarray(levels, dtype=np.float32).reshape(-1, 6)
+    patches = len(levels)
+    primitive = "points" if point_mode else "lines" if domain == "isolines" else "triangles"
+    feedback_mode = {"triangles": GL_TRIANGLES, "lines": GL_LINES, "points": GL_POINTS}[primitive]
+    defines = capture_defines(domain, spacing, order, point_mode)
+    activate(ctx)
+    gl = _gl(ctx)
+    program = ctx.program(vertex_shader=shader_source("tessellation/capture.vert").text,
+                          tess_control_shader=shader_source("tessellation/capture.tesc").text,
+                          tess_evaluation_shader=shader_source("tessellation/capture.tese", defines).text,
+                          varyings=["tess_coord", "patch_id"])
+    vbo = ctx.buffer(np.repeat(levels, patch_vertices, axis=0).tobytes())
+    vao = ctx.vertex_array(program, [(vbo, "4f 2f", "in_outer", "in_inner")])
+    out = ctx.buffer(reserve=max(1, capacity) * CAPTURED.itemsize)
+    framebuffer = ctx.simple_framebuffer((4, 4))             # transform feedback needs one bound
+    queries = (ctypes.c_uint * 2)()
+    patch_vertices_before = ctx.patch_vertices
+    try:
+        framebuffer.use()
+        ctx.patch_vertices = patch_vertices
+        gl["glGenQueries"](2, queries)
+        gl["glUseProgram"](program.glo)
+        gl["glBindVertexArray"](vao.glo)
+        gl["glBindBufferBase"](GL_TRANSFORM_FEEDBACK_BUFFER, 0, out.glo)
+        gl["glEnable"](GL_RASTERIZER_DISCARD)
+        gl["glBeginQuery"](GL_PRIMITIVES_GENERATED, queries[0])
+        gl["glBeginQuery"](GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, queries[1])
+        gl["glBeginTransformFeedback"](feedback_mode)
+        gl["glDrawArrays"](GL_PATCHES, 0, patches * patch_vertices)
+        gl["glEndTransformFeedback"]()
+        gl["glEndQuery"](GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN)
+        gl["glEndQuery"](GL_PRIMITIVES_GENERATED)
+        counts = []
+        for query in queries:
+            value = ctypes.c_uint()
+            gl["glGetQueryObjectuiv"](query, GL_QUERY_RESULT, ctypes.byref(value))
+            counts.append(value.value)
+        generated, written = counts
+        vertices = written * VERTICES_PER_PRIMITIVE[primitive]
+        data = np.frombuffer(out.read(size=vertices * CAPTURED.itemsize), CAPTURED) if vertices else \
+            np.zeros(0, CAPTURED)
+    finally:
+        gl["glDisable"](GL_RASTERIZER_DISCARD)
+        gl["glBindBufferBase"](GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0)
+        gl["glBindVertexArray"](0)
+        gl["glUseProgram"](0)
+        gl["glDeleteQueries"](2, queries)
+        ctx.patch_vertices = patch_vertices_before
+        for item in (vao, vbo, out, program, framebuffer):
+            item.release()
+    return Captured(np.array(data["tess_coord"]), np.array(data["patch_id"]), primitive, generated, written)

@@ -81,14 +81,31 @@ def capture(ctx, domain: str, spacing: str, levels, order: str = "ccw", point_mo
     feedback_mode = {"triangles": GL_TRIANGLES, "lines": GL_LINES, "points": GL_POINTS}[primitive]
     defines = capture_defines(domain, spacing, order, point_mode)
     activate(ctx)
-    gl = _gl(ctx)
     program = ctx.program(vertex_shader=shader_source("tessellation/capture.vert").text,
                           tess_control_shader=shader_source("tessellation/capture.tesc").text,
                           tess_evaluation_shader=shader_source("tessellation/capture.tese", defines).text,
                           varyings=["tess_coord", "patch_id"])
     vbo = ctx.buffer(np.repeat(levels, patch_vertices, axis=0).tobytes())
-    vao = ctx.vertex_array(program, [(vbo, "4f 2f", "in_outer", "in_inner")])
-    out = ctx.buffer(reserve=max(1, capacity) * CAPTURED.itemsize)
+    vao = None
+    try:
+        vao = ctx.vertex_array(program, [(vbo, "4f 2f", "in_outer", "in_inner")])
+        data, generated, written = feedback(ctx, program, vao, patches * patch_vertices, patch_vertices,
+                                            primitive, capacity, CAPTURED)
+    finally:
+        for item in (vao, vbo, program):
+            if item is not None:
+                item.release()
+    return Captured(np.array(data["tess_coord"]), np.array(data["patch_id"]), primitive, generated, written)
+
+
+def feedback(ctx, program, vao, vertices: int, patch_vertices: int, primitive: str, capacity: int,
+             dtype: np.dtype) -> tuple[np.ndarray, int, int]:
+    """Draws `vertices` vertices of `vao` as patches of `patch_vertices` with `program`,
+    rasterisation discarded, and captures its output primitives' vertices (interleaved as
+    `dtype`, at most `capacity`): (the captured records, primitives generated, written)."""
+    gl = _gl(ctx)
+    feedback_mode = {"triangles": GL_TRIANGLES, "lines": GL_LINES, "points": GL_POINTS}[primitive]
+    out = ctx.buffer(reserve=max(1, capacity) * dtype.itemsize)
     framebuffer = ctx.simple_framebuffer((4, 4))             # transform feedback needs one bound
     queries = (ctypes.c_uint * 2)()
     patch_vertices_before = ctx.patch_vertices
@@ -103,7 +120,7 @@ def capture(ctx, domain: str, spacing: str, levels, order: str = "ccw", point_mo
         gl["glBeginQuery"](GL_PRIMITIVES_GENERATED, queries[0])
         gl["glBeginQuery"](GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN, queries[1])
         gl["glBeginTransformFeedback"](feedback_mode)
-        gl["glDrawArrays"](GL_PATCHES, 0, patches * patch_vertices)
+        gl["glDrawArrays"](GL_PATCHES, 0, vertices)
         gl["glEndTransformFeedback"]()
         gl["glEndQuery"](GL_TRANSFORM_FEEDBACK_PRIMITIVES_WRITTEN)
         gl["glEndQuery"](GL_PRIMITIVES_GENERATED)
@@ -113,9 +130,9 @@ def capture(ctx, domain: str, spacing: str, levels, order: str = "ccw", point_mo
             gl["glGetQueryObjectuiv"](query, GL_QUERY_RESULT, ctypes.byref(value))
             counts.append(value.value)
         generated, written = counts
-        vertices = written * VERTICES_PER_PRIMITIVE[primitive]
-        data = np.frombuffer(out.read(size=vertices * CAPTURED.itemsize), CAPTURED) if vertices else \
-            np.zeros(0, CAPTURED)
+        captured = written * VERTICES_PER_PRIMITIVE[primitive]
+        data = np.frombuffer(out.read(size=captured * dtype.itemsize), dtype).copy() if captured else \
+            np.zeros(0, dtype)
     finally:
         gl["glDisable"](GL_RASTERIZER_DISCARD)
         gl["glBindBufferBase"](GL_TRANSFORM_FEEDBACK_BUFFER, 0, 0)
@@ -123,6 +140,6 @@ def capture(ctx, domain: str, spacing: str, levels, order: str = "ccw", point_mo
         gl["glUseProgram"](0)
         gl["glDeleteQueries"](2, queries)
         ctx.patch_vertices = patch_vertices_before
-        for item in (vao, vbo, out, program, framebuffer):
+        for item in (out, framebuffer):
             item.release()
-    return Captured(np.array(data["tess_coord"]), np.array(data["patch_id"]), primitive, generated, written)
+    return data, generated, written

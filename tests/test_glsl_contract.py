@@ -983,12 +983,37 @@ def test_the_tessellation_capture_takes_its_levels_from_vertices_not_uniforms():
     assert TESSELLATION_FILES and not all_uniforms(parse(read_glsl(TESSELLATION_FILES)))
 
 
+# -- the rasteriser's tessellation stages: glsl/tess_control.glsl, tess_evaluation.glsl against
+# reference/tessellation/control.py, evaluation.py (held to each other by
+# tests/test_tessellation_stages.py; the renderer does not draw them yet)
+
+TESSELLATION_STAGES = ("tess_control.glsl", "tess_evaluation.glsl")
+TESSELLATION_TWIN_NAMES = {"u_model": ("model",), "u_view": ("view",), "u_projection": ("projection",),
+                           "u_viewport_height": ("viewport_height",), "u_target_error": ("target_error",),
+                           "u_surface_radius": ("surface_radius",), "u_max_level": ("max_level",),
+                           "u_sphere": ("sphere",)}
+
+
+def test_the_tessellation_stages_uniforms_are_names_their_twins_read():
+    problems = uniforms_the_twin_does_not_read(parse(read_glsl(TESSELLATION_STAGES)), set(),
+                                               TESSELLATION_TWIN_NAMES, twin_text("tessellation"),
+                                               "reference/tessellation/")
+    assert not problems, report(problems)
+
+
+def test_the_tessellation_stages_uniforms_are_those_their_capture_writes():
+    """Until the rasteriser draws them, tests/test_tessellation_stages.py is their uploader."""
+    text = (Path(__file__).parent / "test_tessellation_stages.py").read_text(encoding="utf-8")
+    written = set(re.findall(r'"(u_[a-z_]+)"', text))
+    assert set(all_uniforms(parse(read_glsl(TESSELLATION_STAGES)))) == written
+
+
 # -- coverage ------------------------------------------------------------------------------------
 
 def test_every_twinned_glsl_file_is_held_here():
     """Each file of glsl/ whose first line names its twin is one this test reads."""
     read = {*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *RAYTRACE_FILES, *OUTPUT_FILES,
-            *RADIOSITY_FILES, *TESSELLATION_FILES}
+            *RADIOSITY_FILES, *TESSELLATION_FILES, *TESSELLATION_STAGES}
     twinned = {path.relative_to(glsl_dir()).as_posix() for path in glsl_dir().rglob("*")
                if path.is_file() and path.read_text(encoding="utf-8").startswith("// Twin:")}
     assert twinned <= read, f"not read by tests/test_glsl_contract.py: {sorted(twinned - read)}"

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import dataclasses
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -85,6 +86,12 @@ class RadiositySolution:
     @property
     def unrefined(self) -> Elements:
         return self.elements if self.base is None else self.base
+
+    @cached_property
+    def corner_normals(self) -> np.ndarray:
+        """(E, 3, 3): each corner's normal for the specular term, the crease-angle mean of its
+        elements' as its radiosity is (corner_values); once per solution, not per frame."""
+        return corner_values(self.elements, self.elements.normals)
 
 
 def elements_for(scene, options: RadiosityOptions) -> Elements:
@@ -321,7 +328,7 @@ def specular_display(solution: RadiositySolution, scene, origin) -> SpecularDisp
                         for s in sources], np.float64).reshape(-1, 4)
     to_surfaces = np.eye(4)
     to_surfaces[:3, 3] = origin - surfaces.origin           # camera-relative to the views' relative
-    return SpecularDisplay(corner_values(elements, elements.normals), ks, shininess, elements.obj,
+    return SpecularDisplay(solution.corner_normals, ks, shininess, elements.obj,
                            where, np.array([s.intensity for s in sources], np.float64).reshape(-1, 3),
                            np.array([s.attenuation for s in sources], np.float64).reshape(-1, 3), emitter,
                            surfaces.matrices @ to_surfaces, surfaces.surfaces, surfaces.counts)

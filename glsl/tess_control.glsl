@@ -16,6 +16,7 @@ uniform float u_viewport_height;     // H, pixels
 uniform float u_target_error;        // pixels
 uniform float u_surface_radius;      // R in world units (0: flat, level 1)
 uniform float u_max_level;
+uniform float u_fixed_level;         // > 0: this level on every edge and inside (not by need)
 
 in vec3 v_position[];                // object space
 in vec3 v_normal[];
@@ -23,6 +24,8 @@ out vec3 c_position[];
 out vec3 c_normal[];
 
 float edge_level(vec3 a, vec3 b) {
+    if (u_fixed_level > 0.0)
+        return u_fixed_level;
     float R = u_surface_radius;
     if (!(R > 0.0))
         return 1.0;

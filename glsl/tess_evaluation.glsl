@@ -5,8 +5,10 @@
 // surface's exact normal, in object space. SPACING_* picks the tessellator's spacing
 // (equal, fractional_even, fractional_odd); SURFACE_SPHERE: the sphere of centre u_sphere.xyz
 // and radius u_sphere.w, each point the patch's barycentric point projected from the centre.
-// CAPTURE (tests/test_tessellation_stages.py): the point and its patch's levels handed on to
-// transform feedback.
+// Then the vertex stage's work on the point (glsl/vertex_stage.glsl: world and clip positions,
+// Gouraud's lighting, what each shading mode hands on), as glsl/vertex.glsl does for a mesh.
+// CAPTURE (tests/test_tessellation_stages.py): instead, the point and its patch's levels handed
+// on to transform feedback.
 
 #if defined(SPACING_EQUAL)
 layout(triangles, equal_spacing, ccw) in;
@@ -25,6 +27,8 @@ in vec3 c_normal[];
 out vec3 t_position;                 // object space, on the surface
 out vec3 t_normal;                   // object space, unit
 out vec4 t_levels;                   // gl_TessLevelOuter[0..2], gl_TessLevelInner[0]
+#else
+#include "vertex_stage.glsl"
 #endif
 
 void main() {
@@ -40,6 +44,8 @@ void main() {
     t_position = position;
     t_normal = n;
     t_levels = vec4(gl_TessLevelOuter[0], gl_TessLevelOuter[1], gl_TessLevelOuter[2], gl_TessLevelInner[0]);
-#endif
     gl_Position = vec4(position, 1.0);
+#else
+    vertex_stage(position, n);
+#endif
 }

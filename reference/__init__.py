@@ -15,8 +15,9 @@ says why the module is shared, or which check that does not share it catches its
 - computations held against a check that does not share them: `shadows.py`,
   `shadow_settings.py` and `facets.py` (ray-cast shadow truth), `visibility.py` (the frame
   without culling), `drawn.py` (depth against ray casts), `camera_rays.py` and
-  `raytrace_scene.py` (the rasteriser against the ray tracer) and `hemicube.py` (Howell's
-  closed forms).
+  `raytrace_scene.py` (the rasteriser against the ray tracer), `hemicube.py` (Howell's
+  closed forms) and `tessellation.py` (the levels' rule by the sagitta it bounds, the sphere
+  against the ray tracer's exact one).
 """
 
 from reference.pipeline import render

@@ -43,6 +43,7 @@ from reference.framebuffer import compose_frame
 from reference.rasterizer import WindowTriangles, is_drawn, rasterize, setup_triangles
 from reference.shadow.depth import render_layers
 from reference.shadow.lookup import ShadowMaps
+from reference.tessellation.surface import tessellated_mesh
 from reference.vertex import shade_vertices
 from renderer.core.drawn import DrawnMesh, drawn_meshes
 from renderer.core.facets import face_creases
@@ -77,12 +78,18 @@ def prepare_object(obj, drawn: DrawnMesh, frame_matrices, lights: Lights, eye, w
     viewport transform and snapping -> facing and culling, for one object: `drawn`, what the
     camera pass draws of it (renderer/core/drawn.py: its mesh, or a plane's polygon)."""
     mesh, matrices, material = drawn.mesh, drawn.matrices, obj.material
-    vertices = shade_vertices(mesh.positions, mesh.normals, u_model=matrices.model,
+    if obj.tessellation is not None:      # the tessellation stages' points and triangles
+        positions, normals, faces = tessellated_mesh(obj, matrices, frame_matrices.view,
+                                                     frame_matrices.projection, height)
+        in_uv = None
+    else:
+        positions, normals, faces = mesh.positions, mesh.normals, np.asarray(mesh.faces, dtype=np.int64)
+        in_uv = obj.texture_coordinates(mesh)
+    vertices = shade_vertices(positions, normals, u_model=matrices.model,
                               u_normal_matrix=matrices.normal, u_view=frame_matrices.view,
                               u_projection=frame_matrices.projection, u_eye=eye,
-                              material=material, lights=lights, dtype=dtype,
-                              in_uv=obj.texture_coordinates(mesh))
-    faces = np.asarray(mesh.faces, dtype=np.int64)                         # primitive assembly
+                              material=material, lights=lights, dtype=dtype, in_uv=in_uv)
+                                                                           # primitive assembly
     triangles = (shade_triangles(vertices.v_world_position[faces], material, lights, eye,
                                  v_uv=None if vertices.v_uv is None else vertices.v_uv[faces])
                  if material.shading == "flat" else None)
@@ -187,7 +194,7 @@ def prepare_frame(scene, width: int, height: int, dtype, subpixel_bits: int = SU
                                        index=index, shadowed=shadows is not None)
                         if shown else None)
         first_orders.append(first_order)
-        first_order += len(item.mesh.faces)
+        first_order += len(item.mesh.faces) if prepared[-1] is None else len(prepared[-1].varyings.faces)
     return PreparedFrame(lights, eye, prepared, first_orders, shadows)
 
 

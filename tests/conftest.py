@@ -130,6 +130,9 @@ SHADOW_CASE_SCENES = frozenset({"shadow_boxes", "shadow_thin_contact", "shadow_b
 # window (radiosity_window); the rasteriser's tests over every built-in scene hold them in the
 # full run only, as the ray tracer's scenes.
 # Their radiosity tests are tests/test_radiosity_method.py and their goldens tests/test_goldens.py.
+# The built-in scenes made for the rasteriser's tessellation stages (issue 34): analytic spheres
+# drawn through them, and no ray-tracer terms (tests/test_tessellation_raster.py).
+TESSELLATION_SCENES = frozenset({"tessellated_sphere"})
 RADIOSITY_SCENES = frozenset({"radiosity_furnace", "radiosity_plates", "cornell_box_radiosity", "radiosity_window",
                               "radiosity_specular"})
 

@@ -100,6 +100,10 @@ REFERENCE_SHARES = {
                 "Howell's closed forms (renderer/checks/form_factor_closed_forms.py) in tests/test_hemicube.py",
     "raytrace_scene": "the ray tracer's scene and BVH; the BVH against brute force in tests/test_raytrace_bvh.py, "
                       "the rasteriser against the ray tracer in tests/test_raytrace_trace.py",
+    "tessellation": "a tessellated sphere's patches and the levels' settings and draw bound; the levels' rule "
+                    "by the sagitta it bounds (tests/test_tessellation_stages.py), the bound by the "
+                    "tessellator's twin and the sphere against the ray tracer's exact one "
+                    "(tests/test_tessellation_raster.py)",
 }
 
 

@@ -49,7 +49,7 @@ from reference.texture import lookup_coordinates
 from reference.vertex import VertexOutputs, shade_vertices
 from renderer.core.builtin import builtin_scenes
 from renderer.core.resources import glsl_dir
-from renderer.core.scene import SHADING_MODES
+from renderer.core.scene import SHADING_MODES, SceneObject
 from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.core.shadows import plan_shadows, shadow_layout
 from renderer.core.textures import MaterialTexture, checkerboard
@@ -60,6 +60,8 @@ from renderer.gpu.declarations import (Declaration, declarations, program_unifor
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ShaderSourceError
 
 STAGES = ("vertex.glsl", "geometry.glsl", "fragment.glsl")      # in pipeline order
+# A tessellated object's first stages, in pipeline order (then geometry.glsl and fragment.glsl)
+TESSELLATION_STAGES = ("tess_vertex.glsl", "tess_control.glsl", "tess_evaluation.glsl")
 LIGHTING = "lighting.glsl"
 TEXTURE = "texture.glsl"                 # the material lookup (TEXTURED)
 FLAT_VARYINGS = "flat_varyings.glsl"     # geometry.glsl's outs and fragment.glsl's ins
@@ -86,12 +88,19 @@ GPU_ONLY_UNIFORMS = {
 
 
 def every_feature_scene():
-    """EVERY_FEATURE_SCENE with its first object's material textured (its primitives have UVs)."""
+    """EVERY_FEATURE_SCENE with its first object's material textured (its primitives have UVs)
+    and a tessellated sphere beside its objects."""
+    from renderer.core.scene import Sphere
+    from renderer.core.shapes import sphere_mesh
+    from renderer.core.tessellation import Tessellation
     scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
     first = scene.objects[0]
     texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2))
+    sphere = Sphere((0.0, 0.0, 0.0), 0.3)
+    tessellated = SceneObject("tessellated", sphere_mesh(sphere), replace(first.material, texture=None),
+                              shape=sphere, receives_shadows=False, tessellation=Tessellation())
     return replace(scene, objects=[replace(first, material=replace(first.material, texture=texture)),
-                                   *scene.objects[1:]])
+                                   *scene.objects[1:], tessellated])
 
 
 # -- what the GPU path uses (change here if renderer/gpu moves them) ------------------------------
@@ -139,10 +148,18 @@ def bound_attribute_names(ctx) -> set[str]:
 # An include that declares a stage interface for both ends, and the macro each includer defines
 # as its direction (in or out) before including it.
 INTERFACES = {FLAT_VARYINGS: "FLAT_VARYING"}
+# Included bodies: their declarations are the includer's as they stand (the vertex stage's
+# work, which vertex.glsl and tess_evaluation.glsl both run).
+VERTEX_STAGE = "vertex_stage.glsl"
+BODIES = (VERTEX_STAGE,)
 
 
-def read_glsl(names=(*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES)) -> dict[str, str]:
-    return {name: (glsl_dir() / name).read_text(encoding="utf-8") for name in names}
+def read_glsl(names=(*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *TESSELLATION_STAGES)) -> dict[str, str]:
+    sources = {name: (glsl_dir() / name).read_text(encoding="utf-8") for name in names}
+    for body in BODIES:                 # what they include, read (parse gives it no entry of its own)
+        if any(f'#include "{body}"' in text for text in sources.values()):
+            sources.setdefault(body, (glsl_dir() / body).read_text(encoding="utf-8"))
+    return sources
 
 
 def interface_declarations(file: str, sources: dict[str, str]) -> list[Declaration]:
@@ -156,6 +173,9 @@ def interface_declarations(file: str, sources: dict[str, str]) -> list[Declarati
         if direction is None:
             raise ValueError(f"glsl/{file} includes {include} without #define {macro} in or out")
         found += declarations(include, sources[include].replace(macro, direction.group(1)))
+    for include in BODIES:
+        if f'#include "{include}"' in sources[file]:
+            found += declarations(include, sources[include])
     return found
 
 
@@ -163,7 +183,7 @@ def parse(sources: dict[str, str]) -> dict[str, list[Declaration]]:
     """name -> its declarations and those of the interfaces it includes (an interface alone:
     none, its storage is its includer's)."""
     return {name: declarations(name, text) + interface_declarations(name, sources)
-            for name, text in sources.items()}
+            for name, text in sources.items() if name not in BODIES}
 
 
 def of(decls: list[Declaration], storage: str) -> dict[str, Declaration]:
@@ -555,29 +575,31 @@ def renamed(sources: dict[str, str], file: str, old: str, new: str) -> dict[str,
 
 
 def test_a_renamed_varying_is_caught_naming_the_file_and_the_name():
-    """v_world_normal renamed in vertex.glsl alone (its declaration and its use)."""
-    drifted = renamed(read_glsl(), "vertex.glsl", "v_world_normal", "v_normal_world")
+    """v_world_normal renamed in the vertex stage's body alone (its declaration and its use:
+    vertex_stage.glsl, which vertex.glsl includes)."""
+    drifted = renamed(read_glsl(), VERTEX_STAGE, "v_world_normal", "v_normal_world")
     # declared for Gouraud with shadow maps and for Phong: the checks name the last
     line = [d.line for d in drifted["vertex.glsl"] if d.name == "v_normal_world"][-1]
     stages = report(inputs_not_from_the_stage_before(drifted))
     assert "glsl/fragment.glsl:" in stages and "in v_world_normal is no out of" in stages
     assert report(outputs_nobody_reads(drifted)) == \
-        f"glsl/vertex.glsl:{line}: out v_normal_world is read by no later stage"
+        f"glsl/{VERTEX_STAGE}:{line}: out v_normal_world is read by no later stage"
     twin = report(varyings_not_in_the_twin(drifted))
-    assert (f"glsl/vertex.glsl:{line}: out v_normal_world is not in "
+    assert (f"glsl/{VERTEX_STAGE}:{line}: out v_normal_world is not in "
             f"reference.vertex.VertexOutputs") in twin
 
 
 def test_a_varying_changed_in_one_branch_only_is_caught():
-    """v_world_position made a vec4 for flat shading only (vertex.glsl declares it for each
-    mode: flat, Gouraud with shadow maps, Phong)."""
+    """v_world_position made a vec4 for flat shading only (the vertex stage declares it for
+    each mode: flat, Gouraud with shadow maps, Phong)."""
     sources = read_glsl()
-    text = sources["vertex.glsl"].replace("out vec3 v_world_position;",
-                                          "out vec4 v_world_position;", 1)
-    drifted = parse(sources | {"vertex.glsl": text})
+    text = sources[VERTEX_STAGE].replace("out vec3 v_world_position;",
+                                         "out vec4 v_world_position;", 1)
+    drifted = parse(sources | {VERTEX_STAGE: text})
     first, *others = [d for d in drifted["vertex.glsl"] if d.name == "v_world_position"]
-    assert others and report(declared_differently_in_two_branches(drifted)) == report(
-        [f"{other.where}: out v_world_position is declared otherwise at {first.where}" for other in others])
+    # (found in each stage that includes the body: vertex.glsl, tess_evaluation.glsl)
+    assert others and set(declared_differently_in_two_branches(drifted)) == {
+        f"{other.where}: out v_world_position is declared otherwise at {first.where}" for other in others}
 
 
 def test_a_changed_interpolation_is_caught():
@@ -586,7 +608,7 @@ def test_a_changed_interpolation_is_caught():
     sources = read_glsl()
     drifted = parse(sources | {"fragment.glsl": sources["fragment.glsl"].replace(
         "in vec3 v_color_front;", "flat in vec3 v_color_front;")})
-    assert "in flat vec3 v_color_front differs from the out of glsl/vertex.glsl" in \
+    assert f"in flat vec3 v_color_front differs from the out of glsl/{VERTEX_STAGE}" in \
         report(inputs_not_from_the_stage_before(drifted))
 
 
@@ -987,25 +1009,19 @@ def test_the_tessellation_capture_takes_its_levels_from_vertices_not_uniforms():
 # reference/tessellation/control.py, evaluation.py (held to each other by
 # tests/test_tessellation_stages.py; the renderer does not draw them yet)
 
-TESSELLATION_STAGES = ("tess_control.glsl", "tess_evaluation.glsl")
 TESSELLATION_TWIN_NAMES = {"u_model": ("model",), "u_view": ("view",), "u_projection": ("projection",),
                            "u_viewport_height": ("viewport_height",), "u_target_error": ("target_error",),
                            "u_surface_radius": ("surface_radius",), "u_max_level": ("max_level",),
-                           "u_sphere": ("sphere",)}
+                           "u_fixed_level": ("fixed_level",), "u_sphere": ("sphere",)}
 
 
 def test_the_tessellation_stages_uniforms_are_names_their_twins_read():
-    problems = uniforms_the_twin_does_not_read(parse(read_glsl(TESSELLATION_STAGES)), set(),
-                                               TESSELLATION_TWIN_NAMES, twin_text("tessellation"),
+    """Their own (the vertex stage's work they include is vertex.glsl's, held above)."""
+    stages = read_glsl(TESSELLATION_STAGES[1:])
+    parsed = {name: declarations(name, text) for name, text in stages.items() if name not in BODIES}
+    problems = uniforms_the_twin_does_not_read(parsed, set(), TESSELLATION_TWIN_NAMES, twin_text("tessellation"),
                                                "reference/tessellation/")
     assert not problems, report(problems)
-
-
-def test_the_tessellation_stages_uniforms_are_those_their_capture_writes():
-    """Until the rasteriser draws them, tests/test_tessellation_stages.py is their uploader."""
-    text = (Path(__file__).parent / "test_tessellation_stages.py").read_text(encoding="utf-8")
-    written = set(re.findall(r'"(u_[a-z_]+)"', text))
-    assert set(all_uniforms(parse(read_glsl(TESSELLATION_STAGES)))) == written
 
 
 # -- coverage ------------------------------------------------------------------------------------
@@ -1013,7 +1029,7 @@ def test_the_tessellation_stages_uniforms_are_those_their_capture_writes():
 def test_every_twinned_glsl_file_is_held_here():
     """Each file of glsl/ whose first line names its twin is one this test reads."""
     read = {*STAGES, LIGHTING, TEXTURE, FLAT_VARYINGS, *SHADOW_FILES, *RAYTRACE_FILES, *OUTPUT_FILES,
-            *RADIOSITY_FILES, *TESSELLATION_FILES, *TESSELLATION_STAGES}
+            *RADIOSITY_FILES, *TESSELLATION_FILES, *TESSELLATION_STAGES, *BODIES}
     twinned = {path.relative_to(glsl_dir()).as_posix() for path in glsl_dir().rglob("*")
                if path.is_file() and path.read_text(encoding="utf-8").startswith("// Twin:")}
     assert twinned <= read, f"not read by tests/test_glsl_contract.py: {sorted(twinned - read)}"

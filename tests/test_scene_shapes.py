@@ -14,7 +14,7 @@ from renderer.core.scene import (Material, Plane, Scene, SceneObject, Sphere, Tr
 from renderer.core.scene_file import load_scene, scene_from_dict
 from renderer.errors import SceneError
 
-from conftest import RAYTRACE_SCENES, SHADOW_CASE_SCENES, SHADOW_SCENES
+from conftest import RAYTRACE_SCENES, SHADOW_CASE_SCENES, SHADOW_SCENES, TESSELLATION_SCENES
 
 
 def one_object(**obj) -> dict:
@@ -86,7 +86,9 @@ def test_only_the_ray_tracing_and_shadow_builtin_scenes_use_shapes_and_ray_trace
     tracer's exact shadows, but no k_r, k_t, ior; every other built-in scene uses none of them
     (the rasteriser's scenes stay as they were). The shadow case scenes
     (conftest.SHADOW_CASE_SCENES) use shapes where their case wants them (a floor plane), meshes
-    where it does not (a 200-unit mesh floor, a low-poly sphere), and no ray-tracer terms."""
+    where it does not (a 200-unit mesh floor, a low-poly sphere), and no ray-tracer terms; the
+    tessellation scenes (conftest.TESSELLATION_SCENES) analytic spheres for the tessellation
+    stages, and no ray-tracer terms."""
     descriptions = scene_descriptions()
     for name, path in builtin_scenes().items():
         scene = load_scene(path)
@@ -96,6 +98,9 @@ def test_only_the_ray_tracing_and_shadow_builtin_scenes_use_shapes_and_ray_trace
         made_for_it = name in RAYTRACE_SCENES
         if name in SHADOW_CASE_SCENES:        # shapes where the case wants them, no ray terms
             assert not uses_ray_terms, name
+            continue
+        if name in TESSELLATION_SCENES:       # tessellated spheres, no ray terms
+            assert uses_shapes and not uses_ray_terms, name
             continue
         assert (uses_shapes or uses_ray_terms) == (made_for_it or name in SHADOW_SCENES), name
         assert not (uses_ray_terms and name in SHADOW_SCENES), name

@@ -49,7 +49,7 @@ def gpu_capture(ctx, corners, normals, u: ControlUniforms, spacing):
     """The evaluation stage's points, normals and levels of every primitive vertex in order."""
     activate(ctx)
     defines = {"SURFACE_SPHERE": True, "CAPTURE": True, SPACING_DEFINES[spacing]: True}
-    program = ctx.program(vertex_shader=shader_source("tessellation/stage_capture.vert").text,
+    program = ctx.program(vertex_shader=shader_source("tess_vertex.glsl").text,
                           tess_control_shader=shader_source("tess_control.glsl").text,
                           tess_evaluation_shader=shader_source("tess_evaluation.glsl", defines).text,
                           varyings=["t_position", "t_normal", "t_levels"])
@@ -62,6 +62,7 @@ def gpu_capture(ctx, corners, normals, u: ControlUniforms, spacing):
         program["u_target_error"].value = u.target_error
         program["u_surface_radius"].value = u.surface_radius
         program["u_max_level"].value = u.max_level
+        program["u_fixed_level"].value = u.fixed_level
         program["u_sphere"].value = (*CENTRE, RADIUS)
         layout = [(vbo, "3f 3f", "in_position", "in_normal")] if "in_normal" in program else \
             [(vbo, "3f 12x", "in_position")]                   # a sphere's normals are its own

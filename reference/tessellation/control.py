@@ -10,7 +10,7 @@ rule of renderer/core/tessellation.py, in float32 and in the shader's order of o
     c = sqrt(dot(a - b, a - b));  d = sqrt(max(R^2 - c^2 0.25, 0))
     level = clamp(c (1 - s) / ((2 d) sqrt(s (2 - s))), 1, max)
 
-1 for a flat surface (R = 0) or s >= 1, the largest level for a midpoint at or behind the eye or
+A fixed level (u_fixed_level > 0) is every edge's. Else 1 for a flat surface (R = 0) or s >= 1, the largest level for a midpoint at or behind the eye or
 a chord across the sphere; outer[i] is the edge opposite corner i, inner the largest outer.
 
 Inputs: patches' corners (P, 3, 3) object space, the uniforms as a ControlUniforms.
@@ -35,6 +35,7 @@ class ControlUniforms:
     target_error: float                # u_target_error, pixels
     surface_radius: float              # u_surface_radius, world units (0: flat)
     max_level: float                   # u_max_level
+    fixed_level: float = 0.0           # u_fixed_level: > 0, every level (not by need)
 
 
 def _homogeneous(points32: np.ndarray) -> np.ndarray:
@@ -46,6 +47,8 @@ def edge_levels(a: np.ndarray, b: np.ndarray, u: ControlUniforms) -> np.ndarray:
     f = np.float32
     radius, high = f(u.surface_radius), f(u.max_level)
     shape = a.shape[:-1]
+    if f(u.fixed_level) > 0:
+        return np.full(shape, f(u.fixed_level), f)
     if not radius > 0:
         return np.ones(shape, f)
     mid = matrix_times(u.projection, matrix_times(u.view, _homogeneous((a + b) * f(0.5))))

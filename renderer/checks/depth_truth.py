@@ -8,7 +8,9 @@ from the inverse of the rasteriser's P V, so s is the view depth; docs/conventio
 "Window, pixels and images") against exactly the surfaces the rasteriser draws:
 
 - the triangles of every object's mesh (a sphere's icosphere tessellation too), through the
-  object's camera-relative model matrix in float64;
+  object's camera-relative model matrix in float64; of a tessellated sphere, the triangles the
+  tessellation stages make in this frame (their twin, reference/tessellation/surface.py, bit
+  for bit the GPU's points: tests/test_tessellation_stages.py);
 - for an analytic plane, the infinite plane itself (Scene.world_shape), not the polygon the
   rasteriser draws of it (renderer/core/drawn.py), whose making is what is checked;
 - each only where the rasteriser draws it: a culled object's triangles that face away from
@@ -42,6 +44,7 @@ import numpy as np
 from reference.raytrace.bvh import closest_hit
 from reference.raytrace.camera import camera_ray, pixel_windows
 from reference.raytrace.intersect import ray_plane
+from reference.tessellation.surface import tessellated_mesh
 from renderer.core.bvh import build_bvh
 from renderer.core.camera_rays import camera_ray_uniforms, is_perspective
 from renderer.core.gl_rules import depth_mapping
@@ -94,11 +97,14 @@ def drawn_surfaces(scene: Scene, width: int, height: int) -> Surfaces:
                 offsets.append(plane.offset)
                 plane_owner.append(k)
             continue
-        mesh = obj.mesh
-        if not mesh.triangle_count:
+        if obj.tessellation is not None:            # the tessellation stages' triangles
+            positions, _, faces = tessellated_mesh(obj, m, matrices.view, matrices.projection, height)
+        else:
+            positions, faces = obj.mesh.positions, obj.mesh.faces
+        if not len(faces):
             continue
-        world = np.asarray(mesh.positions, np.float64) @ m.model[:3, :3].T + m.model[:3, 3]
-        corners = world[np.asarray(mesh.faces, np.int64)]
+        world = np.asarray(positions, np.float64) @ m.model[:3, :3].T + m.model[:3, 3]
+        corners = world[np.asarray(faces, np.int64)]
         n = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
         # The eye (the origin) or the view direction on the front side: GL's CCW in the window.
         facing = -np.einsum("ij,ij->i", corners[:, 0], n) if perspective else -(n @ forward)

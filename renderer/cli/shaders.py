@@ -10,7 +10,7 @@ def add_parser(sub) -> None:
     """`shaders`' parser: the scene and --out."""
     shaders = sub.add_parser("shaders", help="write the exact GLSL a scene's draws use")
     shaders.add_argument("scene", nargs="?", help="scene file or built-in scene name (default: the default scene)")
-    shaders.add_argument("--out", type=output_path, help="folder for VARIANT.vert/.geom/.frag "
+    shaders.add_argument("--out", type=output_path, help="folder for VARIANT.vert/.tesc/.tese/.geom/.frag "
                                                    "(default: out/shaders-SCENE_NAME)")
     memory_option(shaders)
 
@@ -31,10 +31,10 @@ def run(args) -> int:
     maps = has_shadow_maps(scene)
     for obj in scene.objects:
         if triangle_bound(obj):            # what the camera pass may draw (renderer/core/drawn.py)
-            variant = ShaderVariant.for_material(scene, obj.material,
-                                                 shadows=maps and obj.receives_shadows)
+            variant = ShaderVariant.for_object(scene, obj, maps=maps)
             users.setdefault(variant, []).append(obj.name)
-    suffixes = {"vertex_shader": "vert", "geometry_shader": "geom", "fragment_shader": "frag"}
+    suffixes = {"vertex_shader": "vert", "tess_control_shader": "tesc", "tess_evaluation_shader": "tese",
+                "geometry_shader": "geom", "fragment_shader": "frag"}
     lines = []
     with outputs() as written:                   # every variant's files or none
         for variant, names in users.items():

@@ -275,6 +275,9 @@ class SceneObject:
     # object declares no motion (a zero vector declares it, still). Children do not follow.
     velocity: tuple | None = None
     angular_velocity: tuple | None = None
+    # The rasteriser's camera pass draws it through the tessellation stages
+    # (renderer/core/tessellation.py Tessellation; an analytic sphere only, for now). None: not.
+    tessellation: object | None = None
 
     def texture_coordinates(self, mesh: Mesh | None = None) -> np.ndarray | None:
         """The UVs (V, 2) of `mesh` (default: the object's own; the camera pass passes what it

@@ -69,7 +69,8 @@ LIGHT_KEYS = {
 }
 BIAS_KEYS = tuple(f.name for f in dataclasses.fields(BiasRule))   # normal, constant, slope
 OBJECT_KEYS = ("name", "mesh", "shape", "material", "scale", "shear", "rotate", "translate", "parent",
-               "cull", "casts_shadows", "receives_shadows", "velocity", "angular_velocity")
+               "cull", "casts_shadows", "receives_shadows", "velocity", "angular_velocity", "tessellation")
+TESSELLATION_KEYS = ("spacing", "error", "level")
 MESH_FILE_KEYS = ("file", "crease_angle")
 SHAPE_TYPES = ("sphere", "plane")
 SHAPE_KEYS = {
@@ -781,7 +782,40 @@ class _Reader(TableReader):
         for motion in ("velocity", "angular_velocity"):          # motion blur, the ray tracer's
             if motion in raw:
                 setattr(obj, motion, self.vec3(raw[motion], key(motion)))
+        if "tessellation" in raw:
+            obj.tessellation = self.tessellation(raw["tessellation"], key("tessellation"), obj)
         return obj
+
+    def tessellation(self, raw: Any, path: str, obj: SceneObject):
+        """An object's tessellation stages (renderer/core/tessellation.py): `spacing` ("equal",
+        "fractional_even", "fractional_odd"), `error` in pixels or a fixed `level` (1 to 64).
+        Only an analytic sphere is tessellated yet, and not with a texture or shadow maps."""
+        from renderer.core import tessellation
+        if not isinstance(raw, dict):
+            self.fail(path, f"expected a table such as {{error = 0.25}} or {{level = 8}}, got {describe_value(raw)}")
+        raw = self.table(raw, path, TESSELLATION_KEYS)
+        if not isinstance(obj.shape, Sphere):
+            self.fail(path, "only an analytic sphere (shape = {type = \"sphere\"}) is tessellated yet")
+        if obj.material.textured:
+            self.fail(path, "a tessellated sphere cannot be textured yet (its seam)")
+        if obj.receives_shadows:
+            self.fail(path, "a tessellated sphere does not look shadow maps up yet: "
+                            "give the object receives_shadows = false")
+        settings = tessellation.Tessellation()
+        if "spacing" in raw:
+            word = self.choice(raw["spacing"], _join(path, "spacing"), "spacing", tuple(tessellation.SPACING_WORDS))
+            settings = dataclasses.replace(settings, spacing=tessellation.SPACING_WORDS[word])
+        if "error" in raw and "level" in raw:
+            self.fail(path, "give either error (pixels, levels by need) or level (fixed), not both")
+        if "error" in raw:
+            settings = dataclasses.replace(settings, error=self.number(raw["error"], _join(path, "error"), above=0.0))
+        if "level" in raw:
+            level = self.number(raw["level"], _join(path, "level"), minimum=1.0)
+            if level > tessellation.MAX_LEVEL:
+                self.fail(_join(path, "level"), f"must be at most {tessellation.MAX_LEVEL:g} "
+                                                f"(GL_MAX_TESS_GEN_LEVEL), got {level:g}")
+            settings = dataclasses.replace(settings, level=level)
+        return settings
 
     def object_material(self, raw: Any, path: str, materials: dict[str, Material]) -> Material:
         if isinstance(raw, str):

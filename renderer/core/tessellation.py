@@ -24,11 +24,71 @@ written with +, -, *, / and sqrt alone, which llvmpipe rounds as IEEE float32 do
 twin's levels are the GPU's bit for bit. Clamped to [1, MAX_LEVEL]; s >= 1 (an error as large as
 the sphere) gives 1; an edge whose midpoint is at or behind the eye (w_mid <= 0) gets MAX_LEVEL.
 The inner level is the largest of the three outer ones.
+
+What a scene asks for (`Tessellation`, an object's `tessellation` table in a scene file): an
+analytic sphere drawn from PATCH_SUBDIVISIONS' icosphere as triangle patches, in the camera
+pass (the shadow passes draw the sphere's own icosphere, renderer/core/shapes.py).
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 TARGET_PIXEL_ERROR = 0.25        # pixels: the issue's target of the geometric error on screen
 MAX_LEVEL = 64.0                 # GL_MAX_TESS_GEN_LEVEL's least value, llvmpipe's
 SPACINGS = ("equal_spacing", "fractional_even_spacing", "fractional_odd_spacing")
 DEFAULT_SPACING = "fractional_odd_spacing"   # levels change smoothly as the camera moves
+PATCH_SUBDIVISIONS = 1           # a tessellated sphere's patches: icosphere(1), 80 triangles
+SPACING_WORDS = {"equal": "equal_spacing", "fractional_even": "fractional_even_spacing",
+                 "fractional_odd": "fractional_odd_spacing"}
+
+# llvmpipe 22.3.6 (reference/tessellation/tessellator.py): a draw's patches are cut into runs
+# of 4096 input vertices whose points share uint16 element indices, so a run must make at most
+# 65,536 points. A triangle patch's levels round up to at most an even n = 2k, whose
+# tessellation has 3 k (k + 1) + 1 points (k rings of 6 j points about the centre; an odd
+# 2k - 1 has 3 k^2), at most 3,169 at level 64 (tests/test_tessellation_raster.py holds the
+# bound to the tessellator's twin).
+MAX_RUN_POINTS = 1 << 16
+
+
+def max_triangle_points(level: float = MAX_LEVEL) -> int:
+    k = int(-(-level // 2))
+    return 3 * k * (k + 1) + 1
+
+
+def patches_per_draw(max_level: float = MAX_LEVEL) -> int:
+    """Triangle patches one draw call may hold so that no run wraps its element indices."""
+    return max(1, MAX_RUN_POINTS // max_triangle_points(max_level))
+
+
+@dataclass(frozen=True)
+class Tessellation:
+    """An object's tessellation (the scene file's `tessellation` table): the spacing, and
+    either the target error in pixels (the levels by need, the rule above) or a fixed `level`
+    on every edge and inside (None: by need)."""
+    spacing: str = DEFAULT_SPACING
+    error: float = TARGET_PIXEL_ERROR
+    level: float | None = None
+
+
+def patch_mesh(sphere):
+    """The coarse patches a tessellated sphere is drawn from: icosphere(PATCH_SUBDIVISIONS) of
+    the sphere, its corners on the surface (renderer/core/shapes.py sphere_mesh)."""
+    from renderer.core.shapes import sphere_mesh
+    return sphere_mesh(sphere, PATCH_SUBDIVISIONS)
+
+
+def check_tessellated(obj) -> None:
+    """A ValueError naming `obj` where its tessellation asks for what the stages do not draw
+    yet: a shape other than an analytic sphere, a texture (the sphere's UV seam), shadow maps
+    looked up (their facets are the patches'). The scene file refuses the same in one line."""
+    from renderer.core.scene import Sphere
+    if obj.tessellation is None:
+        return
+    if not isinstance(obj.shape, Sphere):
+        raise ValueError(f"object {obj.name!r}: only an analytic sphere is tessellated yet")
+    if obj.material.texture is not None:
+        raise ValueError(f"object {obj.name!r}: a tessellated sphere cannot be textured yet")
+    if obj.receives_shadows:
+        raise ValueError(f"object {obj.name!r}: a tessellated sphere does not look shadow maps up "
+                         f"yet (receives_shadows = false)")

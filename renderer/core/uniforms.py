@@ -81,8 +81,18 @@ SHADOW_OBJECT_UNIFORMS = {
 }
 # The depth pass (glsl/shadow/depth.vert): light clip from object coordinates, per pass and object.
 SHADOW_PASS_UNIFORMS = {"u_clip_from_model": "mat4"}
+# A tessellated sphere's (glsl/tess_control.glsl, tess_evaluation.glsl; renderer/core/tessellation.py):
+# per object, and the viewport's height, which its levels' pixels are measured in.
+TESSELLATION_UNIFORMS = {
+    "u_viewport_height": "float",           # H, pixels
+    "u_target_error": "float",              # pixels (Tessellation.error)
+    "u_surface_radius": "float",            # the sphere's radius in world units
+    "u_max_level": "float",                 # tessellation.MAX_LEVEL
+    "u_fixed_level": "float",               # Tessellation.level, 0 for levels by need
+    "u_sphere": "vec4",                     # object space: centre, radius
+}
 UNIFORM_TYPES = (FRAME_UNIFORMS | OBJECT_UNIFORMS | TEXTURE_UNIFORMS | LIGHT_COUNT_UNIFORMS
-                 | SHADOW_UNIFORMS | SHADOW_OBJECT_UNIFORMS | SHADOW_PASS_UNIFORMS)
+                 | SHADOW_UNIFORMS | SHADOW_OBJECT_UNIFORMS | SHADOW_PASS_UNIFORMS | TESSELLATION_UNIFORMS)
 
 
 def _rows(values) -> np.ndarray:
@@ -134,3 +144,20 @@ def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.
             **material_uniforms(obj.material),
             "u_two_sided": np.asarray(int(bool(obj.material.two_sided))),
             **texture_uniforms(obj.material.texture)}
+
+
+def tessellation_uniforms(obj: SceneObject, matrices: ObjectMatrices, height: int) -> dict[str, np.ndarray]:
+    """A tessellated sphere's uniforms (TESSELLATION_UNIFORMS) in a frame `height` pixels tall;
+    empty for an object drawn without the tessellation stages."""
+    from renderer.core.tessellation import MAX_LEVEL
+    settings = obj.tessellation
+    if settings is None:
+        return {}
+    sphere = obj.shape
+    scale = float(np.linalg.norm(np.asarray(matrices.model, dtype=np.float64)[:3, 0]))   # a similarity's
+    return {"u_viewport_height": np.asarray(float(height)),
+            "u_target_error": np.asarray(float(settings.error)),
+            "u_surface_radius": np.asarray(float(sphere.radius) * scale),
+            "u_max_level": np.asarray(MAX_LEVEL),
+            "u_fixed_level": np.asarray(0.0 if settings.level is None else float(settings.level)),
+            "u_sphere": np.asarray([*sphere.centre, sphere.radius], dtype=np.float64)}

@@ -85,6 +85,7 @@ from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
+from renderer.core.tessellation import check_tessellated, patch_mesh, patches_per_draw
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.gpu.polygon_buffers import PolygonBuffers, vertex_bytes
 from renderer.gpu.shadow_maps import ShadowMaps
@@ -106,6 +107,10 @@ DEPTH_FORMAT_NAMES = {GL_DEPTH_COMPONENT24: "DEPTH_COMPONENT24",
                       GL_DEPTH_COMPONENT32F: "DEPTH_COMPONENT32F"}
 
 CULL_FLAGS = {"none": None, "back": "back", "front": "front"}   # SceneObject.cull -> GL face
+
+
+# A tessellated sphere's patches a draw call holds (llvmpipe's uint16 element indices in a run).
+PATCHES_PER_DRAW = patches_per_draw()
 
 
 def make_float_depth(ctx: moderngl.Context, renderbuffer, width: int, height: int,
@@ -166,12 +171,15 @@ class _ObjectBuffers:
     texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
     face_normals: moderngl.Texture | None = None   # its faces (facets.face_texture), once a shadowed program draws it
     polygon: PolygonBuffers | None = None  # an analytic plane's, which the camera pass draws
+    patches: tuple | None = None           # a tessellated sphere's (vbo, ibo, triangles), which the camera pass draws
 
     @property
     def drawn_buffers(self) -> tuple:
         """(vbo, ibo, uv_vbo) the camera pass draws from."""
         if self.polygon is not None:
             return self.polygon.vbo, self.polygon.ibo, self.polygon.uv_vbo
+        if self.patches is not None:
+            return self.patches[0], self.patches[1], None
         return self.vbo, self.ibo, self.uv_vbo
 
     @property
@@ -190,6 +198,7 @@ class _Draw:
     texture: tuple | None = None           # (texture, sampler) bound on MATERIAL_TEXTURE_UNIT
     face_normals: moderngl.Texture | None = None   # bound on FACE_NORMALS_UNIT (a shadowed program's)
     count: int = -1                        # indices drawn (-1: all)
+    patches: int = 0                       # a tessellated object's triangle patches (0: triangles)
 
 
 class GpuRenderer(ContextRenderer):
@@ -290,6 +299,7 @@ class GpuRenderer(ContextRenderer):
             if obj.cull not in CULL_FLAGS:
                 raise ValueError(f"object {obj.name!r}: cull must be one of "
                                  f"{', '.join(CULL_FLAGS)}, got {obj.cull!r}")
+            check_tessellated(obj)
             item = _ObjectBuffers(obj, obj.mesh, None, None, None, {}, {})
             if is_plane(obj):        # its polygon's buffers, at their largest, written per update()
                 item.polygon = PolygonBuffers.make(self.ctx, uvs=True)
@@ -301,6 +311,11 @@ class GpuRenderer(ContextRenderer):
         if mesh.triangle_count:
             item.vbo = self.ctx.buffer(vertex_bytes(mesh))
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
+        if item.obj.tessellation is not None:       # the camera pass draws its patches instead
+            patches = patch_mesh(item.obj.shape)
+            item.patches = (self.ctx.buffer(vertex_bytes(patches)),
+                            self.ctx.buffer(np.ascontiguousarray(patches.faces, dtype=np.uint32).tobytes()),
+                            patches.triangle_count)
         self._upload_uvs(item)
 
     def _upload_uvs(self, item: _ObjectBuffers) -> None:
@@ -318,10 +333,11 @@ class GpuRenderer(ContextRenderer):
         """The mesh's buffers and the vertex arrays (a polygon's buffers stay: release())."""
         for vao in item.vertex_arrays.values():
             vao.release()
-        for buffer in (item.vbo, item.ibo, item.uv_vbo, item.face_normals):
+        for buffer in (item.vbo, item.ibo, item.uv_vbo, item.face_normals, *(item.patches or ())[:2]):
             if buffer is not None:
                 buffer.release()
         item.vertex_arrays, item.vbo, item.ibo, item.uv_vbo, item.face_normals = {}, None, None, None, None
+        item.patches = None
 
     def _face_normals(self, item: _ObjectBuffers) -> moderngl.Texture:
         """The object's faces (normals and creases) as an RGBA32F texture (renderer/core/facets.py
@@ -335,10 +351,8 @@ class GpuRenderer(ContextRenderer):
         return item.face_normals
 
     def _variant(self, obj: SceneObject, linear: bool) -> ShaderVariant:
-        return ShaderVariant.for_material(self.scene, obj.material, linear,
-                                          all_features=not self.specialise,
-                                          shadows=(self._shadows and obj.receives_shadows
-                                                   and self._shadow_layout.any))
+        return ShaderVariant.for_object(self.scene, obj, maps=self._shadows and self._shadow_layout.any,
+                                        linear_output=linear, all_features=not self.specialise)
 
     def _vertex_array(self, item: _ObjectBuffers, variant: ShaderVariant) -> moderngl.VertexArray:
         vao = item.vertex_arrays.get(variant)
@@ -389,7 +403,7 @@ class GpuRenderer(ContextRenderer):
         for index, (item, what) in enumerate(zip(self._objects, drawn)):
             item.uniform_bytes = object_uniform_values(
                 item.obj, what.matrices,
-                None if self._shadow_plan is None else self._shadow_plan.self_masks(index))
+                None if self._shadow_plan is None else self._shadow_plan.self_masks(index), self.height)
             # Uploaded the first time a texture is asked for; a material's new texture then.
             texture = item.obj.material.texture
             item.texture = None if texture is None else self._textures.get(texture)
@@ -464,7 +478,7 @@ class GpuRenderer(ContextRenderer):
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
             facets = self._face_normals(item) if variant.shadows else None
             plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None,
-                              facets, item.count))
+                              facets, item.count, item.patches[2] if variant.tessellation else 0))
         self._shadowed[linear] = any(variant.shadows for variant in programs)
         for program in programs.values():          # the same for every object: set once here
             for name, data in self._frame_uniforms.items():
@@ -559,7 +573,10 @@ class GpuRenderer(ContextRenderer):
                     sampler.use(MATERIAL_TEXTURE_UNIT)
                 if draw.face_normals is not None:
                     draw.face_normals.use(FACE_NORMALS_UNIT)
-                draw.vertex_array.render(moderngl.TRIANGLES, vertices=draw.count)
+                if draw.patches:                  # a tessellated sphere: triangle patches
+                    self._draw_patches(draw)
+                else:
+                    draw.vertex_array.render(moderngl.TRIANGLES, vertices=draw.count)
             if target is not fbo:
                 ctx.copy_framebuffer(fbo, target)    # the MSAA resolve (glBlitFramebuffer)
         finally:
@@ -570,6 +587,17 @@ class GpuRenderer(ContextRenderer):
             if mapping is not STANDARD_DEPTH:
                 self._clip_control(STANDARD_DEPTH)
         return fbo
+
+    def _draw_patches(self, draw: _Draw) -> None:
+        """A tessellated object's patches, PATCHES_PER_DRAW at a time: llvmpipe's element
+        indices wrap past 65,536 generated points in a run of patches (renderer/core/tessellation.py)."""
+        before, self.ctx.patch_vertices = self.ctx.patch_vertices, 3
+        try:
+            for first in range(0, draw.patches, PATCHES_PER_DRAW):
+                count = min(PATCHES_PER_DRAW, draw.patches - first)
+                draw.vertex_array.render(moderngl.PATCHES, vertices=3 * count, first=3 * first)
+        finally:
+            self.ctx.patch_vertices = before
 
     def _clip_control(self, mapping: DepthMapping) -> None:
         """glClipControl with the depth mapping's depth mode (core/gl_rules.py)."""

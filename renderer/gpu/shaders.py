@@ -233,6 +233,9 @@ class ShaderVariant:
     shadows: bool = False            # the shadow-map lookup
     shadow_kernel: int = 0           # every map's filter kernel, compiled in (0: read per light)
     texture: tuple[str, ...] = ()    # the coefficients the texel modulates ("ka", "kd", "ks")
+    # the tessellation stages' spacing (GL's word, renderer/core/tessellation.py) for a
+    # tessellated sphere; "" for none
+    tessellation: str = ""
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
@@ -242,6 +245,8 @@ class ShaderVariant:
         if not set(self.texture) <= set(MODULATED):
             raise ValueError(f"a texture modulates some of {MODULATED}, "
                              f"not {self.texture}")
+        if self.tessellation and self.tessellation not in TESSELLATION_SPACING_DEFINES:
+            raise ValueError(f"unknown tessellation spacing {self.tessellation!r}")
 
     @property
     def light_terms(self) -> bool:
@@ -257,6 +262,9 @@ class ShaderVariant:
             f"TEXTURE_{k.upper()}": k in self.texture for k in MODULATED}
         if self.shadows:                           # glsl/fragment.glsl's face texture
             terms["FACES_PER_ROW"] = FACES_PER_ROW
+        if self.tessellation:                      # a sphere through tess_control / tess_evaluation
+            terms |= {"TESSELLATED": True, "SURFACE_SPHERE": True,
+                      TESSELLATION_SPACING_DEFINES[self.tessellation]: True}
         if self.all_features:
             return {
                 f"SHADING_{self.shading.upper()}": True,
@@ -287,6 +295,7 @@ class ShaderVariant:
         linear = "-linear" if self.linear_output else ""
         shadows = "-shadows" if self.shadows else ""
         shadows += "".join(f"-textured-{k}" for k in self.texture)
+        shadows += f"-tessellated-{self.tessellation.removesuffix('_spacing')}" if self.tessellation else ""
         if self.all_features:
             terms = (f"-{self.num_directional_lights}dir-{self.num_point_lights}point"
                      if self.light_terms else "")
@@ -302,21 +311,33 @@ class ShaderVariant:
 
     @classmethod
     def for_material(cls, scene, material, linear_output: bool = False,
-                     all_features: bool = False, shadows: bool = False) -> "ShaderVariant":
+                     all_features: bool = False, shadows: bool = False,
+                     tessellation: str = "") -> "ShaderVariant":
         """The variant that draws `material` (a renderer.core.scene.Material) in `scene`:
         specialised to what they use, or the all-features build. `shadows`: the object
-        receives shadows and the scene's layout has maps."""
+        receives shadows and the scene's layout has maps; `tessellation`: its spacing, for a
+        tessellated sphere."""
         shadows = bool(shadows)
         texture = modulated_coefficients(material)
         if all_features:
             counts = ((len(scene.directional_lights), len(scene.point_lights))
                       if shadows and material.shading != "phong" else (0, 0))
             return cls(material.shading, False, *counts, linear_output=bool(linear_output),
-                       all_features=True, shadows=shadows, texture=texture)
+                       all_features=True, shadows=shadows, texture=texture, tessellation=tessellation)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
                    len(scene.point_lights), bool(linear_output), material.has_specular,
                    shadows=shadows, shadow_kernel=shared_kernel(scene) if shadows else 0,
-                   texture=texture)
+                   texture=texture, tessellation=tessellation)
+
+    @classmethod
+    def for_object(cls, scene, obj, *, maps: bool, linear_output: bool = False,
+                   all_features: bool = False) -> "ShaderVariant":
+        """The variant the camera pass draws scene object `obj` with (GpuRenderer's and
+        `renderer shaders`'): its material's, looking the shadow maps up where the frame has
+        `maps` and it receives them, through the tessellation stages where it asks for them."""
+        return cls.for_material(scene, obj.material, linear_output, all_features=all_features,
+                                shadows=maps and obj.receives_shadows,
+                                tessellation="" if obj.tessellation is None else obj.tessellation.spacing)
 
 
 
@@ -329,15 +350,25 @@ def modulated_coefficients(material) -> tuple[str, ...]:
 
 
 STAGES = (("vertex_shader", "vertex.glsl"),
+          ("tess_control_shader", "tess_control.glsl"),
+          ("tess_evaluation_shader", "tess_evaluation.glsl"),
           ("geometry_shader", "geometry.glsl"),
           ("fragment_shader", "fragment.glsl"))
+TESSELLATION_STAGES = ("tess_control_shader", "tess_evaluation_shader")
+# glsl/tess_evaluation.glsl's layout: each spacing's define
+TESSELLATION_SPACING_DEFINES = {"equal_spacing": "SPACING_EQUAL", "fractional_even_spacing": "SPACING_FRACTIONAL_EVEN",
+                                "fractional_odd_spacing": "SPACING_FRACTIONAL_ODD"}
 
 
 def program_sources(variant: ShaderVariant) -> dict[str, ShaderSource]:
     """Sources of the stages `variant` links, keyed by moderngl's program() argument names."""
     defines = variant.defines()
-    return {stage: shader_source(filename, defines) for stage, filename in STAGES
-            if stage != "geometry_shader" or variant.uses_geometry_shader}
+    sources = {stage: shader_source(filename, defines) for stage, filename in STAGES
+               if (stage != "geometry_shader" or variant.uses_geometry_shader)
+               and (stage not in TESSELLATION_STAGES or variant.tessellation)}
+    if variant.tessellation:                       # the patch corners pass through unchanged
+        sources["vertex_shader"] = shader_source("tess_vertex.glsl", defines)
+    return sources
 
 
 def program_source(scene, material, linear_output: bool = False) -> tuple[str, str | None, str]:

@@ -17,7 +17,8 @@ import numpy as np
 
 from renderer.core.scene import FrameMatrices, Scene, SceneObject
 from renderer.core.transforms import to_glsl
-from renderer.core.uniforms import ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms, object_uniforms
+from renderer.core.uniforms import (ROWS_PER_LIGHT, UNIFORM_TYPES, frame_uniforms, object_uniforms,
+                                    tessellation_uniforms)
 from renderer.gpu.context import gl_function
 
 MATERIAL_TEXTURE_UNIT = 1                # the unit a textured material's texture is bound to
@@ -76,12 +77,13 @@ def frame_uniform_values(scene: Scene, matrices: FrameMatrices, light_slots: int
     return out
 
 
-def object_uniform_values(obj: SceneObject, matrices, shadow_masks: dict | None = None) -> dict[str, bytes]:
+def object_uniform_values(obj: SceneObject, matrices, shadow_masks: dict | None = None,
+                          height: int = 0) -> dict[str, bytes]:
     """One object's uniforms: its model and normal matrices and its material (a textured
     one's UV transform and texture unit too); with `shadow_masks` (the frame's
     ShadowPlan.self_masks of the object, when the scene has maps) the shadow lookup's per-object
-    masks and its facet normals' unit."""
-    values = object_uniforms(obj, matrices)
+    masks and its facet normals' unit; a tessellated sphere's in a frame `height` pixels tall."""
+    values = object_uniforms(obj, matrices) | tessellation_uniforms(obj, matrices, height)
     if obj.material.texture is not None:
         values["u_texture"] = np.asarray(MATERIAL_TEXTURE_UNIT)
     if shadow_masks is not None:

@@ -1,0 +1,49 @@
+"""# Twin: glsl/tess_control.glsl, glsl/tess_evaluation.glsl (the stages together)
+
+A tessellated object's triangles as the camera pass draws them through the tessellation
+stages (issue 34): its patches (renderer/core/tessellation.py patch_mesh), each patch's levels
+(reference/tessellation/control.py), the tessellator's points and triangles
+(reference/tessellation/tessellator.py), each point placed on the surface
+(reference/tessellation/evaluation.py), patch after patch in draw order, so that the vertex
+stage's twin (reference/vertex.py) then runs on the points as the evaluation stage runs
+glsl/vertex_stage.glsl on them.
+
+Inputs: the object (its shape and Tessellation), its camera-relative model matrix, the frame's
+view and projection matrices and height (renderer/core/uniforms.py tessellation_uniforms).
+Output: (positions (P, 3), normals (P, 3)) float32 object space and faces (T, 3) int64.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from reference.tessellation.control import ControlUniforms, patch_levels
+from reference.tessellation.evaluation import evaluate
+from reference.tessellation.tessellator import tess_coord, tessellate
+from renderer.core.tessellation import check_tessellated, patch_mesh
+from renderer.core.uniforms import tessellation_uniforms
+
+
+def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndarray, height: int):
+    """The object's generated points, normals and triangles (module docstring)."""
+    check_tessellated(obj)
+    values = tessellation_uniforms(obj, object_matrices, height)
+    u = ControlUniforms(object_matrices.model, view, projection, float(values["u_viewport_height"]),
+                        float(values["u_target_error"]), float(values["u_surface_radius"]),
+                        float(values["u_max_level"]), float(values["u_fixed_level"]))
+    sphere = values["u_sphere"]
+    patches = patch_mesh(obj.shape)
+    corners = patches.positions[patches.faces].astype(np.float32)
+    normals = patches.normals[patches.faces].astype(np.float32)
+    positions, shading_normals, faces, offset = [], [], [], 0
+    for patch, level in enumerate(patch_levels(corners, u)):
+        t = tessellate("triangles", obj.tessellation.spacing, level[:3], level[3:])
+        coords = tess_coord(t)
+        p, n = evaluate(coords, np.broadcast_to(corners[patch], (len(coords), 3, 3)),
+                        np.broadcast_to(normals[patch], (len(coords), 3, 3)), (sphere[:3], sphere[3]))
+        positions.append(p)
+        shading_normals.append(n)
+        faces.append(np.asarray(t.indices, np.int64).reshape(-1, 3) + offset)
+        offset += len(coords)
+    return (np.concatenate(positions), np.concatenate(shading_normals),
+            np.concatenate(faces) if faces else np.zeros((0, 3), np.int64))

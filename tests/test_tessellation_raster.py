@@ -7,7 +7,7 @@ By hand: each key read and each refusal one line naming the key; a triangle patc
 over every spacing and level). GPU against twin: every shading mode at the largest level (80
 patches of up to 3,169 points, drawn PATCHES_PER_DRAW at a time: one draw would wrap llvmpipe's
 uint16 indices) and with levels by need, on EGL and OSMesa, within the pipeline tolerance. The
-exact sphere: interior pixels within 1 level of the ray tracer's at 0.1 px (the ray tracer
+exact sphere: interior pixels within 1 level of the ray tracer's at 0.25 px (the ray tracer
 intersects the sphere itself), closer than the untessellated icosphere."""
 
 import dataclasses
@@ -126,11 +126,11 @@ def interior_levels(scene, context):
 
 @pytest.mark.slow
 def test_the_tessellated_sphere_meets_the_exact_sphere_within_a_level(gl_contexts):
-    """At 0.1 px every interior pixel is within 1 level of the ray tracer's exact sphere
-    (measured: mean 0.08); the icosphere the rasteriser draws without the stages (1,280
-    triangles) is 3 levels off at worst, 464 pixels more than 1."""
+    """At the default 0.25 px every interior pixel is within 1 level of the ray tracer's exact
+    sphere; the icosphere the rasteriser draws without the stages (1,280 triangles) is more than
+    1 level off in places."""
     ctx = gl_contexts["egl"]
-    tessellated = interior_levels(scene_from_dict(ball({"error": 0.1})), ctx)
+    tessellated = interior_levels(scene_from_dict(ball({"error": 0.25})), ctx)
     icosphere = interior_levels(scene_from_dict(ball()), ctx)
     assert tessellated.max() <= 1 and tessellated.mean() < icosphere.mean()
     assert icosphere.max() > 1
@@ -140,3 +140,72 @@ def test_the_builtin_scene_loads_with_two_tessellated_spheres():
     scene = load_scene("tessellated_sphere")
     spacings = [o.tessellation.spacing for o in scene.objects if o.tessellation is not None]
     assert spacings == ["fractional_odd_spacing", "equal_spacing"]
+
+
+# -- cracks and extreme cases ------------------------------------------------------------------------
+
+def silhouette_holes(scene, context, size=(160, 120), exact=True):
+    """Background pixels where a crack between patches would show it: inside the drawn
+    surface's own outline (holes it encloses), and with `exact` inside the exact sphere's
+    silhouette shrunk by two pixels (the chords lie inside the sphere by at most the target
+    error, a quarter of a pixel). Returns (holes, pixels looked at)."""
+    with open_renderer(scene, size, context=context) as gpu:
+        frame = gpu.render(depth=False).rgba8
+    width, height = size
+    matrices = scene.matrices(width, height)
+    inverse = np.linalg.inv(matrices.projection @ matrices.view)
+    xs = (np.arange(width) + 0.5) / width * 2 - 1
+    ys = 1 - (np.arange(height) + 0.5) / height * 2
+    far = np.stack(np.broadcast_arrays(xs[None, :], ys[:, None], 1.0, 1.0), -1) @ inverse.T
+    direction = far[..., :3] / far[..., 3:]
+    direction /= np.linalg.norm(direction, axis=-1, keepdims=True)
+    centre = np.asarray(scene.objects[0].shape.centre) - matrices.origin     # camera-relative
+    b = direction @ centre
+    inside = b * b - (centre @ centre - scene.objects[0].shape.radius ** 2) > 0
+    inside = ndimage.binary_erosion(inside, iterations=2) if exact else np.zeros_like(inside)
+    drawn = frame[..., 3] > 0
+    inside |= ndimage.binary_fill_holes(drawn)
+    return int((~drawn & inside).sum()), int(inside.sum())
+
+
+@pytest.mark.parametrize("table", [{"error": 0.25}, {"level": 1}, {"level": 7.3}, {"error": 0.05,
+                                                                                 "spacing": "fractional_even"}])
+def test_no_crack_shows_the_background_through_the_sphere(gl_contexts, table):
+    """(At a fixed level the chords may lie farther inside than two pixels: the drawn
+    outline's own enclosed holes are counted then.)"""
+    holes, inside = silhouette_holes(scene_from_dict(ball(table)), gl_contexts["egl"], exact="error" in table)
+    assert inside > 1000 and holes == 0
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("distance", [1.3, 2.0, 4.0, 12.0, 40.0])
+def test_no_crack_as_the_camera_comes_closer(gl_contexts, distance):
+    """Levels by need change with the distance; at every distance each shared edge gets one
+    level from both of its patches (the eye 1.3 radii from the centre fills the view)."""
+    data = ball({"error": 0.25})
+    data["camera"] = {"eye": [0.0, 0.3 * distance, distance], "look": [0.0, 0.0, 0.0], "fov_y": 45.0,
+                      "near": 0.05}
+    holes, inside = silhouette_holes(scene_from_dict(data), gl_contexts["egl"])
+    assert inside > 5 and holes == 0
+
+
+@pytest.mark.parametrize("case", ["crossing_near_plane", "tiny_far_away", "edge_on_patches"])
+def test_extreme_views_are_drawn_alike_by_the_gpu_and_the_twin(gl_contexts, case):
+    """A sphere cut by the near plane (edges behind the eye get the largest level), a sphere a
+    few pixels wide 60 radii away (every edge at level 1), patches seen edge on at the
+    silhouette of a sphere seen from very near."""
+    data = ball({"error": 0.25})
+    if case == "crossing_near_plane":
+        data["camera"] = {"eye": [0.0, 0.0, 1.05], "look": [0.0, 0.0, 0.0], "fov_y": 60.0, "near": 0.1}
+    elif case == "tiny_far_away":
+        data["camera"] = {"eye": [0.0, 0.0, 60.0], "look": [0.0, 0.0, 0.0], "fov_y": 45.0, "far": 400.0}
+    else:
+        data["camera"] = {"eye": [0.0, 0.0, 1.2], "look": [0.0, 0.0, 0.0], "fov_y": 100.0, "near": 0.01}
+    scene = scene_from_dict(data)
+    with open_renderer(scene, SIZE, context=gl_contexts["egl"]) as gpu:
+        got = gpu.render(depth=False).rgba8
+    with open_renderer(scene, SIZE, backend="reference") as twin:
+        expected = twin.render(depth=False).rgba8
+    result = compare_frames(got, expected)
+    assert PIPELINE_TOLERANCE.passes(result), PIPELINE_TOLERANCE.failures(result)
+    assert (got[..., 3] > 0).any()

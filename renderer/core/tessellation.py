@@ -35,6 +35,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 TARGET_PIXEL_ERROR = 0.25        # pixels: the issue's target of the geometric error on screen
+# The edges' sagitta is held to this share of the target: a triangle's interior dips deeper than
+# its edges (an equilateral one's circumcentre by 4/3 of its edges' midpoints' sagitta, the
+# tessellator's transition triangles more; benchmarks/bench_tessellation.py measures the
+# triangles' deepest points against the target).
+EDGE_ERROR_SHARE = 0.5
 MAX_LEVEL = 64.0                 # GL_MAX_TESS_GEN_LEVEL's least value, llvmpipe's
 SPACINGS = ("equal_spacing", "fractional_even_spacing", "fractional_odd_spacing")
 DEFAULT_SPACING = "fractional_odd_spacing"   # levels change smoothly as the camera moves

@@ -85,7 +85,7 @@ SHADOW_PASS_UNIFORMS = {"u_clip_from_model": "mat4"}
 # per object, and the viewport's height, which its levels' pixels are measured in.
 TESSELLATION_UNIFORMS = {
     "u_viewport_height": "float",           # H, pixels
-    "u_target_error": "float",              # pixels (Tessellation.error)
+    "u_target_error": "float",              # pixels: an edge's bound, Tessellation.error x EDGE_ERROR_SHARE
     "u_surface_radius": "float",            # the sphere's radius in world units
     "u_max_level": "float",                 # tessellation.MAX_LEVEL
     "u_fixed_level": "float",               # Tessellation.level, 0 for levels by need
@@ -149,14 +149,14 @@ def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.
 def tessellation_uniforms(obj: SceneObject, matrices: ObjectMatrices, height: int) -> dict[str, np.ndarray]:
     """A tessellated sphere's uniforms (TESSELLATION_UNIFORMS) in a frame `height` pixels tall;
     empty for an object drawn without the tessellation stages."""
-    from renderer.core.tessellation import MAX_LEVEL
+    from renderer.core.tessellation import EDGE_ERROR_SHARE, MAX_LEVEL
     settings = obj.tessellation
     if settings is None:
         return {}
     sphere = obj.shape
     scale = float(np.linalg.norm(np.asarray(matrices.model, dtype=np.float64)[:3, 0]))   # a similarity's
     return {"u_viewport_height": np.asarray(float(height)),
-            "u_target_error": np.asarray(float(settings.error)),
+            "u_target_error": np.asarray(float(settings.error) * EDGE_ERROR_SHARE),
             "u_surface_radius": np.asarray(float(sphere.radius) * scale),
             "u_max_level": np.asarray(MAX_LEVEL),
             "u_fixed_level": np.asarray(0.0 if settings.level is None else float(settings.level)),

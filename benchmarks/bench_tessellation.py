@@ -103,8 +103,9 @@ def markdown(document: dict) -> str:
         lines.append(f"| {row['way']} | {row['triangles']:,} | {row['frame_ms']:.2f} | {row['geometric_px']:.3f} | "
                      f"{row['image_max']:.0f} | {row['image_mean']:.3f} |")
     same = f["same_error"]
-    lines += ["", f"At the same geometric error, {same['tessellated']} against {same['icosphere']}: "
-                  f"{same['ratio']:.2f}x the frame time.", "", measured_line(document), ""]
+    lines += ["", f"The stages ({same['tessellated']}) against the least-subdivided icosphere with no more "
+                  f"geometric error ({same['icosphere']}): {same['ratio']:.2f}x its frame time.", "",
+              measured_line(document), ""]
     return "\n".join(lines)
 
 

@@ -1296,7 +1296,7 @@ def _check_success(case: Case, outcome: Outcome, new, changed, root: Path) -> li
         out = _opt(argv, "--out")
         folders = ([os.path.relpath(os.path.abspath(os.path.join(root / case.cwd, out)), root)]
                    if out else sorted({str(Path(p).parent) for p in files}))
-        shader_files = {p for p in files if Path(p).suffix in (".vert", ".geom", ".frag")
+        shader_files = {p for p in files if Path(p).suffix in (".vert", ".tesc", ".tese", ".geom", ".frag")
                         and str(Path(p).parent) in folders}
         if not shader_files and "objects: " in outcome.stdout:
             problems.append("shaders listed variants but wrote no shader files")

@@ -54,6 +54,7 @@ from renderer.errors import UserError
 
 IN_FLIGHT = 2                   # calls queued per actor
 CALL_RETRIES = 3                # Ray's own retries of a call lost with its process
+CANCEL_GRACE_S = 5.0            # how long a call cancelled while running may take to end
 QUIET = dict(log_to_driver=False, logging_level="ERROR")
 # Ray's connection bounds while connecting to an --address (its defaults retry for minutes
 # where something answers that is not a Ray head: 82 s measured with the first alone at 2);
@@ -216,11 +217,16 @@ def _schedule(actors: list, batches: list[list]) -> Iterator[tuple[int, list]]:
 
 def _cancel(pending: dict) -> None:
     """Cancel the calls still queued or running, so that killing their actors next (map's
-    end) retries none of them: Ray would say so on stdout, a line per call."""
+    end) retries none of them: Ray would say so on stdout, a line per call. A call already
+    running in an actor is not stopped by its cancel (a synchronous actor's is not): it is
+    given up to CANCEL_GRACE_S to end before the actors are killed, or Ray retries and says so."""
     import ray
     for ref in pending:
         with contextlib.suppress(Exception):
             ray.cancel(ref)
+    if pending:
+        with contextlib.suppress(Exception):
+            ray.wait(list(pending), num_returns=len(pending), timeout=CANCEL_GRACE_S)
 
 
 def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tuple, Any]]:

@@ -125,19 +125,53 @@ def what_changed(old: RadiositySolution | None, elements: Elements, lighting: Li
     triangles and lights with other reflectances, emissions or sky: solve again with the same
     form factors and irradiance), "lights" (draw the lights' buffers again, keep the form
     factors) or "geometry" (draw everything again)."""
-    before = None if old is None else old.unrefined
-    if before is None or not (np.array_equal(before.corners, elements.corners)
-                              and np.array_equal(before.obj, elements.obj)):
+    if old is None:
         return "geometry"
-    if (old.lighting.sources, old.lighting.resolution, old.lighting.specular) != (
+    change = change_between(old.unrefined, old.lighting, elements, lighting)
+    if change in ("materials", "nothing") and not old.form_factors.drawn \
+            and interreflects(elements, old.irradiance, lighting.sky):
+        return "geometry"                     # light bounces now: the hemicubes are needed
+    return change
+
+
+def change_between(before: Elements, lighting_before: Lighting, elements: Elements, lighting: Lighting) -> str:
+    """"geometry", "lights", "materials" or "nothing": what differs between two radiosity
+    problems, their elements and lighting alone (what_changed adds what a solution drew)."""
+    if not (np.array_equal(before.corners, elements.corners) and np.array_equal(before.obj, elements.obj)):
+        return "geometry"
+    if (lighting_before.sources, lighting_before.resolution, lighting_before.specular) != (
             lighting.sources, lighting.resolution, lighting.specular):
         return "lights"
-    if not old.form_factors.drawn and interreflects(elements, old.irradiance, lighting.sky):
-        return "geometry"                     # light bounces now: the hemicubes are needed
     if (np.array_equal(before.reflectance, elements.reflectance)
-            and np.array_equal(before.emission, elements.emission) and old.lighting.sky == lighting.sky):
+            and np.array_equal(before.emission, elements.emission) and lighting_before.sky == lighting.sky):
         return "nothing"
     return "materials"
+
+
+def direct_light(old, change: str, elements: Elements, lighting: Lighting, open_drawer,
+                 keep_surfaces: bool) -> tuple:
+    """(H (E, 3) or None, LightSurfaces or None): the lights' direct irradiance on `elements`,
+    old's where only the materials changed, else drawn from the lights' buffers (`open_drawer`
+    as refreshed's); with `keep_surfaces` and a specular scene, the buffers' surfaces from the
+    same draws (the specular term's shadows)."""
+    kept = [] if keep_surfaces and lighting.specular else None
+    if change == "materials":
+        return old.irradiance, old.light_surfaces if kept is not None else None
+    if not (lighting.sources and len(elements)):
+        return None, None
+    with open_drawer(elements, lighting.resolution, "lights") as drawer:
+        h = light_buffers.irradiance(elements, lighting.sources, drawer.views, keep=kept)
+    return h, kept[0] if kept else None
+
+
+def source_emission(elements: Elements, irradiance, matrix: FormFactors, lighting: Lighting) -> np.ndarray:
+    """(E, 3): what the solvers take as emission, E + rho (H + S), S the sky's radiosity times
+    what each hemicube saw of nothing (matrix.unseen)."""
+    emission = elements.emission if irradiance is None else elements.emission + elements.reflectance * irradiance
+    sky = np.asarray(lighting.sky, np.float64)
+    if sky.any():
+        emission = emission + elements.reflectance * matrix.unseen[:, None] * sky
+    return emission
 
 
 def refreshed(old: RadiositySolution | None, elements: Elements, lighting: Lighting, options: RadiosityOptions,
@@ -193,16 +227,7 @@ def _solved(old, change: str, elements: Elements, lighting: Lighting, options: R
             open_drawer, backend: str, name: str, keep_surfaces: bool = False) -> RadiositySolution:
     """The solution for `elements` given what `change`d since `old`'s (refreshed); with
     `keep_surfaces` and a specular scene, the light buffers' surfaces kept from the same draws."""
-    kept = [] if keep_surfaces and lighting.specular else None
-    if change == "materials":
-        h = old.irradiance
-        if kept is not None and old.light_surfaces is not None:
-            kept.append(old.light_surfaces)
-    elif lighting.sources and len(elements):
-        with open_drawer(elements, lighting.resolution, "lights") as drawer:
-            h = light_buffers.irradiance(elements, lighting.sources, drawer.views, keep=kept)
-    else:
-        h = None
+    h, surfaces = direct_light(old, change, elements, lighting, open_drawer, keep_surfaces)
     matrix = None if change == "geometry" else old.form_factors
     if interreflects(elements, h, lighting.sky) and (matrix is None or not matrix.drawn):
         memory.check_radiosity(len(elements), options.hemicube, backend, name,
@@ -210,7 +235,7 @@ def _solved(old, change: str, elements: Elements, lighting: Lighting, options: R
         with open_drawer(elements, options.hemicube, "hemicubes") as drawer:
             matrix = form_factors(len(elements), options.hemicube, drawer.draw, drawer.batch)
     solution = solve(elements, options, matrix, h, lighting)
-    solution.light_surfaces = kept[0] if kept else None
+    solution.light_surfaces = surfaces
     return solution
 
 
@@ -223,10 +248,7 @@ def solve(elements: Elements, options: RadiosityOptions, matrix: FormFactors | N
     else): the solver's emission is E + rho (H + S)."""
     if matrix is None:
         matrix = FormFactors.none(len(elements), unseen=0.0 if elements.see_each_other else 1.0)
-    emission = elements.emission if irradiance is None else elements.emission + elements.reflectance * irradiance
-    sky = np.asarray(lighting.sky, np.float64)
-    if sky.any():
-        emission = emission + elements.reflectance * matrix.unseen[:, None] * sky
+    emission = source_emission(elements, irradiance, matrix, lighting)
     limit = {} if options.max_iterations is None else (
         {"max_sweeps": options.max_iterations} if options.solver == "gauss-seidel"
         else {"max_shots": options.max_iterations})

@@ -28,10 +28,10 @@ from typing import Iterator
 
 import numpy as np
 
-from renderer.core import light_buffers, memory
+from renderer.core import memory
 from renderer.core.form_factors import FormFactors, RowsDrawn
-from renderer.core.radiosity import (Lighting, RadiositySolution, corner_values, interreflects, solve,
-                                     what_changed)
+from renderer.core.radiosity import (Lighting, RadiositySolution, corner_values, direct_light, interreflects,
+                                     solve, source_emission, what_changed)
 from renderer.core.radiosity_elements import Elements
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.core.radiosity_solve import Shooter, Solution, ambient
@@ -69,15 +69,7 @@ def progressive_solution(old: RadiositySolution | None, elements: Elements, ligh
     if change == "nothing":
         yield Progress(old, "converged", "radiosity: converged", done=True)
         return
-    if change == "materials":
-        h, surfaces = old.irradiance, old.light_surfaces
-    elif lighting.sources and len(elements):
-        kept = [] if lighting.specular else None
-        with open_drawer(elements, lighting.resolution, "lights") as drawer:
-            h = light_buffers.irradiance(elements, lighting.sources, drawer.views, keep=kept)
-        surfaces = kept[0] if kept else None
-    else:
-        h, surfaces = None, None
+    h, surfaces = direct_light(old, change, elements, lighting, open_drawer, keep_surfaces=True)
     matrix = None if change == "geometry" else old.form_factors
     if not interreflects(elements, h, lighting.sky):
         solution = solve(elements, options, matrix, h, lighting)    # exact: no bounce to wait for
@@ -98,10 +90,7 @@ def progressive_solution(old: RadiositySolution | None, elements: Elements, ligh
                 yield Progress(_showing(elements, first_look, h, lighting, surfaces), "hemicubes",
                                f"radiosity: hemicubes {rows.done:,} of {len(elements):,}")
         matrix = rows.matrix()
-    emission = direct
-    sky = np.asarray(lighting.sky, np.float64)
-    if sky.any():
-        emission = emission + rho * matrix.unseen[:, None] * sky
+    emission = source_emission(elements, h, matrix, lighting)
     shooter = Shooter(matrix, elements.areas, rho, emission, tolerance=tolerance)
     step = shots_per_step or max(1, int(SHOTS_PER_STEP_SHARE * len(elements)))
     limit = 100 * len(elements)

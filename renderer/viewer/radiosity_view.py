@@ -13,20 +13,11 @@ RadiosityRenderer in the window's context and handed to the presenter as an imag
 
 from __future__ import annotations
 
-import numpy as np
-
-from renderer.core.radiosity import elements_for, lighting_for
+from renderer.core.radiosity import change_between, elements_for, lighting_for
 from renderer.core.radiosity_options import RadiosityOptions
 from renderer.errors import UserError
 from renderer.gpu.radiosity import RadiosityRenderer
 from renderer.viewer.presenter import CpuImage
-
-
-def _same(a, b) -> bool:
-    """Whether two (elements, lighting) pairs are one radiosity problem."""
-    (ea, la), (eb, lb) = a, b
-    return la == lb and all(np.array_equal(getattr(ea, k), getattr(eb, k))
-                            for k in ("corners", "obj", "reflectance", "emission"))
 
 
 class RadiosityView:
@@ -57,7 +48,7 @@ class RadiosityView:
         self.renderer.scene = drawn                    # the camera, as the viewer moves it
         if changed:
             problem = (elements_for(drawn, self.options), lighting_for(drawn, self.options))
-            if self._for is None or not _same(problem, self._for):
+            if self._for is None or change_between(*self._for, *problem) != "nothing":
                 self._restart(problem)
         if self._steps is not None:
             try:

@@ -21,7 +21,7 @@ from renderer.core import transforms
 from renderer.core.primitives import icosphere
 from renderer.core.tessellation import MAX_LEVEL, SPACINGS, TARGET_PIXEL_ERROR
 from renderer.gpu.context import activate
-from renderer.gpu.shaders import shader_source
+from renderer.gpu.shaders import TESSELLATION_SPACING_DEFINES, shader_source
 from tests.tessellation_capture import feedback
 
 CENTRE, RADIUS = (0.2, 0.1, -0.3), 0.5
@@ -30,8 +30,6 @@ VIEW = transforms.look_at((0.0, 1.0, 3.0), (1.0, 0.5, -2.0), (0.0, 1.0, 0.0))
 PROJECTION = transforms.perspective(np.radians(50.0), 4 / 3, 0.1, 50.0)
 HEIGHT = 240
 CAPTURED = np.dtype([("position", "<f4", 3), ("normal", "<f4", 3), ("levels", "<f4", 4)])
-SPACING_DEFINES = {"equal_spacing": "SPACING_EQUAL", "fractional_even_spacing": "SPACING_FRACTIONAL_EVEN",
-                   "fractional_odd_spacing": "SPACING_FRACTIONAL_ODD"}
 
 
 def uniforms(radius_world=1.5 * RADIUS, target=TARGET_PIXEL_ERROR, view=VIEW):
@@ -48,7 +46,7 @@ def patch_mesh(subdivisions=1):
 def gpu_capture(ctx, corners, normals, u: ControlUniforms, spacing):
     """The evaluation stage's points, normals and levels of every primitive vertex in order."""
     activate(ctx)
-    defines = {"SURFACE_SPHERE": True, "CAPTURE": True, SPACING_DEFINES[spacing]: True}
+    defines = {"SURFACE_SPHERE": True, "CAPTURE": True, TESSELLATION_SPACING_DEFINES[spacing]: True}
     program = ctx.program(vertex_shader=shader_source("tess_vertex.glsl").text,
                           tess_control_shader=shader_source("tess_control.glsl").text,
                           tess_evaluation_shader=shader_source("tess_evaluation.glsl", defines).text,
@@ -100,9 +98,7 @@ def test_the_level_keeps_the_middle_segments_sagitta_at_the_target():
     with L - 1 parts, by more (where the level is above 1 and below the cap)."""
     corners, _ = patch_mesh()
     u = uniforms()
-    world = transforms.transform_points(MODEL, corners.reshape(-1, 3).astype(np.float64))[:, :3].reshape(-1, 3, 3) \
-        if hasattr(transforms, "transform_points") else \
-        (corners.reshape(-1, 3).astype(np.float64) @ MODEL[:3, :3].T + MODEL[:3, 3]).reshape(-1, 3, 3)
+    world = (corners.reshape(-1, 3).astype(np.float64) @ MODEL[:3, :3].T + MODEL[:3, 3]).reshape(-1, 3, 3)
     a, b = world[:, 1], world[:, 2]
     level = edge_levels(a.astype(np.float32), b.astype(np.float32), u).astype(np.float64)
     R = u.surface_radius

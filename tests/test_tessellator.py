@@ -14,7 +14,8 @@ clamps and culling), each on both contexts; then a representative sweep (every d
 spacing, both orders, point mode) in a few draws; then what one draw of many patches does on
 llvmpipe 22.3.6 (runs of 4096 input vertices, uint16 element indices). The exhaustive sweep
 (every integer level 1 .. 64 against a set of others, every eighth from 0 to 66, mixed per-edge
-levels, special values) is marked slow.
+levels, special values) is marked slow, and so is every case's OSMesa run (the same llvmpipe
+tessellator as EGL's; the full run holds both).
 """
 
 import numpy as np
@@ -25,7 +26,8 @@ from reference.tessellation.tessellator import (MAX_RUN_POINTS, PATCH_RUN_VERTIC
                                                 tessellate)
 from tests.tessellation_capture import VERTICES_PER_PRIMITIVE, capture
 
-CONTEXTS = ("egl", "osmesa")
+# OSMesa runs the same llvmpipe tessellator as EGL: its cases in the full run (the default run's budget)
+CONTEXT_PARAMS = ["egl", pytest.param("osmesa", marks=pytest.mark.slow)]
 DOMAINS = ("triangles", "quads", "isolines")
 DENORMAL = float(np.float32(1e-40))
 
@@ -101,7 +103,7 @@ def row(outer, inner=()):
 
 # -- hand-checked cases ----------------------------------------------------------------------------
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_a_quad_at_level_1_is_its_four_corners_and_two_triangles(gl_contexts, kind):
     quad = tessellate("quads", "equal_spacing", [1, 1, 1, 1], [1, 1])
     assert quad.u.tolist() == [0, 1, 1, 0] and quad.v.tolist() == [0, 0, 1, 1]
@@ -114,7 +116,7 @@ def test_a_quad_at_level_1_is_its_four_corners_and_two_triangles(gl_contexts, ki
             assert_draw_matches(gl_contexts[kind], "quads", spacing, [row([1] * 4, [1, 1])], order)
 
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_a_triangle_at_level_1_is_one_triangle(gl_contexts, kind):
     triangle = tessellate("triangles", "equal_spacing", [1, 1, 1], [1])
     # D3D's order: V = 1, then W = 1, then U = 1; gl_TessCoord's third is (1 - u) - v
@@ -125,7 +127,7 @@ def test_a_triangle_at_level_1_is_one_triangle(gl_contexts, kind):
         assert_draw_matches(gl_contexts[kind], "triangles", "equal_spacing", [row([1, 1, 1], [1])], order)
 
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_equal_spacing_at_level_3_puts_the_edge_points_at_fixed_point_thirds(gl_contexts, kind):
     """Points are 15.16 fixed point: a third is 0x5555 / 65536 and two thirds 0xaaab / 65536
     (1 - 0x5555 / 65536, the far half mirrored), not float32(1 / 3) and float32(2 / 3)."""
@@ -140,7 +142,7 @@ def test_equal_spacing_at_level_3_puts_the_edge_points_at_fixed_point_thirds(gl_
     assert_draw_matches(gl_contexts[kind], "quads", "equal_spacing", [row([3] * 4, [3, 3])])
 
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_fractional_odd_at_level_1_and_just_above(gl_contexts, kind):
     """fractional_odd at all levels 1 is the bare triangle; an outer level that stays 1 in
     fixed point (1 + 2^-17 rounds to 0x10000) too; the next float32 above, 0x10001 in fixed
@@ -158,7 +160,7 @@ def test_fractional_odd_at_level_1_and_just_above(gl_contexts, kind):
     assert_draw_matches(gl_contexts[kind], "triangles", "fractional_odd_spacing", levels)
 
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_levels_are_clamped_and_an_outer_level_of_zero_or_nan_culls_the_patch(gl_contexts, kind):
     """An outer level the domain reads <= 0 or NaN culls the patch; so does a denormal one
     (llvmpipe draws with denormals as zero: D3D's C alone would keep it); an unread outer level
@@ -203,7 +205,7 @@ def representative_levels() -> np.ndarray:
 
 
 @pytest.mark.parametrize("domain", DOMAINS)
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_the_twin_tessellates_as_llvmpipe_does(gl_contexts, kind, domain):
     """Every spacing, counter-clockwise over the representative levels; clockwise and point
     mode over a few of them."""
@@ -258,7 +260,7 @@ def test_the_twin_tessellates_as_llvmpipe_does_exhaustively(gl_contexts, domain,
 
 # -- one draw of many patches ------------------------------------------------------------------------
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_a_draw_past_65536_domain_points_wraps_its_uint16_element_indices(gl_contexts, kind):
     """draw_tess.c stores each primitive vertex's element index, the patch's first point's
     number in the draw plus its index, as a uint16. 16 quads at level 63 (4096 points each)
@@ -286,7 +288,7 @@ def test_a_draw_past_65536_domain_points_wraps_its_uint16_element_indices(gl_con
     assert_draw_matches(ctx, "quads", "fractional_odd_spacing", big, twins=twins)
 
 
-@pytest.mark.parametrize("kind", CONTEXTS)
+@pytest.mark.parametrize("kind", CONTEXT_PARAMS)
 def test_a_draw_is_cut_into_runs_of_4096_input_vertices_and_gl_primitive_id_restarts_in_each(gl_contexts, kind):
     """llvmpipe tessellates a draw of patches in runs of 4096 // GL_PATCH_VERTICES patches;
     each run's points and element indices start again from 0, and so does gl_PrimitiveID in

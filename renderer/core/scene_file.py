@@ -39,6 +39,7 @@ from renderer.core.user_files import SCENE_FILE, USER_FILE_CAPS, FileRefused, re
 from renderer.core.primitives import PRIMITIVES
 from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core import shapes
+from renderer.core import tessellation
 from renderer.core.gltf_texture import base_colour_texture
 from renderer.core.texture_keys import read_texture
 from renderer.core.shadow_settings import (FILTERS, MAX_BIAS_TEXELS, RESOLUTIONS, BiasRule, Shadow,
@@ -790,7 +791,6 @@ class _Reader(TableReader):
         """An object's tessellation stages (renderer/core/tessellation.py): `spacing` ("equal",
         "fractional_even", "fractional_odd"), `error` in pixels or a fixed `level` (1 to 64).
         Only an analytic sphere is tessellated yet, and not with a texture or shadow maps."""
-        from renderer.core import tessellation
         if not isinstance(raw, dict):
             self.fail(path, f"expected a table such as {{error = 0.25}} or {{level = 8}}, got {describe_value(raw)}")
         raw = self.table(raw, path, TESSELLATION_KEYS)

@@ -34,6 +34,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from renderer.core.scene import Sphere
+from renderer.core.shapes import sphere_mesh
+
 TARGET_PIXEL_ERROR = 0.25        # pixels: the issue's target of the geometric error on screen
 # The edges' sagitta is held to this share of the target: a triangle's interior dips deeper than
 # its edges (an equilateral one's circumcentre by 4/3 of its edges' midpoints' sagitta, the
@@ -79,7 +82,6 @@ class Tessellation:
 def patch_mesh(sphere):
     """The coarse patches a tessellated sphere is drawn from: icosphere(PATCH_SUBDIVISIONS) of
     the sphere, its corners on the surface (renderer/core/shapes.py sphere_mesh)."""
-    from renderer.core.shapes import sphere_mesh
     return sphere_mesh(sphere, PATCH_SUBDIVISIONS)
 
 
@@ -87,7 +89,6 @@ def check_tessellated(obj) -> None:
     """A ValueError naming `obj` where its tessellation asks for what the stages do not draw
     yet: a shape other than an analytic sphere, a texture (the sphere's UV seam), shadow maps
     looked up (their facets are the patches'). The scene file refuses the same in one line."""
-    from renderer.core.scene import Sphere
     if obj.tessellation is None:
         return
     if not isinstance(obj.shape, Sphere):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from renderer.core.scene import FrameMatrices, Material, ObjectMatrices, Scene, SceneObject
+from renderer.core.tessellation import EDGE_ERROR_SHARE, MAX_LEVEL
 from renderer.core.textures import MaterialTexture
 
 # name -> GLSL type; "vec3[]" is an array with one row per light of that kind.
@@ -149,7 +150,6 @@ def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.
 def tessellation_uniforms(obj: SceneObject, matrices: ObjectMatrices, height: int) -> dict[str, np.ndarray]:
     """A tessellated sphere's uniforms (TESSELLATION_UNIFORMS) in a frame `height` pixels tall;
     empty for an object drawn without the tessellation stages."""
-    from renderer.core.tessellation import EDGE_ERROR_SHARE, MAX_LEVEL
     settings = obj.tessellation
     if settings is None:
         return {}

@@ -409,6 +409,34 @@ def test_ctrl_c_in_this_process_says_how_many_items_are_done(job_file, finished,
     assert LOCK_NAME not in files(out) and not [f for f in files(out) if f.endswith(".tmp")]
 
 
+def test_ctrl_c_while_an_item_is_written_ends_the_calls_before_the_executor_closes(
+        job_file, tmp_path, monkeypatch):
+    # The interrupt lands in the loop that writes, outside the executor's generator: the
+    # generator is closed there (its calls cancelled, Ray's actors killed) before the executor
+    # closes, not when the exception is freed (on Ray, the calls killed with the disconnected
+    # driver's actors were retried, and Ray said so on stdout).
+    events = []
+
+    class Watched(executor.InProcessExecutor):
+        def map(self, factory, batches):
+            try:
+                yield from super().map(factory, batches)
+            finally:
+                events.append("calls ended")
+
+        def close(self):
+            events.append("executor closed")
+
+    def interrupt(self, item, result, *rest):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(executor, "open_executor", lambda *args: Watched())
+    monkeypatch.setattr(batch_run._Writer, "write", interrupt)
+    status, said = batch_here(job_file, tmp_path / "out", monkeypatch)
+    assert (status, said) == (130, ["renderer: interrupted; 0 of 2 items done; run the same "
+                                    "command to resume"])
+    assert events == ["calls ended", "executor closed"]
+
+
 @pytest.mark.slow
 def test_ctrl_c_mid_job_is_one_line_and_status_130_then_the_job_resumes(long_job, tmp_path):
     out = tmp_path / "out"

@@ -250,8 +250,6 @@ def test_a_worker_killed_mid_map_costs_only_a_retry(ray_executor):
 
 
 def test_a_batch_that_always_kills_its_worker_fails_the_map(ray_executor, monkeypatch):
-    from renderer.cluster import ray_executor as module
-    monkeypatch.setattr(module, "CALL_RETRIES", 0)          # the executor's own attempts only
     done = []
     with ray_executor(workers=1) as executor:
         # The batches waiting on the actor (IN_FLIGHT) die with it: any of them may be the

@@ -15,7 +15,7 @@ from renderer.core.scene import (Camera, DirectionalLight, Material, Mesh, Point
                                  SceneObject, Transform)
 from renderer.core.scene_file import load_scene
 from renderer.core.shadow_casting import Occluders, world_geometry
-from renderer.core.shadow_settings import CONSTANT_BIAS_TEXELS, Shadow
+from renderer.core.shadow_settings import CONSTANT_BIAS_TEXELS, FILTERS, RESOLUTIONS, Shadow, auto_resolution
 from renderer.core.shadows import LayerStack, plan_shadows, shadow_layout, shadow_lights
 from renderer.gpu import GpuRenderer
 
@@ -184,3 +184,17 @@ def test_each_kind_of_light_has_a_stack_of_its_own_size():
     assert layout.stack("directional") == LayerStack(2048, 1)
     assert layout.stack("point") == LayerStack(512, 6)
     assert [tile.layer for tile in layout.get("point", 0).tiles] == [0, 1, 2, 3, 4, 5]
+
+
+def test_an_image_far_longer_than_wide_gets_maps_for_its_pixels_not_its_long_side():
+    """Automatic maps hold at most 128 texels per image pixel: at 1 x 16384 (16,384 pixels,
+    2 M texels a map) the directional map's 2 x 16384 -> 4096 halves to 1024 (1 M texels; 2048
+    is 4 M) and a cube face's 8192 -> 4096 to 512 (six faces 1.5 M; 1024 is 6 M), either way
+    round. Usual shapes keep the long side's rule, whatever the filter: 640 x 480 gets 2048 and
+    512 (13.7 and 5.1 texels a pixel), pcf5x5 at 206 x 206 (the worst rounding up: 1030 ->
+    2048) keeps 2048, 98.8 a pixel; the smallest map stays even where it is more."""
+    assert auto_resolution(1, 16384, point=False) == auto_resolution(16384, 1, point=False) == 1024
+    assert auto_resolution(1, 16384, point=True) == auto_resolution(16384, 1, point=True) == 512
+    assert (auto_resolution(640, 480, point=False), auto_resolution(640, 480, point=True)) == (2048, 512)
+    assert auto_resolution(206, 206, point=False, kernel=FILTERS["pcf5x5"]) == 2048
+    assert auto_resolution(1, 1, point=True) == RESOLUTIONS[0]

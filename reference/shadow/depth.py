@@ -246,16 +246,22 @@ def draw_pass(scene, matrices, shadow_pass, layers: ShadowLayers, dtype=np.float
     in_doubt[doubt] = True
     edges = edge_equations(tris.window)
     rows = max(1, tile_pixels // size)
+    # one band's buffers, made once and refilled: a fresh array a band costs its page faults
+    # again (most of a large map's time); `first` is left NONE by _nearest_first
+    scratch = min(rows, size) * size
+    z_all, winner_all, in_ring_all = np.empty(scratch, dtype), np.empty(scratch, np.int64), np.empty(scratch, bool)
+    behind_all, first = np.empty(scratch, dtype), np.full(scratch, NONE)
     for band0 in range(0, size, rows):
         band1 = min(band0 + rows, size)
         region = (0, band0, size, band1)
-        z_buffer = np.ones((band1 - band0) * size, dtype)
-        winner = np.full(len(z_buffer), -1, np.int64)
-        first = np.full(len(z_buffer), NONE)
+        count = (band1 - band0) * size
+        z_buffer, winner, in_ring, behind = (a[:count] for a in (z_all, winner_all, in_ring_all, behind_all))
+        z_buffer.fill(1.0)
+        winner.fill(-1)
+        in_ring.fill(False)
+        behind.fill(1.0)        # at ring texels: the nearest sure cover + tolerance
         ring_texel, ring_triangle, ring_z = _ring(tris, doubt, band0, size, region, dtype)
-        in_ring = np.zeros(len(z_buffer), bool)
         in_ring[ring_texel] = True
-        behind = np.ones(len(z_buffer), dtype)     # at ring texels: the nearest sure cover + tolerance
         for t, px, py in coverage(tris.window, size, size, region=region):
             texel, z = (py - band0) * size + px, _texel_depth(tris.plane, t, px, py, dtype)
             _nearest_first(z_buffer, winner, first, texel, z, t)
@@ -272,18 +278,12 @@ def draw_pass(scene, matrices, shadow_pass, layers: ShadowLayers, dtype=np.float
         layers.below[layer, where // size + band0, where % size] = z_buffer[where] - nearest
         unsure = ring_texel[winner[ring_texel] == ring_triangle]
         layers.above[layer, unsure // size + band0, unsure % size] = behind[unsure] - z_buffer[unsure]
-        drawn = winner >= 0
-        texels = np.flatnonzero(drawn)
+        texels = np.flatnonzero(winner >= 0)         # the rest stay cleared
         t, x, y = winner[texels], texels % size, texels // size + band0
         depth = z_buffer[texels].astype(np.float64)
-        at = (layer, slice(band0, band1), slice(0, size))
-        layers.depth[at] = np.where(drawn, z_buffer, 1.0).astype(np.float32).reshape(-1, size)
-        caster = np.full(len(z_buffer), -1, np.int32)
-        caster[texels] = tris.caster[t]
-        layers.caster[at] = caster.reshape(-1, size)
-        tolerance = np.zeros(len(z_buffer), np.float32)
-        tolerance[texels] = _tolerance(tris, t, x, y, depth)
-        layers.tolerance[at] = tolerance.reshape(-1, size)
+        layers.depth[layer, y, x] = depth.astype(np.float32)
+        layers.caster[layer, y, x] = tris.caster[t]
+        layers.tolerance[layer, y, x] = _tolerance(tris, t, x, y, depth)
 
 
 def render_layers(scene, matrices, plan, dtype=np.float64,

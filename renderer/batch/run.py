@@ -254,8 +254,12 @@ def _run(plan: Plan, executor, summary: Summary, context_kind: str, progress: bo
     batches = batches_of(todo, size)
     factory = functools.partial(ItemWorker, context_kind, keep_frames=plan.compare)
     held = []                                  # --compare: GPU results awaiting the reference
-    with _bar(len(todo), "item", progress) as bar:
-        for index, results in executor.map(factory, batches):
+    # closed on the way out: a Ctrl-C while an item is written (outside the generator) cancels
+    # the calls in flight and stops the actors here, not when the exception is freed, after
+    # the executor has closed (Ray then retries them, and says so on stdout)
+    with _bar(len(todo), "item", progress) as bar, \
+            contextlib.closing(executor.map(factory, batches)) as finished:
+        for index, results in finished:
             for item, result in zip(batches[index], results):
                 if result.error is not None:
                     writer.failed(item.key, result.error, result.bug)
@@ -273,8 +277,9 @@ def _run(plan: Plan, executor, summary: Summary, context_kind: str, progress: bo
 def _compare(held, executor, writer: _Writer, progress: bool) -> None:
     """The reference of each held item, in plain tasks; then its files and record."""
     args = [(item, *result.frame) for item, result in held]
-    with _bar(len(held), "reference", progress) as bar:
-        for index, outcome in executor.tasks(reference_item, args):
+    with _bar(len(held), "reference", progress) as bar, \
+            contextlib.closing(executor.tasks(reference_item, args)) as finished:
+        for index, outcome in finished:
             item, result = held[index]
             if outcome.error is not None:
                 writer.failed(item.key, outcome.error, outcome.bug)

@@ -14,8 +14,8 @@ order. `map` yields (batch index, results) as batches finish, in whatever order 
 callers key results by unit, never by arrival, so nothing depends on which worker ran what.
 
 Faults (Ray): a worker process that dies costs only the batches it held. Ray restarts the
-actor and retries its calls; a batch that still fails is queued again by the executor, and
-after MAX_ATTEMPTS failures of one batch `map` raises BatchFailed. Work must therefore be
+actor; the batches it held are queued again by the executor, and after MAX_ATTEMPTS failures
+of one batch `map` raises BatchFailed. Work must therefore be
 idempotent: a unit may run twice, and its results must be the same bytes both times.
 
 Workers on Ray never write files: they return results and the caller (the driver) writes,
@@ -68,7 +68,9 @@ class Executor(Protocol):
     workers: int        # how many workers run batches at once
 
     def map(self, factory: Callable[[], Any], batches: list[list]) -> Iterator[tuple[int, list]]:
-        """(batch index, worker.run(batch)) for every batch, in the order they finish."""
+        """(batch index, worker.run(batch)) for every batch, in the order they finish: a
+        generator, which a caller stopping early closes (contextlib.closing) before it closes
+        the executor, so that its calls in flight end first."""
 
     def tasks(self, function: Callable, args: Iterable[tuple]) -> Iterator[tuple[int, Any]]:
         """(index, function(*args[index])) for every argument tuple, in the order they finish;

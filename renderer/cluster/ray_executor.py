@@ -29,14 +29,14 @@ them where they are not).
 
 Scheduling. A ray.wait loop with IN_FLIGHT calls queued on each actor, so that an actor
 finishing a batch finds the next one waiting (a call's round trip, benchmarks/results/batch.md, is hidden
-this way). Faults: actors restart without limit (max_restarts=-1) and retry their calls
-(max_task_retries=3); a batch whose call still fails is queued again here, and a batch
-failing MAX_ATTEMPTS times raises BatchFailed (a batch that kills its process every time
-takes the batch queued behind it on the same actor down with it, so BatchFailed may name
-either). An exception raised by the worker's own code is not a fault but a bug (or a
-UserError): it is raised here at once, as in-process. A map or tasks left early (that
-error, or Ctrl-C in the driver) cancels its calls still in flight before the actors go, so
-that Ray retries none of them and prints nothing of them.
+this way). Faults: actors restart without limit (max_restarts=-1); Ray retries no call
+(CALL_RETRIES = 0): a call lost with its process is queued again here, and a batch failing
+MAX_ATTEMPTS times raises BatchFailed (a batch that kills its process every time takes the
+batch queued behind it on the same actor down with it, so BatchFailed may name either). An
+exception raised by the worker's own code is not a fault but a bug (or a UserError): it is
+raised here at once, as in-process. A map or tasks left early (that error, or Ctrl-C in the
+driver) cancels its calls still in flight, then the actors go with any call still running
+in them; Ray retries none of them and prints nothing of them.
 """
 
 from __future__ import annotations
@@ -53,8 +53,10 @@ from renderer.cluster.faults import MAX_ATTEMPTS, BatchFailed
 from renderer.errors import UserError
 
 IN_FLIGHT = 2                   # calls queued per actor
-CALL_RETRIES = 3                # Ray's own retries of a call lost with its process
-CANCEL_GRACE_S = 5.0            # how long a call cancelled while running may take to end
+# Ray's own retries of a call lost with its process: none. Ray prints a line on stdout for each
+# retry it would make, also of the calls of actors killed at a map's end (a Ctrl-C); the loop
+# here queues a lost call again itself (MAX_ATTEMPTS), the one retry rule.
+CALL_RETRIES = 0
 QUIET = dict(log_to_driver=False, logging_level="ERROR")
 # Ray's connection bounds while connecting to an --address (its defaults retry for minutes
 # where something answers that is not a Ray head: 82 s measured with the first alone at 2);
@@ -216,23 +218,19 @@ def _schedule(actors: list, batches: list[list]) -> Iterator[tuple[int, list]]:
 
 
 def _cancel(pending: dict) -> None:
-    """Cancel the calls still queued or running, so that killing their actors next (map's
-    end) retries none of them: Ray would say so on stdout, a line per call. A call already
-    running in an actor is not stopped by its cancel (a synchronous actor's is not): it is
-    given up to CANCEL_GRACE_S to end before the actors are killed, or Ray retries and says so."""
+    """Cancel the calls still queued or running: a queued one is dropped, a running plain
+    task interrupted. A call running in an actor is not stopped (a synchronous actor's is
+    not): it goes with its actor (map's end)."""
     import ray
     for ref in pending:
         with contextlib.suppress(Exception):
             ray.cancel(ref)
-    if pending:
-        with contextlib.suppress(Exception):
-            ray.wait(list(pending), num_returns=len(pending), timeout=CANCEL_GRACE_S)
 
 
 def _as_finished(pending: dict, what: str, again: Callable) -> Iterator[tuple[tuple, Any]]:
     """(tag, result) for each call of `pending` ({ObjectRef: (index, ...)}, which grows as
     the caller submits more) as it finishes: the ray.wait loop. A call lost to a fault
-    (its process died, and Ray's retries with it) is handed to again(tag) to be submitted
+    (its process died) is handed to again(tag) to be submitted
     once more, MAX_ATTEMPTS times per index at most (then BatchFailed); an exception
     raised by the work itself is raised here (_get)."""
     import ray

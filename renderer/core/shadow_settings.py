@@ -21,6 +21,11 @@ DEFAULT_FILTER = "pcf2x2"
 
 RESOLUTIONS = (64, 128, 256, 512, 1024, 2048, 4096)   # texels on a side of a map; powers of two
 MAX_SHADOW_TEXELS = 1 << 26                    # all layers together: 256 MiB of float32 depth
+# An automatic map (a cube's six faces together) holds at most this many texels per image
+# pixel. A map sized by the image's longer side is square, so an image far longer than wide
+# (1 x 16384) would get 29 M texels for 16 K pixels; an image of a usual shape and any filter
+# stays under it (at most 100 for a directional map with pcf5x5, 37.5 for a cube).
+MAX_AUTO_TEXELS_PER_PIXEL = 128
 
 
 @dataclass(frozen=True)
@@ -136,12 +141,17 @@ def auto_resolution(width: int, height: int, point: bool, kernel: int = FILTERS[
     texel per pixel where the camera looks at what the light lights; times the filter's reach
     in texels (footprint_radius: 1 for the default pcf2x2, 2.5 for pcf5x5; not less than 1),
     so that a wider filter reads as far in pixels, and a shadow thinner than its footprint,
-    which it washes out, is as thin on the screen; within RESOLUTIONS.
-    (Held against ray-cast truth: renderer compare --shadows-vs-truth and
+    which it washes out, is as thin on the screen; within RESOLUTIONS; halved while the map
+    (all six faces of a cube) holds more than MAX_AUTO_TEXELS_PER_PIXEL texels per image pixel
+    (only images far longer than wide: their long side's sharpness is given up for time and
+    memory). (Held against ray-cast truth: renderer compare --shadows-vs-truth and
     benchmarks/shadow_truth_table.py give each built-in scene's figures at these sizes.)"""
     target = (max(width, height) / 2 if point else max(width, height) * 2) * max(1.0, footprint_radius(kernel))
-    side = 1 << max(0, math.ceil(math.log2(max(target, 1))))
-    return min(max(side, RESOLUTIONS[0]), RESOLUTIONS[-1])
+    side = min(max(1 << max(0, math.ceil(math.log2(max(target, 1)))), RESOLUTIONS[0]), RESOLUTIONS[-1])
+    faces = 6 if point else 1
+    while side > RESOLUTIONS[0] and faces * side * side > MAX_AUTO_TEXELS_PER_PIXEL * width * height:
+        side //= 2
+    return side
 
 
 def tap_offsets(kernel: int) -> np.ndarray:

@@ -167,19 +167,22 @@ def run_units(executor, runner, work: list[SceneWork], runs: int, facts: tuple,
     """Every unit of `work` through `executor`; the rows in (scene, plan) order. A worker
     whose GL facts differ from the driver's `facts` (the plan's) is refused: one line. `bar`
     (tqdm) moves by each batch's unit_cost times `runs`."""
+    from contextlib import closing
     from functools import partial
     batches = plan_batches(work, runs, executor.workers)
     total = sum(len(batch.units) for batch in batches)
     rows = {}
-    for index, results in executor.map(partial(ReportWorker, runner, size, context_kind), batches):
-        batch = batches[index]
-        for (plan_index, _), result in zip(batch.units, results):
-            if result.gl != facts:
-                raise UserError(f"worker {result.row['worker']} has GL_SUBPIXEL_BITS and MSAA "
-                                f"counts {result.gl}, this machine {facts}: the plan and the "
-                                "reference's errors would differ; use workers alike",
-                                key="--address")
-            rows[(batch.scene_index, plan_index)] = result.row
-        bar.set_description(f"settings ({len(rows)} of {total} done, {batch.scene.name})")
-        bar.update(runs * sum(unit_cost(setting) for _, setting in batch.units))
+    # closed on the way out (an error, Ctrl-C), before the executor is: its calls end first
+    with closing(executor.map(partial(ReportWorker, runner, size, context_kind), batches)) as finished:
+        for index, results in finished:
+            batch = batches[index]
+            for (plan_index, _), result in zip(batch.units, results):
+                if result.gl != facts:
+                    raise UserError(f"worker {result.row['worker']} has GL_SUBPIXEL_BITS and MSAA "
+                                    f"counts {result.gl}, this machine {facts}: the plan and the "
+                                    "reference's errors would differ; use workers alike",
+                                    key="--address")
+                rows[(batch.scene_index, plan_index)] = result.row
+            bar.set_description(f"settings ({len(rows)} of {total} done, {batch.scene.name})")
+            bar.update(runs * sum(unit_cost(setting) for _, setting in batch.units))
     return [rows[key] for key in sorted(rows)]

@@ -2,10 +2,13 @@
 #version 410 core
 // Tessellation control (notes 4.1; issue 34): each triangle patch of a curved surface passes
 // its corners on and asks for the levels that keep the surface's deviation from its chords
-// under u_target_error pixels (renderer/core/tessellation.py states the rule and derives it).
+// under u_target_error pixels (renderer/core/tessellation.py states the rules and derives them).
 // gl_TessLevelOuter[i] is the edge opposite corner i (GL's triangle domain: the edge u = 0
 // joins corners 1 and 2); each edge's level depends on its two end points alone, symmetrically,
 // so the two patches sharing an edge compute it from the same bits and no crack opens.
+// SURFACE_SPHERE: an analytic sphere of radius u_surface_radius (world units). SURFACE_PN: the
+// patch's PN triangle; its net's offsets and its edges' mid normals are made here, once a
+// patch, for glsl/tess_evaluation.glsl (c_offset, c_centre, c_mid_normal).
 
 layout(vertices = 3) out;
 
@@ -22,6 +25,57 @@ in vec3 v_position[];                // object space
 in vec3 v_normal[];
 out vec3 c_position[];
 out vec3 c_normal[];
+
+#ifdef SURFACE_PN
+const float PN_CURVE_BOUND = 0.75;   // renderer/core/tessellation.py
+const float ONE_THIRD = 0.33333334;  // float32(1 / 3)
+in float v_straight[];
+// c_offset[2k], c_offset[2k + 1]: o_ij, o_ji of edge k (corners i = k + 1, j = k + 2, mod 3)
+patch out vec3 c_offset[6];
+patch out vec3 c_centre;             // the net's centre's offset: the six offsets' sum / 4
+patch out vec3 c_mid_normal[3];      // edge k's: n_ij
+
+// o_ab: how far the net's point near corner a on the edge to b leaves the flat triangle
+vec3 pn_offset(vec3 pa, vec3 na, vec3 pb) {
+    float w = dot(pb - pa, na);
+    return na * (-w * ONE_THIRD);
+}
+
+vec3 pn_mid_normal(vec3 pa, vec3 na, vec3 pb, vec3 nb) {
+    vec3 e = pb - pa;
+    float e2 = dot(e, e);
+    float v = e2 > 0.0 ? 2.0 * dot(e, na + nb) / e2 : 0.0;
+    return normalize((na + nb) - v * e);
+}
+
+// the level that keeps a cubic whose control points' largest second difference is m (world
+// units) within the target of its chords, seen at clip w
+float pn_level(float m, float w) {
+    if (!(w > 0.0))
+        return u_max_level;
+    float pixels_per_unit = u_viewport_height * u_projection[1][1] / (2.0 * w);
+    float e = u_target_error / pixels_per_unit;
+    float level = sqrt(PN_CURVE_BOUND * m / e);
+    return clamp(level, 1.0, u_max_level);
+}
+
+// the length in world units of an object-space second difference
+float world_length(vec3 d) {
+    return length((u_model * vec4(d, 0.0)).xyz);
+}
+
+float clip_w(vec3 world) {
+    return (u_projection * (u_view * vec4(world, 1.0))).w;
+}
+
+// edge k's level from its ends alone: its two second differences swap with the ends
+float pn_edge_level(vec3 a, vec3 b, vec3 o_ab, vec3 o_ba) {
+    if (u_fixed_level > 0.0)
+        return u_fixed_level;
+    float m = max(world_length(o_ba - 2.0 * o_ab), world_length(o_ab - 2.0 * o_ba));
+    return pn_level(m, clip_w((a + b) * 0.5));
+}
+#endif
 
 float edge_level(vec3 a, vec3 b) {
     if (u_fixed_level > 0.0)
@@ -49,6 +103,41 @@ float edge_level(vec3 a, vec3 b) {
 void main() {
     c_position[gl_InvocationID] = v_position[gl_InvocationID];
     c_normal[gl_InvocationID] = v_normal[gl_InvocationID];
+#ifdef SURFACE_PN
+    if (gl_InvocationID == 0) {
+        vec3 offsets[6];
+        for (int k = 0; k < 3; k++) {
+            int i = (k + 1) % 3, j = (k + 2) % 3;
+            bool curved = !(v_straight[k] > 0.5);
+            offsets[2 * k] = curved ? pn_offset(v_position[i], v_normal[i], v_position[j]) : vec3(0.0);
+            offsets[2 * k + 1] = curved ? pn_offset(v_position[j], v_normal[j], v_position[i]) : vec3(0.0);
+            c_offset[2 * k] = offsets[2 * k];
+            c_offset[2 * k + 1] = offsets[2 * k + 1];
+            c_mid_normal[k] = pn_mid_normal(v_position[i], v_normal[i], v_position[j], v_normal[j]);
+        }
+        vec3 centre = (((((offsets[0] + offsets[1]) + offsets[2]) + offsets[3]) + offsets[4]) + offsets[5]) * 0.25;
+        c_centre = centre;
+        vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
+        vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
+        vec3 p2 = (u_model * vec4(v_position[2], 1.0)).xyz;
+        float outer0 = pn_edge_level(p1, p2, offsets[0], offsets[1]);
+        float outer1 = pn_edge_level(p2, p0, offsets[2], offsets[3]);
+        float outer2 = pn_edge_level(p0, p1, offsets[4], offsets[5]);
+        gl_TessLevelOuter[0] = outer0;
+        gl_TessLevelOuter[1] = outer1;
+        gl_TessLevelOuter[2] = outer2;
+        float inner = max(max(outer0, outer1), outer2);
+        if (!(u_fixed_level > 0.0)) {
+            // the interior's second differences: (o_ik + o_jk) - 2 c for corner k; o_ik is the
+            // offset near i on the edge to k: edge j's (corners k, i) second, edge i's first
+            float m = max(max(world_length((offsets[3] + offsets[0]) - 2.0 * centre),
+                              world_length((offsets[5] + offsets[2]) - 2.0 * centre)),
+                          world_length((offsets[1] + offsets[4]) - 2.0 * centre));
+            inner = max(inner, pn_level(m, clip_w(((p0 + p1) + p2) * ONE_THIRD)));
+        }
+        gl_TessLevelInner[0] = inner;
+    }
+#else
     if (gl_InvocationID == 0) {
         vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
         vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
@@ -61,4 +150,5 @@ void main() {
         gl_TessLevelOuter[2] = outer2;
         gl_TessLevelInner[0] = max(max(outer0, outer1), outer2);
     }
+#endif
 }

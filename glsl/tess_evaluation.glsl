@@ -4,7 +4,13 @@
 // (gl_TessCoord, barycentric in GL's triangle domain) placed on the exact surface, with the
 // surface's exact normal, in object space. SPACING_* picks the tessellator's spacing
 // (equal, fractional_even, fractional_odd); SURFACE_SPHERE: the sphere of centre u_sphere.xyz
-// and radius u_sphere.w, each point the patch's barycentric point projected from the centre.
+// and radius u_sphere.w, each point the patch's barycentric point projected from the centre;
+// SURFACE_PN: the patch's PN triangle (renderer/core/tessellation.py), from the net the control
+// stage made: the flat point plus each edge's term and the centre's, the normal the paper's
+// quadratic. Each edge's term is written so that the edge's two patches compute it alike:
+// 3 (t_a t_b) (t_a o_ab + t_b o_ba), products and sums of two, which commute; on an edge the
+// other terms are exactly 0. `precise` keeps that order: without it the compiler regroups the
+// products (half the points an ulp off the twin's, and an edge's two patches could differ).
 // Then the vertex stage's work on the point (glsl/vertex_stage.glsl: world and clip positions,
 // Gouraud's lighting, what each shading mode hands on), as glsl/vertex.glsl does for a mesh.
 // CAPTURE (tests/test_tessellation_stages.py): instead, the point and its patch's levels handed
@@ -22,6 +28,16 @@ uniform vec4 u_sphere;               // object space: centre xyz, radius w
 
 in vec3 c_position[];
 in vec3 c_normal[];
+#ifdef SURFACE_PN
+patch in vec3 c_offset[6];
+patch in vec3 c_centre;
+patch in vec3 c_mid_normal[3];
+
+// edge k's term (corners i = k + 1, j = k + 2, mod 3)
+vec3 pn_edge(float ti, float tj, vec3 o_ij, vec3 o_ji) {
+    return (3.0 * (ti * tj)) * (ti * o_ij + tj * o_ji);
+}
+#endif
 
 #ifdef CAPTURE
 out vec3 t_position;                 // object space, on the surface
@@ -33,9 +49,17 @@ out vec4 t_levels;                   // gl_TessLevelOuter[0..2], gl_TessLevelInn
 
 void main() {
     vec3 p = gl_TessCoord.x * c_position[0] + gl_TessCoord.y * c_position[1] + gl_TessCoord.z * c_position[2];
-#ifdef SURFACE_SPHERE
+#if defined(SURFACE_SPHERE)
     vec3 n = normalize(p - u_sphere.xyz);
     vec3 position = u_sphere.xyz + u_sphere.w * n;
+#elif defined(SURFACE_PN)
+    vec3 t = gl_TessCoord;
+    precise vec3 edges = (pn_edge(t.y, t.z, c_offset[0], c_offset[1]) + pn_edge(t.z, t.x, c_offset[2], c_offset[3]))
+                         + pn_edge(t.x, t.y, c_offset[4], c_offset[5]);
+    precise vec3 position = (p + edges) + (6.0 * ((t.x * t.y) * t.z)) * c_centre;
+    precise vec3 n = normalize(((((t.x * t.x) * c_normal[0] + (t.y * t.y) * c_normal[1]) + (t.z * t.z) * c_normal[2])
+                        + ((t.y * t.z) * c_mid_normal[0] + (t.z * t.x) * c_mid_normal[1]))
+                       + (t.x * t.y) * c_mid_normal[2]);
 #else
     vec3 n = normalize(gl_TessCoord.x * c_normal[0] + gl_TessCoord.y * c_normal[1] + gl_TessCoord.z * c_normal[2]);
     vec3 position = p;

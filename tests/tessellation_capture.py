@@ -143,3 +143,46 @@ def feedback(ctx, program, vao, vertices: int, patch_vertices: int, primitive: s
         for item in (out, framebuffer):
             item.release()
     return data, generated, written
+
+
+STAGE_OUTPUTS = np.dtype([("position", "<f4", 3), ("normal", "<f4", 3), ("levels", "<f4", 4)])
+
+
+def capture_stages(ctx, defines: dict, corners: np.ndarray, layout: str, attributes: tuple,
+                   uniforms, extra: dict | None = None) -> np.ndarray:
+    """The rasteriser's own stages (glsl/tess_vertex.glsl, tess_control.glsl,
+    tess_evaluation.glsl with `defines` and CAPTURE) drawing `corners` ((P * 3, K) float32,
+    three rows a triangle patch, read as `layout` into `attributes`) with the control uniforms
+    (a reference.tessellation.control.ControlUniforms) and `extra` ones: each primitive
+    vertex's point, normal and its patch's levels (STAGE_OUTPUTS), in order."""
+    activate(ctx)
+    from renderer.core import transforms
+    program = ctx.program(vertex_shader=shader_source("tess_vertex.glsl", defines).text,
+                          tess_control_shader=shader_source("tess_control.glsl", defines).text,
+                          tess_evaluation_shader=shader_source("tess_evaluation.glsl", defines | {"CAPTURE": True}).text,
+                          varyings=["t_position", "t_normal", "t_levels"])
+    vbo = ctx.buffer(np.ascontiguousarray(corners, np.float32).tobytes())
+    vao = None
+    try:
+        for name, matrix in (("u_model", uniforms.model), ("u_view", uniforms.view),
+                             ("u_projection", uniforms.projection)):
+            program[name].write(transforms.to_glsl(matrix))
+        values = {"u_viewport_height": uniforms.viewport_height, "u_target_error": uniforms.target_error,
+                  "u_surface_radius": uniforms.surface_radius, "u_max_level": uniforms.max_level,
+                  "u_fixed_level": uniforms.fixed_level, **(extra or {})}
+        for name, value in values.items():
+            if name in program:                      # the compiler drops what a surface does not read
+                program[name].value = value
+        wanted = [name for name in attributes if name in program]
+        if wanted != list(attributes):               # an attribute dropped: skip its bytes
+            layout = " ".join(part if name in program else f"{int(part[0]) * 4}x"
+                              for part, name in zip(layout.split(), attributes))
+        vao = ctx.vertex_array(program, [(vbo, layout, *wanted)])
+        data, generated, written = feedback(ctx, program, vao, len(corners), 3, "triangles", 1 << 20,
+                                            STAGE_OUTPUTS)
+        assert generated == written
+        return data
+    finally:
+        for item in (vao, vbo, program):
+            if item is not None:
+                item.release()

@@ -30,12 +30,13 @@ BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_p
                  "glossy", "motion_blur", "textured_mesh", "checker_horizon", "globe",
                  "shadow_boxes", "shadow_thin_contact", "shadow_big_floor", "shadow_lowpoly_sphere",
                  "shadow_knot_floor", "radiosity_furnace", "radiosity_plates", "cornell_box_radiosity",
-                 "radiosity_window", "radiosity_specular", "tessellated_sphere"}
+                 "radiosity_window", "radiosity_specular", "tessellated_sphere", "pn_triangles"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera, a ground under it), or a backdrop (tir_bubble's checkerboard) filling
 # the view.
 PARTLY_OUTSIDE = {"near_plane", "tir_bubble", "shadow_room", "checker_horizon", "shadow_boxes", "radiosity_furnace",
-                  "shadow_big_floor", "radiosity_window", "radiosity_specular", "tessellated_sphere"}
+                  "shadow_big_floor", "radiosity_window", "radiosity_specular", "tessellated_sphere",
+                  "pn_triangles"}
 IMAGE_SIZES = [(640, 480), (320, 240)]
 # Objects out of view by design: the wall behind a camera inside a closed room (the white
 # furnace: closed, so that B = E / (1 - rho) holds; the window room's wall beside the camera,

@@ -87,8 +87,8 @@ def test_only_the_ray_tracing_and_shadow_builtin_scenes_use_shapes_and_ray_trace
     (the rasteriser's scenes stay as they were). The shadow case scenes
     (conftest.SHADOW_CASE_SCENES) use shapes where their case wants them (a floor plane), meshes
     where it does not (a 200-unit mesh floor, a low-poly sphere), and no ray-tracer terms; the
-    tessellation scenes (conftest.TESSELLATION_SCENES) analytic spheres for the tessellation
-    stages, and no ray-tracer terms."""
+    tessellation scenes (conftest.TESSELLATION_SCENES) analytic spheres or meshes for the
+    tessellation stages, and no ray-tracer terms."""
     descriptions = scene_descriptions()
     for name, path in builtin_scenes().items():
         scene = load_scene(path)
@@ -99,8 +99,8 @@ def test_only_the_ray_tracing_and_shadow_builtin_scenes_use_shapes_and_ray_trace
         if name in SHADOW_CASE_SCENES:        # shapes where the case wants them, no ray terms
             assert not uses_ray_terms, name
             continue
-        if name in TESSELLATION_SCENES:       # tessellated spheres, no ray terms
-            assert uses_shapes and not uses_ray_terms, name
+        if name in TESSELLATION_SCENES:       # tessellated spheres or meshes, no ray terms
+            assert not uses_ray_terms and any(o.tessellation for o in scene.objects), name
             continue
         assert (uses_shapes or uses_ray_terms) == (made_for_it or name in SHADOW_SCENES), name
         assert not (uses_ray_terms and name in SHADOW_SCENES), name

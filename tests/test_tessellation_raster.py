@@ -68,14 +68,17 @@ def test_a_bad_tessellation_table_is_one_line(table, extra, words):
     assert words in line and "\n" not in line
 
 
-def test_only_an_analytic_sphere_is_tessellated_yet():
-    data = ball({})
+def test_a_mesh_is_tessellated_as_pn_triangles_and_a_plane_not_at_all():
+    data = ball({"level": 3})
     obj = data["objects"][0]
     del obj["shape"]
     obj["mesh"] = {"primitive": "icosphere"}
+    assert scene_from_dict(data).objects[0].tessellation == Tessellation(level=3, surface="pn_triangles")
+    obj["shape"] = {"type": "plane"}
+    del obj["mesh"]
     with pytest.raises(SceneError) as info:
         scene_from_dict(data)
-    assert "only an analytic sphere" in info.value.line()
+    assert "objects[0].tessellation: a plane is flat" in info.value.line()
 
 
 # -- splitting the draws ---------------------------------------------------------------------------

@@ -20,16 +20,15 @@ from reference.tessellation.tessellator import primitive_vertices, tessellate
 from renderer.core import transforms
 from renderer.core.primitives import icosphere
 from renderer.core.tessellation import MAX_LEVEL, SPACINGS, TARGET_PIXEL_ERROR
-from renderer.gpu.context import activate
-from renderer.gpu.shaders import TESSELLATION_SPACING_DEFINES, shader_source
-from tests.tessellation_capture import feedback
+from renderer.gpu.shaders import TESSELLATION_SPACING_DEFINES
+from tests.tessellation_capture import STAGE_OUTPUTS, capture_stages
 
 CENTRE, RADIUS = (0.2, 0.1, -0.3), 0.5
 MODEL = transforms.translate(1.0, 0.5, -2.0) @ transforms.rotate_y(0.3) @ transforms.scale(1.5, 1.5, 1.5)
 VIEW = transforms.look_at((0.0, 1.0, 3.0), (1.0, 0.5, -2.0), (0.0, 1.0, 0.0))
 PROJECTION = transforms.perspective(np.radians(50.0), 4 / 3, 0.1, 50.0)
 HEIGHT = 240
-CAPTURED = np.dtype([("position", "<f4", 3), ("normal", "<f4", 3), ("levels", "<f4", 4)])
+CAPTURED = STAGE_OUTPUTS
 
 
 def uniforms(radius_world=1.5 * RADIUS, target=TARGET_PIXEL_ERROR, view=VIEW):
@@ -44,35 +43,11 @@ def patch_mesh(subdivisions=1):
 
 
 def gpu_capture(ctx, corners, normals, u: ControlUniforms, spacing):
-    """The evaluation stage's points, normals and levels of every primitive vertex in order."""
-    activate(ctx)
-    defines = {"SURFACE_SPHERE": True, "CAPTURE": True, TESSELLATION_SPACING_DEFINES[spacing]: True}
-    program = ctx.program(vertex_shader=shader_source("tess_vertex.glsl").text,
-                          tess_control_shader=shader_source("tess_control.glsl").text,
-                          tess_evaluation_shader=shader_source("tess_evaluation.glsl", defines).text,
-                          varyings=["t_position", "t_normal", "t_levels"])
-    vbo = ctx.buffer(np.concatenate([corners.reshape(-1, 3), normals.reshape(-1, 3)], axis=1).tobytes())
-    vao = None
-    try:
-        for name, matrix in (("u_model", u.model), ("u_view", u.view), ("u_projection", u.projection)):
-            program[name].write(transforms.to_glsl(matrix))
-        program["u_viewport_height"].value = u.viewport_height
-        program["u_target_error"].value = u.target_error
-        program["u_surface_radius"].value = u.surface_radius
-        program["u_max_level"].value = u.max_level
-        program["u_fixed_level"].value = u.fixed_level
-        program["u_sphere"].value = (*CENTRE, RADIUS)
-        layout = [(vbo, "3f 3f", "in_position", "in_normal")] if "in_normal" in program else \
-            [(vbo, "3f 12x", "in_position")]                   # a sphere's normals are its own
-        vao = ctx.vertex_array(program, layout)
-        data, generated, written = feedback(ctx, program, vao, len(corners) * 3, 3, "triangles",
-                                            1 << 20, CAPTURED)
-        assert generated == written
-        return data
-    finally:
-        for item in (vao, vbo, program):
-            if item is not None:
-                item.release()
+    """The evaluation stage's points, normals and levels of every primitive vertex in order
+    (a sphere's normals are its own: the stages may drop in_normal)."""
+    rows = np.concatenate([corners.reshape(-1, 3), normals.reshape(-1, 3)], axis=1)
+    return capture_stages(ctx, {"SURFACE_SPHERE": True, TESSELLATION_SPACING_DEFINES[spacing]: True}, rows,
+                          "3f 3f", ("in_position", "in_normal"), u, {"u_sphere": (*CENTRE, RADIUS)})
 
 
 def twin(corners, normals, u: ControlUniforms, spacing):

@@ -13,6 +13,14 @@ rule of renderer/core/tessellation.py, in float32 and in the shader's order of o
 A fixed level (u_fixed_level > 0) is every edge's. Else 1 for a flat surface (R = 0) or s >= 1, the largest level for a midpoint at or behind the eye or
 a chord across the sphere; outer[i] is the edge opposite corner i, inner the largest outer.
 
+PN triangles (SURFACE_PN; `pn_net`, `pn_patch_levels`): each edge's offsets o_ab = N_a ((-w) / 3)
+(w = dot(P_b - P_a, N_a); 1/3 multiplied as float32 0.33333334), zero on a straight edge; the
+centre's ((((o0 + o1) + o2) + o3) + o4) + o5) 0.25; each edge's mid normal
+normalize((N_a + N_b) - v e), e = P_b - P_a, v = (2 dot(e, N_a + N_b)) / dot(e, e) (0 for a
+point edge). An edge's level: m = max(|M (o_ba - 2 o_ab, 0)|, |M (o_ab - 2 o_ba, 0)|), then
+sqrt((0.75 m) / e) with e = target / k at the edge's midpoint, clamped (max and min as GLSL's
+on NaN: the number); the inner level also the interior's, at the centroid ((p0 + p1) + p2) / 3.
+
 Inputs: patches' corners (P, 3, 3) object space, the uniforms as a ControlUniforms.
 Output: (P, 4) float32 levels: outer[0..2], inner[0] (gl_TessLevelOuter / gl_TessLevelInner).
 """
@@ -23,7 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from reference.glsl_builtins import dot, matrix_times
+from reference.glsl_builtins import dot, length, matrix_times, normalize
 
 
 @dataclass(frozen=True)
@@ -65,6 +73,80 @@ def edge_levels(a: np.ndarray, b: np.ndarray, u: ControlUniforms) -> np.ndarray:
     level = np.where(d > 0, level, high)
     level = np.where(s < 1, level, f(1))
     return np.where(w > 0, level, high).astype(f)
+
+
+ONE_THIRD = np.float32(1.0 / 3.0)      # glsl/tess_control.glsl's
+PN_CURVE_BOUND = np.float32(0.75)
+
+
+def _pn_offset(pa, na, pb):
+    return na * ((-dot(pb - pa, na)) * ONE_THIRD)[..., None]
+
+
+def _pn_mid_normal(pa, na, pb, nb):
+    f = np.float32
+    e = pb - pa
+    e2 = dot(e, e)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        v = np.where(e2 > 0, f(2) * dot(e, na + nb) / e2, f(0)).astype(f)
+    return normalize((na + nb) - v[..., None] * e)
+
+
+def pn_net(corners: np.ndarray, normals: np.ndarray, straight: np.ndarray):
+    """A PN patch's net as the control stage makes it: offsets (P, 6, 3) (edge k's o_ij, o_ji,
+    i = k + 1, j = k + 2 mod 3), the centre's (P, 3), the edges' mid normals (P, 3, 3); from
+    corners and normals (P, 3, 3) and straight (P, 3) (renderer/core/tessellation.py PatchNet)."""
+    c, n = np.asarray(corners, np.float32), np.asarray(normals, np.float32)
+    offsets, mids = [], []
+    for k in range(3):
+        i, j = (k + 1) % 3, (k + 2) % 3
+        curved = ~(np.asarray(straight)[:, k] > 0.5)[:, None]
+        offsets.append(np.where(curved, _pn_offset(c[:, i], n[:, i], c[:, j]), np.float32(0)))
+        offsets.append(np.where(curved, _pn_offset(c[:, j], n[:, j], c[:, i]), np.float32(0)))
+        mids.append(_pn_mid_normal(c[:, i], n[:, i], c[:, j], n[:, j]))
+    centre = offsets[0]
+    for o in offsets[1:]:
+        centre = centre + o
+    return (np.stack(offsets, axis=1).astype(np.float32), (centre * np.float32(0.25)).astype(np.float32),
+            np.stack(mids, axis=1).astype(np.float32))
+
+
+def _world_length(model, d):
+    return length(matrix_times(model, np.concatenate([d, np.zeros(d.shape[:-1] + (1,), np.float32)], axis=-1))[..., :3])
+
+
+def _pn_level(m, world, u: ControlUniforms):
+    f = np.float32
+    w = matrix_times(u.projection, matrix_times(u.view, _homogeneous(world)))[..., 3]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        pixels_per_unit = f(u.viewport_height) * f(u.projection[1, 1]) / (f(2) * w)
+        e = f(u.target_error) / pixels_per_unit
+        level = np.sqrt(PN_CURVE_BOUND * m / e)
+    level = np.fmin(np.fmax(level, f(1)), f(u.max_level))
+    return np.where(w > 0, level, f(u.max_level)).astype(f)
+
+
+def pn_patch_levels(corners: np.ndarray, offsets: np.ndarray, centre: np.ndarray,
+                    u: ControlUniforms) -> np.ndarray:
+    """(P, 4) float32 levels of PN patches: corners (P, 3, 3) object space, their net
+    (`pn_net`'s offsets and centre)."""
+    f = np.float32
+    world = matrix_times(u.model, _homogeneous(np.asarray(corners, f)))[..., :3]
+    p0, p1, p2 = world[:, 0], world[:, 1], world[:, 2]
+    o = [offsets[:, k] for k in range(6)]
+    if f(u.fixed_level) > 0:
+        return np.full((len(corners), 4), f(u.fixed_level), f)
+    outer = []
+    for k, (a, b) in enumerate(((p1, p2), (p2, p0), (p0, p1))):
+        o_ab, o_ba = o[2 * k], o[2 * k + 1]
+        m = np.fmax(_world_length(u.model, o_ba - f(2) * o_ab), _world_length(u.model, o_ab - f(2) * o_ba))
+        outer.append(_pn_level(m, (a + b) * f(0.5), u))
+    inner = np.fmax(np.fmax(outer[0], outer[1]), outer[2])
+    m = np.fmax(np.fmax(_world_length(u.model, (o[3] + o[0]) - f(2) * centre),
+                        _world_length(u.model, (o[5] + o[2]) - f(2) * centre)),
+                _world_length(u.model, (o[1] + o[4]) - f(2) * centre))
+    inner = np.fmax(inner, _pn_level(m, ((p0 + p1) + p2) * ONE_THIRD, u))
+    return np.stack([*outer, inner], axis=1).astype(f)
 
 
 def patch_levels(corners: np.ndarray, u: ControlUniforms) -> np.ndarray:

@@ -1,8 +1,9 @@
 """# Twin: glsl/tess_control.glsl, glsl/tess_evaluation.glsl (the stages together)
 
 A tessellated object's triangles as the camera pass draws them through the tessellation
-stages (issue 34): its patches (renderer/core/tessellation.py patch_mesh), each patch's levels
-(reference/tessellation/control.py), the tessellator's points and triangles
+stages (issue 34): its patches (renderer/core/tessellation.py: a sphere's patch_mesh, a mesh's
+pn_patches), each patch's levels (reference/tessellation/control.py; a PN patch's net too),
+the tessellator's points and triangles
 (reference/tessellation/tessellator.py), each point placed on the surface
 (reference/tessellation/evaluation.py), patch after patch in draw order, so that the vertex
 stage's twin (reference/vertex.py) then runs on the points as the evaluation stage runs
@@ -17,10 +18,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.tessellation.control import ControlUniforms, patch_levels
-from reference.tessellation.evaluation import evaluate
+from reference.tessellation.control import ControlUniforms, patch_levels, pn_net, pn_patch_levels
+from reference.tessellation.evaluation import evaluate, evaluate_pn
 from reference.tessellation.tessellator import tess_coord, tessellate
-from renderer.core.tessellation import check_tessellated, patch_mesh
+from renderer.core.tessellation import check_tessellated, patch_mesh, pn_patches
 from renderer.core.uniforms import tessellation_uniforms
 
 
@@ -32,15 +33,27 @@ def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndar
                         float(values["u_target_error"]), float(values["u_surface_radius"]),
                         float(values["u_max_level"]), float(values["u_fixed_level"]))
     sphere = values["u_sphere"]
-    patches = patch_mesh(obj.shape)
-    corners = patches.positions[patches.faces].astype(np.float32)
-    normals = patches.normals[patches.faces].astype(np.float32)
+    if obj.tessellation.surface == "pn_triangles":
+        net = pn_patches(obj.mesh)
+        corners, normals = net.positions, net.normals
+        offsets, centres, mids = pn_net(corners, normals, net.straight)
+        levels = pn_patch_levels(corners, offsets, centres, u)
+    else:
+        patches = patch_mesh(obj.shape)
+        corners = patches.positions[patches.faces].astype(np.float32)
+        normals = patches.normals[patches.faces].astype(np.float32)
+        levels = patch_levels(corners, u)
     positions, shading_normals, faces, offset = [], [], [], 0
-    for patch, level in enumerate(patch_levels(corners, u)):
+    for patch, level in enumerate(levels):
         t = tessellate("triangles", obj.tessellation.spacing, level[:3], level[3:])
         coords = tess_coord(t)
-        p, n = evaluate(coords, np.broadcast_to(corners[patch], (len(coords), 3, 3)),
-                        np.broadcast_to(normals[patch], (len(coords), 3, 3)), (sphere[:3], sphere[3]))
+
+        def each(value):
+            return np.broadcast_to(value[patch], (len(coords), *value.shape[1:]))
+        if obj.tessellation.surface == "pn_triangles":
+            p, n = evaluate_pn(coords, each(corners), each(normals), each(offsets), each(centres), each(mids))
+        else:
+            p, n = evaluate(coords, each(corners), each(normals), (sphere[:3], sphere[3]))
         positions.append(p)
         shading_normals.append(n)
         faces.append(np.asarray(t.indices, np.int64).reshape(-1, 3) + offset)

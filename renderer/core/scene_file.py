@@ -790,18 +790,20 @@ class _Reader(TableReader):
     def tessellation(self, raw: Any, path: str, obj: SceneObject):
         """An object's tessellation stages (renderer/core/tessellation.py): `spacing` ("equal",
         "fractional_even", "fractional_odd"), `error` in pixels or a fixed `level` (1 to 64).
-        Only an analytic sphere is tessellated yet, and not with a texture or shadow maps."""
+        An analytic sphere's points go on the sphere, a mesh's on its PN triangles; not with a
+        texture or shadow maps yet."""
         if not isinstance(raw, dict):
             self.fail(path, f"expected a table such as {{error = 0.25}} or {{level = 8}}, got {describe_value(raw)}")
         raw = self.table(raw, path, TESSELLATION_KEYS)
-        if not isinstance(obj.shape, Sphere):
-            self.fail(path, "only an analytic sphere (shape = {type = \"sphere\"}) is tessellated yet")
+        if obj.shape is not None and not isinstance(obj.shape, Sphere):
+            self.fail(path, "a plane is flat: only an analytic sphere or a mesh is tessellated")
         if obj.material.textured:
-            self.fail(path, "a tessellated sphere cannot be textured yet (its seam)")
+            self.fail(path, "a tessellated object cannot be textured yet (a sphere's seam, a mesh's "
+                            "UVs across its patches)")
         if obj.receives_shadows:
-            self.fail(path, "a tessellated sphere does not look shadow maps up yet: "
+            self.fail(path, "a tessellated object does not look shadow maps up yet: "
                             "give the object receives_shadows = false")
-        settings = tessellation.Tessellation()
+        settings = tessellation.Tessellation(surface=tessellation.surface_of(obj))
         if "spacing" in raw:
             word = self.choice(raw["spacing"], _join(path, "spacing"), "spacing", tuple(tessellation.SPACING_WORDS))
             settings = dataclasses.replace(settings, spacing=tessellation.SPACING_WORDS[word])

@@ -25,14 +25,47 @@ twin's levels are the GPU's bit for bit. Clamped to [1, MAX_LEVEL]; s >= 1 (an e
 the sphere) gives 1; an edge whose midpoint is at or behind the eye (w_mid <= 0) gets MAX_LEVEL.
 The inner level is the largest of the three outer ones.
 
+PN triangles (Vlachos, Peters, Boyd and Mitchell 2001, "Curved PN Triangles"): a mesh object
+is drawn from its own triangles as patches, each a cubic Bezier triangle made from its corners'
+positions P and normals N alone. Written as the flat triangle plus offsets (the flat triangle's
+cubic net is its linear interpolation): the edge point of the net near corner a on the edge to
+corner b moves by o_ab = N_a (-(P_b - P_a).N_a / 3) (the paper's b_210 = (2 P_1 + P_2 - w_12 N_1) / 3),
+the centre by c = (sum of the six o) / 4 (b_111 = E + (E - V) / 2), so that
+
+    p(t) = flat(t) + sum over edges (a, b) of 3 (t_a t_b) (t_a o_ab + t_b o_ba) + 6 (t_0 t_1 t_2) c
+
+and the normal is the paper's quadratic: N_0 t_0^2 + N_1 t_1^2 + N_2 t_2^2 + the edges' mid
+normals n_ab t_a t_b, n_ab = normalize(N_a + N_b - v_ab (P_b - P_a)),
+v_ab = 2 (P_b - P_a).(N_a + N_b) / |P_b - P_a|^2, normalised. On an edge only that edge's
+term is not zero, and each term is written so that both patches of the edge compute it from the
+same bits (products and sums of two commute), so the shared edge is the same curve, point for
+point, and no crack opens. Where the mesh's vertices split at a crease (the two faces of an edge
+see other normals at its ends), the edge is kept straight in both (`pn_patches`: o_ab = o_ba =
+0): each side's normals would bend it its own way.
+
+An edge's level bounds the distance of its curve from the chords between the tessellator's
+points: its cubic's control points' second differences d_a = o_ba - 2 o_ab, d_b = o_ab - 2 o_ba
+(in world units: the model matrix times them, an affine map's) bound the curve's second
+derivative by 6 max(|d_a|, |d_b|), and a chord over a parameter interval h strays at most h^2/8
+of that from the curve: within e world units (e = target / k, as above) when
+
+    L >= sqrt(PN_CURVE_BOUND max(|d_a|, |d_b|) / e),        PN_CURVE_BOUND = 6 / 8
+
+from the edge's two ends alone, symmetrically (d_a and d_b swap with the ends). The inner level
+is at least the outer ones and the interior's own need: the net's second differences across the
+patch, (o_ik + o_jk) - 2 c for each corner k, at the patch centre's k.
+
 What a scene asks for (`Tessellation`, an object's `tessellation` table in a scene file): an
-analytic sphere drawn from PATCH_SUBDIVISIONS' icosphere as triangle patches, in the camera
-pass (the shadow passes draw the sphere's own icosphere, renderer/core/shapes.py).
+analytic sphere drawn from PATCH_SUBDIVISIONS' icosphere as triangle patches, or a mesh's
+triangles as PN triangles, in the camera pass (the shadow passes draw the sphere's own
+icosphere, the mesh as it is).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+
+import numpy as np
 
 from renderer.core.scene import Sphere
 from renderer.core.shapes import sphere_mesh
@@ -49,6 +82,11 @@ DEFAULT_SPACING = "fractional_odd_spacing"   # levels change smoothly as the cam
 PATCH_SUBDIVISIONS = 1           # a tessellated sphere's patches: icosphere(1), 80 triangles
 SPACING_WORDS = {"equal": "equal_spacing", "fractional_even": "fractional_even_spacing",
                  "fractional_odd": "fractional_odd_spacing"}
+# What the evaluation stage places the points on: an analytic sphere's exact surface, or a
+# mesh's PN triangles (the object's kind decides: `surface_of`).
+SURFACES = ("sphere", "pn_triangles")
+PN_CURVE_BOUND = 0.75            # 6 / 8: |B''| <= 6 max second difference; a chord strays h^2 / 8 of it
+ONE_THIRD = 1.0 / 3.0            # o_ab's factor, multiplied (float32 0.33333334), not divided
 
 # llvmpipe 22.3.6 (reference/tessellation/tessellator.py): a draw's patches are cut into runs
 # of 4096 input vertices whose points share uint16 element indices, so a run must make at most
@@ -77,6 +115,71 @@ class Tessellation:
     spacing: str = DEFAULT_SPACING
     error: float = TARGET_PIXEL_ERROR
     level: float | None = None
+    surface: str = "sphere"      # SURFACES: what the points are placed on
+
+
+def surface_of(obj) -> str:
+    """What a tessellated object's points are placed on: its analytic sphere, or its mesh's
+    PN triangles (an object without an analytic shape)."""
+    return "sphere" if isinstance(obj.shape, Sphere) else "pn_triangles"
+
+
+@dataclass(frozen=True)
+class PatchNet:
+    """A mesh's PN-triangle patches as the camera pass draws them, a patch per face, its
+    corners in the face's order: positions and normals (P, 3, 3) float32 object space, and
+    `straight` (P, 3) float32, 1.0 where the edge opposite that corner is kept straight."""
+    positions: np.ndarray
+    normals: np.ndarray
+    straight: np.ndarray
+
+    @property
+    def count(self) -> int:
+        return len(self.positions)
+
+
+def pn_patches(mesh) -> PatchNet:
+    """A patch per face of `mesh` (module docstring). An edge is kept straight where another
+    face meets it whose corners there have the same positions but other normals (a crease
+    the mesh splits its vertices at) or where more than two faces meet (no surface to follow);
+    an edge on the mesh's border, or shared with the same normals, is curved."""
+    faces = np.asarray(mesh.faces, np.int64)
+    positions = np.asarray(mesh.positions, np.float32)
+    normals = np.asarray(mesh.normals, np.float32)
+    corners, corner_normals = positions[faces], normals[faces]
+    # each face's edges: edge k joins corners k + 1 and k + 2 (GL's outer level k's edge)
+    ends = np.stack([faces[:, [1, 2]], faces[:, [2, 0]], faces[:, [0, 1]]], axis=1).reshape(-1, 2)
+    # an edge by its ends' exact positions (their bits), in either order; its ends' normals
+    # in that order
+    a, b = positions[ends[:, 0]].view(np.uint32), positions[ends[:, 1]].view(np.uint32)
+    swap = _lexicographic_less(b, a)
+    first = np.where(swap[:, None], b, a)
+    second = np.where(swap[:, None], a, b)
+    key = np.concatenate([first, second], axis=1)
+    na, nb = normals[ends[:, 0]], normals[ends[:, 1]]
+    end_normals = np.concatenate([np.where(swap[:, None], nb, na), np.where(swap[:, None], na, nb)],
+                                 axis=1).view(np.uint32)
+    _, edge, uses = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    edge = edge.reshape(-1)
+    # the edge's normals as its first face sees them; any other face that differs makes it straight
+    order = np.argsort(edge, kind="stable")
+    first_use = np.empty(len(uses), np.int64)
+    first_use[edge[order[::-1]]] = order[::-1]
+    differs = np.any(end_normals != end_normals[first_use[edge]], axis=1)
+    creased = np.zeros(len(uses), bool)
+    np.logical_or.at(creased, edge, differs)
+    straight = (creased | (uses > 2))[edge].reshape(-1, 3).astype(np.float32)
+    return PatchNet(corners, corner_normals, straight)
+
+
+def _lexicographic_less(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise a < b, comparing the first column first: (N,) bool of (N, K) arrays."""
+    less = np.zeros(len(a), bool)
+    decided = np.zeros(len(a), bool)
+    for k in range(a.shape[1]):
+        less |= ~decided & (a[:, k] < b[:, k])
+        decided |= a[:, k] != b[:, k]
+    return less
 
 
 def patch_mesh(sphere):
@@ -87,14 +190,18 @@ def patch_mesh(sphere):
 
 def check_tessellated(obj) -> None:
     """A ValueError naming `obj` where its tessellation asks for what the stages do not draw
-    yet: a shape other than an analytic sphere, a texture (the sphere's UV seam), shadow maps
-    looked up (their facets are the patches'). The scene file refuses the same in one line."""
+    yet: an analytic shape other than a sphere (a plane is flat: it needs none), a texture (the
+    sphere's UV seam; a mesh's UVs across the patches), shadow maps looked up (their facets are
+    the patches'). The scene file refuses the same in one line."""
     if obj.tessellation is None:
         return
-    if not isinstance(obj.shape, Sphere):
-        raise ValueError(f"object {obj.name!r}: only an analytic sphere is tessellated yet")
+    if obj.shape is not None and not isinstance(obj.shape, Sphere):
+        raise ValueError(f"object {obj.name!r}: a plane is flat; only a sphere or a mesh is tessellated")
+    if obj.tessellation.surface != surface_of(obj):
+        raise ValueError(f"object {obj.name!r}: its tessellation's surface is "
+                         f"{obj.tessellation.surface!r}, its kind's {surface_of(obj)!r}")
     if obj.material.texture is not None:
-        raise ValueError(f"object {obj.name!r}: a tessellated sphere cannot be textured yet")
+        raise ValueError(f"object {obj.name!r}: a tessellated object cannot be textured yet")
     if obj.receives_shadows:
-        raise ValueError(f"object {obj.name!r}: a tessellated sphere does not look shadow maps up "
+        raise ValueError(f"object {obj.name!r}: a tessellated object does not look shadow maps up "
                          f"yet (receives_shadows = false)")

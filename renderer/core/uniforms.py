@@ -148,16 +148,21 @@ def object_uniforms(obj: SceneObject, matrices: ObjectMatrices) -> dict[str, np.
 
 
 def tessellation_uniforms(obj: SceneObject, matrices: ObjectMatrices, height: int) -> dict[str, np.ndarray]:
-    """A tessellated sphere's uniforms (TESSELLATION_UNIFORMS) in a frame `height` pixels tall;
-    empty for an object drawn without the tessellation stages."""
+    """A tessellated object's uniforms (TESSELLATION_UNIFORMS) in a frame `height` pixels tall;
+    empty for an object drawn without the tessellation stages. A PN-triangle mesh has no
+    sphere: radius 0 and u_sphere 0, which its stages do not read."""
     settings = obj.tessellation
     if settings is None:
         return {}
-    sphere = obj.shape
-    scale = float(np.linalg.norm(np.asarray(matrices.model, dtype=np.float64)[:3, 0]))   # a similarity's
+    if settings.surface == "sphere":
+        sphere = obj.shape
+        scale = float(np.linalg.norm(np.asarray(matrices.model, dtype=np.float64)[:3, 0]))   # a similarity's
+        radius, centre_radius = float(sphere.radius) * scale, [*sphere.centre, sphere.radius]
+    else:
+        radius, centre_radius = 0.0, [0.0, 0.0, 0.0, 0.0]
     return {"u_viewport_height": np.asarray(float(height)),
             "u_target_error": np.asarray(float(settings.error) * EDGE_ERROR_SHARE),
-            "u_surface_radius": np.asarray(float(sphere.radius) * scale),
+            "u_surface_radius": np.asarray(radius),
             "u_max_level": np.asarray(MAX_LEVEL),
             "u_fixed_level": np.asarray(0.0 if settings.level is None else float(settings.level)),
-            "u_sphere": np.asarray([*sphere.centre, sphere.radius], dtype=np.float64)}
+            "u_sphere": np.asarray(centre_radius, dtype=np.float64)}

@@ -85,7 +85,7 @@ from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
-from renderer.core.tessellation import check_tessellated, patch_mesh, patches_per_draw
+from renderer.core.tessellation import check_tessellated, patch_mesh, patches_per_draw, pn_patches
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.gpu.polygon_buffers import PolygonBuffers, vertex_bytes
 from renderer.gpu.shadow_maps import ShadowMaps
@@ -171,7 +171,7 @@ class _ObjectBuffers:
     texture: tuple | None = None           # (moderngl.Texture, moderngl.Sampler) of its material
     face_normals: moderngl.Texture | None = None   # its faces (facets.face_texture), once a shadowed program draws it
     polygon: PolygonBuffers | None = None  # an analytic plane's, which the camera pass draws
-    patches: tuple | None = None           # a tessellated sphere's (vbo, ibo, triangles), which the camera pass draws
+    patches: tuple | None = None           # a tessellated object's (vbo, ibo, patches), which the camera pass draws
 
     @property
     def drawn_buffers(self) -> tuple:
@@ -311,7 +311,15 @@ class GpuRenderer(ContextRenderer):
         if mesh.triangle_count:
             item.vbo = self.ctx.buffer(vertex_bytes(mesh))
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
-        if item.obj.tessellation is not None:       # the camera pass draws its patches instead
+        if item.obj.tessellation is None:
+            pass
+        elif item.obj.tessellation.surface == "pn_triangles":   # a patch per face, its corners apart
+            net = pn_patches(mesh)
+            corners = np.concatenate([net.positions, net.normals, net.straight[..., None]], axis=2)
+            item.patches = (self.ctx.buffer(np.ascontiguousarray(corners, dtype=np.float32).tobytes()),
+                            self.ctx.buffer(np.arange(3 * net.count, dtype=np.uint32).tobytes()),
+                            net.count)
+        else:                                       # the camera pass draws its patches instead
             patches = patch_mesh(item.obj.shape)
             item.patches = (self.ctx.buffer(vertex_bytes(patches)),
                             self.ctx.buffer(np.ascontiguousarray(patches.faces, dtype=np.uint32).tobytes()),
@@ -359,7 +367,9 @@ class GpuRenderer(ContextRenderer):
         if vao is None:
             program = self._programs.get(variant)
             vbo, ibo, uv_vbo = item.drawn_buffers
-            if program.get("in_normal", None) is not None:
+            if program.get("in_straight", None) is not None:    # a PN patch's corners
+                content = [(vbo, "3f 3f 1f", "in_position", "in_normal", "in_straight")]
+            elif program.get("in_normal", None) is not None:
                 content = [(vbo, "3f 3f", "in_position", "in_normal")]
             else:                                    # flat: the normal is the face's, not read
                 content = [(vbo, "3f 3x4", "in_position")]

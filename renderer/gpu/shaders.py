@@ -236,6 +236,8 @@ class ShaderVariant:
     # the tessellation stages' spacing (GL's word, renderer/core/tessellation.py) for a
     # tessellated sphere; "" for none
     tessellation: str = ""
+    # what its evaluation stage places the points on (renderer/core/tessellation.py SURFACES)
+    surface: str = "sphere"
 
     def __post_init__(self):
         if self.shading not in ("flat", "gouraud", "phong"):
@@ -247,6 +249,8 @@ class ShaderVariant:
                              f"not {self.texture}")
         if self.tessellation and self.tessellation not in TESSELLATION_SPACING_DEFINES:
             raise ValueError(f"unknown tessellation spacing {self.tessellation!r}")
+        if self.surface not in SURFACE_DEFINES:
+            raise ValueError(f"unknown tessellated surface {self.surface!r}")
 
     @property
     def light_terms(self) -> bool:
@@ -262,8 +266,8 @@ class ShaderVariant:
             f"TEXTURE_{k.upper()}": k in self.texture for k in MODULATED}
         if self.shadows:                           # glsl/fragment.glsl's face texture
             terms["FACES_PER_ROW"] = FACES_PER_ROW
-        if self.tessellation:                      # a sphere through tess_control / tess_evaluation
-            terms |= {"TESSELLATED": True, "SURFACE_SPHERE": True,
+        if self.tessellation:                      # through tess_control / tess_evaluation
+            terms |= {"TESSELLATED": True, SURFACE_DEFINES[self.surface]: True,
                       TESSELLATION_SPACING_DEFINES[self.tessellation]: True}
         if self.all_features:
             return {
@@ -295,7 +299,9 @@ class ShaderVariant:
         linear = "-linear" if self.linear_output else ""
         shadows = "-shadows" if self.shadows else ""
         shadows += "".join(f"-textured-{k}" for k in self.texture)
-        shadows += f"-tessellated-{self.tessellation.removesuffix('_spacing')}" if self.tessellation else ""
+        if self.tessellation:
+            shadows += f"-tessellated-{self.tessellation.removesuffix('_spacing')}"
+            shadows += "-pn" if self.surface == "pn_triangles" else ""
         if self.all_features:
             terms = (f"-{self.num_directional_lights}dir-{self.num_point_lights}point"
                      if self.light_terms else "")
@@ -312,22 +318,23 @@ class ShaderVariant:
     @classmethod
     def for_material(cls, scene, material, linear_output: bool = False,
                      all_features: bool = False, shadows: bool = False,
-                     tessellation: str = "") -> "ShaderVariant":
+                     tessellation: str = "", surface: str = "sphere") -> "ShaderVariant":
         """The variant that draws `material` (a renderer.core.scene.Material) in `scene`:
         specialised to what they use, or the all-features build. `shadows`: the object
         receives shadows and the scene's layout has maps; `tessellation`: its spacing, for a
-        tessellated sphere."""
+        tessellated object, `surface` what its points go on."""
         shadows = bool(shadows)
         texture = modulated_coefficients(material)
         if all_features:
             counts = ((len(scene.directional_lights), len(scene.point_lights))
                       if shadows and material.shading != "phong" else (0, 0))
             return cls(material.shading, False, *counts, linear_output=bool(linear_output),
-                       all_features=True, shadows=shadows, texture=texture, tessellation=tessellation)
+                       all_features=True, shadows=shadows, texture=texture, tessellation=tessellation,
+                       surface=surface)
         return cls(material.shading, bool(material.two_sided), len(scene.directional_lights),
                    len(scene.point_lights), bool(linear_output), material.has_specular,
                    shadows=shadows, shadow_kernel=shared_kernel(scene) if shadows else 0,
-                   texture=texture, tessellation=tessellation)
+                   texture=texture, tessellation=tessellation, surface=surface)
 
     @classmethod
     def for_object(cls, scene, obj, *, maps: bool, linear_output: bool = False,
@@ -337,7 +344,8 @@ class ShaderVariant:
         `maps` and it receives them, through the tessellation stages where it asks for them."""
         return cls.for_material(scene, obj.material, linear_output, all_features=all_features,
                                 shadows=maps and obj.receives_shadows,
-                                tessellation="" if obj.tessellation is None else obj.tessellation.spacing)
+                                tessellation="" if obj.tessellation is None else obj.tessellation.spacing,
+                                surface="sphere" if obj.tessellation is None else obj.tessellation.surface)
 
 
 
@@ -356,6 +364,7 @@ STAGES = (("vertex_shader", "vertex.glsl"),
           ("fragment_shader", "fragment.glsl"))
 TESSELLATION_STAGES = ("tess_control_shader", "tess_evaluation_shader")
 # glsl/tess_evaluation.glsl's layout: each spacing's define
+SURFACE_DEFINES = {"sphere": "SURFACE_SPHERE", "pn_triangles": "SURFACE_PN"}
 TESSELLATION_SPACING_DEFINES = {"equal_spacing": "SPACING_EQUAL", "fractional_even_spacing": "SPACING_FRACTIONAL_EVEN",
                                 "fractional_odd_spacing": "SPACING_FRACTIONAL_ODD"}
 

@@ -8,7 +8,8 @@
 // so the two patches sharing an edge compute it from the same bits and no crack opens.
 // SURFACE_SPHERE: an analytic sphere of radius u_surface_radius (world units). SURFACE_PN: the
 // patch's PN triangle; its net's offsets and its edges' mid normals are made here, once a
-// patch, for glsl/tess_evaluation.glsl (c_offset, c_centre, c_mid_normal).
+// patch, for glsl/tess_evaluation.glsl (c_offset, c_centre, c_mid_normal). SURFACE_DISPLACED:
+// the patch displaced by a height image; its UV tangents made here (c_tangent_s, c_tangent_t).
 
 layout(vertices = 3) out;
 
@@ -25,6 +26,51 @@ in vec3 v_position[];                // object space
 in vec3 v_normal[];
 out vec3 c_position[];
 out vec3 c_normal[];
+
+// the length in world units of an object-space vector
+float world_length(vec3 d) {
+    return length((u_model * vec4(d, 0.0)).xyz);
+}
+
+float clip_w(vec3 world) {
+    return (u_projection * (u_view * vec4(world, 1.0))).w;
+}
+
+#ifdef SURFACE_DISPLACED
+uniform vec2 u_height_size;          // the height image's width and height, texels
+uniform float u_height_slope;        // g: the largest height step between neighbouring texels
+uniform float u_displacement_scale;  // S: object units for a height of 1
+uniform vec2 u_height_uv_scale;      // the lookup st = uv * scale + offset
+uniform vec2 u_height_uv_offset;
+in vec2 v_uv[];
+out vec2 c_st[];                     // the corners' lookup coordinates
+patch out vec3 c_tangent_s;          // dP/ds, dP/dt of the patch (object space)
+patch out vec3 c_tangent_t;
+
+// st = uv * scale + offset, rounded after the product and after the sum (as glsl/texture.glsl)
+vec2 lookup_st(vec2 uv) {
+    vec2 st = uv * u_height_uv_scale;
+    return st + u_height_uv_offset;
+}
+
+// the edge from a to b (world) of lookup coordinates ua to ub and object normals na, nb: a part per texel
+// at most, and as few as keep the height's stray from the chords within the target
+float displaced_edge_level(vec3 a, vec3 b, vec3 na, vec3 nb, vec2 ua, vec2 ub) {
+    if (u_fixed_level > 0.0)
+        return u_fixed_level;
+    vec2 span = abs(ub - ua) * u_height_size;
+    float texels = max(span.x, span.y);
+    float w = clip_w((a + b) * 0.5);
+    float level = texels;
+    if (w > 0.0) {
+        float pixels_per_unit = u_viewport_height * u_projection[1][1] / (2.0 * w);
+        float e = u_target_error / pixels_per_unit;
+        float s = u_displacement_scale * max(world_length(na), world_length(nb));
+        level = min(texels * (u_height_slope * s) / (2.0 * e), texels);
+    }
+    return clamp(level, 1.0, u_max_level);
+}
+#endif
 
 #ifdef SURFACE_PN
 const float PN_CURVE_BOUND = 0.75;   // renderer/core/tessellation.py
@@ -57,15 +103,6 @@ float pn_level(float m, float w) {
     float e = u_target_error / pixels_per_unit;
     float level = sqrt(PN_CURVE_BOUND * m / e);
     return clamp(level, 1.0, u_max_level);
-}
-
-// the length in world units of an object-space second difference
-float world_length(vec3 d) {
-    return length((u_model * vec4(d, 0.0)).xyz);
-}
-
-float clip_w(vec3 world) {
-    return (u_projection * (u_view * vec4(world, 1.0))).w;
 }
 
 // edge k's level from its ends alone: its two second differences swap with the ends
@@ -136,6 +173,31 @@ void main() {
             inner = max(inner, pn_level(m, clip_w(((p0 + p1) + p2) * ONE_THIRD)));
         }
         gl_TessLevelInner[0] = inner;
+    }
+#elif defined(SURFACE_DISPLACED)
+    c_st[gl_InvocationID] = lookup_st(v_uv[gl_InvocationID]);
+    if (gl_InvocationID == 0) {
+        vec2 st0 = lookup_st(v_uv[0]);
+        vec2 st1 = lookup_st(v_uv[1]);
+        vec2 st2 = lookup_st(v_uv[2]);
+        vec3 e1 = v_position[1] - v_position[0];
+        vec3 e2 = v_position[2] - v_position[0];
+        vec2 d1 = st1 - st0;
+        vec2 d2 = st2 - st0;
+        float det = d1.x * d2.y - d2.x * d1.y;
+        float r = det != 0.0 ? 1.0 / det : 0.0;
+        c_tangent_s = (e1 * d2.y - e2 * d1.y) * r;
+        c_tangent_t = (e2 * d1.x - e1 * d2.x) * r;
+        vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
+        vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
+        vec3 p2 = (u_model * vec4(v_position[2], 1.0)).xyz;
+        float outer0 = displaced_edge_level(p1, p2, v_normal[1], v_normal[2], st1, st2);
+        float outer1 = displaced_edge_level(p2, p0, v_normal[2], v_normal[0], st2, st0);
+        float outer2 = displaced_edge_level(p0, p1, v_normal[0], v_normal[1], st0, st1);
+        gl_TessLevelOuter[0] = outer0;
+        gl_TessLevelOuter[1] = outer1;
+        gl_TessLevelOuter[2] = outer2;
+        gl_TessLevelInner[0] = max(max(outer0, outer1), outer2);
     }
 #else
     if (gl_InvocationID == 0) {

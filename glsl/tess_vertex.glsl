@@ -14,11 +14,18 @@ out vec3 v_normal;
 in float in_straight;                // 1.0: the patch's edge opposite this corner stays straight
 out float v_straight;
 #endif
+#ifdef SURFACE_DISPLACED
+in vec2 in_uv;                       // where the height image is read
+out vec2 v_uv;
+#endif
 
 void main() {
     v_position = in_position;
     v_normal = in_normal;
 #ifdef SURFACE_PN
     v_straight = in_straight;
+#endif
+#ifdef SURFACE_DISPLACED
+    v_uv = in_uv;
 #endif
 }

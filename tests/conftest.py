@@ -131,9 +131,9 @@ SHADOW_CASE_SCENES = frozenset({"shadow_boxes", "shadow_thin_contact", "shadow_b
 # full run only, as the ray tracer's scenes.
 # Their radiosity tests are tests/test_radiosity_method.py and their goldens tests/test_goldens.py.
 # The built-in scenes made for the rasteriser's tessellation stages (issue 34): analytic spheres
-# and meshes as PN triangles drawn through them, and no ray-tracer terms
-# (tests/test_tessellation_raster.py, tests/test_pn_triangles.py).
-TESSELLATION_SCENES = frozenset({"tessellated_sphere", "pn_triangles"})
+# and meshes as PN triangles or displaced by a height image drawn through them, and no ray-tracer
+# terms (tests/test_tessellation_raster.py, tests/test_pn_triangles.py, tests/test_displacement.py).
+TESSELLATION_SCENES = frozenset({"tessellated_sphere", "pn_triangles", "displaced_plane"})
 RADIOSITY_SCENES = frozenset({"radiosity_furnace", "radiosity_plates", "cornell_box_radiosity", "radiosity_window",
                               "radiosity_specular"})
 

@@ -186,3 +186,27 @@ def capture_stages(ctx, defines: dict, corners: np.ndarray, layout: str, attribu
         for item in (vao, vbo, program):
             if item is not None:
                 item.release()
+
+
+def gpu_against_twin(scene, ctx, size=(320, 240)):
+    """The GPU's frame of `scene` against the reference's (renderer.checks.compare's Comparison)."""
+    from renderer.checks.compare import compare_frames
+    from renderer.methods import open_renderer
+    with open_renderer(scene, size, context=ctx) as gpu:
+        got = gpu.render(depth=False).rgba8
+    with open_renderer(scene, size, backend="reference") as reference:
+        expected = reference.render(depth=False).rgba8
+    return compare_frames(got, expected)
+
+
+def lonely_edge_points(captured_positions, edge_points, exempt=lambda point: False) -> tuple[int, list]:
+    """Crack-freeness by points: `edge_points` [(patch, (N, 3) positions on its edges)] from the
+    twin, all of them among the GPU's `captured_positions`; (how many distinct edge points,
+    those that only one patch makes and `exempt` (their bytes) does not excuse)."""
+    gpu_points = {p.tobytes() for p in captured_positions}
+    seen_by: dict[bytes, set] = {}
+    for patch, points in edge_points:
+        for p in points:
+            seen_by.setdefault(p.tobytes(), set()).add(patch)
+    assert seen_by.keys() <= gpu_points
+    return len(seen_by), [key for key, patches in seen_by.items() if len(patches) < 2 and not exempt(key)]

@@ -88,19 +88,26 @@ GPU_ONLY_UNIFORMS = {
 
 
 def every_feature_scene():
-    """EVERY_FEATURE_SCENE with its first object's material textured (its primitives have UVs)
-    and a tessellated sphere beside its objects."""
+    """EVERY_FEATURE_SCENE with its first object's material textured (its primitives have UVs),
+    and beside its objects a tessellated sphere, a PN-triangle mesh and a displaced plane."""
+    from renderer.core.primitives import plane, torus
     from renderer.core.scene import Sphere
     from renderer.core.shapes import sphere_mesh
-    from renderer.core.tessellation import Tessellation
+    from renderer.core.tessellation import Displacement, Tessellation
     scene = load_scene(builtin_scenes()[EVERY_FEATURE_SCENE])
     first = scene.objects[0]
     texture = MaterialTexture(checkerboard(2, ((1.0, 1.0, 1.0), (0.5, 0.5, 0.5)), 2))
     sphere = Sphere((0.0, 0.0, 0.0), 0.3)
-    tessellated = SceneObject("tessellated", sphere_mesh(sphere), replace(first.material, texture=None),
+    untextured = replace(first.material, texture=None)
+    tessellated = SceneObject("tessellated", sphere_mesh(sphere), untextured,
                               shape=sphere, receives_shadows=False, tessellation=Tessellation())
+    pn = SceneObject("pn", torus(0.3, 0.1, 8, 6), untextured, receives_shadows=False,
+                     tessellation=Tessellation(surface="pn_triangles"))
+    displaced = SceneObject("displaced", plane(1.0, 2), untextured, receives_shadows=False,
+                            tessellation=Tessellation(surface="displaced",
+                                                      displacement=Displacement(texture.texture, 0.2)))
     return replace(scene, objects=[replace(first, material=replace(first.material, texture=texture)),
-                                   *scene.objects[1:], tessellated])
+                                   *scene.objects[1:], tessellated, pn, displaced])
 
 
 # -- what the GPU path uses (change here if renderer/gpu moves them) ------------------------------
@@ -560,9 +567,12 @@ def test_the_gpu_only_uniforms_are_declared(parsed):
 
 
 def test_the_vertex_attributes_are_the_ones_the_gpu_path_binds(parsed, gl_contexts):
-    attributes = set(of(parsed["vertex.glsl"], "in"))
+    """glsl/vertex.glsl's and glsl/tess_vertex.glsl's (a tessellated object's patch corners:
+    a PN patch's straight edges, a displaced one's UVs) together."""
+    tessellated = declarations(TESSELLATION_STAGES[0], read_glsl(TESSELLATION_STAGES[:1])[TESSELLATION_STAGES[0]])
+    attributes = set(of(parsed["vertex.glsl"], "in")) | set(of(tessellated, "in"))
     bound = bound_attribute_names(gl_contexts["egl"])
-    assert attributes == bound, (f"glsl/vertex.glsl: in {', '.join(sorted(attributes))}; "
+    assert attributes == bound, (f"glsl/vertex.glsl, tess_vertex.glsl: in {', '.join(sorted(attributes))}; "
                                  f"GpuRenderer binds {', '.join(sorted(bound))}")
 
 
@@ -1006,13 +1016,19 @@ def test_the_tessellation_capture_takes_its_levels_from_vertices_not_uniforms():
 
 
 # -- the rasteriser's tessellation stages: glsl/tess_control.glsl, tess_evaluation.glsl against
-# reference/tessellation/control.py, evaluation.py (held to each other by
-# tests/test_tessellation_stages.py; the renderer does not draw them yet)
+# reference/tessellation/control.py, evaluation.py, surface.py (held to each other by
+# tests/test_tessellation_stages.py, test_pn_triangles.py, test_displacement.py)
 
 TESSELLATION_TWIN_NAMES = {"u_model": ("model",), "u_view": ("view",), "u_projection": ("projection",),
                            "u_viewport_height": ("viewport_height",), "u_target_error": ("target_error",),
                            "u_surface_radius": ("surface_radius",), "u_max_level": ("max_level",),
-                           "u_fixed_level": ("fixed_level",), "u_sphere": ("sphere",)}
+                           "u_fixed_level": ("fixed_level",), "u_sphere": ("sphere",),
+                           # a displaced mesh's: the height image itself, and the uniforms the
+                           # twin takes by name from renderer/core/uniforms.py
+                           "u_height": ("texture",), "u_height_texel": ("u_height_texel",),
+                           "u_height_size": ("u_height_size",), "u_height_slope": ("u_height_slope",),
+                           "u_displacement_scale": ("u_displacement_scale",),
+                           "u_height_uv_scale": ("u_height_uv_scale",), "u_height_uv_offset": ("u_height_uv_offset",)}
 
 
 def test_the_tessellation_stages_uniforms_are_names_their_twins_read():

@@ -210,6 +210,7 @@ def test_osmesa_draws_the_egl_paths(gl_contexts):
     assert np.array_equal(*frames)
 
 
+@pytest.mark.slow             # 7 s: the full run's (the default run 92 s with it)
 def test_radiosity_against_the_path_tracer_comes_closer_as_its_elements_refine():
     """renderer/checks/radiosity_vs_pathtrace.py on the Cornell box at 16 x 12 (two frames of
     256 paths a pixel): three element sizes, each half the last, the mean difference falling."""

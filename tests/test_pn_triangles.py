@@ -22,7 +22,6 @@ from scipy import ndimage
 from reference.tessellation.control import ControlUniforms, pn_net, pn_patch_levels
 from reference.tessellation.evaluation import evaluate_pn
 from reference.tessellation.tessellator import primitive_vertices, tessellate
-from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core import primitives, transforms
 from renderer.core.scene_file import load_scene, scene_from_dict
@@ -30,7 +29,7 @@ from renderer.core.tessellation import (EDGE_ERROR_SHARE, MAX_LEVEL, SPACINGS, T
                                         PatchNet, pn_patches)
 from renderer.gpu.shaders import TESSELLATION_SPACING_DEFINES
 from renderer.methods import open_renderer
-from tests.tessellation_capture import STAGE_OUTPUTS, capture_stages
+from tests.tessellation_capture import STAGE_OUTPUTS, capture_stages, gpu_against_twin, lonely_edge_points
 
 OCTAHEDRON = Path(__file__).resolve().parents[1] / "assets" / "meshes" / "octahedron.ply"
 
@@ -224,14 +223,8 @@ def test_no_crack_every_edge_point_is_a_point_of_the_neighbour_too(gl_contexts):
     net = mesh_patches()
     got = gpu_capture(gl_contexts["egl"], net, uniforms(), "fractional_odd_spacing")
     _, _, edge_points = twin(net, uniforms(), "fractional_odd_spacing")
-    gpu_points = {p.tobytes() for p in got["position"]}
-    seen_by = {}
-    for patch, points in edge_points:
-        for p in points:
-            seen_by.setdefault(p.tobytes(), set()).add(patch)
-    assert seen_by.keys() <= gpu_points
-    lonely = [key for key, patches in seen_by.items() if len(patches) < 2]
-    assert len(seen_by) > 300 and not lonely
+    points, lonely = lonely_edge_points(got["position"], edge_points)
+    assert points > 300 and not lonely
 
 
 # -- the rasteriser ------------------------------------------------------------------------------
@@ -242,11 +235,7 @@ def test_the_builtin_scene_is_drawn_alike_by_the_gpu_and_the_twin(gl_contexts, k
     by need; 0 mismatched pixels after the pipeline's allowance."""
     scene = load_scene("pn_triangles")
     assert {o.name for o in scene.objects if o.tessellation} == {"octahedron", "torus", "cylinder"}
-    with open_renderer(scene, (320, 240), context=gl_contexts[kind]) as gpu:
-        got = gpu.render(depth=False).rgba8
-    with open_renderer(scene, (320, 240), backend="reference") as twin_renderer:
-        expected = twin_renderer.render(depth=False).rgba8
-    result = compare_frames(got, expected)
+    result = gpu_against_twin(scene, gl_contexts[kind])
     assert PIPELINE_TOLERANCE.passes(result) and result.mismatched_pixels == 0, \
         PIPELINE_TOLERANCE.failures(result)
 

@@ -30,7 +30,8 @@ BUILTIN_NAMES = {"sphere", "gouraud_vs_phong", "coloured_lights", "point_light_p
                  "glossy", "motion_blur", "textured_mesh", "checker_horizon", "globe",
                  "shadow_boxes", "shadow_thin_contact", "shadow_big_floor", "shadow_lowpoly_sphere",
                  "shadow_knot_floor", "radiosity_furnace", "radiosity_plates", "cornell_box_radiosity",
-                 "radiosity_window", "radiosity_specular", "tessellated_sphere", "pn_triangles"}
+                 "radiosity_window", "radiosity_specular", "tessellated_sphere", "pn_triangles",
+                 "displaced_plane"}
 # Scenes whose objects deliberately reach outside the view: through the near plane (a room
 # around the camera, a ground under it), or a backdrop (tir_bubble's checkerboard) filling
 # the view.

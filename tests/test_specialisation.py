@@ -124,12 +124,16 @@ def test_all_features_build_gives_identical_images(name, gl_contexts):
         a, b = specialised.render(linear=True), general.render(linear=True)
         assert all(v.all_features for v in general.programs)
         assert not any(v.all_features for v in specialised.programs)
-        # Texture code (a sampler, UVs) only in the programs of textured materials, in both.
+        # Texture code (a sampler, UVs) only in the programs of textured materials, in both, and
+        # of displaced objects (their height image, read at their UVs by the evaluation stage).
         textured = {obj.material.texture is not None for obj in scene.objects}
         for gpu in (specialised, general):
             assert {bool(v.texture) for v in gpu.programs} == textured
             for variant, program in gpu.programs.items():
-                assert ("u_texture" in program) == ("in_uv" in program) == bool(variant.texture)
+                displaced = bool(variant.tessellation) and variant.surface == "displaced"
+                assert ("u_texture" in program) == bool(variant.texture)
+                assert ("u_height" in program) == displaced
+                assert ("in_uv" in program) == (bool(variant.texture) or displaced)
     np.testing.assert_array_equal(a.rgba8, b.rgba8)
     np.testing.assert_array_equal(a.depth, b.depth)
 

@@ -10,6 +10,9 @@ textures/globe.png   512 x 256 equirectangular "globe" (scene globe): u = 1/2 + 
                      lines every 30 degrees, the prime meridian white with a magenta disc
                      where it meets the equator (what faces +z), so a rotation shows
 textures/crate.png   256 x 256 crate: planks, a frame, a diagonal brace
+textures/heights.png 64 x 64 height image (scene displaced_plane; linear, grey: the red channel
+                     is the height): a low dome, two crossed ridges and a ring of ripples,
+                     0.1 to 0.9, every step between neighbouring texels small
 meshes/textured_box.glb
                      a 2 x 1.2 x 1 box whose every face carries the whole 160 x 96 (NPOT)
                      label texture embedded as its base colour (TEXCOORD_0 and
@@ -96,6 +99,19 @@ def label(width: int = LABEL_SIZE[0], height: int = LABEL_SIZE[1]) -> np.ndarray
     return image.astype(np.uint8)
 
 
+def heights(size: int = 64) -> np.ndarray:
+    """The height image (module docstring), (H, W, 3) uint8 grey, row 0 at the top (v = 1)."""
+    u = (np.arange(size) + 0.5) / size
+    v = 1.0 - (np.arange(size) + 0.5) / size
+    x, y = np.meshgrid(u - 0.5, v - 0.5)
+    r = np.hypot(x, y)
+    dome = 0.35 * np.exp(-(r / 0.22) ** 2)
+    ridges = 0.12 * (np.exp(-((x - y) / 0.05) ** 2) + np.exp(-((x + y - 0.3) / 0.06) ** 2))
+    ripples = 0.08 * np.cos(2 * np.pi * r / 0.12) * np.exp(-((r - 0.36) / 0.08) ** 2)
+    height = np.clip(0.15 + dome + ridges + ripples, 0.1, 0.9)
+    return np.repeat(np.round(height * 255).astype(np.uint8)[..., None], 3, axis=2)
+
+
 def png_bytes(image: np.ndarray) -> bytes:
     from PIL import Image
 
@@ -126,6 +142,7 @@ def main() -> None:
     outputs = {
         ASSETS / "textures" / "globe.png": png_bytes(globe()),
         ASSETS / "textures" / "crate.png": png_bytes(crate()),
+        ASSETS / "textures" / "heights.png": png_bytes(heights()),
         ASSETS / "meshes" / "textured_box.glb": textured_box(),
     }
     for path, data in outputs.items():

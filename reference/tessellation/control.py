@@ -149,6 +149,47 @@ def pn_patch_levels(corners: np.ndarray, offsets: np.ndarray, centre: np.ndarray
     return np.stack([*outer, inner], axis=1).astype(f)
 
 
+def displaced_tangents(corners: np.ndarray, uvs: np.ndarray):
+    """A displaced patch's dP/ds and dP/dt (P, 3) each, from its corners (P, 3, 3) and UVs
+    (P, 3, 2): e1 = c1 - c0, e2 = c2 - c0, d1, d2 alike; det = d1.x d2.y - d2.x d1.y,
+    r = 1 / det (0 where det is 0); (e1 d2.y - e2 d1.y) r and (e2 d1.x - e1 d2.x) r."""
+    f = np.float32
+    c, w = np.asarray(corners, f), np.asarray(uvs, f)
+    e1, e2 = c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]
+    d1, d2 = w[:, 1] - w[:, 0], w[:, 2] - w[:, 0]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    with np.errstate(divide="ignore"):
+        r = np.where(det != 0, f(1) / det, f(0)).astype(f)[:, None]
+    return ((e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r).astype(f), ((e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r).astype(f)
+
+
+def displaced_patch_levels(corners: np.ndarray, normals: np.ndarray, uvs: np.ndarray, u: ControlUniforms,
+                           height_size, slope: float, scale: float) -> np.ndarray:
+    """(P, 4) float32 levels of displaced patches (renderer/core/tessellation.py's rule, the
+    control stage's order): per edge, texels = max(|ub - ua| (W, H)); where the midpoint's w > 0
+    min((texels (g s)) / (2 e), texels), s = S max(|M n_a|, |M n_b|); clamped."""
+    f = np.float32
+    if f(u.fixed_level) > 0:
+        return np.full((len(corners), 4), f(u.fixed_level), f)
+    world = matrix_times(u.model, _homogeneous(np.asarray(corners, f)))[..., :3]
+    n, w = np.asarray(normals, f), np.asarray(uvs, f)
+    size = np.asarray(height_size, f)
+    outer = []
+    for i, j in ((1, 2), (2, 0), (0, 1)):
+        span = np.abs(w[:, j] - w[:, i]) * size
+        texels = np.maximum(span[:, 0], span[:, 1])
+        mid_w = matrix_times(u.projection, matrix_times(u.view, _homogeneous((world[:, i] + world[:, j]) * f(0.5))))[..., 3]
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            pixels_per_unit = f(u.viewport_height) * f(u.projection[1, 1]) / (f(2) * mid_w)
+            e = f(u.target_error) / pixels_per_unit
+            s = f(scale) * np.fmax(_world_length(u.model, n[:, i]), _world_length(u.model, n[:, j]))
+            need = np.fmin(texels * (f(slope) * s) / (f(2) * e), texels)
+        level = np.where(mid_w > 0, need, texels)
+        outer.append(np.fmin(np.fmax(level, f(1)), f(u.max_level)).astype(f))
+    inner = np.fmax(np.fmax(outer[0], outer[1]), outer[2])
+    return np.stack([*outer, inner], axis=1).astype(f)
+
+
 def patch_levels(corners: np.ndarray, u: ControlUniforms) -> np.ndarray:
     """(P, 4) float32: outer[0..2], inner[0] of each patch's corners (P, 3, 3) object space."""
     world = matrix_times(u.model, _homogeneous(np.asarray(corners, np.float32)))[..., :3]

@@ -19,11 +19,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.glsl_builtins import normalize
+from reference.glsl_builtins import cross, dot, normalize
+from reference.sampler import sample
+from renderer.core.tessellation import DISPLACEMENT_SAMPLER
 
 
 def barycentric(tess_coord: np.ndarray, corners: np.ndarray) -> np.ndarray:
-    """(u c0 + v c1) + w c2 over (N, 3) tess coords and (N, 3, 3) corners, float32."""
+    """(u c0 + v c1) + w c2 over (N, 3) tess coords and (N, 3, K) corners, float32."""
     t = np.asarray(tess_coord, np.float32)
     c = np.asarray(corners, np.float32)
     return (t[:, 0:1] * c[:, 0] + t[:, 1:2] * c[:, 1]) + t[:, 2:3] * c[:, 2]
@@ -47,6 +49,31 @@ def evaluate_pn(tess_coord: np.ndarray, corners: np.ndarray, normals: np.ndarray
     normal = normalize(((((t0 * t0) * n[:, 0] + (t1 * t1) * n[:, 1]) + (t2 * t2) * n[:, 2])
                         + ((t1 * t2) * m[:, 0] + (t2 * t0) * m[:, 1])) + (t0 * t1) * m[:, 2])
     return position.astype(f), normal.astype(f)
+
+
+def evaluate_displaced(tess_coord: np.ndarray, corners: np.ndarray, normals: np.ndarray, uvs: np.ndarray,
+                       tangent_s: np.ndarray, tangent_t: np.ndarray, texture, scale: float):
+    """A displaced patch's points and normals: tess coords (N, 3), the patch's corners, normals
+    (N, 3, 3) and UVs (N, 3, 2), its tangents (N, 3) each (control.py displaced_tangents), the
+    height image (a Texture) and S. The height is the red channel of sample() at level 0 with
+    the displacement sampler (reference/sampler.py, as textureLod in the evaluation stage)."""
+    f = np.float32
+    t = np.asarray(tess_coord, f)
+    p = barycentric(t, corners)
+    st = barycentric(t, uvs)
+    along = normalize(barycentric(t, normals))
+
+    def height(s, v):
+        return sample(texture, DISPLACEMENT_SAMPLER, s, v, lod=0.0)[:, 0].astype(f)
+    S = f(scale)
+    position = p + along * (height(st[:, 0], st[:, 1]) * S)[:, None]
+    texel = (f(1) / f(texture.width), f(1) / f(texture.height))      # u_height_texel
+    dh_ds = (height(st[:, 0] + texel[0], st[:, 1]) - height(st[:, 0] - texel[0], st[:, 1])) * (f(texture.width) * f(0.5))
+    dh_dt = (height(st[:, 0], st[:, 1] + texel[1]) - height(st[:, 0], st[:, 1] - texel[1])) * (f(texture.height) * f(0.5))
+    across = cross(np.asarray(tangent_s, f) + along * (S * dh_ds)[:, None],
+                   np.asarray(tangent_t, f) + along * (S * dh_dt)[:, None])
+    facing = dot(across, along) < 0
+    return position.astype(f), normalize(np.where(facing[:, None], -across, across)).astype(f)
 
 
 def evaluate(tess_coord: np.ndarray, corners: np.ndarray, normals: np.ndarray, sphere=None):

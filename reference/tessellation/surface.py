@@ -18,10 +18,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from reference.tessellation.control import ControlUniforms, patch_levels, pn_net, pn_patch_levels
-from reference.tessellation.evaluation import evaluate, evaluate_pn
+from reference.tessellation.control import (ControlUniforms, displaced_patch_levels, displaced_tangents,
+                                            patch_levels, pn_net, pn_patch_levels)
+from reference.tessellation.evaluation import evaluate, evaluate_displaced, evaluate_pn
 from reference.tessellation.tessellator import tess_coord, tessellate
-from renderer.core.tessellation import check_tessellated, patch_mesh, pn_patches
+from reference.texture import lookup_coordinates
+from renderer.core.tessellation import check_tessellated, displaced_patches, patch_mesh, pn_patches
 from renderer.core.uniforms import tessellation_uniforms
 
 
@@ -33,7 +35,16 @@ def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndar
                         float(values["u_target_error"]), float(values["u_surface_radius"]),
                         float(values["u_max_level"]), float(values["u_fixed_level"]))
     sphere = values["u_sphere"]
-    if obj.tessellation.surface == "pn_triangles":
+    surface = obj.tessellation.surface
+    if surface == "displaced":
+        corners, normals, uv = displaced_patches(obj.mesh)
+        displacement = obj.tessellation.displacement
+        uvs = lookup_coordinates(uv.reshape(-1, 2), values["u_height_uv_scale"],
+                                 values["u_height_uv_offset"]).reshape(uv.shape)
+        tangent_s, tangent_t = displaced_tangents(corners, uvs)
+        levels = displaced_patch_levels(corners, normals, uvs, u, values["u_height_size"],
+                                        float(values["u_height_slope"]), float(values["u_displacement_scale"]))
+    elif surface == "pn_triangles":
         net = pn_patches(obj.mesh)
         corners, normals = net.positions, net.normals
         offsets, centres, mids = pn_net(corners, normals, net.straight)
@@ -50,7 +61,10 @@ def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndar
 
         def each(value):
             return np.broadcast_to(value[patch], (len(coords), *value.shape[1:]))
-        if obj.tessellation.surface == "pn_triangles":
+        if surface == "displaced":
+            p, n = evaluate_displaced(coords, each(corners), each(normals), each(uvs), each(tangent_s),
+                                      each(tangent_t), displacement.texture, displacement.scale)
+        elif surface == "pn_triangles":
             p, n = evaluate_pn(coords, each(corners), each(normals), each(offsets), each(centres), each(mids))
         else:
             p, n = evaluate(coords, each(corners), each(normals), (sphere[:3], sphere[3]))

@@ -41,7 +41,7 @@ from renderer.core.primitives import TRIANGLES as PRIMITIVE_TRIANGLES
 from renderer.core import shapes
 from renderer.core import tessellation
 from renderer.core.gltf_texture import base_colour_texture
-from renderer.core.texture_keys import read_texture
+from renderer.core.texture_keys import read_image, read_texture
 from renderer.core.shadow_settings import (FILTERS, MAX_BIAS_TEXELS, RESOLUTIONS, BiasRule, Shadow,
                                            auto_bias)
 from renderer.core.textures import MaterialTexture
@@ -71,7 +71,8 @@ LIGHT_KEYS = {
 BIAS_KEYS = tuple(f.name for f in dataclasses.fields(BiasRule))   # normal, constant, slope
 OBJECT_KEYS = ("name", "mesh", "shape", "material", "scale", "shear", "rotate", "translate", "parent",
                "cull", "casts_shadows", "receives_shadows", "velocity", "angular_velocity", "tessellation")
-TESSELLATION_KEYS = ("spacing", "error", "level")
+TESSELLATION_KEYS = ("spacing", "error", "level", "displacement")
+DISPLACEMENT_KEYS = ("image", "scale", "uv_scale", "uv_offset")
 MESH_FILE_KEYS = ("file", "crease_angle")
 SHAPE_TYPES = ("sphere", "plane")
 SHAPE_KEYS = {
@@ -803,7 +804,11 @@ class _Reader(TableReader):
         if obj.receives_shadows:
             self.fail(path, "a tessellated object does not look shadow maps up yet: "
                             "give the object receives_shadows = false")
-        settings = tessellation.Tessellation(surface=tessellation.surface_of(obj))
+        settings = tessellation.Tessellation(surface="sphere" if isinstance(obj.shape, Sphere) else "pn_triangles")
+        if "displacement" in raw:
+            settings = dataclasses.replace(settings, surface="displaced",
+                                           displacement=self.displacement(raw["displacement"],
+                                                                          _join(path, "displacement"), obj))
         if "spacing" in raw:
             word = self.choice(raw["spacing"], _join(path, "spacing"), "spacing", tuple(tessellation.SPACING_WORDS))
             settings = dataclasses.replace(settings, spacing=tessellation.SPACING_WORDS[word])
@@ -818,6 +823,28 @@ class _Reader(TableReader):
                                                 f"(GL_MAX_TESS_GEN_LEVEL), got {level:g}")
             settings = dataclasses.replace(settings, level=level)
         return settings
+
+    def displacement(self, raw: Any, path: str, obj: SceneObject) -> "tessellation.Displacement":
+        """A mesh's displacement: `image` (a height image, its red channel read as linear 0 to 1),
+        `scale` (object units for a height of 1), and where it is read: st = uv * `uv_scale` +
+        `uv_offset` (as a material texture's)."""
+        if not isinstance(raw, dict):
+            self.fail(path, f"expected a table such as {{image = \"textures/heights.png\", scale = 0.2}}, "
+                            f"got {describe_value(raw)}")
+        raw = self.table(raw, path, DISPLACEMENT_KEYS)
+        if obj.shape is not None:
+            self.fail(path, "displaces a mesh (its points along its normals); an analytic shape has none to move")
+        if obj.mesh.uvs is None:
+            self.fail(path, f"the mesh ({obj.mesh.source or 'made in code'}) has no texture coordinates "
+                            f"to read the height image at")
+        for key in ("image", "scale"):
+            if key not in raw:
+                self.fail(_join(path, key), "is required")
+        texture = read_image(self, raw["image"], _join(path, "image"), "linear", self.textures)
+        return tessellation.Displacement(
+            texture, self.number(raw["scale"], _join(path, "scale")),
+            tuple(self.numbers(raw.get("uv_scale", (1.0, 1.0)), _join(path, "uv_scale"), 2)),
+            tuple(self.numbers(raw.get("uv_offset", (0.0, 0.0)), _join(path, "uv_offset"), 2)))
 
     def object_material(self, raw: Any, path: str, materials: dict[str, Material]) -> Material:
         if isinstance(raw, str):

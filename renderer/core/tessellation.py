@@ -55,10 +55,30 @@ from the edge's two ends alone, symmetrically (d_a and d_b swap with the ends). 
 is at least the outer ones and the interior's own need: the net's second differences across the
 patch, (o_ik + o_jk) - 2 c for each corner k, at the patch centre's k.
 
+Displacement (a mesh with `displacement`: `Displacement`): each point the tessellator makes on
+a mesh's triangle is moved along the triangle's interpolated normal by S h, h the red channel
+of a height image at the point's interpolated lookup coordinates (st = uv * uv_scale +
+uv_offset at the corners; textureLod at level 0, bilinear, clamped to the edge), S the scale in
+object units. Its normal is the displaced surface's: the cross product
+of the displaced surface's UV tangents, T_s + N S dh/ds and T_t + N S dh/dt (T_s, T_t the
+triangle's dP/ds and dP/dt, made once a patch; dh/ds, dh/dt central differences a texel apart).
+An edge's level: the height changes by at most g (DISPLACEMENT_SLOPE: the largest difference
+between neighbouring texels) a texel, so across a part of k texels the surface strays from the
+chord by at most k g S_w / 2 (S_w: S in world units, the model matrix times the ends' normals,
+the larger): within e when the edge's T texels (the larger of |ds| W and |dt| H) are cut into
+
+    L >= T g S_w / (2 e),            L <= T (a part per texel)
+
+parts, clamped to [1, MAX_LEVEL]: the chords then stay within e, or where a part per texel
+caps L, within g S_w / 2 (the image holds nothing finer than its texels; a finer cut would
+follow the bilinear creases between them at many times the cost); both ends enter symmetrically (no crack: the point, its UV,
+its height and its normal are the same from both patches of an edge). The inner level is the
+largest outer one.
+
 What a scene asks for (`Tessellation`, an object's `tessellation` table in a scene file): an
 analytic sphere drawn from PATCH_SUBDIVISIONS' icosphere as triangle patches, or a mesh's
-triangles as PN triangles, in the camera pass (the shadow passes draw the sphere's own
-icosphere, the mesh as it is).
+triangles as PN triangles, or displaced by a height image, in the camera pass (the shadow passes
+draw the sphere's own icosphere, the mesh as it is).
 """
 
 from __future__ import annotations
@@ -69,6 +89,7 @@ import numpy as np
 
 from renderer.core.scene import Sphere
 from renderer.core.shapes import sphere_mesh
+from renderer.core.textures import Sampler, Texture
 
 TARGET_PIXEL_ERROR = 0.25        # pixels: the issue's target of the geometric error on screen
 # The edges' sagitta is held to this share of the target: a triangle's interior dips deeper than
@@ -84,7 +105,7 @@ SPACING_WORDS = {"equal": "equal_spacing", "fractional_even": "fractional_even_s
                  "fractional_odd": "fractional_odd_spacing"}
 # What the evaluation stage places the points on: an analytic sphere's exact surface, or a
 # mesh's PN triangles (the object's kind decides: `surface_of`).
-SURFACES = ("sphere", "pn_triangles")
+SURFACES = ("sphere", "pn_triangles", "displaced")
 PN_CURVE_BOUND = 0.75            # 6 / 8: |B''| <= 6 max second difference; a chord strays h^2 / 8 of it
 ONE_THIRD = 1.0 / 3.0            # o_ab's factor, multiplied (float32 0.33333334), not divided
 
@@ -116,12 +137,43 @@ class Tessellation:
     error: float = TARGET_PIXEL_ERROR
     level: float | None = None
     surface: str = "sphere"      # SURFACES: what the points are placed on
+    displacement: "Displacement | None" = None
+
+
+# The height image's sampler: bilinear at level 0 (textureLod(u_height, st, 0)), clamped
+DISPLACEMENT_SAMPLER = Sampler(wrap="clamp", filter="bilinear")
+
+
+@dataclass(frozen=True)
+class Displacement:
+    """A mesh displaced along its normals by `scale` (object units) times a height image's red
+    channel (linear, 0 to 1) at its UVs."""
+    texture: Texture
+    scale: float
+    uv_scale: tuple = (1.0, 1.0)     # the lookup at st = uv * uv_scale + uv_offset (as a texture's)
+    uv_offset: tuple = (0.0, 0.0)
+
+    @property
+    def slope(self) -> float:
+        """g: the largest difference between the heights of two texels side by side (0 to 1)."""
+        return displacement_slope(self.texture)
+
+
+def displacement_slope(texture: Texture) -> float:
+    """The largest |h(i + 1) - h(i)| between neighbouring texels of level 0's red channel, in
+    float32 heights (texel / 255)."""
+    red = texture.levels[0][..., 0].astype(np.float32) / np.float32(255)
+    across = np.abs(np.diff(red, axis=1)).max(initial=0.0)
+    down = np.abs(np.diff(red, axis=0)).max(initial=0.0)
+    return float(max(across, down))
 
 
 def surface_of(obj) -> str:
-    """What a tessellated object's points are placed on: its analytic sphere, or its mesh's
-    PN triangles (an object without an analytic shape)."""
-    return "sphere" if isinstance(obj.shape, Sphere) else "pn_triangles"
+    """What a tessellated object's points are placed on: its analytic sphere, its mesh
+    displaced by a height image, or its mesh's PN triangles."""
+    if isinstance(obj.shape, Sphere):
+        return "sphere"
+    return "displaced" if obj.tessellation is not None and obj.tessellation.displacement else "pn_triangles"
 
 
 @dataclass(frozen=True)
@@ -136,6 +188,13 @@ class PatchNet:
     @property
     def count(self) -> int:
         return len(self.positions)
+
+
+def displaced_patches(mesh):
+    """A displaced mesh's patches, a patch per face, its corners in the face's order:
+    positions, normals (P, 3, 3) and UVs (P, 3, 2), float32 object space."""
+    faces = np.asarray(mesh.faces, np.int64)
+    return tuple(np.asarray(values, np.float32)[faces] for values in (mesh.positions, mesh.normals, mesh.uvs))
 
 
 def pn_patches(mesh) -> PatchNet:
@@ -197,6 +256,8 @@ def check_tessellated(obj) -> None:
         return
     if obj.shape is not None and not isinstance(obj.shape, Sphere):
         raise ValueError(f"object {obj.name!r}: a plane is flat; only a sphere or a mesh is tessellated")
+    if obj.tessellation.surface == "displaced" and obj.mesh.uvs is None:
+        raise ValueError(f"object {obj.name!r}: a displaced mesh needs texture coordinates")
     if obj.tessellation.surface != surface_of(obj):
         raise ValueError(f"object {obj.name!r}: its tessellation's surface is "
                          f"{obj.tessellation.surface!r}, its kind's {surface_of(obj)!r}")

@@ -52,6 +52,11 @@ def read_texture(reader, raw: Any, path: str, cache: dict) -> MaterialTexture:
                            _modulate(reader, raw.get("modulate", ["kd"]), key("modulate")))
 
 
+def read_image(reader, value: Any, path: str, colorspace: str, cache: dict) -> Texture:
+    """The Texture of the image file `value` names at key `path`, read once per scene."""
+    return _image(reader, value, path, colorspace, cache)
+
+
 def _image(reader, value: Any, path: str, colorspace: str, cache: dict) -> Texture:
     file = reader.find_file(value, path, "image")
     cache_key = ("image", str(file.resolve()), colorspace)

@@ -91,6 +91,14 @@ TESSELLATION_UNIFORMS = {
     "u_max_level": "float",                 # tessellation.MAX_LEVEL
     "u_fixed_level": "float",               # Tessellation.level, 0 for levels by need
     "u_sphere": "vec4",                     # object space: centre, radius
+    # a displaced mesh's (Tessellation.displacement)
+    "u_height": "sampler2D",                # the height image's texture unit (the GPU path's alone)
+    "u_height_size": "vec2",                # its width and height, texels
+    "u_height_texel": "vec2",               # float32(1) / width, float32(1) / height
+    "u_height_slope": "float",              # Displacement.slope: the largest step between texels
+    "u_displacement_scale": "float",        # Displacement.scale: object units for a height of 1
+    "u_height_uv_scale": "vec2",            # Displacement.uv_scale, uv_offset: st = uv * scale + offset
+    "u_height_uv_offset": "vec2",
 }
 UNIFORM_TYPES = (FRAME_UNIFORMS | OBJECT_UNIFORMS | TEXTURE_UNIFORMS | LIGHT_COUNT_UNIFORMS
                  | SHADOW_UNIFORMS | SHADOW_OBJECT_UNIFORMS | SHADOW_PASS_UNIFORMS | TESSELLATION_UNIFORMS)
@@ -160,9 +168,18 @@ def tessellation_uniforms(obj: SceneObject, matrices: ObjectMatrices, height: in
         radius, centre_radius = float(sphere.radius) * scale, [*sphere.centre, sphere.radius]
     else:
         radius, centre_radius = 0.0, [0.0, 0.0, 0.0, 0.0]
-    return {"u_viewport_height": np.asarray(float(height)),
-            "u_target_error": np.asarray(float(settings.error) * EDGE_ERROR_SHARE),
-            "u_surface_radius": np.asarray(radius),
-            "u_max_level": np.asarray(MAX_LEVEL),
-            "u_fixed_level": np.asarray(0.0 if settings.level is None else float(settings.level)),
-            "u_sphere": np.asarray(centre_radius, dtype=np.float64)}
+    values = {"u_viewport_height": np.asarray(float(height)),
+              "u_target_error": np.asarray(float(settings.error) * EDGE_ERROR_SHARE),
+              "u_surface_radius": np.asarray(radius),
+              "u_max_level": np.asarray(MAX_LEVEL),
+              "u_fixed_level": np.asarray(0.0 if settings.level is None else float(settings.level)),
+              "u_sphere": np.asarray(centre_radius, dtype=np.float64)}
+    displacement = settings.displacement
+    if displacement is not None:
+        size = np.asarray([displacement.texture.width, displacement.texture.height], np.float32)
+        values |= {"u_height_size": size, "u_height_texel": np.float32(1) / size,
+                   "u_height_slope": np.asarray(displacement.slope),
+                   "u_displacement_scale": np.asarray(float(displacement.scale)),
+                   "u_height_uv_scale": np.asarray(displacement.uv_scale, np.float64),
+                   "u_height_uv_offset": np.asarray(displacement.uv_offset, np.float64)}
+    return values

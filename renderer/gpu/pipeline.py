@@ -85,13 +85,14 @@ from renderer.core.frame import Frame, image_size
 from renderer.core.gl_rules import GL_LOWER_LEFT, STANDARD_DEPTH, DepthMapping, depth_mapping, check_light_count
 from renderer.core.scene import Mesh, Scene, SceneObject
 from renderer.core.shadows import ShadowLayout, plan_shadows, shadow_layout
-from renderer.core.tessellation import check_tessellated, patch_mesh, patches_per_draw, pn_patches
+from renderer.core.tessellation import (DISPLACEMENT_SAMPLER, check_tessellated, displaced_patches, patch_mesh,
+                                        patches_per_draw, pn_patches)
 from renderer.gpu.shaders import ALL_FEATURES_LIGHTS, ProgramCache, ShaderVariant
 from renderer.gpu.polygon_buffers import PolygonBuffers, vertex_bytes
 from renderer.gpu.shadow_maps import ShadowMaps
 from renderer.gpu.textures import TextureCache
 from renderer.core.transforms import jitter, to_glsl
-from renderer.gpu.uniforms import (FACE_NORMALS_UNIT, MATERIAL_TEXTURE_UNIT, frame_uniform_values,
+from renderer.gpu.uniforms import (DISPLACEMENT_TEXTURE_UNIT, FACE_NORMALS_UNIT, MATERIAL_TEXTURE_UNIT, frame_uniform_values,
                                    object_uniform_values)
 from renderer.core.visibility import visible_objects
 
@@ -199,6 +200,7 @@ class _Draw:
     face_normals: moderngl.Texture | None = None   # bound on FACE_NORMALS_UNIT (a shadowed program's)
     count: int = -1                        # indices drawn (-1: all)
     patches: int = 0                       # a tessellated object's triangle patches (0: triangles)
+    heights: tuple | None = None           # (texture, sampler) of a displaced object's height image
 
 
 class GpuRenderer(ContextRenderer):
@@ -313,7 +315,12 @@ class GpuRenderer(ContextRenderer):
             item.ibo = self.ctx.buffer(np.ascontiguousarray(mesh.faces, dtype=np.uint32).tobytes())
         if item.obj.tessellation is None:
             pass
-        elif item.obj.tessellation.surface == "pn_triangles":   # a patch per face, its corners apart
+        elif item.obj.tessellation.surface == "displaced":   # a patch per face, its corners apart
+            corners = np.concatenate(displaced_patches(mesh), axis=2)
+            item.patches = (self.ctx.buffer(np.ascontiguousarray(corners, dtype=np.float32).tobytes()),
+                            self.ctx.buffer(np.arange(3 * len(corners), dtype=np.uint32).tobytes()),
+                            len(corners))
+        elif item.obj.tessellation.surface == "pn_triangles":
             net = pn_patches(mesh)
             corners = np.concatenate([net.positions, net.normals, net.straight[..., None]], axis=2)
             item.patches = (self.ctx.buffer(np.ascontiguousarray(corners, dtype=np.float32).tobytes()),
@@ -367,13 +374,16 @@ class GpuRenderer(ContextRenderer):
         if vao is None:
             program = self._programs.get(variant)
             vbo, ibo, uv_vbo = item.drawn_buffers
-            if program.get("in_straight", None) is not None:    # a PN patch's corners
+            surface = item.obj.tessellation.surface if variant.tessellation else None
+            if surface == "pn_triangles":                  # a PN patch's corners
                 content = [(vbo, "3f 3f 1f", "in_position", "in_normal", "in_straight")]
+            elif surface == "displaced":                   # a displaced patch's corners
+                content = [(vbo, "3f 3f 2f", "in_position", "in_normal", "in_uv")]
             elif program.get("in_normal", None) is not None:
                 content = [(vbo, "3f 3f", "in_position", "in_normal")]
             else:                                    # flat: the normal is the face's, not read
                 content = [(vbo, "3f 3x4", "in_position")]
-            if program.get("in_uv", None) is not None:   # textured, and the texel is used
+            if program.get("in_uv", None) is not None and surface is None:   # textured, the texel used
                 content.append((uv_vbo, "2f", "in_uv"))
             vao = self.ctx.vertex_array(program, content, index_buffer=ibo,
                                         index_element_size=4)
@@ -487,8 +497,11 @@ class GpuRenderer(ContextRenderer):
             cull = CULL_FLAGS[item.obj.cull]
             enable = moderngl.DEPTH_TEST | (moderngl.CULL_FACE if cull else 0)
             facets = self._face_normals(item) if variant.shadows else None
+            displacement = item.obj.tessellation.displacement if variant.tessellation else None
+            heights = None if displacement is None else (self._textures.texture(displacement.texture),
+                                                         self._textures.sampler(DISPLACEMENT_SAMPLER))
             plan.append(_Draw(vao, enable, cull, uploads, item.texture if variant.texture else None,
-                              facets, item.count, item.patches[2] if variant.tessellation else 0))
+                              facets, item.count, item.patches[2] if variant.tessellation else 0, heights))
         self._shadowed[linear] = any(variant.shadows for variant in programs)
         for program in programs.values():          # the same for every object: set once here
             for name, data in self._frame_uniforms.items():
@@ -583,6 +596,9 @@ class GpuRenderer(ContextRenderer):
                     sampler.use(MATERIAL_TEXTURE_UNIT)
                 if draw.face_normals is not None:
                     draw.face_normals.use(FACE_NORMALS_UNIT)
+                if draw.heights is not None:
+                    draw.heights[0].use(DISPLACEMENT_TEXTURE_UNIT)
+                    draw.heights[1].use(DISPLACEMENT_TEXTURE_UNIT)
                 if draw.patches:                  # a tessellated sphere: triangle patches
                     self._draw_patches(draw)
                 else:
@@ -593,6 +609,9 @@ class GpuRenderer(ContextRenderer):
             textured = [draw.texture for draw in plan if draw.texture is not None]
             if textured:                              # unbinds (glBindSampler(unit, 0))
                 textured[-1][1].clear(MATERIAL_TEXTURE_UNIT)
+            displaced = [draw.heights for draw in plan if draw.heights is not None]
+            if displaced:
+                displaced[-1][1].clear(DISPLACEMENT_TEXTURE_UNIT)
             ctx.wireframe = False
             if mapping is not STANDARD_DEPTH:
                 self._clip_control(STANDARD_DEPTH)

@@ -301,7 +301,7 @@ class ShaderVariant:
         shadows += "".join(f"-textured-{k}" for k in self.texture)
         if self.tessellation:
             shadows += f"-tessellated-{self.tessellation.removesuffix('_spacing')}"
-            shadows += "-pn" if self.surface == "pn_triangles" else ""
+            shadows += {"sphere": "", "pn_triangles": "-pn", "displaced": "-displaced"}[self.surface]
         if self.all_features:
             terms = (f"-{self.num_directional_lights}dir-{self.num_point_lights}point"
                      if self.light_terms else "")
@@ -364,7 +364,7 @@ STAGES = (("vertex_shader", "vertex.glsl"),
           ("fragment_shader", "fragment.glsl"))
 TESSELLATION_STAGES = ("tess_control_shader", "tess_evaluation_shader")
 # glsl/tess_evaluation.glsl's layout: each spacing's define
-SURFACE_DEFINES = {"sphere": "SURFACE_SPHERE", "pn_triangles": "SURFACE_PN"}
+SURFACE_DEFINES = {"sphere": "SURFACE_SPHERE", "pn_triangles": "SURFACE_PN", "displaced": "SURFACE_DISPLACED"}
 TESSELLATION_SPACING_DEFINES = {"equal_spacing": "SPACING_EQUAL", "fractional_even_spacing": "SPACING_FRACTIONAL_EVEN",
                                 "fractional_odd_spacing": "SPACING_FRACTIONAL_ODD"}
 

@@ -23,6 +23,7 @@ from renderer.gpu.context import gl_function
 
 MATERIAL_TEXTURE_UNIT = 1                # the unit a textured material's texture is bound to
 FACE_NORMALS_UNIT = 3                    # a shadowed Phong or Gouraud object's facet normals
+DISPLACEMENT_TEXTURE_UNIT = 4            # a displaced object's height image (its evaluation stage)
 # The texture units each kind of light's shadow-map stack (array texture) is bound to.
 SHADOW_MAPS_UNITS = {"directional": 0, "point": 2}
 
@@ -86,6 +87,8 @@ def object_uniform_values(obj: SceneObject, matrices, shadow_masks: dict | None 
     values = object_uniforms(obj, matrices) | tessellation_uniforms(obj, matrices, height)
     if obj.material.texture is not None:
         values["u_texture"] = np.asarray(MATERIAL_TEXTURE_UNIT)
+    if obj.tessellation is not None and obj.tessellation.displacement is not None:
+        values["u_height"] = np.asarray(DISPLACEMENT_TEXTURE_UNIT)
     if shadow_masks is not None:
         values |= {name: np.asarray(mask) for name, mask in shadow_masks.items()}
         values["u_shadow_facets"] = np.asarray(int(obj.shape is None))

@@ -163,6 +163,13 @@ void main() {
     // world space on the side N lights (flat: its face normal, N itself), and how steeply its
     // neighbours rise on that side. An analytic shape's triangles only stand in for its smooth
     // surface (u_shadow_facets 0): its normal is N, its crease how steeply the facet tilts off N.
+    // A tessellated sphere (TESSELLATED): N, and no crease. Its maps hold its icosphere, whose
+    // facets lie inside the sphere, so no point of the tessellated surface lies behind its own
+    // caster's depth; and gl_PrimitiveID numbers its patches, not the triangles drawn.
+#ifdef TESSELLATED
+    shadow_facet_normal = N;
+    shadow_crease = 0.0;
+#else
     ivec2 at = ivec2(2 * (gl_PrimitiveID % FACES_PER_ROW), gl_PrimitiveID / FACES_PER_ROW);
     vec4 face = texelFetch(u_face_normals, at, 0);
     vec3 wound = normalize_or_zero(u_normal_matrix * face.xyz);
@@ -179,6 +186,7 @@ void main() {
         float c = abs(dot(wound, N));
         shadow_crease = c > 0.0 ? min(sqrt(max(1.0 - c * c, 0.0)) / c, SHADOW_CREASE_CAP) : SHADOW_CREASE_CAP;
     }
+#endif
 #endif
 #if defined(SHADING_PHONG)
 #ifdef TEXTURED

@@ -96,9 +96,10 @@ def prepare_object(obj, drawn: DrawnMesh, frame_matrices, lights: Lights, eye, w
     clipped = clip_triangles(vertices.gl_Position[faces], reversed_z)
     window = setup_triangles(clipped.gl_Position, width, height, subpixel_bits, reversed_z)
     keep = is_drawn(window.area2, obj.cull)
-    # a mesh's facets are its surface; an analytic shape's triangles only stand in for it
+    # a mesh's facets are its surface; an analytic shape's triangles only stand in for it; a
+    # tessellated sphere's lookup takes N and no crease (glsl/fragment.glsl, TESSELLATED)
     receiver = shadowed and obj.receives_shadows
-    facets = world_facet_normals(mesh, matrices.normal, dtype) if receiver else None
+    facets = world_facet_normals(mesh, matrices.normal, dtype) if receiver and obj.tessellation is None else None
     creases = face_creases(mesh) if receiver and obj.shape is None else None
     return PreparedObject(ObjectVaryings(material, faces, vertices, triangles, obj.receives_shadows,
                                          displace_lookup, index, facets, creases),

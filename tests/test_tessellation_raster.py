@@ -20,10 +20,13 @@ from reference.tessellation.tessellator import tessellate
 from renderer.checks.compare import compare_frames
 from renderer.checks.tolerance import PIPELINE_TOLERANCE
 from renderer.core.scene_file import load_scene, scene_from_dict
-from renderer.core.tessellation import MAX_LEVEL, SPACINGS, Tessellation, max_triangle_points, patches_per_draw
+from renderer.checks.methods import compare_methods
+from renderer.core.tessellation import (MAX_LEVEL, SPACINGS, Tessellation, max_triangle_points, patches_per_draw,
+                                        with_tessellated_spheres)
 from renderer.errors import SceneError
 from renderer.gpu.pipeline import PATCHES_PER_DRAW
 from renderer.methods import open_renderer
+from tests.tessellation_capture import gpu_against_twin
 
 SIZE = (96, 72)
 
@@ -58,10 +61,12 @@ def test_the_tessellation_table_is_read():
     ({"level": 0.5}, {}, "objects[0].tessellation.level"),
     ({"spacing": "odd"}, {}, "objects[0].tessellation.spacing"),
     ({"colour": 1}, {}, "objects[0].tessellation"),
-    ({}, {"receives_shadows": True}, "does not look shadow maps up yet"),
+    ({}, {"receives_shadows": True, "mesh": {"primitive": "torus"}}, "does not look shadow maps up yet"),
 ])
 def test_a_bad_tessellation_table_is_one_line(table, extra, words):
     data = ball(table, **extra)
+    if "mesh" in extra:
+        del data["objects"][0]["shape"]
     with pytest.raises(SceneError) as info:
         scene_from_dict(data)
     line = info.value.line()
@@ -212,3 +217,49 @@ def test_extreme_views_are_drawn_alike_by_the_gpu_and_the_twin(gl_contexts, case
     result = compare_frames(got, expected)
     assert PIPELINE_TOLERANCE.passes(result), PIPELINE_TOLERANCE.failures(result)
     assert (got[..., 3] > 0).any()
+
+
+# -- shadows, and compare --methods --tessellate -------------------------------------------------------
+
+@pytest.mark.parametrize("kind", ["egl", "osmesa"])
+def test_tessellated_spheres_receiving_shadows_are_drawn_alike(gl_contexts, kind):
+    """classic with its three spheres through the stages: they cast shadows on each other and
+    the floor and receive them (the lookup with the sphere's normal, no crease); GPU against
+    twin 0 mismatched pixels."""
+    scene, count = with_tessellated_spheres(load_scene("classic"))
+    assert count == 3 and all(o.receives_shadows for o in scene.objects)
+    result = gpu_against_twin(scene, gl_contexts[kind], (160, 120))
+    assert PIPELINE_TOLERANCE.passes(result) and result.mismatched_pixels == 0, \
+        PIPELINE_TOLERANCE.failures(result)
+
+
+def test_with_tessellated_spheres_takes_the_untextured_analytic_spheres_only():
+    globe = load_scene("globe")                    # a textured sphere
+    assert with_tessellated_spheres(globe)[1] == 0
+    scene, count = with_tessellated_spheres(load_scene("tessellated_sphere"), 0.1)
+    assert count == 0                              # they ask for their own already
+    scene, count = with_tessellated_spheres(load_scene("classic"), 0.1)
+    assert [o.tessellation and o.tessellation.error for o in scene.objects] == [None, 0.1, 0.1, 0.1]
+
+
+def test_compare_methods_tessellate_falls_at_640x480(gl_contexts):
+    """The "tessellation" cause on classic at 640 x 480: 184 pixels as icospheres, 26 through
+    the stages at 0.25 pixel (benchmarks/bench_methods_tessellation.py has every size)."""
+    scene = load_scene("classic")
+    before = compare_methods(scene, 640, 480, context=gl_contexts["egl"]).counts()["tessellation"]
+    after = compare_methods(with_tessellated_spheres(scene)[0], 640, 480,
+                            context=gl_contexts["egl"]).counts()["tessellation"]
+    assert after < before / 3, (before, after)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["--tessellate", "0"], "--tessellate: must be a number of pixels above 0"),
+    (["--tessellate", "nan"], "--tessellate: must be a number of pixels above 0"),
+    (["mesh_file", "--tessellate"], "--tessellate: the scene has no untextured analytic sphere"),
+])
+def test_compare_tessellate_refuses_in_one_line(cli_here, tmp_path, argv, words):
+    scene = [] if argv[0] == "mesh_file" else ["classic"]
+    done = cli_here("compare", *scene, "--methods", *argv, "--size", "32x24", "--out", str(tmp_path / "o"))
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and lines[0].startswith(f"renderer: {words}"), done.stderr
+    assert not (tmp_path / "o").exists()

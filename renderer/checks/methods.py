@@ -64,8 +64,9 @@ CAUSES = (
           "either side; neither is wrong, and the pipeline tolerance's ±1 px allowance forgives it"),
     Cause("tessellation", (255, 120, 0), "orange",
           "the surface seen, or its shading, differs beyond ±1 px: the rasteriser draws an "
-          "analytic sphere as an icosphere (and skips the faces an object's cull names; a plane "
-          "it draws as itself to the view's edge); the ray tracer's exact shapes are right"),
+          "analytic sphere as an icosphere, or through the tessellation stages within their "
+          "target (compare --methods --tessellate), (and skips the faces an object's cull names; "
+          "a plane it draws as itself to the view's edge); the ray tracer's exact shapes are right"),
     Cause("sampling", (0, 220, 220), "cyan",
           "several samples per pixel: the ray tracer averages its samples (anti-aliased edges), "
           "the rasteriser takes one at the pixel centre; the average is nearer the pixel's "

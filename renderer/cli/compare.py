@@ -40,6 +40,11 @@ def add_parser(sub) -> None:
                               "--seed), both on the GPU: where they differ and why (shadows, "
                               "reflection, edges, tessellation, ...); writes raster.png, raytrace.png, "
                               "causes.png and methods.json (default folder: compare-methods-SCENE_NAME)")
+    compare.add_argument("--tessellate", type=float, nargs="?", const=0.25, default=None, metavar="PIXELS",
+                         help="with --methods: draw each untextured analytic sphere through the "
+                              "tessellation stages, levels by need keeping the surface within PIXELS "
+                              "(default 0.25) of its triangles, instead of as an icosphere "
+                              "(docs/tessellation.md)")
     compare.add_argument("--shadows-vs-truth", action="store_true",
                          help="how wrong the rasteriser's shadow maps are against ray-cast "
                               "shadows (pixels wrongly lit or shadowed, inside or outside a "
@@ -92,6 +97,13 @@ def run_methods(args) -> int:
     scene = load_traced(args, *(chosen.need(args.size, ["gpu"], args.options if chosen.options
                                             is type(args.options) else chosen.options())
                                 for chosen in METHODS.values()))
+    if args.tessellate is not None:
+        from renderer.core.tessellation import with_tessellated_spheres
+        if not args.tessellate > 0 or args.tessellate == float("inf"):
+            raise UserError(f"must be a number of pixels above 0, got {args.tessellate:g}", key="--tessellate")
+        scene, count = with_tessellated_spheres(scene, args.tessellate)
+        if not count:
+            raise UserError("the scene has no untextured analytic sphere to tessellate", key="--tessellate")
     out = check_folder(args.out or default_output(f"compare-methods-{output_stem(scene)}"))
     names = [out / name for name in ("raster.png", "raytrace.png", "causes.png", "methods.json")]
     check_outputs(*names)
@@ -211,6 +223,8 @@ def run(args) -> int:
     check_raytrace_options(args)
     if args.methods:
         return run_methods(args)
+    if args.tessellate is not None:
+        args.parser.error("--tessellate is for --methods: the rasteriser against the ray tracer")
     scene = load_traced(args, method(args.method).need(args.size, ["gpu", "reference"], args.options))
     out = check_folder(args.out or default_output(f"compare-{output_stem(scene)}"))
     names = [out / "gpu.png", out / "reference.png", out / "diff.png"]

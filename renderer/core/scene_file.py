@@ -801,9 +801,9 @@ class _Reader(TableReader):
         if obj.material.textured:
             self.fail(path, "a tessellated object cannot be textured yet (a sphere's seam, a mesh's "
                             "UVs across its patches)")
-        if obj.receives_shadows:
-            self.fail(path, "a tessellated object does not look shadow maps up yet: "
-                            "give the object receives_shadows = false")
+        if obj.receives_shadows and obj.shape is None:
+            self.fail(path, "a tessellated mesh does not look shadow maps up yet (they hold its flat "
+                            "triangles): give the object receives_shadows = false")
         settings = tessellation.Tessellation(surface="sphere" if isinstance(obj.shape, Sphere) else "pn_triangles")
         if "displacement" in raw:
             settings = dataclasses.replace(settings, surface="displaced",

@@ -250,8 +250,9 @@ def patch_mesh(sphere):
 def check_tessellated(obj) -> None:
     """A ValueError naming `obj` where its tessellation asks for what the stages do not draw
     yet: an analytic shape other than a sphere (a plane is flat: it needs none), a texture (the
-    sphere's UV seam; a mesh's UVs across the patches), shadow maps looked up (their facets are
-    the patches'). The scene file refuses the same in one line."""
+    sphere's UV seam; a mesh's UVs across the patches), a mesh's shadow maps looked up (they
+    hold its flat triangles, which a PN surface's folds or a displaced bump rise above and dip
+    below). The scene file refuses the same in one line."""
     if obj.tessellation is None:
         return
     if obj.shape is not None and not isinstance(obj.shape, Sphere):
@@ -263,6 +264,18 @@ def check_tessellated(obj) -> None:
                          f"{obj.tessellation.surface!r}, its kind's {surface_of(obj)!r}")
     if obj.material.texture is not None:
         raise ValueError(f"object {obj.name!r}: a tessellated object cannot be textured yet")
-    if obj.receives_shadows:
-        raise ValueError(f"object {obj.name!r}: a tessellated object does not look shadow maps up "
+    if obj.receives_shadows and obj.tessellation.surface != "sphere":
+        raise ValueError(f"object {obj.name!r}: a tessellated mesh does not look shadow maps up "
                          f"yet (receives_shadows = false)")
+
+
+def with_tessellated_spheres(scene, error: float = TARGET_PIXEL_ERROR):
+    """A copy of `scene` whose analytic spheres that ask for no tessellation and carry no
+    texture are drawn through the tessellation stages with levels by need at `error` pixels
+    (`renderer compare --methods --tessellate`), and how many they are."""
+    import dataclasses
+    chosen = [isinstance(o.shape, Sphere) and o.tessellation is None and o.material.texture is None
+              for o in scene.objects]
+    objects = [dataclasses.replace(o, tessellation=Tessellation(error=error)) if pick else o
+               for o, pick in zip(scene.objects, chosen)]
+    return dataclasses.replace(scene, objects=objects), sum(chosen)

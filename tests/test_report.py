@@ -502,6 +502,7 @@ def test_radiosity_settings_cover_each_knob():
     assert all(s.options().elements_across == s.across for s in plan)
 
 
+@pytest.mark.slow     # 10 s, most of it the path-traced truth: the full run's (the default run 90 s with it)
 def test_a_tiny_radiosity_sweep_gpu_and_twin(tmp_path, gl_contexts):
     """The Cornell box at 16x12 against its path-traced truth: finer elements, less error; one
     Gauss-Seidel sweep more error than converged; the twin's error the GPU's (the same item

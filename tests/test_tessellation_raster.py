@@ -242,6 +242,7 @@ def test_with_tessellated_spheres_takes_the_untextured_analytic_spheres_only():
     assert [o.tessellation and o.tessellation.error for o in scene.objects] == [None, 0.1, 0.1, 0.1]
 
 
+@pytest.mark.slow
 def test_compare_methods_tessellate_falls_at_640x480(gl_contexts):
     """The "tessellation" cause on classic at 640 x 480: 184 pixels as icospheres, 26 through
     the stages at 0.25 pixel (benchmarks/bench_methods_tessellation.py has every size)."""

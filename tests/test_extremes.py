@@ -492,6 +492,17 @@ def test_a_light_inside_a_closed_mesh_lights_nothing_outside_it(gl_contexts):
 TEXTURE_CASES = sorted(n for n in RENDERED if n.startswith("tex_"))
 
 
+def test_the_tessellation_cases_are_the_issues():
+    """Issue 34's list: levels at 1 and at GL_MAX_TESS_GEN_LEVEL, a patch crossing the near
+    plane, a tiny sphere far away, patches edge on (the approaching camera's cracks:
+    tests/test_tessellation_raster.py and test_pn_triangles.py)."""
+    cases = sorted(n for n in RENDERED if n.startswith("tess_"))
+    assert cases == ["tess_edge_on", "tess_levels_1_and_64", "tess_near_plane", "tess_tiny_far"]
+    levels = {o.name: o.tessellation.level for o in extreme_scene("tess_levels_1_and_64").objects}
+    assert levels == {"level_1": 1.0, "level_64": 64.0}
+    assert {o.tessellation.surface for o in extreme_scene("tess_edge_on").objects} == {"displaced", "pn_triangles"}
+
+
 def test_the_texture_cases_are_the_issues():
     """Issue 17's list: a checkerboard plane to the horizon (minification, moire), a texture
     magnified 1000 times, a 1 x 1 texture, a non-power-of-two texture, UVs of +-1e6 with

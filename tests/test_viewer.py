@@ -543,3 +543,28 @@ def test_with_shadows_off_d_says_there_is_no_map_and_the_reference_matches(on_x_
         assert viewer.figures is not None and viewer.figures["mismatched"] == 0
         assert "shadow map of directional light 1: shadows are off (O)" in viewer._overlay_text()
         assert not viewer._map_shown
+
+
+# -- tessellation: the title's levels, W's wireframe of the generated triangles ----------------------
+
+def test_the_title_shows_the_tessellation_levels_and_w_draws_the_generated_triangles(on_x_display):
+    """tessellated_sphere at 160x120: the title's levels are the control stage's twin's for
+    the view (its least and largest); the wireframe is the stages' triangles, more lines than
+    the 80 patches alone would draw."""
+    from reference.tessellation.surface import levels_in_view
+    authored = scene("tessellated_sphere")
+    found = levels_in_view(authored, 160, 120)
+    low, high = min(f[1] for f in found), max(f[2] for f in found)
+    with Viewer(authored, 160, 120, vsync=False) as v:
+        shaded = shown_after_a_frame(v)
+        assert f"tessellation levels {low:.1f}-{high:.1f}" in v.title() and high > 2
+        press(v, glfw.KEY_W)
+        lines = shown_after_a_frame(v)
+        patches = replace(authored, objects=[replace(o, tessellation=replace(o.tessellation, level=1.0))
+                                             if o.tessellation else o for o in authored.objects])
+    with Viewer(patches, 160, 120, vsync=False) as v:
+        press(v, glfw.KEY_W)
+        coarse = shown_after_a_frame(v)
+    background = shaded[0, 0].astype(int)                     # the sky: a corner
+    drawn = lambda image: (np.abs(image.astype(int) - background).max(axis=-1) > 8).sum()   # noqa: E731
+    assert drawn(lines) > 1.5 * drawn(coarse) > 0 and drawn(lines) < drawn(shaded)

@@ -27,8 +27,9 @@ from renderer.core.tessellation import check_tessellated, displaced_patches, pat
 from renderer.core.uniforms import tessellation_uniforms
 
 
-def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndarray, height: int):
-    """The object's generated points, normals and triangles (module docstring)."""
+def control_stage(obj, object_matrices, view: np.ndarray, projection: np.ndarray, height: int):
+    """The control stage's work on the object's patches: (their levels (P, 4) float32, and a
+    function of (patch, tess coords) giving the evaluation stage's points and normals)."""
     check_tessellated(obj)
     values = tessellation_uniforms(obj, object_matrices, height)
     u = ControlUniforms(object_matrices.model, view, projection, float(values["u_viewport_height"]),
@@ -54,23 +55,42 @@ def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndar
         corners = patches.positions[patches.faces].astype(np.float32)
         normals = patches.normals[patches.faces].astype(np.float32)
         levels = patch_levels(corners, u)
+
+    def evaluation_stage(patch: int, coords: np.ndarray):
+        def each(value):
+            return np.broadcast_to(value[patch], (len(coords), *value.shape[1:]))
+        if surface == "displaced":
+            return evaluate_displaced(coords, each(corners), each(normals), each(uvs), each(tangent_s),
+                                      each(tangent_t), displacement.texture, displacement.scale)
+        if surface == "pn_triangles":
+            return evaluate_pn(coords, each(corners), each(normals), each(offsets), each(centres), each(mids))
+        return evaluate(coords, each(corners), each(normals), (sphere[:3], sphere[3]))
+    return levels, evaluation_stage
+
+
+def tessellated_mesh(obj, object_matrices, view: np.ndarray, projection: np.ndarray, height: int):
+    """The object's generated points, normals and triangles (module docstring)."""
+    levels, evaluation_stage = control_stage(obj, object_matrices, view, projection, height)
     positions, shading_normals, faces, offset = [], [], [], 0
     for patch, level in enumerate(levels):
         t = tessellate("triangles", obj.tessellation.spacing, level[:3], level[3:])
         coords = tess_coord(t)
-
-        def each(value):
-            return np.broadcast_to(value[patch], (len(coords), *value.shape[1:]))
-        if surface == "displaced":
-            p, n = evaluate_displaced(coords, each(corners), each(normals), each(uvs), each(tangent_s),
-                                      each(tangent_t), displacement.texture, displacement.scale)
-        elif surface == "pn_triangles":
-            p, n = evaluate_pn(coords, each(corners), each(normals), each(offsets), each(centres), each(mids))
-        else:
-            p, n = evaluate(coords, each(corners), each(normals), (sphere[:3], sphere[3]))
+        p, n = evaluation_stage(patch, coords)
         positions.append(p)
         shading_normals.append(n)
         faces.append(np.asarray(t.indices, np.int64).reshape(-1, 3) + offset)
         offset += len(coords)
     return (np.concatenate(positions), np.concatenate(shading_normals),
             np.concatenate(faces) if faces else np.zeros((0, 3), np.int64))
+
+
+def levels_in_view(scene, width: int, height: int) -> list[tuple[str, float, float]]:
+    """(name, least, largest level) of each tessellated object as the camera pass draws it at
+    width x height (outer and inner levels of all its patches): the viewer's title."""
+    matrices = scene.matrices(width, height)
+    out = []
+    for obj, object_matrices in zip(scene.objects, matrices.objects):
+        if obj.tessellation is not None:
+            levels, _ = control_stage(obj, object_matrices, matrices.view, matrices.projection, height)
+            out.append((obj.name, float(levels.min()), float(levels.max())))
+    return out

@@ -121,6 +121,19 @@ STABILITY = {
     "tex_npot": "NPOT repeat takes u's fraction before the texel, at every level by the base "
                 "level's size (as llvmpipe); mirror takes the float path; the mip chain's "
                 "fractional box weights are the same uploaded levels for both",
+    # the tessellation stages (docs/tessellation.md)
+    "tess_levels_1_and_64": "levels are clamped to [1, 64] in the control stage and the twin's "
+                            "tessellator is llvmpipe's line by line; a patch makes at most 3,169 "
+                            "points, so 20 patches a draw keep each run's uint16 indices from "
+                            "wrapping (one draw at level 64 draws later patches on wrong points)",
+    "tess_near_plane": "an edge whose midpoint's clip w is at or below 0 gets the largest level, "
+                       "never one from a negative w; the generated triangles are clipped in "
+                       "homogeneous coordinates like any others",
+    "tess_tiny_far": "a need below one part clamps to level 1 (the patch drawn as it is); s >= 1 "
+                     "(an error as large as the sphere) gives 1 too",
+    "tess_edge_on": "levels depend on world lengths and depth, not on the patch's projected "
+                    "area, so a grazing patch gets the levels its edges need; the displaced "
+                    "heights are read at level 0 (no derivatives in the evaluation stage)",
     # ray traced (docs/conventions.md, "Rays")
     "rad_stiff_furnace": "the delta form factors are scaled to sum to exactly 1, so a closed room's "
                          "rows sum to 1 within 1e-15 and B = E / (1 - rho) holds at rho = 0.999 "

@@ -143,6 +143,7 @@ class Viewer:
             self._map_lines: tuple = ()        # the overlay's lines on it (none: not asked for)
             self._map_shown = False            # the picture is the map view
             self._version = 0                 # bumped whenever the shaded image would change
+            self._levels_version, self._levels = -1, (0.0, 0.0)   # the title's tessellation levels
             self._view: tuple | None = None   # what the version stands for
             self._requested = -1              # the version the reference was asked for
             self._reference_version = -1      # the version the reference images show
@@ -436,11 +437,27 @@ class Viewer:
         elif self._solved_in_steps and self._radiosity is not None:
             tracing = f" | {self._radiosity.line}"
         shadows = f" | shadows {'on' if self.state.shadows else 'off'}"
+        shadows += self._levels_text()
         if self._map_shown:
             shadows += f" (map of {light_names_of(self.authored)[self.state.shadow_map]})"
         return (f"renderer view: {self.authored.name}{tracing}{timing}{shadows} | "
                 f"{self.presenter.name} buffering{latency_text} | "
                 f"v-sync {'on' if self.state.vsync else 'off'} | H for help")
+
+    def _levels_text(self) -> str:
+        """" | tessellation levels A-B" where the rasteriser draws objects through the
+        tessellation stages: the least and largest level of their patches in this view (their
+        control stage's twin, reference/tessellation/surface.py), worked out again only when
+        the view changes."""
+        if not self._rasterising or not any(o.tessellation for o in self.shown.objects):
+            return ""
+        if self._levels_version != self._version:
+            from reference.tessellation.surface import levels_in_view
+            found = levels_in_view(self.shown, self.gpu.width, self.gpu.height)
+            self._levels = (min(low for _, low, _ in found), max(high for _, _, high in found))
+            self._levels_version = self._version
+        low, high = self._levels
+        return f" | tessellation levels {low:.1f}-{high:.1f}"
 
     # -- screenshots -------------------------------------------------------------------------
     def window_image(self) -> np.ndarray:

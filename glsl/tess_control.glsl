@@ -36,6 +36,13 @@ float clip_w(vec3 world) {
     return (u_projection * (u_view * vec4(world, 1.0))).w;
 }
 
+// the target error in world units at clip w (> 0): the target in pixels over the pixels a
+// world unit spans there, H P11 / (2 w)
+float world_error(float w) {
+    float pixels_per_unit = u_viewport_height * u_projection[1][1] / (2.0 * w);
+    return u_target_error / pixels_per_unit;
+}
+
 #ifdef SURFACE_DISPLACED
 uniform vec2 u_height_size;          // the height image's width and height, texels
 uniform float u_height_slope;        // g: the largest height step between neighbouring texels
@@ -63,8 +70,7 @@ float displaced_edge_level(vec3 a, vec3 b, vec3 na, vec3 nb, vec2 ua, vec2 ub) {
     float w = clip_w((a + b) * 0.5);
     float level = texels;
     if (w > 0.0) {
-        float pixels_per_unit = u_viewport_height * u_projection[1][1] / (2.0 * w);
-        float e = u_target_error / pixels_per_unit;
+        float e = world_error(w);
         float s = u_displacement_scale * max(world_length(na), world_length(nb));
         level = min(texels * (u_height_slope * s) / (2.0 * e), texels);
     }
@@ -99,9 +105,7 @@ vec3 pn_mid_normal(vec3 pa, vec3 na, vec3 pb, vec3 nb) {
 float pn_level(float m, float w) {
     if (!(w > 0.0))
         return u_max_level;
-    float pixels_per_unit = u_viewport_height * u_projection[1][1] / (2.0 * w);
-    float e = u_target_error / pixels_per_unit;
-    float level = sqrt(PN_CURVE_BOUND * m / e);
+    float level = sqrt(PN_CURVE_BOUND * m / world_error(w));
     return clamp(level, 1.0, u_max_level);
 }
 
@@ -120,11 +124,10 @@ float edge_level(vec3 a, vec3 b) {
     float R = u_surface_radius;
     if (!(R > 0.0))
         return 1.0;
-    vec4 mid = u_projection * (u_view * vec4((a + b) * 0.5, 1.0));
-    if (!(mid.w > 0.0))
+    float w = clip_w((a + b) * 0.5);
+    if (!(w > 0.0))
         return u_max_level;                                   // at or behind the eye
-    float pixels_per_unit = u_viewport_height * u_projection[1][1] / (2.0 * mid.w);
-    float s = u_target_error / pixels_per_unit / R;           // e / R
+    float s = world_error(w) / R;                             // e / R
     if (!(s < 1.0))
         return 1.0;
     vec3 chord_vector = a - b;
@@ -137,80 +140,77 @@ float edge_level(vec3 a, vec3 b) {
     return clamp(level, 1.0, u_max_level);
 }
 
+// the patch's levels (outer 0..2, inner) from its world corners; a PN patch's net and a
+// displaced patch's tangents handed on too
+#if defined(SURFACE_PN)
+vec4 patch_levels(vec3 p0, vec3 p1, vec3 p2) {
+    vec3 offsets[6];
+    for (int k = 0; k < 3; k++) {
+        int i = (k + 1) % 3, j = (k + 2) % 3;
+        bool curved = !(v_straight[k] > 0.5);
+        offsets[2 * k] = curved ? pn_offset(v_position[i], v_normal[i], v_position[j]) : vec3(0.0);
+        offsets[2 * k + 1] = curved ? pn_offset(v_position[j], v_normal[j], v_position[i]) : vec3(0.0);
+        c_offset[2 * k] = offsets[2 * k];
+        c_offset[2 * k + 1] = offsets[2 * k + 1];
+        c_mid_normal[k] = pn_mid_normal(v_position[i], v_normal[i], v_position[j], v_normal[j]);
+    }
+    vec3 centre = (((((offsets[0] + offsets[1]) + offsets[2]) + offsets[3]) + offsets[4]) + offsets[5]) * 0.25;
+    c_centre = centre;
+    float outer0 = pn_edge_level(p1, p2, offsets[0], offsets[1]);
+    float outer1 = pn_edge_level(p2, p0, offsets[2], offsets[3]);
+    float outer2 = pn_edge_level(p0, p1, offsets[4], offsets[5]);
+    float inner = max(max(outer0, outer1), outer2);
+    if (!(u_fixed_level > 0.0)) {
+        // the interior's second differences: (o_ik + o_jk) - 2 c for corner k (the two
+        // offsets on the edges to k, near their other ends): corners 2, 0, 1 in turn
+        float m = max(max(world_length((offsets[3] + offsets[0]) - 2.0 * centre),
+                          world_length((offsets[5] + offsets[2]) - 2.0 * centre)),
+                      world_length((offsets[1] + offsets[4]) - 2.0 * centre));
+        inner = max(inner, pn_level(m, clip_w(((p0 + p1) + p2) * ONE_THIRD)));
+    }
+    return vec4(outer0, outer1, outer2, inner);
+}
+#elif defined(SURFACE_DISPLACED)
+vec4 patch_levels(vec3 p0, vec3 p1, vec3 p2) {
+    vec2 st0 = lookup_st(v_uv[0]);
+    vec2 st1 = lookup_st(v_uv[1]);
+    vec2 st2 = lookup_st(v_uv[2]);
+    vec3 e1 = v_position[1] - v_position[0];
+    vec3 e2 = v_position[2] - v_position[0];
+    vec2 d1 = st1 - st0;
+    vec2 d2 = st2 - st0;
+    float det = d1.x * d2.y - d2.x * d1.y;
+    float r = det != 0.0 ? 1.0 / det : 0.0;
+    c_tangent_s = (e1 * d2.y - e2 * d1.y) * r;
+    c_tangent_t = (e2 * d1.x - e1 * d2.x) * r;
+    float outer0 = displaced_edge_level(p1, p2, v_normal[1], v_normal[2], st1, st2);
+    float outer1 = displaced_edge_level(p2, p0, v_normal[2], v_normal[0], st2, st0);
+    float outer2 = displaced_edge_level(p0, p1, v_normal[0], v_normal[1], st0, st1);
+    return vec4(outer0, outer1, outer2, max(max(outer0, outer1), outer2));
+}
+#else
+vec4 patch_levels(vec3 p0, vec3 p1, vec3 p2) {
+    float outer0 = edge_level(p1, p2);
+    float outer1 = edge_level(p2, p0);
+    float outer2 = edge_level(p0, p1);
+    return vec4(outer0, outer1, outer2, max(max(outer0, outer1), outer2));
+}
+#endif
+
 void main() {
     c_position[gl_InvocationID] = v_position[gl_InvocationID];
     c_normal[gl_InvocationID] = v_normal[gl_InvocationID];
-#ifdef SURFACE_PN
-    if (gl_InvocationID == 0) {
-        vec3 offsets[6];
-        for (int k = 0; k < 3; k++) {
-            int i = (k + 1) % 3, j = (k + 2) % 3;
-            bool curved = !(v_straight[k] > 0.5);
-            offsets[2 * k] = curved ? pn_offset(v_position[i], v_normal[i], v_position[j]) : vec3(0.0);
-            offsets[2 * k + 1] = curved ? pn_offset(v_position[j], v_normal[j], v_position[i]) : vec3(0.0);
-            c_offset[2 * k] = offsets[2 * k];
-            c_offset[2 * k + 1] = offsets[2 * k + 1];
-            c_mid_normal[k] = pn_mid_normal(v_position[i], v_normal[i], v_position[j], v_normal[j]);
-        }
-        vec3 centre = (((((offsets[0] + offsets[1]) + offsets[2]) + offsets[3]) + offsets[4]) + offsets[5]) * 0.25;
-        c_centre = centre;
-        vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
-        vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
-        vec3 p2 = (u_model * vec4(v_position[2], 1.0)).xyz;
-        float outer0 = pn_edge_level(p1, p2, offsets[0], offsets[1]);
-        float outer1 = pn_edge_level(p2, p0, offsets[2], offsets[3]);
-        float outer2 = pn_edge_level(p0, p1, offsets[4], offsets[5]);
-        gl_TessLevelOuter[0] = outer0;
-        gl_TessLevelOuter[1] = outer1;
-        gl_TessLevelOuter[2] = outer2;
-        float inner = max(max(outer0, outer1), outer2);
-        if (!(u_fixed_level > 0.0)) {
-            // the interior's second differences: (o_ik + o_jk) - 2 c for corner k; o_ik is the
-            // offset near i on the edge to k: edge j's (corners k, i) second, edge i's first
-            float m = max(max(world_length((offsets[3] + offsets[0]) - 2.0 * centre),
-                              world_length((offsets[5] + offsets[2]) - 2.0 * centre)),
-                          world_length((offsets[1] + offsets[4]) - 2.0 * centre));
-            inner = max(inner, pn_level(m, clip_w(((p0 + p1) + p2) * ONE_THIRD)));
-        }
-        gl_TessLevelInner[0] = inner;
-    }
-#elif defined(SURFACE_DISPLACED)
+#ifdef SURFACE_DISPLACED
     c_st[gl_InvocationID] = lookup_st(v_uv[gl_InvocationID]);
-    if (gl_InvocationID == 0) {
-        vec2 st0 = lookup_st(v_uv[0]);
-        vec2 st1 = lookup_st(v_uv[1]);
-        vec2 st2 = lookup_st(v_uv[2]);
-        vec3 e1 = v_position[1] - v_position[0];
-        vec3 e2 = v_position[2] - v_position[0];
-        vec2 d1 = st1 - st0;
-        vec2 d2 = st2 - st0;
-        float det = d1.x * d2.y - d2.x * d1.y;
-        float r = det != 0.0 ? 1.0 / det : 0.0;
-        c_tangent_s = (e1 * d2.y - e2 * d1.y) * r;
-        c_tangent_t = (e2 * d1.x - e1 * d2.x) * r;
-        vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
-        vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
-        vec3 p2 = (u_model * vec4(v_position[2], 1.0)).xyz;
-        float outer0 = displaced_edge_level(p1, p2, v_normal[1], v_normal[2], st1, st2);
-        float outer1 = displaced_edge_level(p2, p0, v_normal[2], v_normal[0], st2, st0);
-        float outer2 = displaced_edge_level(p0, p1, v_normal[0], v_normal[1], st0, st1);
-        gl_TessLevelOuter[0] = outer0;
-        gl_TessLevelOuter[1] = outer1;
-        gl_TessLevelOuter[2] = outer2;
-        gl_TessLevelInner[0] = max(max(outer0, outer1), outer2);
-    }
-#else
-    if (gl_InvocationID == 0) {
-        vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
-        vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
-        vec3 p2 = (u_model * vec4(v_position[2], 1.0)).xyz;
-        float outer0 = edge_level(p1, p2);
-        float outer1 = edge_level(p2, p0);
-        float outer2 = edge_level(p0, p1);
-        gl_TessLevelOuter[0] = outer0;
-        gl_TessLevelOuter[1] = outer1;
-        gl_TessLevelOuter[2] = outer2;
-        gl_TessLevelInner[0] = max(max(outer0, outer1), outer2);
-    }
 #endif
+    if (gl_InvocationID == 0) {
+        vec3 p0 = (u_model * vec4(v_position[0], 1.0)).xyz;
+        vec3 p1 = (u_model * vec4(v_position[1], 1.0)).xyz;
+        vec3 p2 = (u_model * vec4(v_position[2], 1.0)).xyz;
+        vec4 levels = patch_levels(p0, p1, p2);
+        gl_TessLevelOuter[0] = levels.x;
+        gl_TessLevelOuter[1] = levels.y;
+        gl_TessLevelOuter[2] = levels.z;
+        gl_TessLevelInner[0] = levels.w;
+    }
 }

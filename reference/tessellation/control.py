@@ -50,6 +50,19 @@ def _homogeneous(points32: np.ndarray) -> np.ndarray:
     return np.concatenate([points32, np.ones(points32.shape[:-1] + (1,), np.float32)], axis=-1)
 
 
+def _clip_w(world: np.ndarray, u: ControlUniforms) -> np.ndarray:
+    """clip_w: P (V (world, 1)), its w."""
+    return matrix_times(u.projection, matrix_times(u.view, _homogeneous(world)))[..., 3]
+
+
+def _world_error(w: np.ndarray, u: ControlUniforms) -> np.ndarray:
+    """world_error: the target over the pixels a world unit spans at clip w, H P11 / (2 w)."""
+    f = np.float32
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        pixels_per_unit = f(u.viewport_height) * f(u.projection[1, 1]) / (f(2) * w)
+        return f(u.target_error) / pixels_per_unit
+
+
 def edge_levels(a: np.ndarray, b: np.ndarray, u: ControlUniforms) -> np.ndarray:
     """(...,) float32: the level of each edge from world points a to b (..., 3) float32."""
     f = np.float32
@@ -59,11 +72,9 @@ def edge_levels(a: np.ndarray, b: np.ndarray, u: ControlUniforms) -> np.ndarray:
         return np.full(shape, f(u.fixed_level), f)
     if not radius > 0:
         return np.ones(shape, f)
-    mid = matrix_times(u.projection, matrix_times(u.view, _homogeneous((a + b) * f(0.5))))
-    w = mid[..., 3]
+    w = _clip_w((a + b) * f(0.5), u)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        pixels_per_unit = f(u.viewport_height) * f(u.projection[1, 1]) / (f(2) * w)
-        s = f(u.target_error) / pixels_per_unit / radius
+        s = _world_error(w, u) / radius
         chord = a - b
         c2 = dot(chord, chord)
         c = np.sqrt(c2)
@@ -117,11 +128,9 @@ def _world_length(model, d):
 
 def _pn_level(m, world, u: ControlUniforms):
     f = np.float32
-    w = matrix_times(u.projection, matrix_times(u.view, _homogeneous(world)))[..., 3]
+    w = _clip_w(world, u)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        pixels_per_unit = f(u.viewport_height) * f(u.projection[1, 1]) / (f(2) * w)
-        e = f(u.target_error) / pixels_per_unit
-        level = np.sqrt(PN_CURVE_BOUND * m / e)
+        level = np.sqrt(PN_CURVE_BOUND * m / _world_error(w, u))
     level = np.fmin(np.fmax(level, f(1)), f(u.max_level))
     return np.where(w > 0, level, f(u.max_level)).astype(f)
 
@@ -178,10 +187,9 @@ def displaced_patch_levels(corners: np.ndarray, normals: np.ndarray, uvs: np.nda
     for i, j in ((1, 2), (2, 0), (0, 1)):
         span = np.abs(w[:, j] - w[:, i]) * size
         texels = np.maximum(span[:, 0], span[:, 1])
-        mid_w = matrix_times(u.projection, matrix_times(u.view, _homogeneous((world[:, i] + world[:, j]) * f(0.5))))[..., 3]
+        mid_w = _clip_w((world[:, i] + world[:, j]) * f(0.5), u)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            pixels_per_unit = f(u.viewport_height) * f(u.projection[1, 1]) / (f(2) * mid_w)
-            e = f(u.target_error) / pixels_per_unit
+            e = _world_error(mid_w, u)
             s = f(scale) * np.fmax(_world_length(u.model, n[:, i]), _world_length(u.model, n[:, j]))
             need = np.fmin(texels * (f(slope) * s) / (f(2) * e), texels)
         level = np.where(mid_w > 0, need, texels)

@@ -83,10 +83,13 @@ draw the sphere's own icosphere, the mesh as it is).
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
+from renderer.core.mesh_cache import per_mesh
 from renderer.core.scene import Sphere
 from renderer.core.shapes import sphere_mesh
 from renderer.core.textures import Sampler, Texture
@@ -153,9 +156,10 @@ class Displacement:
     uv_scale: tuple = (1.0, 1.0)     # the lookup at st = uv * uv_scale + uv_offset (as a texture's)
     uv_offset: tuple = (0.0, 0.0)
 
-    @property
+    @functools.cached_property
     def slope(self) -> float:
-        """g: the largest difference between the heights of two texels side by side (0 to 1)."""
+        """g: the largest difference between the heights of two texels side by side (0 to 1),
+        worked out once (every frame's uniforms read it)."""
         return displacement_slope(self.texture)
 
 
@@ -190,6 +194,7 @@ class PatchNet:
         return len(self.positions)
 
 
+@per_mesh
 def displaced_patches(mesh):
     """A displaced mesh's patches, a patch per face, its corners in the face's order:
     positions, normals (P, 3, 3) and UVs (P, 3, 2), float32 object space."""
@@ -197,48 +202,32 @@ def displaced_patches(mesh):
     return tuple(np.asarray(values, np.float32)[faces] for values in (mesh.positions, mesh.normals, mesh.uvs))
 
 
+@per_mesh
 def pn_patches(mesh) -> PatchNet:
-    """A patch per face of `mesh` (module docstring). An edge is kept straight where another
-    face meets it whose corners there have the same positions but other normals (a crease
-    the mesh splits its vertices at) or where more than two faces meet (no surface to follow);
-    an edge on the mesh's border, or shared with the same normals, is curved."""
+    """A patch per face of `mesh` (module docstring), made once per Mesh. An edge is kept
+    straight where another face meets it whose corners there have the same positions but other
+    normals (a crease the mesh splits its vertices at) or where more than two faces meet (no
+    surface to follow); an edge on the mesh's border, or shared with the same normals, is
+    curved."""
     faces = np.asarray(mesh.faces, np.int64)
     positions = np.asarray(mesh.positions, np.float32)
     normals = np.asarray(mesh.normals, np.float32)
-    corners, corner_normals = positions[faces], normals[faces]
     # each face's edges: edge k joins corners k + 1 and k + 2 (GL's outer level k's edge)
     ends = np.stack([faces[:, [1, 2]], faces[:, [2, 0]], faces[:, [0, 1]]], axis=1).reshape(-1, 2)
-    # an edge by its ends' exact positions (their bits), in either order; its ends' normals
-    # in that order
-    a, b = positions[ends[:, 0]].view(np.uint32), positions[ends[:, 1]].view(np.uint32)
-    swap = _lexicographic_less(b, a)
-    first = np.where(swap[:, None], b, a)
-    second = np.where(swap[:, None], a, b)
-    key = np.concatenate([first, second], axis=1)
-    na, nb = normals[ends[:, 0]], normals[ends[:, 1]]
-    end_normals = np.concatenate([np.where(swap[:, None], nb, na), np.where(swap[:, None], na, nb)],
-                                 axis=1).view(np.uint32)
-    _, edge, uses = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    # an edge by its ends' positions (their exact bits: a position's number), in either order
+    _, place = np.unique(positions.view(np.uint32), axis=0, return_inverse=True)
+    place = place.reshape(-1)[ends]
+    swap = place[:, 0] > place[:, 1]
+    first = np.where(swap, ends[:, 1], ends[:, 0])
+    second = np.where(swap, ends[:, 0], ends[:, 1])
+    _, edge, uses = np.unique(np.sort(place, axis=1), axis=0, return_inverse=True, return_counts=True)
     edge = edge.reshape(-1)
-    # the edge's normals as its first face sees them; any other face that differs makes it straight
-    order = np.argsort(edge, kind="stable")
-    first_use = np.empty(len(uses), np.int64)
-    first_use[edge[order[::-1]]] = order[::-1]
-    differs = np.any(end_normals != end_normals[first_use[edge]], axis=1)
-    creased = np.zeros(len(uses), bool)
-    np.logical_or.at(creased, edge, differs)
+    # a crease: the edge's faces see more than one pair of normals at its ends
+    seen = np.concatenate([edge[:, None], normals[first].view(np.uint32), normals[second].view(np.uint32)], axis=1)
+    pairs = np.unique(seen, axis=0)
+    creased = np.bincount(pairs[:, 0].astype(np.int64), minlength=len(uses)) > 1
     straight = (creased | (uses > 2))[edge].reshape(-1, 3).astype(np.float32)
-    return PatchNet(corners, corner_normals, straight)
-
-
-def _lexicographic_less(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise a < b, comparing the first column first: (N,) bool of (N, K) arrays."""
-    less = np.zeros(len(a), bool)
-    decided = np.zeros(len(a), bool)
-    for k in range(a.shape[1]):
-        less |= ~decided & (a[:, k] < b[:, k])
-        decided |= a[:, k] != b[:, k]
-    return less
+    return PatchNet(positions[faces], normals[faces], straight)
 
 
 def patch_mesh(sphere):
@@ -273,7 +262,6 @@ def with_tessellated_spheres(scene, error: float = TARGET_PIXEL_ERROR):
     """A copy of `scene` whose analytic spheres that ask for no tessellation and carry no
     texture are drawn through the tessellation stages with levels by need at `error` pixels
     (`renderer compare --methods --tessellate`), and how many they are."""
-    import dataclasses
     chosen = [isinstance(o.shape, Sphere) and o.tessellation is None and o.material.texture is None
               for o in scene.objects]
     objects = [dataclasses.replace(o, tessellation=Tessellation(error=error)) if pick else o
